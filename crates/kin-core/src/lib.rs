@@ -1,0 +1,69 @@
+//! # kin-core — kinematics of a 12-DoF quadruped, `no_std`, f32
+//!
+//! Leg forward and inverse kinematics, body rotation and full-body IK/FK, the leg Jacobian and
+//! adapters to the conventions of the two source papers:
+//!
+//! - **seed 000**: A. Shahriar, *A Balanced Positional Control Architecture for a 12-DoF
+//!   Quadruped Robot through Simulation-validation and Hardware Testing*.
+//! - **seed 001**: M. J. Fernando, G. R. Saypulaev, M. R. Saypulaev, *Analysis of a Four-Legged
+//!   Robot Kinematics during Rotational Movements of Its Body*, 2025.
+//!
+//! The same code runs on the host and on the ATmega2560 firmware. No allocation, no panics on
+//! any input, and never a NaN out: unreachable targets are typed errors ([`leg::IkError`]) or
+//! explicitly reported clamps ([`leg::Clamp`]).
+//!
+//! ## Conventions
+//! - SI units everywhere (m, rad, s); names carry units (`x_m`, `hip_rad`).
+//! - **Body frame**: origin at the body's geometric centre, x forward, y left, z up (REP 103).
+//!   Legs [`LegId::FL`], `FR`, `RL`, `RR`; hip (abduction-axis) mount of each leg at
+//!   `(±length/2, ±width/2, 0)`.
+//! - **Hip frame** of a leg: origin at its hip mount, axes parallel to the body frame. Side sign
+//!   `s = +1` for left legs, `−1` for right legs.
+//! - **Joint angles** (abduction, hip, knee), rad; one chain covers both papers:
+//!   `foot_in_hip = Rx(a)·([0, s·d_lat, −d_ax] + Ry(h)·[0,0,−L_femur] + Ry(h+k)·[0,0,−L_tibia])`
+//!   with `Rx(a) = [[1,0,0],[0,cos a,−sin a],[0,sin a,cos a]]`,
+//!   `Ry(a) = [[cos a,0,sin a],[0,1,0],[−sin a,0,cos a]]`. `d_lat` is seed 000's lateral coxa
+//!   offset `La` (perpendicular to the leg plane); `d_ax` is seed 001's abduction link `l0`
+//!   (in the leg plane, hanging down). All angles zero: leg straight down.
+//! - **IK branch**: knee ≤ 0 by default ([`KneeBend::Backward`]; [`KneeBend::Forward`] gives
+//!   knee ≥ 0), and the abduction whose un-abducted foot lies below the hip.
+//! - **Body pose** ([`body::Pose`]): roll, pitch, yaw (rad) and translation x, y, z (m) of the
+//!   body in the world frame, which coincides with the body frame in the nominal pose. The
+//!   [`RotationOrder`] names the matrix product left to right: `zyx` is
+//!   `R = Rz(yaw)·Ry(pitch)·Rx(roll)` (the default), `zxy` is seed 001's `Γψ·Γθ·Γγ`.
+//!   With pivot `c`: `foot_in_hip = Rᵀ·(foot_in_world − t − c) + c − hip_in_body`.
+//! - **Nominal stance** of height `H`: `foot_in_world = hip_in_body + (0, s·d_lat, −H)`.
+//!
+//! ## Modules
+//! - [`robot`]: [`Robot`] description and the presets [`Robot::shahriar2023`],
+//!   [`Robot::fernando2025`].
+//! - [`leg`]: FK (closed form and DH form), IK, reachability, [`ReachPolicy`].
+//! - [`rotation`], [`body`]: body rotation in six orders, full-body IK/FK.
+//! - [`jacobian`]: velocity kinematics and the singularity measure.
+//! - [`paper`]: seed 000 (θ1, θ2, θ3) and seed 001 (β, α, φ) angle adapters.
+//! - [`math`]: the [`Math`] backend trait (`libm`, fast polynomials, or a firmware's own).
+//!
+//! ## Why not nalgebra inside
+//! The kinematics needs a 3-vector, a 3×3 rotation and a dozen operations on them; the
+//! hand-written [`Vec3`]/[`Mat3`] keep every operation visible, `const`, and free of generic
+//! machinery on the AVR. nalgebra (f64) is the independent oracle in the tests instead. See
+//! `BENCHMARKS.md` for the firmware-size measurement behind this choice.
+
+#![no_std]
+#![forbid(unsafe_code)]
+
+pub mod body;
+pub mod jacobian;
+pub mod leg;
+pub mod math;
+pub mod paper;
+pub mod robot;
+pub mod rotation;
+pub mod vec;
+
+pub use body::{BodyConfig, BodySolution, Pose};
+pub use leg::{Clamp, IkError, LegSolution, ReachPolicy, Unreachable};
+pub use math::{DefaultMath, Math};
+pub use robot::{Joint, JointAngles, JointLimits, KneeBend, LegGeometry, LegId, Robot};
+pub use rotation::RotationOrder;
+pub use vec::{Mat3, Vec3};
