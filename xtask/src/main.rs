@@ -1,3 +1,273 @@
-//! Project automation.
+//! Project automation, dependency-free so that it compiles in seconds.
+//!
+//! `cargo xtask ci` runs every check of the project, in order, stopping at the first failure:
+//!
+//! | step           | what                                                                  |
+//! |----------------|-----------------------------------------------------------------------|
+//! | `deps`         | `scripts/install-deps.sh`: Debian packages and rustup components      |
+//! | `fmt`          | `cargo fmt --all --check`                                             |
+//! | `clippy`       | `cargo clippy --workspace --all-targets -- -D warnings`               |
+//! | `avr-kin-core` | no_std build of kin-core for `avr-none` (atmega2560), nightly + build-std=core |
+//! | `firmware`     | `cargo build --release` in `firmware-avr/` (when that directory exists) |
+//! | `test`         | `cargo test --workspace`                                              |
+//! | `doc`          | `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`     |
+//!
+//! `cargo xtask ci --list` prints the steps; `cargo xtask ci STEP...` runs only those.
+//!
+//! Child processes do not inherit the toolchain selection of the cargo that started this
+//! program (`RUSTUP_TOOLCHAIN`): each directory's `rust-toolchain.toml` decides, as it does for
+//! a developer typing the same command.
 
-fn main() {}
+use std::env;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+use std::time::{Duration, Instant};
+
+/// Target CPU of the robot's controller board (Arduino Mega 2560).
+const AVR_TARGET_CPU: &str = "atmega2560";
+
+/// One check: a program run with arguments and extra environment in a directory.
+struct Step {
+    /// Short name, used by `cargo xtask ci STEP`.
+    name: &'static str,
+    /// Directory relative to the workspace root.
+    dir: &'static str,
+    /// Program and arguments.
+    argv: Vec<&'static str>,
+    /// Extra environment variables.
+    env: Vec<(&'static str, String)>,
+    /// Environment variables removed for this step (besides the common ones).
+    env_remove: Vec<&'static str>,
+}
+
+impl Step {
+    fn new(name: &'static str, argv: &[&'static str]) -> Step {
+        Step {
+            name,
+            dir: ".",
+            argv: argv.to_vec(),
+            env: Vec::new(),
+            env_remove: Vec::new(),
+        }
+    }
+
+    fn in_dir(mut self, dir: &'static str) -> Step {
+        self.dir = dir;
+        self
+    }
+
+    fn with_env(mut self, key: &'static str, value: impl Into<String>) -> Step {
+        self.env.push((key, value.into()));
+        self
+    }
+
+    fn without_env(mut self, key: &'static str) -> Step {
+        self.env_remove.push(key);
+        self
+    }
+
+    /// The command as a developer would type it from the workspace root.
+    fn display(&self) -> String {
+        let mut s = String::new();
+        if self.dir != "." {
+            s.push_str(&format!("(cd {} && ", self.dir));
+        }
+        for (k, v) in &self.env {
+            s.push_str(&format!("{k}=\"{v}\" "));
+        }
+        s.push_str(&self.argv.join(" "));
+        if self.dir != "." {
+            s.push(')');
+        }
+        s
+    }
+}
+
+/// The checks run by `cargo xtask ci`, in order. Add new checks here.
+fn ci_steps(root: &Path) -> Vec<Step> {
+    let mut steps = vec![
+        Step::new("deps", &["bash", "scripts/install-deps.sh"]),
+        Step::new("fmt", &["cargo", "fmt", "--all", "--check"]),
+        Step::new(
+            "clippy",
+            &[
+                "cargo",
+                "clippy",
+                "--workspace",
+                "--all-targets",
+                "--",
+                "-D",
+                "warnings",
+            ],
+        ),
+        // kin-core must stay no_std and build for the firmware's target. `[unstable] build-std`
+        // cannot live in the root .cargo/config.toml (it breaks host builds), hence the flags;
+        // a separate target dir keeps the host artifacts valid.
+        Step::new(
+            "avr-kin-core",
+            &[
+                "cargo",
+                "+nightly",
+                "build",
+                "-p",
+                "kin-core",
+                "--release",
+                "--target",
+                "avr-none",
+                "-Z",
+                "build-std=core",
+                "--target-dir",
+                "target/avr",
+            ],
+        )
+        .with_env("RUSTFLAGS", format!("-C target-cpu={AVR_TARGET_CPU}"))
+        .without_env("CARGO_ENCODED_RUSTFLAGS"),
+    ];
+    // The firmware is its own workspace with its own toolchain and .cargo/config.toml, which
+    // cargo and rustup only read from the current directory.
+    if root.join("firmware-avr/Cargo.toml").is_file() {
+        steps.push(
+            Step::new("firmware", &["cargo", "build", "--release"])
+                .in_dir("firmware-avr")
+                .without_env("RUSTFLAGS")
+                .without_env("CARGO_ENCODED_RUSTFLAGS"),
+        );
+    }
+    steps.push(Step::new("test", &["cargo", "test", "--workspace"]));
+    steps.push(
+        Step::new("doc", &["cargo", "doc", "--workspace", "--no-deps"])
+            .with_env("RUSTDOCFLAGS", "-D warnings"),
+    );
+    steps
+}
+
+/// Variables set by the cargo/rustup that started this program, which would otherwise leak
+/// into the checks (e.g. `RUSTUP_TOOLCHAIN` would override `firmware-avr/rust-toolchain.toml`).
+fn is_inherited_cargo_var(key: &str) -> bool {
+    matches!(
+        key,
+        "RUSTUP_TOOLCHAIN"
+            | "RUSTUP_TOOLCHAIN_SOURCE"
+            | "RUST_RECURSION_COUNT"
+            | "CARGO"
+            | "CARGO_MANIFEST_DIR"
+            | "CARGO_MANIFEST_PATH"
+            | "CARGO_PRIMARY_PACKAGE"
+            | "CARGO_CRATE_NAME"
+            | "CARGO_BIN_NAME"
+    ) || key.starts_with("CARGO_PKG_")
+}
+
+fn run_step(root: &Path, step: &Step) -> Result<(), String> {
+    let (program, args) = step
+        .argv
+        .split_first()
+        .ok_or_else(|| format!("step {} has no command", step.name))?;
+    let mut cmd = Command::new(program);
+    cmd.args(args).current_dir(root.join(step.dir));
+    for (key, _) in env::vars_os() {
+        if key.to_str().is_some_and(is_inherited_cargo_var) {
+            cmd.env_remove(&key);
+        }
+    }
+    for key in &step.env_remove {
+        cmd.env_remove(key);
+    }
+    for (key, value) in &step.env {
+        cmd.env(key, value);
+    }
+    let status = cmd
+        .status()
+        .map_err(|e| format!("cannot start `{program}`: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("`{}` failed ({status})", step.display()))
+    }
+}
+
+fn workspace_root() -> PathBuf {
+    let xtask_dir = env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")));
+    xtask_dir
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or(xtask_dir)
+}
+
+fn fmt_duration(d: Duration) -> String {
+    let s = d.as_secs_f64();
+    if s < 60.0 {
+        format!("{s:.1} s")
+    } else {
+        format!("{}m{:04.1}s", (s / 60.0).floor() as u64, s % 60.0)
+    }
+}
+
+fn ci(args: &[String]) -> ExitCode {
+    let root = workspace_root();
+    let all = ci_steps(&root);
+    if args.iter().any(|a| a == "--list") {
+        for step in &all {
+            println!("{:<14} {}", step.name, step.display());
+        }
+        return ExitCode::SUCCESS;
+    }
+    if let Some(unknown) = args
+        .iter()
+        .find(|a| !all.iter().any(|s| s.name == a.as_str()))
+    {
+        eprintln!("xtask ci: unknown step `{unknown}`; `cargo xtask ci --list` shows the steps");
+        return ExitCode::from(2);
+    }
+    let steps: Vec<&Step> = all
+        .iter()
+        .filter(|s| args.is_empty() || args.iter().any(|a| a == s.name))
+        .collect();
+
+    let start = Instant::now();
+    let mut done: Vec<(&str, Duration)> = Vec::new();
+    for step in steps {
+        println!("\n==> [{}] {}", step.name, step.display());
+        let t = Instant::now();
+        let result = run_step(&root, step);
+        let took = t.elapsed();
+        done.push((step.name, took));
+        match result {
+            Ok(()) => println!("<== [{}] ok in {}", step.name, fmt_duration(took)),
+            Err(e) => {
+                eprintln!("<== [{}] FAILED in {}: {e}", step.name, fmt_duration(took));
+                eprintln!(
+                    "xtask ci: FAILED at step `{}` after {}",
+                    step.name,
+                    fmt_duration(start.elapsed())
+                );
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    println!("\nxtask ci: all steps passed");
+    for (name, took) in &done {
+        println!("  {name:<14} {:>10}", fmt_duration(*took));
+    }
+    println!("  {:<14} {:>10}", "total", fmt_duration(start.elapsed()));
+    ExitCode::SUCCESS
+}
+
+const USAGE: &str = "usage: cargo xtask ci [--list | STEP...]";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = env::args().skip(1).collect();
+    match args.split_first() {
+        Some((cmd, rest)) if cmd == "ci" => ci(rest),
+        Some((cmd, _)) if cmd == "-h" || cmd == "--help" => {
+            println!("{USAGE}");
+            ExitCode::SUCCESS
+        }
+        _ => {
+            eprintln!("{USAGE}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Installs everything the checks need on a Debian 12 machine, idempotently.
+#
+#   - Debian packages: the AVR toolchain (firmware link), simavr and the libraries its Rust
+#     bindings build against (emulator tests), libudev (serial ports / flashing).
+#   - rustup: the `nightly` toolchain with `rust-src` (no_std build for avr-none with
+#     `-Z build-std=core`), and clippy + rustfmt on `stable` (rust-toolchain.toml).
+#
+# Does nothing (and needs no network) when everything is already present. Installing needs
+# root; without it, a missing piece is an error naming the command to run.
+set -euo pipefail
+
+APT_PACKAGES=(
+    gcc-avr avr-libc binutils-avr
+    libelf-dev libclang-dev libzstd-dev zlib1g-dev pkg-config make
+    simavr
+    libudev-dev
+)
+NIGHTLY=nightly
+STABLE_COMPONENTS=(clippy rustfmt)
+
+die() {
+    echo "install-deps: error: $*" >&2
+    exit 1
+}
+
+is_root() { [ "$(id -u)" -eq 0 ]; }
+
+# --- Debian packages -------------------------------------------------------------------------
+missing=()
+for pkg in "${APT_PACKAGES[@]}"; do
+    status=$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)
+    if [ "$status" != "install ok installed" ]; then
+        missing+=("$pkg")
+    fi
+done
+
+if [ "${#missing[@]}" -gt 0 ]; then
+    command -v apt-get >/dev/null 2>&1 ||
+        die "missing packages (${missing[*]}) and no apt-get: this script supports Debian 12"
+    is_root ||
+        die "missing packages: ${missing[*]}; run as root: apt-get update && apt-get install -y ${missing[*]}"
+    echo "install-deps: installing ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -q </dev/null
+    apt-get install -y -q --no-install-recommends "${APT_PACKAGES[@]}" </dev/null
+else
+    echo "install-deps: Debian packages present"
+fi
+
+# --- Rust toolchains -------------------------------------------------------------------------
+command -v rustup >/dev/null 2>&1 || die "rustup not found on PATH (see https://rustup.rs)"
+
+# The parent cargo exports the toolchain it runs under; queries here name toolchains explicitly.
+unset RUSTUP_TOOLCHAIN
+
+has_component() { # toolchain component
+    rustup component list --toolchain "$1" --installed 2>/dev/null | grep -q "^$2\(-\|$\)"
+}
+
+if ! rustup toolchain list | grep -q "^${NIGHTLY}-"; then
+    echo "install-deps: installing toolchain ${NIGHTLY} with rust-src"
+    rustup toolchain install "$NIGHTLY" --profile minimal --component rust-src </dev/null
+elif ! has_component "$NIGHTLY" rust-src; then
+    echo "install-deps: adding rust-src to ${NIGHTLY}"
+    rustup component add rust-src --toolchain "$NIGHTLY" </dev/null
+else
+    echo "install-deps: ${NIGHTLY} with rust-src present"
+fi
+
+stable_missing=()
+for c in "${STABLE_COMPONENTS[@]}"; do
+    has_component stable "$c" || stable_missing+=("$c")
+done
+if [ "${#stable_missing[@]}" -gt 0 ]; then
+    echo "install-deps: adding ${stable_missing[*]} to stable"
+    rustup component add "${stable_missing[@]}" --toolchain stable </dev/null
+else
+    echo "install-deps: stable with ${STABLE_COMPONENTS[*]} present"
+fi
