@@ -1,0 +1,60 @@
+//! Group `body_ik`: one body pose → twelve joint angles per iteration
+//! (`kin_core::body::inverse_at_stance`), over 10,000 seeded poses in seed 000's ranges
+//! (roll ±28°, pitch ±21°, yaw ±21°), the seed 000 robot at its stance height `bh` = 0.277 m,
+//! rotation order `zyx` about the body centre.
+//!
+//! - `kin_core`: the default `Fast` math backend.
+//! - `kin_core_libm`: the `Libm` reference backend.
+
+mod common;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use kin_core::math::Libm;
+use kin_core::{body, BodyConfig, ReachPolicy, Robot};
+use std::hint::black_box;
+
+fn body_ik(c: &mut Criterion) {
+    let robot = Robot::shahriar2023();
+    let config = BodyConfig::default();
+    let height_m = common::STANCE_HEIGHT_SHAHRIAR_M;
+    let poses = common::body_poses();
+    let n = poses.len();
+    for p in &poses {
+        body::inverse_at_stance(&robot, p, &config, height_m, ReachPolicy::Reject)
+            .expect("seed 000 pose ranges are reachable at the nominal stance");
+    }
+
+    let mut group = c.benchmark_group("body_ik");
+    group.bench_function("kin_core", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let p = &poses[i];
+            i = if i + 1 == n { 0 } else { i + 1 };
+            black_box(body::inverse_at_stance(
+                &robot,
+                black_box(p),
+                &config,
+                height_m,
+                ReachPolicy::Reject,
+            ))
+        });
+    });
+    group.bench_function("kin_core_libm", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let p = &poses[i];
+            i = if i + 1 == n { 0 } else { i + 1 };
+            black_box(body::inverse_at_stance_with::<Libm>(
+                &robot,
+                black_box(p),
+                &config,
+                height_m,
+                ReachPolicy::Reject,
+            ))
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, body_ik);
+criterion_main!(benches);
