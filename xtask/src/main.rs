@@ -271,3 +271,64 @@ fn main() -> ExitCode {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(steps: &[Step]) -> Vec<&'static str> {
+        steps.iter().map(|s| s.name).collect()
+    }
+
+    #[test]
+    fn step_names_are_unique_and_cover_the_required_checks() {
+        let steps = ci_steps(&workspace_root());
+        let mut n = names(&steps);
+        for required in ["deps", "fmt", "clippy", "avr-kin-core", "test", "doc"] {
+            assert!(n.contains(&required), "missing step {required}");
+        }
+        n.sort_unstable();
+        let len = n.len();
+        n.dedup();
+        assert_eq!(n.len(), len, "duplicate step names");
+    }
+
+    #[test]
+    fn deps_run_first_and_firmware_builds_before_tests() {
+        let root = env::temp_dir().join(format!("xtask-test-{}", std::process::id()));
+        std::fs::create_dir_all(root.join("firmware-avr")).unwrap();
+        assert!(!names(&ci_steps(&root)).contains(&"firmware"));
+        std::fs::write(root.join("firmware-avr/Cargo.toml"), "").unwrap();
+        let n = names(&ci_steps(&root));
+        std::fs::remove_dir_all(&root).unwrap();
+        assert_eq!(n[0], "deps");
+        let pos = |name| n.iter().position(|s| *s == name).unwrap();
+        assert!(pos("firmware") < pos("test"));
+    }
+
+    #[test]
+    fn toolchain_selection_of_the_parent_cargo_is_not_inherited() {
+        for key in [
+            "RUSTUP_TOOLCHAIN",
+            "CARGO",
+            "CARGO_MANIFEST_DIR",
+            "CARGO_PKG_NAME",
+        ] {
+            assert!(is_inherited_cargo_var(key), "{key}");
+        }
+        for key in ["CARGO_HOME", "RUSTUP_HOME", "CARGO_TARGET_DIR", "PATH"] {
+            assert!(!is_inherited_cargo_var(key), "{key}");
+        }
+    }
+
+    #[test]
+    fn avr_step_builds_kin_core_for_the_board() {
+        let steps = ci_steps(&workspace_root());
+        let avr = steps.iter().find(|s| s.name == "avr-kin-core").unwrap();
+        assert_eq!(
+            avr.display(),
+            "RUSTFLAGS=\"-C target-cpu=atmega2560\" cargo +nightly build -p kin-core --release \
+             --target avr-none -Z build-std=core --target-dir target/avr"
+        );
+    }
+}
