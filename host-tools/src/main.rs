@@ -1,5 +1,39 @@
-//! `quadctl`: command-line front end of the quadruped kinematics.
+//! `quadctl`: command-line front end of the quadruped kinematics. See `quadctl --help`.
 
-fn main() {
-    println!("quadctl");
+use clap::{Parser, Subcommand};
+use host_tools::cmd;
+use std::process::ExitCode;
+
+const ABOUT: &str = "Kinematics of a 12-DoF quadruped: leg IK/FK and body poses, as CSV batches.
+
+Units: metres and radians in every CSV (degrees only in human-readable tables). Frames: body
+frame at the body centre, x forward, y left, z up; hip frame of a leg at its hip mount, axes
+parallel to the body frame. Run `quadctl <command> --help` for the columns of each command.";
+
+#[derive(Debug, Parser)]
+#[command(name = "quadctl", version, about = ABOUT)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    Ik(cmd::ik::Args),
+    Fk(cmd::fk::Args),
+    Pose(cmd::pose::Args),
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Ik(args) => {
+            cmd::run_batch(&args.input.input, |i, o, d| cmd::ik::run(&args, i, o, d))
+        }
+        Command::Fk(args) => {
+            cmd::run_batch(&args.input.input, |i, o, d| cmd::fk::run(&args, i, o, d))
+        }
+        Command::Pose(args) => {
+            cmd::run_batch(&args.input.input, |i, o, d| cmd::pose::run(&args, i, o, d))
+        }
+    }
 }
