@@ -43,7 +43,7 @@ if [ "${#missing[@]}" -gt 0 ]; then
     echo "install-deps: installing ${missing[*]}"
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -q </dev/null
-    apt-get install -y -q --no-install-recommends "${APT_PACKAGES[@]}" </dev/null
+    apt-get install -y -q "${APT_PACKAGES[@]}" </dev/null
 else
     echo "install-deps: Debian packages present"
 fi
