@@ -1,0 +1,417 @@
+//! Framing: `COBS(postcard(message) ‖ CRC-16 big-endian) ‖ 0x00`.
+//!
+//! - [`encode_frame`] serializes a message straight into COBS-encoded bytes (no intermediate
+//!   buffer), appending the CRC ([`crate::crc`]) and the `0x00` delimiter.
+//! - [`Accumulator`] takes received bytes in any chunking, decodes COBS on the fly into a
+//!   bounded buffer of `N` bytes, checks the CRC and deserializes at each delimiter. The caller
+//!   loops on [`Feed::remaining`] until [`Feed::NeedMore`] so that back-to-back frames in one
+//!   read are all seen.
+//!
+//! Empty frames (two delimiters in a row) are ignored: a sender may start with a `0x00` to
+//! flush a receiver that holds the remains of a broken frame.
+
+use crate::crc;
+use core::fmt;
+use postcard::ser_flavors::Flavor;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+/// Frame delimiter.
+pub const DELIMITER: u8 = 0x00;
+
+/// Length of the CRC trailer, bytes.
+pub const CRC_LEN: usize = 2;
+
+/// Largest decoded frame (postcard bytes + CRC) a receiver must accept, bytes. Every message of
+/// this version fits (the largest, an [`crate::DeviceToHost::Ack`], takes at most
+/// [`crate::DEVICE_TO_HOST_MAX_LEN`]); the rest is headroom for later minor versions.
+pub const MAX_DECODED_LEN: usize = 128;
+
+/// Largest frame on the wire, COBS overhead and delimiter included, bytes.
+pub const MAX_FRAME_LEN: usize = encoded_len_max(MAX_DECODED_LEN);
+
+/// Upper bound of the wire size (COBS + delimiter) of `decoded_len` decoded bytes:
+/// `n + ⌈n/254⌉ + 1` (one COBS code byte per started block of 254 bytes, at least one).
+pub const fn encoded_len_max(decoded_len: usize) -> usize {
+    let blocks = if decoded_len == 0 {
+        1
+    } else {
+        decoded_len.div_ceil(254)
+    };
+    decoded_len + blocks + 1
+}
+
+/// Why a frame could not be built or read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Error {
+    /// The output buffer is too small for the encoded frame.
+    BufferFull,
+    /// The serializer failed for another reason (never for this crate's messages).
+    Serialize,
+    /// The COBS encoding is broken: a block runs past the delimiter.
+    Cobs,
+    /// The decoded frame is shorter than one byte plus the CRC.
+    TooShort,
+    /// The CRC does not match.
+    BadCrc,
+    /// The decoded frame exceeds the receiver's buffer.
+    Oversize,
+    /// The message ends before all its fields.
+    Truncated,
+    /// An enum discriminant this version does not know (e.g. a message of a newer minor).
+    UnknownVariant,
+    /// A malformed value: a varint that does not terminate, a bool or option tag not 0/1.
+    BadEncoding,
+    /// Bytes are left after the message (before the CRC).
+    TrailingBytes,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Error::BufferFull => "output buffer too small",
+            Error::Serialize => "serializer error",
+            Error::Cobs => "broken COBS encoding",
+            Error::TooShort => "frame too short",
+            Error::BadCrc => "CRC mismatch",
+            Error::Oversize => "frame exceeds the receive buffer",
+            Error::Truncated => "message truncated",
+            Error::UnknownVariant => "unknown enum variant",
+            Error::BadEncoding => "malformed value",
+            Error::TrailingBytes => "bytes left after the message",
+        })
+    }
+}
+
+impl core::error::Error for Error {}
+
+impl From<postcard::Error> for Error {
+    fn from(e: postcard::Error) -> Self {
+        match e {
+            postcard::Error::SerializeBufferFull => Error::BufferFull,
+            postcard::Error::DeserializeUnexpectedEnd => Error::Truncated,
+            // serde's derived enum visitor reports an unknown variant index as a custom error.
+            postcard::Error::SerdeDeCustom | postcard::Error::DeserializeBadEnum => {
+                Error::UnknownVariant
+            }
+            postcard::Error::DeserializeBadVarint
+            | postcard::Error::DeserializeBadBool
+            | postcard::Error::DeserializeBadOption
+            | postcard::Error::DeserializeBadChar
+            | postcard::Error::DeserializeBadUtf8
+            | postcard::Error::DeserializeBadEncoding
+            | postcard::Error::DeserializeBadCrc => Error::BadEncoding,
+            _ => Error::Serialize,
+        }
+    }
+}
+
+/// A postcard flavor that updates the CRC and COBS-encodes each byte straight into a slice.
+struct CobsCrcSlice<'b> {
+    out: &'b mut [u8],
+    /// Next free position.
+    pos: usize,
+    /// Position of the current block's code byte.
+    code_idx: usize,
+    /// Current block's code: 1 + number of data bytes in the block.
+    code: u8,
+    crc: u16,
+}
+
+impl<'b> CobsCrcSlice<'b> {
+    fn new(out: &'b mut [u8]) -> Result<Self, postcard::Error> {
+        if out.is_empty() {
+            return Err(postcard::Error::SerializeBufferFull);
+        }
+        Ok(CobsCrcSlice {
+            out,
+            pos: 1,
+            code_idx: 0,
+            code: 1,
+            crc: crc::INIT,
+        })
+    }
+
+    fn write(&mut self, at: usize, byte: u8) -> Result<(), postcard::Error> {
+        *self
+            .out
+            .get_mut(at)
+            .ok_or(postcard::Error::SerializeBufferFull)? = byte;
+        Ok(())
+    }
+
+    /// Closes the current block and reserves the code byte of the next one.
+    fn close_block(&mut self) -> Result<(), postcard::Error> {
+        self.write(self.code_idx, self.code)?;
+        self.code_idx = self.pos;
+        self.write(self.pos, 0)?;
+        self.pos += 1;
+        self.code = 1;
+        Ok(())
+    }
+
+    /// COBS-encodes one byte.
+    fn put(&mut self, byte: u8) -> Result<(), postcard::Error> {
+        if byte == 0 {
+            return self.close_block();
+        }
+        self.write(self.pos, byte)?;
+        self.pos += 1;
+        self.code += 1;
+        if self.code == 0xFF {
+            self.close_block()?;
+        }
+        Ok(())
+    }
+}
+
+impl<'b> Flavor for CobsCrcSlice<'b> {
+    type Output = &'b [u8];
+
+    fn try_push(&mut self, data: u8) -> postcard::Result<()> {
+        self.crc = crc::update(self.crc, data);
+        self.put(data)
+    }
+
+    fn finalize(mut self) -> postcard::Result<&'b [u8]> {
+        let [hi, lo] = self.crc.to_be_bytes();
+        self.put(hi)?;
+        self.put(lo)?;
+        self.write(self.code_idx, self.code)?;
+        self.write(self.pos, DELIMITER)?;
+        let len = self.pos + 1;
+        let out: &'b [u8] = self.out;
+        Ok(&out[..len])
+    }
+}
+
+/// Serializes `msg`, appends its CRC, COBS-encodes everything and ends it with `0x00`, in
+/// `out`. Returns the frame (a prefix of `out`).
+///
+/// # Errors
+/// [`Error::BufferFull`] when `out` is too small ([`MAX_FRAME_LEN`] is always enough for this
+/// crate's messages).
+pub fn encode_frame<'b, T: Serialize + ?Sized>(
+    msg: &T,
+    out: &'b mut [u8],
+) -> Result<&'b [u8], Error> {
+    let flavor = CobsCrcSlice::new(out)?;
+    Ok(postcard::serialize_with_flavor(msg, flavor)?)
+}
+
+/// Checks the CRC of a decoded frame (postcard bytes ‖ CRC) and deserializes its message.
+///
+/// # Errors
+/// [`Error::TooShort`], [`Error::BadCrc`], or a decode error ([`Error::Truncated`],
+/// [`Error::UnknownVariant`], [`Error::BadEncoding`], [`Error::TrailingBytes`]).
+pub fn decode_payload<T: DeserializeOwned>(decoded: &[u8]) -> Result<T, Error> {
+    if decoded.len() < CRC_LEN + 1 {
+        return Err(Error::TooShort);
+    }
+    let (body, trailer) = decoded.split_at(decoded.len() - CRC_LEN);
+    if crc::checksum(body).to_be_bytes() != [trailer[0], trailer[1]] {
+        return Err(Error::BadCrc);
+    }
+    let (msg, rest) = postcard::take_from_bytes::<T>(body)?;
+    if !rest.is_empty() {
+        return Err(Error::TrailingBytes);
+    }
+    Ok(msg)
+}
+
+/// What [`Accumulator::feed`] found. Every variant but `NeedMore` carries the bytes after the
+/// delimiter that ended the frame: feed them again.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Feed<'a, T> {
+    /// All input consumed; no frame ended in it.
+    NeedMore,
+    /// A frame with a good CRC and a valid message.
+    Frame {
+        /// The message.
+        msg: T,
+        /// Input not yet consumed.
+        remaining: &'a [u8],
+    },
+    /// A frame whose CRC did not match.
+    BadCrc {
+        /// Input not yet consumed.
+        remaining: &'a [u8],
+    },
+    /// A frame with a good structure but broken COBS, too short, or not a valid message.
+    BadFrame {
+        /// The decode error.
+        error: Error,
+        /// Input not yet consumed.
+        remaining: &'a [u8],
+    },
+    /// A frame longer than the buffer; its bytes were dropped up to its delimiter.
+    Oversize {
+        /// Input not yet consumed.
+        remaining: &'a [u8],
+    },
+}
+
+impl<'a, T> Feed<'a, T> {
+    /// The unconsumed input (empty for [`Feed::NeedMore`]).
+    pub fn remaining(&self) -> &'a [u8] {
+        match self {
+            Feed::NeedMore => &[],
+            Feed::Frame { remaining, .. }
+            | Feed::BadCrc { remaining }
+            | Feed::BadFrame { remaining, .. }
+            | Feed::Oversize { remaining } => remaining,
+        }
+    }
+}
+
+/// Receives a byte stream and yields one [`Feed`] per delimiter-terminated frame, with `N`
+/// bytes of buffer for the decoded frame (postcard bytes + CRC). Memory: `N` + 14 bytes.
+///
+/// ```
+/// use quad_protocol::{encode_frame, Accumulator, Feed, HostToDevice, Request, MAX_FRAME_LEN};
+///
+/// let mut wire = [0u8; 2 * MAX_FRAME_LEN];
+/// let mut n = 0;
+/// for seq in [7, 8] {
+///     let msg = HostToDevice { seq, request: Request::GetState };
+///     n += encode_frame(&msg, &mut wire[n..]).unwrap().len();
+/// }
+///
+/// let mut acc = Accumulator::<128>::new();
+/// let mut seen = 0;
+/// let mut input = &wire[..n]; // one read returned both frames back-to-back
+/// loop {
+///     match acc.feed::<HostToDevice>(input) {
+///         Feed::NeedMore => break,
+///         Feed::Frame { msg, remaining } => {
+///             assert_eq!(msg.seq, 7 + seen);
+///             seen += 1;
+///             input = remaining;
+///         }
+///         other => input = other.remaining(), // count or nack, then go on
+///     }
+/// }
+/// assert_eq!(seen, 2);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Accumulator<const N: usize> {
+    buf: [u8; N],
+    len: usize,
+    /// Data bytes left in the current COBS block; 0 = the next byte is a code byte.
+    block_left: u8,
+    /// Code byte of the current block; 0 = no byte of this frame seen yet.
+    code: u8,
+    overflow: bool,
+    frames_ok: u32,
+    frames_bad: u32,
+}
+
+impl<const N: usize> Default for Accumulator<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> Accumulator<N> {
+    /// An empty accumulator.
+    pub const fn new() -> Self {
+        Accumulator {
+            buf: [0; N],
+            len: 0,
+            block_left: 0,
+            code: 0,
+            overflow: false,
+            frames_ok: 0,
+            frames_bad: 0,
+        }
+    }
+
+    /// Drops a partial frame (the counters stay).
+    pub fn reset(&mut self) {
+        self.len = 0;
+        self.block_left = 0;
+        self.code = 0;
+        self.overflow = false;
+    }
+
+    /// Frames that ended in [`Feed::Frame`] (wrapping).
+    pub const fn frames_ok(&self) -> u32 {
+        self.frames_ok
+    }
+
+    /// Frames that ended in [`Feed::BadCrc`], [`Feed::BadFrame`] or [`Feed::Oversize`]
+    /// (wrapping).
+    pub const fn frames_bad(&self) -> u32 {
+        self.frames_bad
+    }
+
+    /// True while a frame is partly received.
+    pub const fn in_frame(&self) -> bool {
+        self.code != 0
+    }
+
+    fn push(&mut self, byte: u8) {
+        if self.len < N {
+            self.buf[self.len] = byte;
+            self.len += 1;
+        } else {
+            self.overflow = true;
+        }
+    }
+
+    /// Consumes `input` up to and including the first delimiter that ends a non-empty frame,
+    /// and reports that frame; or consumes everything and returns [`Feed::NeedMore`].
+    pub fn feed<'a, T: DeserializeOwned>(&mut self, input: &'a [u8]) -> Feed<'a, T> {
+        for (i, &byte) in input.iter().enumerate() {
+            if byte == DELIMITER {
+                if self.code == 0 {
+                    continue; // empty frame
+                }
+                let remaining = &input[i + 1..];
+                let result = self.finish::<T>();
+                self.reset();
+                return match result {
+                    Ok(msg) => {
+                        self.frames_ok = self.frames_ok.wrapping_add(1);
+                        Feed::Frame { msg, remaining }
+                    }
+                    Err(error) => {
+                        self.frames_bad = self.frames_bad.wrapping_add(1);
+                        match error {
+                            Error::Oversize => Feed::Oversize { remaining },
+                            Error::BadCrc => Feed::BadCrc { remaining },
+                            error => Feed::BadFrame { error, remaining },
+                        }
+                    }
+                };
+            }
+            if self.overflow {
+                continue;
+            }
+            if self.block_left == 0 {
+                // A code byte. The block before it, unless it was a full 0xFF block, ended in
+                // an implicit zero.
+                if self.code != 0 && self.code != 0xFF {
+                    self.push(0);
+                }
+                self.code = byte;
+                self.block_left = byte - 1;
+            } else {
+                self.push(byte);
+                self.block_left -= 1;
+            }
+        }
+        Feed::NeedMore
+    }
+
+    fn finish<T: DeserializeOwned>(&self) -> Result<T, Error> {
+        if self.overflow {
+            return Err(Error::Oversize);
+        }
+        if self.block_left != 0 {
+            return Err(Error::Cobs);
+        }
+        decode_payload(&self.buf[..self.len])
+    }
+}

@@ -1,0 +1,73 @@
+//! # quad-protocol — the host ↔ ATmega2560 wire protocol, `no_std`, no allocation
+//!
+//! One crate shared by the firmware and the host tools, so both sides build and read the same
+//! bytes and map angles to servo pulses with the same code:
+//!
+//! - [`msg`]: the messages, named by direction — [`HostToDevice`] (a sequence number and a
+//!   [`Request`]) and [`DeviceToHost`] (an answer echoing that sequence number: `HelloAck`,
+//!   `Ack` with the [`Readback`], `Calibration`, or `Nack` with a typed [`NackReason`]).
+//! - [`frame`]: `COBS(postcard(message) ‖ CRC-16) ‖ 0x00` — [`encode_frame`] and the
+//!   bounded [`Accumulator`] for split, concatenated, oversize and garbled input.
+//! - [`crc`]: CRC-16/IBM-3740 (CCITT-FALSE), bitwise, no table.
+//! - [`servo`]: per-joint [`servo::Calibration`] and the angle ↔ pulse mapping.
+//!
+//! The byte-level specification with an example frame per message is `docs/protocol.md`.
+//!
+//! ## Versions
+//! [`PROTOCOL_VERSION`] is `major << 8 | minor`. The host opens with [`Request::Hello`]; a
+//! device whose major differs answers [`NackReason::UnknownVersion`] carrying its own version.
+//! Within one major, a minor only appends enum variants, flag bits and nothing else, and a
+//! peer sends nothing newer than the lower of the two minors.
+//!
+//! ## Sizes
+//! Every decoded frame (postcard bytes + CRC) of this version fits in [`MAX_DECODED_LEN`]
+//! (128 bytes); on the wire that is at most [`MAX_FRAME_LEN`] (130 bytes). f32 only; no f64.
+
+#![no_std]
+#![forbid(unsafe_code)]
+
+pub mod crc;
+pub mod frame;
+pub mod msg;
+pub mod servo;
+
+pub use frame::{
+    decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
+};
+pub use msg::{
+    DeviceInfo, DeviceToHost, FirmwareVersion, Flags, HostToDevice, LinkLossAction, LinkTimeout,
+    NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+};
+
+/// This crate's protocol version: `major << 8 | minor` (1.0).
+pub const PROTOCOL_VERSION: u16 = 0x0100;
+
+/// Major part of a protocol version.
+#[inline]
+pub const fn version_major(version: u16) -> u8 {
+    (version >> 8) as u8
+}
+
+/// Minor part of a protocol version.
+#[inline]
+pub const fn version_minor(version: u16) -> u8 {
+    (version & 0xFF) as u8
+}
+
+/// True when a peer announcing `peer_version` can talk to this crate (same major).
+#[inline]
+pub const fn is_compatible(peer_version: u16) -> bool {
+    version_major(peer_version) == version_major(PROTOCOL_VERSION)
+}
+
+/// Largest decoded [`HostToDevice`] frame of this version (postcard bytes + CRC), bytes:
+/// seq (≤ 3) + variant (1) + `SetFeet`/`SetJoints` (48) + CRC (2).
+pub const HOST_TO_DEVICE_MAX_LEN: usize = 3 + 1 + 48 + frame::CRC_LEN;
+
+/// Largest decoded [`DeviceToHost`] frame of this version (postcard bytes + CRC), bytes:
+/// variant (1) + seq (≤ 3) + angles (48) + pulses (12 × ≤ 3) + flags (1) + two counters
+/// (2 × ≤ 5) + CRC (2).
+pub const DEVICE_TO_HOST_MAX_LEN: usize = 1 + 3 + 48 + 12 * 3 + 1 + 2 * 5 + frame::CRC_LEN;
+
+const _: () = assert!(HOST_TO_DEVICE_MAX_LEN <= MAX_DECODED_LEN);
+const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);

@@ -1,0 +1,450 @@
+//! The messages, named by direction: [`HostToDevice`] (requests) and [`DeviceToHost`]
+//! (answers).
+//!
+//! Every type here is serialized with postcard; the declaration order of fields and enum
+//! variants **is** the wire format (variant index = discriminant varint). Append new variants
+//! and fields only at the end, and only in a new minor version (see `docs/protocol.md`).
+//! Leg, joint, rotation-order and reach-policy enums and the body pose are kin-core's own
+//! types ([`LegId`], [`Joint`], [`RotationOrder`], [`ReachPolicy`], [`Pose`]); the golden tests
+//! pin their encoding.
+//!
+//! Arrays of twelve joint values are in kin-core's canonical order
+//! `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`; arrays of four feet in leg order
+//! FL, FR, RL, RR.
+
+use crate::servo;
+use core::fmt;
+use kin_core::{IkError, Joint, LegId, Pose, ReachPolicy, RotationOrder, Unreachable};
+use serde::{Deserialize, Serialize};
+
+/// One request from the host. The device answers every request it can read with exactly one
+/// [`DeviceToHost`] carrying the same `seq`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HostToDevice {
+    /// Sequence number chosen by the host, echoed by the answer. A retry of the same request
+    /// reuses it.
+    pub seq: u16,
+    /// What the host asks.
+    pub request: Request,
+}
+
+/// What the host asks. The comment on each variant names the answer.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Request {
+    /// Handshake: the host's [`crate::PROTOCOL_VERSION`]. → [`DeviceToHost::HelloAck`], or
+    /// [`NackReason::UnknownVersion`] when the major versions differ. Variant index 0 and its
+    /// layout are frozen across all versions.
+    Hello {
+        /// The host's protocol version.
+        version: u16,
+    },
+    /// Report the current state without moving anything. → [`DeviceToHost::Ack`].
+    GetState,
+    /// Body pose in the world frame; the device solves full-body IK with the feet held at the
+    /// stance of its [`PoseConfig`]. → [`DeviceToHost::Ack`] or a nack (nothing moves).
+    SetBodyPose(Pose),
+    /// Feet positions in the body frame, m, leg order FL, FR, RL, RR; `[x, y, z]` each.
+    /// → [`DeviceToHost::Ack`] or a nack.
+    SetFeet {
+        /// The four feet in the body frame, m.
+        feet_in_body_m: [[f32; 3]; 4],
+    },
+    /// Twelve joint angles, rad, canonical order; bypasses the IK (joint limits and servo
+    /// calibration still apply). → [`DeviceToHost::Ack`] or a nack.
+    SetJoints {
+        /// The twelve joint angles, rad.
+        angles_rad: [f32; 12],
+    },
+    /// Switch the servo outputs on or off (off at power-on). → [`DeviceToHost::Ack`].
+    SetOutputs {
+        /// True to drive the outputs.
+        enabled: bool,
+    },
+    /// Configure the link-loss failsafe. → [`DeviceToHost::Ack`].
+    SetLinkTimeout(LinkTimeout),
+    /// Replace one servo's calibration in RAM (not yet persisted). → [`DeviceToHost::Ack`] or
+    /// [`NackReason::BadCalibration`].
+    SetCalibration {
+        /// Which servo.
+        servo: ServoId,
+        /// The new calibration.
+        calibration: servo::Calibration,
+    },
+    /// Read one servo's calibration. → [`DeviceToHost::Calibration`].
+    GetCalibration {
+        /// Which servo.
+        servo: ServoId,
+    },
+    /// Persist all twelve calibrations. → [`DeviceToHost::Ack`] or [`NackReason::Storage`].
+    SaveCalibration,
+    /// Set how [`Request::SetBodyPose`] is interpreted. → [`DeviceToHost::Ack`] or
+    /// [`NackReason::InvalidArgument`].
+    SetPoseConfig(PoseConfig),
+}
+
+/// One servo: a leg and one of its joints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct ServoId {
+    /// The leg.
+    pub leg: LegId,
+    /// The joint of that leg.
+    pub joint: Joint,
+}
+
+impl ServoId {
+    /// All twelve servos in canonical order.
+    pub const ALL: [ServoId; 12] = {
+        let mut out = [ServoId {
+            leg: LegId::FL,
+            joint: Joint::Abduction,
+        }; 12];
+        let mut i = 0;
+        while i < 12 {
+            out[i] = ServoId {
+                leg: LegId::ALL[i / 3],
+                joint: Joint::ALL[i % 3],
+            };
+            i += 1;
+        }
+        out
+    };
+
+    /// Index in the canonical twelve-value order: `3·leg + joint`.
+    #[inline]
+    pub const fn index(self) -> usize {
+        3 * self.leg.index() + self.joint as usize
+    }
+
+    /// The servo at `index` in the canonical order.
+    #[inline]
+    pub const fn from_index(index: usize) -> Option<ServoId> {
+        if index < 12 {
+            Some(ServoId::ALL[index])
+        } else {
+            None
+        }
+    }
+}
+
+impl fmt::Display for ServoId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}.{}", self.leg, self.joint)
+    }
+}
+
+/// What the device does when no valid frame arrived for `timeout_ms`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum LinkLossAction {
+    /// Keep the last pulses on the outputs (the default).
+    #[default]
+    Hold,
+    /// Stop the pulses (hobby servos then go limp).
+    Disable,
+}
+
+/// Link-loss failsafe settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct LinkTimeout {
+    /// Time without a valid frame before the failsafe acts, ms; 0 = never.
+    pub timeout_ms: u16,
+    /// What the failsafe does.
+    pub action: LinkLossAction,
+}
+
+/// How the device interprets [`Request::SetBodyPose`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PoseConfig {
+    /// Stance height `H`: the feet are held at `hip_in_body + (0, s·d_lat, −H)`, m (> 0).
+    pub stance_height_m: f32,
+    /// Rotation order of roll, pitch and yaw.
+    pub order: RotationOrder,
+    /// Reject unreachable targets, or clamp them and report [`Flags::CLAMPED`].
+    pub policy: ReachPolicy,
+}
+
+/// Robot geometry the firmware was built for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum RobotPreset {
+    /// [`kin_core::Robot::shahriar2023`] (seed 000).
+    Shahriar2023,
+    /// [`kin_core::Robot::fernando2025`] (seed 001).
+    Fernando2025,
+    /// A geometry that is none of the presets.
+    Custom,
+}
+
+impl RobotPreset {
+    /// The kin-core robot of a preset; `None` for [`RobotPreset::Custom`].
+    pub const fn robot(self) -> Option<kin_core::Robot> {
+        match self {
+            RobotPreset::Shahriar2023 => Some(kin_core::Robot::shahriar2023()),
+            RobotPreset::Fernando2025 => Some(kin_core::Robot::fernando2025()),
+            RobotPreset::Custom => None,
+        }
+    }
+
+    /// The preset of kin-core's name (`shahriar2023`, `fernando2025`).
+    pub fn from_name(name: &str) -> Option<RobotPreset> {
+        match name {
+            "shahriar2023" => Some(RobotPreset::Shahriar2023),
+            "fernando2025" => Some(RobotPreset::Fernando2025),
+            _ => None,
+        }
+    }
+}
+
+/// Firmware release, semantic-version style.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct FirmwareVersion {
+    /// Major.
+    pub major: u8,
+    /// Minor.
+    pub minor: u8,
+    /// Patch.
+    pub patch: u8,
+}
+
+/// What the device tells about itself in [`DeviceToHost::HelloAck`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DeviceInfo {
+    /// The device's [`crate::PROTOCOL_VERSION`].
+    pub version: u16,
+    /// Firmware release.
+    pub firmware: FirmwareVersion,
+    /// Robot geometry compiled into the firmware.
+    pub robot: RobotPreset,
+    /// Largest decoded frame (postcard bytes + CRC) the device accepts, bytes.
+    pub max_frame_len: u16,
+    /// Current pose interpretation.
+    pub pose_config: PoseConfig,
+    /// Current link-loss failsafe.
+    pub link_timeout: LinkTimeout,
+}
+
+/// Status bits of a [`Readback`], one byte on the wire. Unknown bits are reserved: senders
+/// write 0, receivers ignore them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub struct Flags(pub u8);
+
+impl Flags {
+    /// The last target was moved by [`ReachPolicy::Clamp`] (the angles are not those asked).
+    pub const CLAMPED: u8 = 1 << 0;
+    /// A joint or servo limit acted on the last target.
+    pub const LIMITED: u8 = 1 << 1;
+    /// The servo outputs are driven.
+    pub const OUTPUTS_ENABLED: u8 = 1 << 2;
+    /// The link-loss failsafe has acted since the last valid frame.
+    pub const FAILSAFE_ACTIVE: u8 = 1 << 3;
+    /// A calibration in RAM differs from the stored one.
+    pub const CALIBRATION_UNSAVED: u8 = 1 << 4;
+    /// No valid stored calibration was found at power-on: defaults are in use.
+    pub const CALIBRATION_DEFAULT: u8 = 1 << 5;
+
+    /// No bit set.
+    pub const EMPTY: Flags = Flags(0);
+
+    /// True when every bit of `mask` is set.
+    #[inline]
+    pub const fn contains(self, mask: u8) -> bool {
+        self.0 & mask == mask
+    }
+
+    /// These flags with the bits of `mask` set to `on`.
+    #[inline]
+    #[must_use]
+    pub const fn with(self, mask: u8, on: bool) -> Flags {
+        if on {
+            Flags(self.0 | mask)
+        } else {
+            Flags(self.0 & !mask)
+        }
+    }
+}
+
+/// What the device did: the state after the request, for the host's readback check.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Readback {
+    /// The twelve joint angles the device holds (computed by its IK, or as set), rad;
+    /// canonical order. Always finite.
+    pub angles_rad: [f32; 12],
+    /// The twelve pulse widths on the outputs, half-µs (one 0.5 µs timer tick each; 3000 =
+    /// 1500 µs); 0 = that output is off. Canonical order.
+    pub pulses_half_us: [u16; 12],
+    /// Status bits.
+    pub flags: Flags,
+    /// Frames received with a good CRC since power-on (wrapping).
+    pub frames_ok: u32,
+    /// Frames dropped for a bad CRC, bad encoding or oversize since power-on (wrapping).
+    pub frames_bad: u32,
+}
+
+/// One answer from the device.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum DeviceToHost {
+    /// The request was refused; nothing moved. Variant index 0 and its layout are frozen.
+    Nack {
+        /// The request's sequence number; `None` when the frame could not be read
+        /// ([`NackReason::BadCrc`], [`NackReason::BadFrame`], [`NackReason::Oversize`]).
+        seq: Option<u16>,
+        /// Why.
+        reason: NackReason,
+    },
+    /// Answer to [`Request::Hello`] with a compatible version.
+    HelloAck {
+        /// The request's sequence number.
+        seq: u16,
+        /// The device.
+        info: DeviceInfo,
+    },
+    /// The request was carried out (or, for [`Request::GetState`], the state is reported).
+    Ack {
+        /// The request's sequence number.
+        seq: u16,
+        /// The state after the request.
+        readback: Readback,
+    },
+    /// Answer to [`Request::GetCalibration`].
+    Calibration {
+        /// The request's sequence number.
+        seq: u16,
+        /// Which servo.
+        servo: ServoId,
+        /// Its calibration in RAM.
+        calibration: servo::Calibration,
+    },
+}
+
+impl DeviceToHost {
+    /// The echoed sequence number; `None` for a nack of an unreadable frame.
+    pub const fn seq(&self) -> Option<u16> {
+        match self {
+            DeviceToHost::Nack { seq, .. } => *seq,
+            DeviceToHost::HelloAck { seq, .. }
+            | DeviceToHost::Ack { seq, .. }
+            | DeviceToHost::Calibration { seq, .. } => Some(*seq),
+        }
+    }
+}
+
+/// Why a foot target cannot be reached (kin-core's [`Unreachable`] without the joint-limit and
+/// non-finite cases, which have their own [`NackReason`]s).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ReachFault {
+    /// Farther than femur + tibia.
+    TooFar,
+    /// Closer than |femur − tibia|.
+    TooClose,
+    /// Within `d_lat` of the abduction axis.
+    InsideOffset,
+    /// A reason this protocol version has no code for.
+    Other,
+}
+
+/// Why a request was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum NackReason {
+    /// The host's major version differs from the device's. Variant index 0 is frozen.
+    UnknownVersion {
+        /// The device's own [`crate::PROTOCOL_VERSION`].
+        supported: u16,
+    },
+    /// A frame arrived whose CRC did not match.
+    BadCrc,
+    /// A frame arrived that is not valid COBS or not a valid message.
+    BadFrame,
+    /// A frame arrived that exceeds the device's buffer.
+    Oversize,
+    /// A motion or configuration request arrived before a successful [`Request::Hello`].
+    HelloRequired,
+    /// A foot cannot reach its target.
+    Unreachable {
+        /// The first leg (in order FL, FR, RL, RR) that cannot reach.
+        leg: LegId,
+        /// Why.
+        fault: ReachFault,
+    },
+    /// A joint angle would leave the robot's joint limits.
+    JointLimit {
+        /// The leg.
+        leg: LegId,
+        /// The joint.
+        joint: Joint,
+    },
+    /// A joint angle maps to a pulse outside that servo's calibrated `[min_us, max_us]`.
+    ServoRange {
+        /// The leg.
+        leg: LegId,
+        /// The joint.
+        joint: Joint,
+        /// Below min or above max.
+        fault: servo::Error,
+    },
+    /// A value in the request is NaN or infinite.
+    NonFinite,
+    /// A calibration was refused.
+    BadCalibration(servo::Error),
+    /// The device cannot take the request now (e.g. a save is in progress).
+    Busy,
+    /// A motion request arrived while the outputs are disabled.
+    OutputsDisabled,
+    /// The calibration storage failed.
+    Storage,
+    /// A configuration value is out of its admissible range.
+    InvalidArgument,
+}
+
+impl From<IkError> for NackReason {
+    fn from(e: IkError) -> Self {
+        let fault = match e.kind {
+            Unreachable::JointLimit(joint) => return NackReason::JointLimit { leg: e.leg, joint },
+            Unreachable::NonFinite => return NackReason::NonFinite,
+            Unreachable::TooFar => ReachFault::TooFar,
+            Unreachable::TooClose => ReachFault::TooClose,
+            Unreachable::InsideOffset => ReachFault::InsideOffset,
+            _ => ReachFault::Other,
+        };
+        NackReason::Unreachable { leg: e.leg, fault }
+    }
+}
+
+impl fmt::Display for ReachFault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ReachFault::TooFar => "too_far",
+            ReachFault::TooClose => "too_close",
+            ReachFault::InsideOffset => "inside_offset",
+            ReachFault::Other => "other",
+        })
+    }
+}
+
+impl fmt::Display for NackReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            NackReason::UnknownVersion { supported } => write!(
+                f,
+                "unknown version (device speaks {}.{})",
+                crate::version_major(*supported),
+                crate::version_minor(*supported)
+            ),
+            NackReason::BadCrc => f.write_str("bad CRC"),
+            NackReason::BadFrame => f.write_str("bad frame"),
+            NackReason::Oversize => f.write_str("oversize frame"),
+            NackReason::HelloRequired => f.write_str("hello required first"),
+            NackReason::Unreachable { leg, fault } => write!(f, "unreachable: {leg} {fault}"),
+            NackReason::JointLimit { leg, joint } => write!(f, "joint limit: {leg}.{joint}"),
+            NackReason::ServoRange { leg, joint, fault } => {
+                write!(f, "servo range: {leg}.{joint}: {fault}")
+            }
+            NackReason::NonFinite => f.write_str("non-finite value"),
+            NackReason::BadCalibration(e) => write!(f, "bad calibration: {e}"),
+            NackReason::Busy => f.write_str("busy"),
+            NackReason::OutputsDisabled => f.write_str("outputs disabled"),
+            NackReason::Storage => f.write_str("storage error"),
+            NackReason::InvalidArgument => f.write_str("invalid argument"),
+        }
+    }
+}
+
+impl core::error::Error for NackReason {}
