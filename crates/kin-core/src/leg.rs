@@ -315,7 +315,9 @@ fn solve<M: Math>(
     if moved {
         ck = ck.clamp(-1.0, 1.0);
     }
-    let sk_sq = 1.0 - ck * ck;
+    // sin²k = (1 + cos k)(1 − cos k) from the factored forms: accurate near a folded or
+    // straight knee, where 1 − ck² loses the digits that set the foot's distance.
+    let sk_sq = ((dist2 - near2) / two_l1l2) * ((far2 - dist2) / two_l1l2);
     let sk_abs = M::sqrt(if sk_sq > 0.0 { sk_sq } else { 0.0 });
     let sk = match bend {
         KneeBend::Backward => -sk_abs,
