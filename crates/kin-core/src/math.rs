@@ -124,9 +124,9 @@ impl Math for Fast {
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
         // Quadrant k = round(x / (π/2)); r = x − k·π/2 in two parts (Cody–Waite).
-        const INV_FRAC_PI_2: f32 = 0.636_619_8;
+        const INV_FRAC_PI_2: f32 = core::f32::consts::FRAC_2_PI;
         const PIO2_HI: f32 = 1.570_312_5; // exact in 11 bits
-        const PIO2_LO: f32 = 4.838_267_9e-4;
+        const PIO2_LO: f32 = 4.838_268e-4;
         let k = libm::roundf(x * INV_FRAC_PI_2);
         let r = (x - k * PIO2_HI) - k * PIO2_LO;
         let r2 = r * r;
@@ -134,9 +134,9 @@ impl Math for Fast {
         let s = r
             * (1.0
                 + r2 * (-1.666_666_6e-1
-                    + r2 * (8.333_326_3e-3 + r2 * (-1.983_867_3e-4 + r2 * 2.713_535_4e-6))));
+                    + r2 * (8.333_326e-3 + r2 * (-1.983_867_2e-4 + r2 * 2.713_535_5e-6))));
         let c = 1.0
-            + r2 * (-0.5 + r2 * (4.166_661_7e-2 + r2 * (-1.388_661_9e-3 + r2 * 2.437_992_9e-5)));
+            + r2 * (-0.5 + r2 * (4.166_661_6e-2 + r2 * (-1.388_662e-3 + r2 * 2.437_992_8e-5)));
         let q = (k as i32) & 3;
         match q {
             0 => (s, c),
