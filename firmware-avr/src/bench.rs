@@ -1,0 +1,187 @@
+//! The cycle benchmark's request loop, shared by the `bench` (avr-libc) and `bench-libm`
+//! (plain Rust soft-float) binaries.
+//!
+//! The host sends targets over USART0 and times each solve by the cycles between the rising
+//! and the falling edge of the marker pin [`MARKER`] (PA0, Mega header D22), which is high
+//! exactly around the call. In simavr the host counts the cycles between the two edges; on a
+//! real board a logic analyser does the same.
+//!
+//! Wire format (all little-endian, f32 as IEEE-754 bits):
+//!
+//! | request | bytes | answer |
+//! |---|---|---|
+//! | empty call (marker overhead) | `E` | `e` |
+//! | one leg IK | `L`, backend u8, leg u8, x y z f32 (hip frame, m) | `l`, status u8, abduction hip knee f32 |
+//! | body pose at the stance | `B`, backend u8, roll pitch yaw x y z f32 | `b`, status u8, 12 × f32 |
+//! | memory | `S` | `s`, static SRAM u16, max stack u16 |
+//!
+//! Status 0 = solved, 1 = unreachable, 2 = unknown backend. Boot sends `R` once ready.
+//! Robot: [`kin_core::Robot::shahriar2023`] with its knee bend and limits; body poses about
+//! the body centre in rotation order zyx, feet held at the stance of height
+//! [`STANCE_HEIGHT_M`]; [`kin_core::ReachPolicy::Reject`].
+
+use crate::pac;
+use crate::usart::Usart0;
+use kin_core::{body, leg, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
+
+/// Stance height of the body-pose benchmark: seed 000 Table 4 body height, m.
+pub const STANCE_HEIGHT_M: f32 = 0.277;
+
+/// The marker pin: PA0 (D22).
+pub const MARKER: u8 = 0;
+
+/// The robot of the benchmark.
+pub const ROBOT: Robot = Robot::shahriar2023();
+
+/// Solves one leg with the given backend.
+pub type LegFn = fn(&Robot, LegId, Vec3) -> Result<[f32; 3], IkError>;
+/// Solves one body pose with the given backend.
+pub type BodyFn = fn(&Robot, &Pose) -> Result<[f32; 12], IkError>;
+
+/// A math backend under test.
+pub struct Backend {
+    /// The id the host selects it by.
+    pub id: u8,
+    /// Its leg IK.
+    pub leg: LegFn,
+    /// Its body IK.
+    pub body: BodyFn,
+}
+
+/// kin-core's leg IK on backend `M`.
+#[inline(never)]
+pub fn leg_with<M: Math>(
+    robot: &Robot,
+    leg_id: LegId,
+    foot_in_hip: Vec3,
+) -> Result<[f32; 3], IkError> {
+    leg::inverse_with::<M>(robot, leg_id, foot_in_hip, ReachPolicy::Reject)
+        .map(|s| s.angles.to_array())
+}
+
+/// kin-core's body IK at the stance on backend `M`.
+#[inline(never)]
+pub fn body_with<M: Math>(robot: &Robot, pose: &Pose) -> Result<[f32; 12], IkError> {
+    body::inverse_at_stance_with::<M>(
+        robot,
+        pose,
+        &BodyConfig::default(),
+        STANCE_HEIGHT_M,
+        ReachPolicy::Reject,
+    )
+    .map(|s| s.flat())
+}
+
+const STATUS_OK: u8 = 0;
+const STATUS_UNREACHABLE: u8 = 1;
+const STATUS_UNKNOWN_BACKEND: u8 = 2;
+
+fn read_byte(usart: &mut Usart0) -> u8 {
+    loop {
+        if let Some(b) = usart.read() {
+            return b;
+        }
+    }
+}
+
+fn read_f32(usart: &mut Usart0) -> f32 {
+    let mut b = [0u8; 4];
+    for x in &mut b {
+        *x = read_byte(usart);
+    }
+    f32::from_le_bytes(b)
+}
+
+fn marker(porta: &pac::PORTA, high: bool) {
+    // SAFETY: any PORTA value is valid; only PA0 changes.
+    porta.porta().modify(|r, w| unsafe {
+        w.bits(if high {
+            r.bits() | 1 << MARKER
+        } else {
+            r.bits() & !(1 << MARKER)
+        })
+    });
+}
+
+/// Serves benchmark requests forever (see the module docs). Interrupts must be enabled (the
+/// receiver is interrupt-driven).
+pub fn serve(usart: &mut Usart0, porta: &pac::PORTA, backends: &[Backend]) -> ! {
+    // SAFETY: any DDRA value is valid; PA0 becomes an output, low.
+    marker(porta, false);
+    porta
+        .ddra()
+        .modify(|r, w| unsafe { w.bits(r.bits() | 1 << MARKER) });
+    let robot = ROBOT;
+    usart.write(b'R');
+    loop {
+        match read_byte(usart) {
+            b'E' => {
+                marker(porta, true);
+                core::hint::black_box(());
+                marker(porta, false);
+                usart.write(b'e');
+            }
+            b'L' => {
+                let backend = read_byte(usart);
+                let leg_id = LegId::from_index(read_byte(usart) as usize & 3).unwrap_or(LegId::FL);
+                let foot = Vec3::new(read_f32(usart), read_f32(usart), read_f32(usart));
+                usart.write(b'l');
+                match backends.iter().find(|b| b.id == backend) {
+                    Some(b) => {
+                        let robot = core::hint::black_box(&robot);
+                        marker(porta, true);
+                        let r = (b.leg)(robot, leg_id, foot);
+                        marker(porta, false);
+                        send_result(usart, r.as_ref().map(|a| &a[..]), 3);
+                    }
+                    None => send_status(usart, STATUS_UNKNOWN_BACKEND, 3),
+                }
+            }
+            b'B' => {
+                let backend = read_byte(usart);
+                let mut a = [0.0f32; 6];
+                for v in &mut a {
+                    *v = read_f32(usart);
+                }
+                let pose = Pose::from_array(a);
+                usart.write(b'b');
+                match backends.iter().find(|b| b.id == backend) {
+                    Some(b) => {
+                        let robot = core::hint::black_box(&robot);
+                        marker(porta, true);
+                        let r = (b.body)(robot, &pose);
+                        marker(porta, false);
+                        send_result(usart, r.as_ref().map(|a| &a[..]), 12);
+                    }
+                    None => send_status(usart, STATUS_UNKNOWN_BACKEND, 12),
+                }
+            }
+            b'S' => {
+                usart.write(b's');
+                usart.write_all(&crate::stack::static_bytes().to_le_bytes());
+                usart.write_all(&crate::stack::max_used_bytes().to_le_bytes());
+            }
+            _ => {}
+        }
+    }
+}
+
+fn send_result(usart: &mut Usart0, r: Result<&[f32], &IkError>, n: usize) {
+    match r {
+        Ok(angles) => {
+            usart.write(STATUS_OK);
+            for a in angles {
+                usart.write_all(&a.to_le_bytes());
+            }
+        }
+        Err(_) => send_status(usart, STATUS_UNREACHABLE, n),
+    }
+}
+
+/// A failure status followed by `n` NaN-free zero angles (fixed answer length).
+fn send_status(usart: &mut Usart0, status: u8, n: usize) {
+    usart.write(status);
+    for _ in 0..n {
+        usart.write_all(&0.0f32.to_le_bytes());
+    }
+}

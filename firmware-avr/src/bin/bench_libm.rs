@@ -1,0 +1,31 @@
+//! Cycle benchmark of the straightforward build: kin-core's `Libm` backend (Rust libm) on
+//! compiler-builtins' soft-float, without avr-libc (see `firmware_avr::bench`). Backend 2 only.
+
+#![no_std]
+#![no_main]
+#![feature(abi_avr_interrupt)]
+
+use firmware_avr::bench::{self, Backend};
+use firmware_avr::usart::{self, Baud, Usart0};
+use kin_core::math::Libm;
+
+static BACKENDS: [Backend; 1] = [Backend {
+    id: 2,
+    leg: bench::leg_with::<Libm>,
+    body: bench::body_with::<Libm>,
+}];
+
+#[avr_device::entry]
+fn main() -> ! {
+    firmware_avr::stack::paint();
+    let dp = firmware_avr::pac::Peripherals::take().unwrap();
+    let mut usart = Usart0::new(dp.USART0, Baud::B1000000);
+    // SAFETY: the handler is defined below and touches only its own state.
+    unsafe { avr_device::interrupt::enable() };
+    bench::serve(&mut usart, &dp.PORTA, &BACKENDS)
+}
+
+#[avr_device::interrupt(atmega2560)]
+fn USART0_RX() {
+    usart::on_rx_interrupt();
+}

@@ -1,0 +1,44 @@
+//! Millisecond clock on Timer2 (8-bit, CTC mode, prescaler 64, OCR2A = 249: 1 kHz).
+//!
+//! The binary forwards the `TIMER2_COMPA` interrupt to [`on_tick_interrupt`].
+
+use crate::pac;
+use avr_device::interrupt::{self, Mutex};
+use core::cell::Cell;
+
+static MILLIS: Mutex<Cell<u32>> = Mutex::new(Cell::new(0));
+
+/// Compare value for 1 ms at 16 MHz / 64: 250 counts.
+const OCR_1MS: u8 = 249;
+
+/// The running millisecond clock. Wraps after 2³² ms (49.7 days).
+pub struct Clock {
+    _tc2: pac::TC2,
+}
+
+impl Clock {
+    /// Starts Timer2 at 1 kHz with its compare-A interrupt (interrupts must be enabled by the
+    /// caller).
+    pub fn new(tc2: pac::TC2) -> Clock {
+        tc2.tccr2a().write(|w| w.wgm2().ctc());
+        tc2.ocr2a().write(|w| w.set(OCR_1MS));
+        tc2.tcnt2().write(|w| w.set(0));
+        tc2.timsk2().write(|w| w.ocie2a().set_bit());
+        tc2.tccr2b().write(|w| w.cs2().prescale_64());
+        Clock { _tc2: tc2 }
+    }
+
+    /// Milliseconds since [`Clock::new`].
+    pub fn now_ms(&self) -> u32 {
+        interrupt::free(|cs| MILLIS.borrow(cs).get())
+    }
+}
+
+/// Advances the clock by one millisecond; call from the `TIMER2_COMPA` interrupt.
+#[inline(always)]
+pub fn on_tick_interrupt() {
+    interrupt::free(|cs| {
+        let c = MILLIS.borrow(cs);
+        c.set(c.get().wrapping_add(1));
+    });
+}

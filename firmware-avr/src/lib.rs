@@ -1,0 +1,52 @@
+//! # firmware-avr — the hardware shell of the quadruped's ATmega2560 (Arduino Mega 2560)
+//!
+//! Everything that touches registers lives here; the device's behaviour (decode → IK →
+//! calibration → outputs) lives in portable crates and is plugged in by the binaries.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`servo`] | 12 servo outputs on the output-compare units of Timer1/3/4/5 (50 Hz, 0.5 µs ticks), `embedded_hal::pwm::SetDutyCycle` per channel |
+//! | [`clock`] | millisecond clock on Timer2 |
+//! | [`usart`] | USART0: interrupt-driven receive into a bounded ring buffer, polled transmit |
+//! | [`watchdog`] | watchdog enable/feed and the reset cause |
+//! | [`stack`] | SRAM painting at boot and the high-water mark of the stack |
+//! | [`bench`] | the cycle benchmark's request loop (used by the `bench` binaries only) |
+//!
+//! The CPU clock is [`F_CPU_HZ`] (the Mega's 16 MHz crystal).
+//!
+//! Interrupt handlers must be defined in the binary crate (a handler in a library is not
+//! pulled in by the linker): each binary forwards `USART0_RX` to [`usart::on_rx_interrupt`]
+//! and `TIMER2_COMPA` to [`clock::on_tick_interrupt`].
+
+#![no_std]
+#![feature(asm_experimental_arch)]
+#![deny(unsafe_op_in_unsafe_fn)]
+#![warn(missing_docs)]
+
+pub mod bench;
+pub mod clock;
+pub mod servo;
+pub mod stack;
+pub mod usart;
+pub mod watchdog;
+
+pub use avr_device::atmega2560 as pac;
+
+/// CPU clock frequency, Hz.
+pub const F_CPU_HZ: u32 = 16_000_000;
+
+/// Puts every output into its safe state and waits for the watchdog: all servo compare
+/// outputs disconnected (pins low), interrupts off. No `core::fmt` (it would cost about 7 KB
+/// of flash and 1 KB of SRAM).
+#[panic_handler]
+fn panic(_info: &core::panic::PanicInfo) -> ! {
+    avr_device::interrupt::disable();
+    // SAFETY: interrupts are off and this function never returns, so no other code can hold
+    // the timer peripherals while they are stolen here.
+    let dp = unsafe { pac::Peripherals::steal() };
+    servo::force_all_low(&dp);
+    loop {
+        // Not feeding the watchdog: it resets the MCU (when enabled).
+        core::hint::spin_loop();
+    }
+}
