@@ -1,14 +1,15 @@
-//! Framing: `COBS(postcard(message) ‖ CRC-16 big-endian) ‖ 0x00`.
+//! Framing: `0x00 ‖ COBS(postcard(message) ‖ CRC-16 big-endian) ‖ 0x00`.
 //!
 //! - [`encode_frame`] serializes a message straight into COBS-encoded bytes (no intermediate
-//!   buffer), appending the CRC ([`crate::crc`]) and the `0x00` delimiter.
+//!   buffer), appending the CRC ([`crate::crc`]), between two `0x00` delimiters.
 //! - [`Accumulator`] takes received bytes in any chunking, decodes COBS on the fly into a
 //!   bounded buffer of `N` bytes, checks the CRC and deserializes at each delimiter. The caller
 //!   loops on [`Feed::remaining`] until [`Feed::NeedMore`] so that back-to-back frames in one
 //!   read are all seen.
 //!
-//! Empty frames (two delimiters in a row) are ignored: a sender may start with a `0x00` to
-//! flush a receiver that holds the remains of a broken frame.
+//! Empty frames (two delimiters in a row) are ignored. Every frame **starts** with a delimiter
+//! too: it ends whatever a receiver holds from line noise or a truncated frame, so the next good
+//! frame is never merged with garbage. Back-to-back frames thus show `00 00` between them.
 
 use crate::crc;
 use core::fmt;
@@ -27,18 +28,19 @@ pub const CRC_LEN: usize = 2;
 /// [`crate::DEVICE_TO_HOST_MAX_LEN`]); the rest is headroom for later minor versions.
 pub const MAX_DECODED_LEN: usize = 128;
 
-/// Largest frame on the wire, COBS overhead and delimiter included, bytes.
+/// Largest frame on the wire, COBS overhead and both delimiters included, bytes.
 pub const MAX_FRAME_LEN: usize = encoded_len_max(MAX_DECODED_LEN);
 
-/// Upper bound of the wire size (COBS + delimiter) of `decoded_len` decoded bytes:
-/// `n + ⌈n/254⌉ + 1` (one COBS code byte per started block of 254 bytes, at least one).
+/// Upper bound of the wire size (COBS + two delimiters) of `decoded_len` decoded bytes:
+/// `n + ⌈n/254⌉ + 2` (one COBS code byte per started block of 254 bytes, at least one). Exact
+/// for `n < 254`.
 pub const fn encoded_len_max(decoded_len: usize) -> usize {
     let blocks = if decoded_len == 0 {
         1
     } else {
         decoded_len.div_ceil(254)
     };
-    decoded_len + blocks + 1
+    decoded_len + blocks + 2
 }
 
 /// Why a frame could not be built or read.
@@ -121,13 +123,14 @@ struct CobsCrcSlice<'b> {
 
 impl<'b> CobsCrcSlice<'b> {
     fn new(out: &'b mut [u8]) -> Result<Self, postcard::Error> {
-        if out.is_empty() {
+        if out.len() < 2 {
             return Err(postcard::Error::SerializeBufferFull);
         }
+        out[0] = DELIMITER;
         Ok(CobsCrcSlice {
             out,
-            pos: 1,
-            code_idx: 0,
+            pos: 2,
+            code_idx: 1,
             code: 1,
             crc: crc::INIT,
         })
@@ -186,8 +189,8 @@ impl<'b> Flavor for CobsCrcSlice<'b> {
     }
 }
 
-/// Serializes `msg`, appends its CRC, COBS-encodes everything and ends it with `0x00`, in
-/// `out`. Returns the frame (a prefix of `out`).
+/// Serializes `msg`, appends its CRC, COBS-encodes everything and puts it between two `0x00`
+/// delimiters, in `out`. Returns the frame (a prefix of `out`).
 ///
 /// # Errors
 /// [`Error::BufferFull`] when `out` is too small ([`MAX_FRAME_LEN`] is always enough for this
@@ -266,7 +269,8 @@ impl<'a, T> Feed<'a, T> {
 }
 
 /// Receives a byte stream and yields one [`Feed`] per delimiter-terminated frame, with `N`
-/// bytes of buffer for the decoded frame (postcard bytes + CRC). Memory: `N` + 14 bytes.
+/// bytes of buffer for the decoded frame (postcard bytes + CRC). Memory: `N` bytes plus 13 bytes
+/// of state on the AVR (16-bit `usize`).
 ///
 /// ```
 /// use quad_protocol::{encode_frame, Accumulator, Feed, HostToDevice, Request, MAX_FRAME_LEN};

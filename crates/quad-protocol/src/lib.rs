@@ -21,7 +21,7 @@
 //!
 //! ## Sizes
 //! Every decoded frame (postcard bytes + CRC) of this version fits in [`MAX_DECODED_LEN`]
-//! (128 bytes); on the wire that is at most [`MAX_FRAME_LEN`] (130 bytes). f32 only; no f64.
+//! (128 bytes); on the wire that is at most [`MAX_FRAME_LEN`] (131 bytes). f32 only; no f64.
 
 #![no_std]
 #![forbid(unsafe_code)]

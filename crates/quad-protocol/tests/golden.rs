@@ -382,18 +382,19 @@ fn every_answer_has_its_golden_bytes() {
 
 #[test]
 fn hand_written_frames() {
-    // Hello: payload 01 00 80 02, CRC 0xC9AE → 01 00 80 02 c9 ae → COBS 02 01 | 05 80 02 c9 ae.
+    // Hello: payload 01 00 80 02, CRC 0xC9AE → 01 00 80 02 c9 ae → COBS 02 01 | 05 80 02 c9 ae,
+    // between two delimiters.
     let mut buf = [0u8; MAX_FRAME_LEN];
     let hello = h2d(1, Request::Hello { version: 0x0100 });
     assert_eq!(
         to_hex(encode_frame(&hello, &mut buf).unwrap()),
-        "02 01 05 80 02 c9 ae 00"
+        "00 02 01 05 80 02 c9 ae 00"
     );
     // GetState seq 300: ac 02 01 + CRC 0x7222, no zero → one block of 5.
     let get = h2d(300, Request::GetState);
     assert_eq!(
         to_hex(encode_frame(&get, &mut buf).unwrap()),
-        "06 ac 02 01 72 22 00"
+        "00 06 ac 02 01 72 22 00"
     );
     // Nack BadCrc: 00 00 01 + CRC 0xDCBD → two empty blocks, then 01 dc bd.
     let nack = DeviceToHost::Nack {
@@ -402,7 +403,7 @@ fn hand_written_frames() {
     };
     assert_eq!(
         to_hex(encode_frame(&nack, &mut buf).unwrap()),
-        "01 01 04 01 dc bd 00"
+        "00 01 01 04 01 dc bd 00"
     );
 }
 

@@ -78,11 +78,13 @@ pub fn ref_cobs_decode(enc: &[u8]) -> Option<Vec<u8>> {
     Some(out)
 }
 
-/// The expected wire frame of postcard bytes `payload`: COBS(payload ‖ CRC big-endian) ‖ 00.
+/// The expected wire frame of postcard bytes `payload`:
+/// 00 ‖ COBS(payload ‖ CRC big-endian) ‖ 00.
 pub fn ref_frame(payload: &[u8]) -> Vec<u8> {
     let mut data = payload.to_vec();
     data.extend_from_slice(&ref_crc(payload).to_be_bytes());
-    let mut out = ref_cobs_encode(&data);
+    let mut out = vec![0];
+    out.extend(ref_cobs_encode(&data));
     out.push(0);
     out
 }
