@@ -344,6 +344,25 @@ fn solve<M: Math>(
     Ok((raw, reached))
 }
 
+/// Under [`ReachPolicy::Clamp`], targets farther than this along any axis (m) are first
+/// shrunk towards the hip to this distance.
+const FAR_M: f32 = 1.0e6;
+
+/// `|a − b|` without overflowing the squares of far targets.
+#[inline]
+fn distance(a: Vec3, b: Vec3) -> f32 {
+    let d = a - b;
+    let m = libm::fmaxf(
+        libm::fabsf(d.x),
+        libm::fmaxf(libm::fabsf(d.y), libm::fabsf(d.z)),
+    );
+    if m > FAR_M {
+        m * (d * (1.0 / m)).norm()
+    } else {
+        d.norm()
+    }
+}
+
 /// Analytic leg IK: the foot target in the hip frame → joint angles.
 ///
 /// Branches: the knee bend of `robot.knee_bend`, and the abduction whose un-abducted foot lies
@@ -365,12 +384,23 @@ pub fn inverse_with<M: Math>(
         return Err(err(Unreachable::NonFinite));
     }
     let g = &robot.leg;
-    let (raw, reached) =
-        solve::<M>(g, leg.side(), robot.knee_bend, foot_in_hip, policy).map_err(err)?;
+    // Far outside the workspace a clamped answer depends only on the target's direction;
+    // shrinking such a target keeps its squares clear of f32 overflow (|p| ≳ 1.8e19 m), which
+    // would otherwise turn a finite target into NaN angles.
+    let m = libm::fmaxf(
+        libm::fabsf(foot_in_hip.x),
+        libm::fmaxf(libm::fabsf(foot_in_hip.y), libm::fabsf(foot_in_hip.z)),
+    );
+    let target = if policy == ReachPolicy::Clamp && m > FAR_M {
+        foot_in_hip * (FAR_M / m)
+    } else {
+        foot_in_hip
+    };
+    let (raw, reached) = solve::<M>(g, leg.side(), robot.knee_bend, target, policy).map_err(err)?;
     let mut angles = raw.angles;
     let mut clamped = reached.map(|(kind, p)| Clamp {
         kind,
-        distance_m: (p - foot_in_hip).norm(),
+        distance_m: distance(p, foot_in_hip),
     });
     if let Some(joint) = robot.limits.first_violation(angles) {
         if policy == ReachPolicy::Reject {
@@ -384,7 +414,7 @@ pub fn inverse_with<M: Math>(
         let reached = forward_with::<M>(g, leg, angles);
         clamped = Some(Clamp {
             kind: clamped.map_or(Unreachable::JointLimit(joint), |c| c.kind),
-            distance_m: (reached - foot_in_hip).norm(),
+            distance_m: distance(reached, foot_in_hip),
         });
     }
     if !angles.is_finite() {
