@@ -42,6 +42,8 @@
 //! - [`jacobian`]: velocity kinematics and the singularity measure.
 //! - [`paper`]: seed 000 (θ1, θ2, θ3) and seed 001 (β, α, φ) angle adapters.
 //! - [`math`]: the [`Math`] backend trait (`libm`, fast polynomials, or a firmware's own).
+//! - [`motion`]: foot paths, seed 001's body-motion laws, trot / walk gaits.
+//! - [`preflight`]: sweep a motion and report reach, margins, singularity, joint speeds.
 //!
 //! ## Why not nalgebra inside
 //! The kinematics needs a 3-vector, a 3×3 rotation and a dozen operations on them; the
@@ -56,7 +58,9 @@ pub mod body;
 pub mod jacobian;
 pub mod leg;
 pub mod math;
+pub mod motion;
 pub mod paper;
+pub mod preflight;
 pub mod robot;
 pub mod rotation;
 pub mod vec;

@@ -1,0 +1,304 @@
+//! Trot / walk gait generator driven by a body velocity command, built on the foot paths.
+//!
+//! The body moves at a constant twist: velocity `v = (forward, lateral)` in its own frame and
+//! yaw rate `ω` (counter-clockwise positive, REP 103). Over a time `s` it is displaced by
+//! `X(s) = (Rz(ω·s), p(s))` with `p(s) = ∫₀ˢ Rz(ω·u)·v du`.
+//!
+//! Leg `i` has phase `φ_i = frac(t/T + o_i)`: swing for `φ < 1 − d`, stance after (duty factor
+//! `d`). In stance the foot is fixed in the world at `X(t_mid)·n_i`, where `t_mid` is the middle
+//! of that stance and `n_i` the neutral foothold (nominal stance at height `H`); in the body
+//! frame it is therefore `X(t_mid − t)·n_i` — exact no-slip for any `v` and `ω`, and symmetric
+//! about `n_i`. In swing the foot moves, in the body frame, from its lift-off point
+//! `X(−dT/2)·n_i` to its next touch-down point `X(dT/2)·n_i` along the chosen
+//! [`PathKind`] (stride = their distance, apex = the step height). For
+//! a straight command (`ω = 0`) the stance is the paths' linear stance and the Bézier swing
+//! joins it with C1 continuity.
+
+use super::path::{AnyPath, FootPath, PathKind, Stride};
+use super::{
+    check_reach, finite, fract01, non_negative, positive, Contact, Error, Frame, Motion, Phase,
+};
+use crate::body::{BodyConfig, Pose};
+use crate::math::{wrap_pi, Math};
+use crate::robot::{LegId, Robot};
+use crate::rotation::RotationOrder;
+use crate::vec::Vec3;
+
+/// Body velocity command, in the body frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Velocity {
+    /// Forward speed (body x), m/s.
+    pub forward_m_s: f32,
+    /// Lateral speed (body y, left positive), m/s.
+    pub lateral_m_s: f32,
+    /// Yaw rate (about z, counter-clockwise positive), rad/s.
+    pub yaw_rad_s: f32,
+}
+
+/// A named footfall pattern: phase offsets and duty factor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Pattern {
+    /// Diagonal pairs in antiphase: FL + RR at 0, FR + RL at ½; duty 0.5.
+    Trot,
+    /// Lateral-sequence walk RL → FL → RR → FR, a quarter cycle apart; duty 0.75 (always three
+    /// feet down).
+    Walk,
+}
+
+impl Pattern {
+    /// Phase offsets in leg order FL, FR, RL, RR, cycles.
+    pub const fn phase_offsets(self) -> [f32; 4] {
+        match self {
+            Pattern::Trot => [0.0, 0.5, 0.5, 0.0],
+            Pattern::Walk => [0.25, 0.75, 0.0, 0.5],
+        }
+    }
+
+    /// Stance fraction of the cycle.
+    pub const fn duty_factor(self) -> f32 {
+        match self {
+            Pattern::Trot => 0.5,
+            Pattern::Walk => 0.75,
+        }
+    }
+
+    /// `trot` or `walk`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Pattern::Trot => "trot",
+            Pattern::Walk => "walk",
+        }
+    }
+}
+
+/// Parameters of a [`Gait`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GaitParams {
+    /// The robot.
+    pub robot: Robot,
+    /// Stance height `H` (hip plane above the ground), m.
+    pub stance_height_m: f32,
+    /// Gait cycle `T`, s.
+    pub cycle_s: f32,
+    /// Stance fraction `d` ∈ (0, 1).
+    pub duty_factor: f32,
+    /// Phase offsets `o_i` in leg order FL, FR, RL, RR, cycles.
+    pub phase_offsets: [f32; 4],
+    /// Apex of the swing above the ground, m (not used by the semicircle, whose apex is half
+    /// its stride).
+    pub step_height_m: f32,
+    /// Body velocity command.
+    pub velocity: Velocity,
+    /// Swing shape.
+    pub swing: PathKind,
+    /// Rotation order of the pose (only yaw changes, so this matters only to consumers).
+    pub order: RotationOrder,
+}
+
+impl GaitParams {
+    /// Default cycle, s.
+    pub const DEFAULT_CYCLE_S: f32 = 0.8;
+    /// Default step height as a fraction of the stance height.
+    pub const DEFAULT_STEP_HEIGHT_FRACTION: f32 = 0.15;
+
+    /// `pattern` on `robot` at `stance_height_m`, standing still (zero velocity), with a cycle
+    /// of [`Self::DEFAULT_CYCLE_S`], a step height of [`Self::DEFAULT_STEP_HEIGHT_FRACTION`]·H
+    /// and the Bézier swing.
+    pub fn new(pattern: Pattern, robot: Robot, stance_height_m: f32) -> GaitParams {
+        GaitParams {
+            robot,
+            stance_height_m,
+            cycle_s: Self::DEFAULT_CYCLE_S,
+            duty_factor: pattern.duty_factor(),
+            phase_offsets: pattern.phase_offsets(),
+            step_height_m: Self::DEFAULT_STEP_HEIGHT_FRACTION * stance_height_m,
+            velocity: Velocity::default(),
+            swing: PathKind::Bezier,
+            order: RotationOrder::default(),
+        }
+    }
+}
+
+/// `sin(x)/x`, exact at 0.
+#[inline]
+fn sinc<M: Math>(x: f32) -> f32 {
+    if libm::fabsf(x) < 1e-3 {
+        1.0 - x * x / 6.0
+    } else {
+        M::sin_cos(x).0 / x
+    }
+}
+
+/// A trot or walk: see the module docs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gait {
+    p: GaitParams,
+    neutral: [Vec3; 4],
+}
+
+impl Gait {
+    /// Validates the parameters: finite values, `H > 0`, `T > 0`, `d ∈ (0, 1)`, the step
+    /// height ≥ 0 and below the hips; then checks that every foot reaches its neutral foothold
+    /// (`stance_height_m`), its lift-off and touch-down points (the velocity command sets the
+    /// stride: `velocity`) and its swing apex (`step_height_m`). [`crate::preflight`] sweeps the
+    /// whole motion.
+    pub fn new(p: GaitParams) -> Result<Gait, Error> {
+        p.robot.validate()?;
+        positive(p.stance_height_m, "stance_height_m")?;
+        positive(p.cycle_s, "cycle_s")?;
+        let d = finite(p.duty_factor, "duty_factor")?;
+        if !(d > 0.0 && d < 1.0) {
+            return Err(Error::OutOfRange {
+                parameter: "duty_factor",
+                expected: "in (0, 1)",
+            });
+        }
+        for o in p.phase_offsets {
+            finite(o, "phase_offsets")?;
+        }
+        non_negative(p.step_height_m, "step_height_m")?;
+        if !(p.step_height_m < p.stance_height_m) {
+            return Err(Error::OutOfRange {
+                parameter: "step_height_m",
+                expected: "below the stance height (a lifted foot stays below the hips)",
+            });
+        }
+        finite(p.velocity.forward_m_s, "forward_m_s")?;
+        finite(p.velocity.lateral_m_s, "lateral_m_s")?;
+        finite(p.velocity.yaw_rad_s, "yaw_rad_s")?;
+        let gait = Gait {
+            p,
+            neutral: p.robot.stance_feet(p.stance_height_m),
+        };
+        let cfg = gait.body_config();
+        let zero = Pose::default();
+        check_reach(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
+        let at = |phase: f32| {
+            LegId::ALL.map(|leg| gait.foot_in_body_with::<crate::DefaultMath>(leg, phase).0)
+        };
+        check_reach(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
+        check_reach(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
+        check_reach(&p.robot, &zero, &cfg, &at(0.5 * (1.0 - d)), "step_height_m")?;
+        Ok(gait)
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> &GaitParams {
+        &self.p
+    }
+
+    /// Neutral footholds (nominal stance at height `H`), body frame, m.
+    pub const fn neutral_feet(&self) -> [Vec3; 4] {
+        self.neutral
+    }
+
+    /// Body displacement `X(s)` applied to a point `n` of the body frame: `p(s) + Rz(ω·s)·n`.
+    fn displaced<M: Math>(&self, s: f32, n: Vec3) -> Vec3 {
+        let v = self.p.velocity;
+        let x = v.yaw_rad_s * s;
+        let (sn, cs) = M::sin_cos(x);
+        let (sh, _) = M::sin_cos(0.5 * x);
+        let a = s * sinc::<M>(x); // ∫ cos
+        let b = s * sh * sinc::<M>(0.5 * x); // ∫ sin = (1 − cos x)/ω
+        Vec3::new(
+            v.forward_m_s * a - v.lateral_m_s * b + cs * n.x - sn * n.y,
+            v.forward_m_s * b + v.lateral_m_s * a + sn * n.x + cs * n.y,
+            n.z,
+        )
+    }
+
+    /// Foot of `leg` in the body frame at leg phase `phase` (cycles; wrapped), and its contact.
+    pub fn foot_in_body_with<M: Math>(&self, leg: LegId, phase: f32) -> (Vec3, Contact) {
+        let phase = Phase::wrap(phase);
+        let (t, d) = (self.p.cycle_s, self.p.duty_factor);
+        let n = self.neutral[leg.index()];
+        let swing_end = 1.0 - d;
+        if phase.value() >= swing_end {
+            // Time since the middle of the stance.
+            let tau = (phase.value() - (1.0 - 0.5 * d)) * t;
+            return (self.displaced::<M>(-tau, n), Contact::Stance);
+        }
+        let half_stance = 0.5 * d * t;
+        let lift_off = self.displaced::<M>(-half_stance, n);
+        let touch_down = self.displaced::<M>(half_stance, n);
+        let chord = touch_down - lift_off;
+        let length = libm::sqrtf(chord.x * chord.x + chord.y * chord.y);
+        let (ux, uy) = if length > 0.0 {
+            (chord.x / length, chord.y / length)
+        } else {
+            (1.0, 0.0)
+        };
+        let mid = (lift_off + touch_down) * 0.5;
+        let path = AnyPath::new(
+            self.p.swing,
+            Stride::unchecked(length, self.p.step_height_m, d),
+        );
+        let o = path.offset_with::<M>(phase);
+        (
+            Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z),
+            Contact::Swing,
+        )
+    }
+
+    /// Phase of `leg` at time `t_s`, cycles in `[0, 1)`.
+    pub fn leg_phase(&self, leg: LegId, t_s: f32) -> f32 {
+        fract01(fract01(t_s / self.p.cycle_s) + self.p.phase_offsets[leg.index()])
+    }
+
+    /// Stride of each leg in the body frame for the current command (distance between lift-off
+    /// and touch-down points), m.
+    pub fn step_length_m(&self, leg: LegId) -> f32 {
+        let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
+        let n = self.neutral[leg.index()];
+        (self.displaced::<crate::DefaultMath>(half, n)
+            - self.displaced::<crate::DefaultMath>(-half, n))
+        .norm()
+    }
+}
+
+impl Motion for Gait {
+    fn robot(&self) -> &Robot {
+        &self.p.robot
+    }
+
+    fn body_config(&self) -> BodyConfig {
+        BodyConfig {
+            order: self.p.order,
+            pivot_m: Vec3::ZERO,
+        }
+    }
+
+    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+        finite(t_s, "t_s")?;
+        let body = self.displaced::<M>(t_s, Vec3::ZERO);
+        let yaw = wrap_pi(self.p.velocity.yaw_rad_s * t_s);
+        let (sn, cs) = M::sin_cos(yaw);
+        let mut feet = [Vec3::ZERO; 4];
+        let mut contact = [Contact::Stance; 4];
+        for leg in LegId::ALL {
+            let (f, c) = self.foot_in_body_with::<M>(leg, self.leg_phase(leg, t_s));
+            feet[leg.index()] = Vec3::new(
+                body.x + cs * f.x - sn * f.y,
+                body.y + sn * f.x + cs * f.y,
+                body.z + f.z,
+            );
+            contact[leg.index()] = c;
+        }
+        Ok(Frame {
+            pose: Pose {
+                yaw_rad: yaw,
+                x_m: body.x,
+                y_m: body.y,
+                ..Pose::default()
+            },
+            feet_in_world: feet,
+            contact,
+        })
+    }
+
+    fn period_s(&self) -> Option<f32> {
+        Some(self.p.cycle_s)
+    }
+}

@@ -1,0 +1,542 @@
+//! Body-motion laws of seed 001 (eq. 6–11) and feet following a path under a held body
+//! (seed 000 §3.2).
+//!
+//! ## Seed 001 leg numbering
+//! Leg 1 = FL (ρ = (0.5, 0.25) m), 2 = FR (0.5, −0.25), 3 = RR (−0.5, −0.25), 4 = RL
+//! (−0.5, 0.25). The crossed pairs of eq. 10–11 are (1, 3) = FL + RR and (2, 4) = FR + RL.
+//!
+//! ## Heights
+//! Seed 001 puts the contact points at `z_K = 0` with the body centre above them; here the
+//! world frame is the body frame of the nominal pose, so the ground is `z = −H` with `H` the
+//! stance height (≈ 0.9294 m for seed 001's initial pose with [`Robot::fernando2025`]).
+
+use super::path::{AnyPath, FootPath};
+use super::{
+    check_reach, finite, finite_vec, fract01, non_negative, positive, Contact, Error, Frame,
+    Motion, Phase,
+};
+use crate::body::{BodyConfig, Pose};
+use crate::math::{wrap_pi, Math};
+use crate::paper;
+use crate::robot::{JointAngles, LegId, Robot};
+use crate::rotation::RotationOrder;
+use crate::vec::Vec3;
+use core::f32::consts::PI;
+
+/// Feet in the world frame of the nominal pose for all four legs at joint angles `q`:
+/// `hip_in_body + leg::forward(q)`.
+pub fn stance_from_angles(robot: &Robot, q: JointAngles) -> [Vec3; 4] {
+    LegId::ALL.map(|leg| robot.hip_in_body(leg) + crate::leg::forward(&robot.leg, leg, q))
+}
+
+/// Seed 001's initial stance (eq. 5: φ = 120°, α = 60°, β = 0) for `robot`, via
+/// [`paper::from_seed001`] and forward kinematics. With [`Robot::fernando2025`] the feet are
+/// straight below the hips at `z = −(l0 + (l1 + l2)·sin 60°)` ≈ −0.9294 m.
+pub fn seed001_stance(robot: &Robot) -> [Vec3; 4] {
+    stance_from_angles(robot, paper::from_seed001(paper::SEED001_INITIAL))
+}
+
+/// Stance height of seed 000's pose sweeps (roll ±28°, pitch ±21°, yaw ±21°) with
+/// [`Robot::shahriar2023`], m: 0.40 m, 72 % of the 0.557 m leg, leaves ≥ 4 cm of reach at the
+/// extremes (see the tests for the margins).
+pub const SEED000_SWEEP_STANCE_HEIGHT_M: f32 = 0.40;
+
+/// The axis a [`Sway`] rotates about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Axis {
+    /// Roll θ, about x (seed 001 eq. 6).
+    Roll,
+    /// Pitch γ, about y (seed 001 eq. 8).
+    Pitch,
+    /// Yaw ψ, about z (seed 000's twisting posture).
+    Yaw,
+}
+
+impl Axis {
+    /// `roll`, `pitch` or `yaw`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Axis::Roll => "roll",
+            Axis::Pitch => "pitch",
+            Axis::Yaw => "yaw",
+        }
+    }
+}
+
+/// Parameters of a [`Sway`]: `angle(t) = angle0 + A·sin(2πt/T)` on one axis, the other angles
+/// constant, feet fixed (seed 001 eq. 6–8), body centre fixed (`v_C = 0`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SwayParams {
+    /// The robot.
+    pub robot: Robot,
+    /// The axis that oscillates.
+    pub axis: Axis,
+    /// Amplitude `A`, rad.
+    pub amplitude_rad: f32,
+    /// Period `T`, s.
+    pub period_s: f32,
+    /// Constant roll θ0, rad.
+    pub roll0_rad: f32,
+    /// Constant pitch γ0, rad.
+    pub pitch0_rad: f32,
+    /// Constant yaw ψ0, rad.
+    pub yaw0_rad: f32,
+    /// Rotation order of the pose.
+    pub order: RotationOrder,
+    /// The feet on the ground (eq. 7: `x_K(t) = x_K(0)`, `y_K(t) = y_K(0)`), world frame, m.
+    pub feet_in_world: [Vec3; 4],
+}
+
+impl SwayParams {
+    /// Seed 001's values: [`Robot::fernando2025`], `A` = 0.2 rad, `T` = 20 s, θ0 = γ0 = ψ0 = 0,
+    /// order `zxy`, feet at [`seed001_stance`]. `Axis::Roll` is eq. 6, `Axis::Pitch` eq. 8.
+    pub fn seed001(axis: Axis) -> SwayParams {
+        let robot = Robot::fernando2025();
+        SwayParams {
+            robot,
+            axis,
+            amplitude_rad: 0.2,
+            period_s: 20.0,
+            roll0_rad: 0.0,
+            pitch0_rad: 0.0,
+            yaw0_rad: 0.0,
+            order: RotationOrder::Zxy,
+            feet_in_world: seed001_stance(&robot),
+        }
+    }
+
+    /// Seed 000's pose sweep about `axis` (§3.1, Table 4: roll ±28°, pitch and yaw ±21°) with
+    /// [`Robot::shahriar2023`] at [`SEED000_SWEEP_STANCE_HEIGHT_M`], order `zyx`, run as a sine of
+    /// period 10 s (the paper steps 1° at a time; a sine covers the same range).
+    pub fn seed000(axis: Axis) -> SwayParams {
+        let robot = Robot::shahriar2023();
+        let amplitude_deg: f32 = match axis {
+            Axis::Roll => 28.0,
+            Axis::Pitch | Axis::Yaw => 21.0,
+        };
+        SwayParams {
+            robot,
+            axis,
+            amplitude_rad: amplitude_deg.to_radians(),
+            period_s: 10.0,
+            roll0_rad: 0.0,
+            pitch0_rad: 0.0,
+            yaw0_rad: 0.0,
+            order: RotationOrder::Zyx,
+            feet_in_world: robot.stance_feet(SEED000_SWEEP_STANCE_HEIGHT_M),
+        }
+    }
+}
+
+/// Seed 001's sway laws (eq. 6–8): one body angle oscillates, feet fixed, centre fixed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sway {
+    p: SwayParams,
+}
+
+impl Sway {
+    /// Validates the parameters: finite values, `T > 0`, and the feet reachable at `t = 0` and at
+    /// both extremes `angle0 ± A` (a quick check; [`crate::preflight`] sweeps the whole motion).
+    pub fn new(p: SwayParams) -> Result<Sway, Error> {
+        p.robot.validate()?;
+        finite(p.amplitude_rad, "amplitude_rad")?;
+        positive(p.period_s, "period_s")?;
+        finite(p.roll0_rad, "roll0_rad")?;
+        finite(p.pitch0_rad, "pitch0_rad")?;
+        finite(p.yaw0_rad, "yaw0_rad")?;
+        for f in p.feet_in_world {
+            finite_vec(f, "feet_in_world")?;
+        }
+        let s = Sway { p };
+        let cfg = s.body_config();
+        check_reach(
+            &p.robot,
+            &s.pose_at(0.0),
+            &cfg,
+            &p.feet_in_world,
+            "feet_in_world",
+        )?;
+        for sign in [1.0, -1.0] {
+            check_reach(
+                &p.robot,
+                &s.pose_at(sign * p.amplitude_rad),
+                &cfg,
+                &p.feet_in_world,
+                "amplitude_rad",
+            )?;
+        }
+        Ok(s)
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> &SwayParams {
+        &self.p
+    }
+
+    /// The oscillating angle's offset from its constant, `A·sin(2πt/T)`, rad.
+    pub fn offset_rad_with<M: Math>(&self, t_s: f32) -> f32 {
+        let phase = fract01(t_s / self.p.period_s);
+        self.p.amplitude_rad * M::sin_cos(2.0 * PI * phase).0
+    }
+
+    fn pose_at(&self, offset_rad: f32) -> Pose {
+        let (mut r, mut p, mut y) = (self.p.roll0_rad, self.p.pitch0_rad, self.p.yaw0_rad);
+        match self.p.axis {
+            Axis::Roll => r += offset_rad,
+            Axis::Pitch => p += offset_rad,
+            Axis::Yaw => y += offset_rad,
+        }
+        Pose::rotation(r, p, y)
+    }
+}
+
+impl Motion for Sway {
+    fn robot(&self) -> &Robot {
+        &self.p.robot
+    }
+
+    fn body_config(&self) -> BodyConfig {
+        BodyConfig {
+            order: self.p.order,
+            pivot_m: Vec3::ZERO,
+        }
+    }
+
+    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+        finite(t_s, "t_s")?;
+        Ok(Frame {
+            pose: self.pose_at(self.offset_rad_with::<M>(t_s)),
+            feet_in_world: self.p.feet_in_world,
+            contact: [Contact::Stance; 4],
+        })
+    }
+
+    fn period_s(&self) -> Option<f32> {
+        Some(self.p.period_s)
+    }
+}
+
+/// Parameters of seed 001's yaw turn (eq. 9–11): `ψ(t) = ψ0 − ω_z·t` about the fixed body
+/// centre, the crossed pairs (FL, RR) and (FR, RL) stepping alternately along the circles of
+/// their feet.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct YawTurnParams {
+    /// The robot.
+    pub robot: Robot,
+    /// `ω_z`, rad/s; positive turns clockwise seen from above (ψ decreases, eq. 9).
+    pub omega_rad_s: f32,
+    /// Step period `T1` (one full cycle of both pairs), s.
+    pub step_period_s: f32,
+    /// Lift height `h_K` of the half-wave sine, m.
+    pub lift_height_m: f32,
+    /// Initial yaw ψ0, rad.
+    pub yaw0_rad: f32,
+    /// Constant roll θ0, rad.
+    pub roll0_rad: f32,
+    /// Constant pitch γ0, rad.
+    pub pitch0_rad: f32,
+    /// Rotation order of the pose.
+    pub order: RotationOrder,
+    /// The feet at `t = 0` relative to the body, i.e. in the world frame of the pose with
+    /// ψ = 0; each foot's `ρ_i`, `α_i` are taken from its `(x, y)`, m.
+    pub stance_feet: [Vec3; 4],
+}
+
+impl YawTurnParams {
+    /// Seed 001's values: [`Robot::fernando2025`], ω_z = 0.085 rad/s, T1 = 6 s, h_K = 0.3 m,
+    /// ψ0 = θ0 = γ0 = 0, order `zxy`, feet at [`seed001_stance`].
+    pub fn seed001() -> YawTurnParams {
+        let robot = Robot::fernando2025();
+        YawTurnParams {
+            robot,
+            omega_rad_s: 0.085,
+            step_period_s: 6.0,
+            lift_height_m: 0.3,
+            yaw0_rad: 0.0,
+            roll0_rad: 0.0,
+            pitch0_rad: 0.0,
+            order: RotationOrder::Zxy,
+            stance_feet: seed001_stance(&robot),
+        }
+    }
+}
+
+/// True for the legs of seed 001's pair (1, 3) = (FL, RR), which swing in the first half of
+/// each step period; (2, 4) = (FR, RL) swing in the second half.
+pub const fn in_pair_13(leg: LegId) -> bool {
+    matches!(leg, LegId::FL | LegId::RR)
+}
+
+/// Seed 001's yaw turn, eq. 9–11 as corrected in `docs/papers.md` ("Seed 001 eq. 10–11").
+///
+/// With `τ = t mod T1` and `k = ⌊t/T1⌋`:
+/// - `Δ13 = k·T1 + (2τ if τ < T1/2 else T1)`, `Δ24 = k·T1 + (0 if τ < T1/2 else 2(τ − T1/2))`
+///   (eq. 11 with a floored `mod`);
+/// - foot `i` at `ρ_i·(cos a_i, sin a_i)` with `a_i = α_i + ψ0 − ω_z·Δ_i` and
+///   `α_i = atan2(y_i, x_i)` of its stance position (eq. 10 corrected: atan2, cos/sin, sign);
+/// - lift `h_K·max(0, sin(2πt/T1))` for (FL, RR) and `h_K·max(0, −sin(2πt/T1))` for (FR, RL)
+///   above the stance height (eq. 10's half-wave).
+///
+/// A stance foot stays fixed while the body turns by `ω_z·T1/2`; a swing foot moves by
+/// `ω_z·T1` along its circle in `T1/2`. The joint angles repeat with period `T1`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct YawTurn {
+    p: YawTurnParams,
+    rho_m: [f32; 4],
+    alpha_rad: [f32; 4],
+}
+
+impl YawTurn {
+    /// Validates the parameters: finite values, `T1 > 0`, `h_K ≥ 0` and below the hips, and
+    /// the feet reachable at `t = 0`, at both apexes and at the end of each swing (a quick check;
+    /// [`crate::preflight`] sweeps the whole motion).
+    pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
+        p.robot.validate()?;
+        finite(p.omega_rad_s, "omega_rad_s")?;
+        positive(p.step_period_s, "step_period_s")?;
+        non_negative(p.lift_height_m, "lift_height_m")?;
+        finite(p.yaw0_rad, "yaw0_rad")?;
+        finite(p.roll0_rad, "roll0_rad")?;
+        finite(p.pitch0_rad, "pitch0_rad")?;
+        for f in p.stance_feet {
+            finite_vec(f, "stance_feet")?;
+            if !(f.z + p.lift_height_m < 0.0) {
+                return Err(Error::OutOfRange {
+                    parameter: "lift_height_m",
+                    expected: "below the stance height (a lifted foot stays below the hips)",
+                });
+            }
+        }
+        let turn = YawTurn {
+            p,
+            rho_m: p.stance_feet.map(|f| libm::sqrtf(f.x * f.x + f.y * f.y)),
+            alpha_rad: p.stance_feet.map(|f| libm::atan2f(f.y, f.x)),
+        };
+        let cfg = turn.body_config();
+        let t1 = p.step_period_s;
+        for (t, name) in [
+            (0.0, "stance_feet"),
+            (0.25 * t1, "lift_height_m"),
+            (0.75 * t1, "lift_height_m"),
+            (0.499 * t1, "omega_rad_s"),
+            (0.999 * t1, "omega_rad_s"),
+        ] {
+            let f = turn.frame_with::<crate::DefaultMath>(t)?;
+            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
+        }
+        Ok(turn)
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> &YawTurnParams {
+        &self.p
+    }
+
+    /// Radius `ρ_i` of each foot's circle, m (order FL, FR, RL, RR).
+    pub const fn rho_m(&self) -> [f32; 4] {
+        self.rho_m
+    }
+
+    /// Angle `α_i = atan2(y_i, x_i)` of each foot at `t = 0` relative to the body, rad.
+    pub const fn alpha_rad(&self) -> [f32; 4] {
+        self.alpha_rad
+    }
+
+    /// `(k, τ)` with `t = k·T1 + τ`, `τ ∈ [0, T1)`.
+    fn split(&self, t_s: f32) -> (f32, f32) {
+        let t1 = self.p.step_period_s;
+        let mut k = libm::floorf(t_s / t1);
+        let mut tau = t_s - k * t1;
+        if tau < 0.0 {
+            k -= 1.0;
+            tau += t1;
+        }
+        if tau >= t1 {
+            k += 1.0;
+            tau -= t1;
+        }
+        if !(tau >= 0.0 && tau < t1) {
+            tau = 0.0;
+        }
+        (k, tau)
+    }
+
+    /// Eq. 11's `Δ13` and `Δ24` within the current step period (`Δ − k·T1`), s.
+    pub fn deltas_in_period_s(&self, t_s: f32) -> (f32, f32) {
+        let (_, tau) = self.split(t_s);
+        Self::local_deltas(self.p.step_period_s, tau)
+    }
+
+    fn local_deltas(t1: f32, tau: f32) -> (f32, f32) {
+        let half = 0.5 * t1;
+        if tau < half {
+            (2.0 * tau, 0.0)
+        } else {
+            (t1, 2.0 * (tau - half))
+        }
+    }
+}
+
+impl Motion for YawTurn {
+    fn robot(&self) -> &Robot {
+        &self.p.robot
+    }
+
+    fn body_config(&self) -> BodyConfig {
+        BodyConfig {
+            order: self.p.order,
+            pivot_m: Vec3::ZERO,
+        }
+    }
+
+    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+        finite(t_s, "t_s")?;
+        let p = &self.p;
+        let t1 = p.step_period_s;
+        let (k, tau) = self.split(t_s);
+        // Yaw at the start of this step period, wrapped once so that body and feet share it.
+        let base = wrap_pi(p.yaw0_rad - p.omega_rad_s * (k * t1));
+        let yaw = wrap_pi(base - p.omega_rad_s * tau);
+        let (d13, d24) = Self::local_deltas(t1, tau);
+        let first_half = tau < 0.5 * t1;
+        let wave = M::sin_cos(2.0 * PI * (tau / t1)).0;
+        let lift13 = if first_half && wave > 0.0 { wave } else { 0.0 };
+        let lift24 = if !first_half && wave < 0.0 {
+            -wave
+        } else {
+            0.0
+        };
+        let mut feet = [Vec3::ZERO; 4];
+        let mut contact = [Contact::Stance; 4];
+        for leg in LegId::ALL {
+            let i = leg.index();
+            let (delta, lift, swing) = if in_pair_13(leg) {
+                (d13, lift13, first_half)
+            } else {
+                (d24, lift24, !first_half)
+            };
+            let a = self.alpha_rad[i] + base - p.omega_rad_s * delta;
+            let (s, c) = M::sin_cos(a);
+            feet[i] = Vec3::new(
+                self.rho_m[i] * c,
+                self.rho_m[i] * s,
+                p.stance_feet[i].z + p.lift_height_m * lift,
+            );
+            contact[i] = if swing {
+                Contact::Swing
+            } else {
+                Contact::Stance
+            };
+        }
+        Ok(Frame {
+            pose: Pose::rotation(p.roll0_rad, p.pitch0_rad, yaw),
+            feet_in_world: feet,
+            contact,
+        })
+    }
+
+    fn period_s(&self) -> Option<f32> {
+        Some(self.p.step_period_s)
+    }
+}
+
+/// Parameters of [`LegPaths`]: every foot follows a [`FootPath`] around its stance point while
+/// the body is held at the nominal pose (seed 000 §3.2, where one leg traces a rectangle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegPathsParams {
+    /// The robot.
+    pub robot: Robot,
+    /// The path each foot follows (x along the body's x axis).
+    pub path: AnyPath,
+    /// Duration of one loop of the path, s.
+    pub cycle_s: f32,
+    /// Phase offset of each leg (order FL, FR, RL, RR), cycles.
+    pub phase_offsets: [f32; 4],
+    /// The stance point of each foot (path offset zero), world frame, m.
+    pub stance_feet: [Vec3; 4],
+}
+
+impl LegPathsParams {
+    /// Seed 000 Fig. 8: [`Robot::shahriar2023`], [`crate::motion::path::Rectangle::seed000`]
+    /// (stride 0.1 m, lift 0.05 m) at stance height 0.2 m, 3 s per loop, all legs in phase.
+    pub fn seed000() -> LegPathsParams {
+        let robot = Robot::shahriar2023();
+        LegPathsParams {
+            robot,
+            path: AnyPath::Rectangle(super::path::Rectangle::seed000()),
+            cycle_s: 3.0,
+            phase_offsets: [0.0; 4],
+            stance_feet: robot.stance_feet(super::path::Rectangle::SEED000_STANCE_HEIGHT_M),
+        }
+    }
+}
+
+/// Feet following a path under a held body (the body does not move; stance feet slide).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegPaths {
+    p: LegPathsParams,
+}
+
+impl LegPaths {
+    /// Number of phases per leg the constructor checks for reach.
+    const REACH_SAMPLES: u16 = 64;
+
+    /// Validates the parameters: finite values, `cycle_s > 0`, and the path reachable by every
+    /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive).
+    pub fn new(p: LegPathsParams) -> Result<LegPaths, Error> {
+        p.robot.validate()?;
+        positive(p.cycle_s, "cycle_s")?;
+        for o in p.phase_offsets {
+            finite(o, "phase_offsets")?;
+        }
+        for f in p.stance_feet {
+            finite_vec(f, "stance_feet")?;
+        }
+        let lp = LegPaths { p };
+        let cfg = lp.body_config();
+        for i in 0..Self::REACH_SAMPLES {
+            let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
+            let feet = LegId::ALL.map(|leg| p.stance_feet[leg.index()] + p.path.offset(phase));
+            check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
+        }
+        Ok(lp)
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> &LegPathsParams {
+        &self.p
+    }
+}
+
+impl Motion for LegPaths {
+    fn robot(&self) -> &Robot {
+        &self.p.robot
+    }
+
+    fn body_config(&self) -> BodyConfig {
+        BodyConfig::default()
+    }
+
+    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+        finite(t_s, "t_s")?;
+        let base = fract01(t_s / self.p.cycle_s);
+        let mut feet = self.p.stance_feet;
+        let mut contact = [Contact::Stance; 4];
+        for leg in LegId::ALL {
+            let i = leg.index();
+            let phase = Phase::wrap(base + self.p.phase_offsets[i]);
+            feet[i] = feet[i] + self.p.path.offset_with::<M>(phase);
+            contact[i] = self.p.path.contact(phase);
+        }
+        Ok(Frame {
+            pose: Pose::default(),
+            feet_in_world: feet,
+            contact,
+        })
+    }
+
+    fn period_s(&self) -> Option<f32> {
+        Some(self.p.cycle_s)
+    }
+}
