@@ -309,23 +309,27 @@ fn solve<M: Math>(
         }
     }
     let dist2 = u * u + v * v;
+    // Law of cosines scaled by 2·L1·L2 (no division; atan2 is scale-invariant):
+    // c = 2·L1·L2·cos k = D² − L1² − L2², s = 2·L1·L2·sin k with
+    // s² = (D² − (L1−L2)²)·((L1+L2)² − D²), the factored form that stays accurate near a
+    // folded or straight knee, where (2·L1·L2)² − c² loses the digits that set the foot's
+    // distance.
     let two_l1l2 = 2.0 * l1 * l2;
-    let mut ck = (dist2 - l1 * l1 - l2 * l2) / two_l1l2;
-    // Only rounding can push a projected point past ±1 here.
+    let mut c = dist2 - (l1 * l1 + l2 * l2);
+    // Only rounding can push a projected point past ±2·L1·L2 here.
     if moved {
-        ck = ck.clamp(-1.0, 1.0);
+        c = c.clamp(-two_l1l2, two_l1l2);
     }
-    // sin²k = (1 + cos k)(1 − cos k) from the factored forms: accurate near a folded or
-    // straight knee, where 1 − ck² loses the digits that set the foot's distance.
-    let sk_sq = ((dist2 - near2) / two_l1l2) * ((far2 - dist2) / two_l1l2);
-    let sk_abs = M::sqrt(if sk_sq > 0.0 { sk_sq } else { 0.0 });
-    let sk = match bend {
-        KneeBend::Backward => -sk_abs,
-        KneeBend::Forward => sk_abs,
+    let s_sq = (dist2 - near2) * (far2 - dist2);
+    let s_abs = M::sqrt(if s_sq > 0.0 { s_sq } else { 0.0 });
+    let s = match bend {
+        KneeBend::Backward => -s_abs,
+        KneeBend::Forward => s_abs,
     };
-    let knee = M::atan2(sk, ck);
-    // hip = angle(−v, −u) − angle(L1 + L2·cos k, L2·sin k).
-    let (bx, by) = (l1 + l2 * ck, l2 * sk);
+    let knee = M::atan2(s, c);
+    // hip = angle(−v, −u) − angle(L1 + L2·cos k, L2·sin k), the second vector scaled by 2·L1:
+    // (D² + L1² − L2², s).
+    let (bx, by) = (dist2 + (l1 * l1 - l2 * l2), s);
     let (ax, ay) = (-v, -u);
     let hip = M::atan2(bx * ay - by * ax, bx * ax + by * ay);
 
@@ -387,14 +391,20 @@ pub fn inverse_with<M: Math>(
     // Far outside the workspace a clamped answer depends only on the target's direction;
     // shrinking such a target keeps its squares clear of f32 overflow (|p| ≳ 1.8e19 m), which
     // would otherwise turn a finite target into NaN angles.
-    let m = libm::fmaxf(
-        libm::fabsf(foot_in_hip.x),
-        libm::fmaxf(libm::fabsf(foot_in_hip.y), libm::fabsf(foot_in_hip.z)),
-    );
-    let target = if policy == ReachPolicy::Clamp && m > FAR_M {
-        foot_in_hip * (FAR_M / m)
-    } else {
-        foot_in_hip
+    // (Computed only under Clamp: the Reject path, the hot one, stays free of it.)
+    let target = match policy {
+        ReachPolicy::Clamp => {
+            let m = libm::fmaxf(
+                libm::fabsf(foot_in_hip.x),
+                libm::fmaxf(libm::fabsf(foot_in_hip.y), libm::fabsf(foot_in_hip.z)),
+            );
+            if m > FAR_M {
+                foot_in_hip * (FAR_M / m)
+            } else {
+                foot_in_hip
+            }
+        }
+        ReachPolicy::Reject => foot_in_hip,
     };
     let (raw, reached) = solve::<M>(g, leg.side(), robot.knee_bend, target, policy).map_err(err)?;
     let mut angles = raw.angles;

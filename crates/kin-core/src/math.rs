@@ -5,8 +5,10 @@
 //! while the algebra stays in one place:
 //!
 //! - [`Fast`] (the default, [`DefaultMath`]): minimax polynomials for `atan2` and `sin`/`cos`
-//!   (absolute error ≤ 3e-7 rad, about one f32 ulp at π; see the tests), `libm` for `sqrt`. Branch-light and quick on
-//!   hosts with hardware floating point.
+//!   (absolute error ≤ 3e-7 rad, about one f32 ulp at π; see the tests), `libm` for `sqrt`.
+//!   `atan2` is branch-free (random quadrants cost no mispredictions) and its polynomial is
+//!   evaluated in Estrin's scheme (a short dependency chain); quick on hosts with hardware
+//!   floating point. See `BENCHMARKS.md`.
 //! - [`Libm`]: the `libm` crate's correctly rounded-ish `atan2f`, `sinf`, `cosf`, `sqrtf`.
 //!   The reference the others are tested against.
 //! - Firmware may implement [`Math`] itself, e.g. on top of avr-libc's hand-written assembly.
@@ -66,18 +68,22 @@ const ATAN_COEFFS: [f32; 8] = [
     -0.004_054_559,
 ];
 
+/// atan(t) ≈ t·P(t²) on [0, 1], with P evaluated in Estrin's scheme: the same
+/// coefficients as Horner's rule but three multiply–add levels deep instead of seven, which
+/// shortens the dependency chain of the IK.
 #[inline]
 fn atan_unit(t: f32) -> f32 {
-    let t2 = t * t;
-    let mut p = ATAN_COEFFS[7];
-    p = p * t2 + ATAN_COEFFS[6];
-    p = p * t2 + ATAN_COEFFS[5];
-    p = p * t2 + ATAN_COEFFS[4];
-    p = p * t2 + ATAN_COEFFS[3];
-    p = p * t2 + ATAN_COEFFS[2];
-    p = p * t2 + ATAN_COEFFS[1];
-    p = p * t2 + ATAN_COEFFS[0];
-    p * t
+    let c = &ATAN_COEFFS;
+    let s = t * t;
+    let s2 = s * s;
+    let s4 = s2 * s2;
+    let p01 = c[0] + c[1] * s;
+    let p23 = c[2] + c[3] * s;
+    let p45 = c[4] + c[5] * s;
+    let p67 = c[6] + c[7] * s;
+    let q0 = p01 + p23 * s2;
+    let q1 = p45 + p67 * s2;
+    (q0 + q1 * s4) * t
 }
 
 impl Math for Fast {
@@ -86,39 +92,30 @@ impl Math for Fast {
         libm::sqrtf(x)
     }
 
+    /// Branch-free: the octant is folded into an offset and a sign chosen next to the
+    /// division, so random quadrants cost no mispredicted branches.
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
+        const SIGN: u32 = 0x8000_0000;
+        // |atan2| = offset ± atan(t), indexed by (swap, x < 0): (0, +), (π, −), (π/2, −),
+        // (π/2, +); then the sign of y.
+        const OFFSET: [f32; 4] = [0.0, PI, FRAC_PI_2, FRAC_PI_2];
         let ax = libm::fabsf(x);
         let ay = libm::fabsf(y);
-        let (num, den, swap) = if ay > ax {
-            (ax, ay, true)
-        } else {
-            (ay, ax, false)
-        };
-        if den == 0.0 {
-            // atan2(±0, ±0): same convention as libm for the signs that matter here.
-            return if x.is_sign_negative() {
-                if y.is_sign_negative() {
-                    -PI
-                } else {
-                    PI
-                }
-            } else {
-                y
-            };
-        }
-        let mut r = atan_unit(num / den);
-        if swap {
-            r = FRAC_PI_2 - r;
-        }
-        if x < 0.0 {
-            r = PI - r;
-        }
-        if y < 0.0 {
-            -r
-        } else {
-            r
-        }
+        let swap = ay > ax;
+        let x_neg = x.is_sign_negative();
+        // Written as comparisons (not f32::min/max) so that they compile to minss/maxss.
+        let num = if ay < ax { ay } else { ax };
+        let den = if ay > ax { ay } else { ax };
+        let t = num / den;
+        // atan2(±0, ±0): 0/0 is NaN, which this comparison maps to t = 0, giving ±0 or ±π by
+        // the signs, as libm does.
+        let t = if t > 0.0 { t } else { 0.0 };
+        let y_sign = y.to_bits() & SIGN;
+        let t_sign = (((swap != x_neg) as u32) << 31) ^ y_sign;
+        let offset = OFFSET[(((swap as usize) << 1) | x_neg as usize) & 3];
+        let offset = f32::from_bits(offset.to_bits() | y_sign);
+        offset + atan_unit(f32::from_bits(t.to_bits() ^ t_sign))
     }
 
     #[inline]
@@ -135,8 +132,8 @@ impl Math for Fast {
             * (1.0
                 + r2 * (-1.666_666_6e-1
                     + r2 * (8.333_326e-3 + r2 * (-1.983_867_2e-4 + r2 * 2.713_535_5e-6))));
-        let c = 1.0
-            + r2 * (-0.5 + r2 * (4.166_661_6e-2 + r2 * (-1.388_662e-3 + r2 * 2.437_992_8e-5)));
+        let c =
+            1.0 + r2 * (-0.5 + r2 * (4.166_661_6e-2 + r2 * (-1.388_662e-3 + r2 * 2.437_992_8e-5)));
         let q = (k as i32) & 3;
         match q {
             0 => (s, c),
@@ -199,6 +196,37 @@ mod tests {
         assert_eq!(Fast::atan2(0.0, 0.0), 0.0);
         assert_eq!(Fast::atan2(0.0, -1.0), PI);
         assert_eq!(Fast::atan2(1.0, 0.0), FRAC_PI_2);
+    }
+
+    #[test]
+    fn fast_atan2_signed_zeros_and_axes_match_libm() {
+        for (y, x) in [
+            (0.0f32, 0.0f32),
+            (-0.0, 0.0),
+            (0.0, -0.0),
+            (-0.0, -0.0),
+            (0.0, 2.0),
+            (-0.0, 2.0),
+            (0.0, -2.0),
+            (-0.0, -2.0),
+            (2.0, 0.0),
+            (2.0, -0.0),
+            (-2.0, 0.0),
+            (-2.0, -0.0),
+            (1.0, 1.0),
+            (-1.0, -1.0),
+        ] {
+            let (got, want) = (Fast::atan2(y, x), libm::atan2f(y, x));
+            assert!(
+                (got - want).abs() < 3.0e-7,
+                "atan2({y}, {x}) = {got}, libm {want}"
+            );
+            assert_eq!(
+                got.is_sign_negative(),
+                want.is_sign_negative(),
+                "atan2({y}, {x})"
+            );
+        }
     }
 
     #[test]
