@@ -4,6 +4,8 @@
 
 #![allow(dead_code)]
 
+pub mod cases;
+
 /// Parses `"01 0a ff"` into bytes.
 pub fn hex(s: &str) -> Vec<u8> {
     s.split_whitespace()

@@ -1,0 +1,301 @@
+//! One example of every message with its postcard bytes written by hand from the postcard wire
+//! format: varint u16/u32 (7 bits per byte, least significant group first, high bit = more),
+//! f32 as 4 bytes little-endian, enum variant index as a varint, bool and option tags as one
+//! byte, fixed arrays without a length, struct fields in declaration order.
+//! Shared by the golden test, the docs test and the `wire_examples` example.
+
+use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
+use quad_protocol::{
+    servo, DeviceInfo, DeviceToHost, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
+    LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+};
+
+pub fn h2d(seq: u16, request: Request) -> HostToDevice {
+    HostToDevice { seq, request }
+}
+
+/// A calibration with exactly representable values.
+pub const CAL: servo::Calibration = servo::Calibration {
+    zero_rad: 0.0625,
+    reversed: true,
+    us_per_rad: 640.0,
+    center_us: 1520,
+    min_us: 1000,
+    max_us: 2000,
+};
+
+/// Every request with its postcard bytes.
+pub fn requests() -> Vec<(&'static str, HostToDevice, &'static str)> {
+    vec![
+        (
+            "Hello",
+            // seq 1 | variant 0 | version 0x0100 = varint 80 02
+            h2d(1, Request::Hello { version: 0x0100 }),
+            "01 00 80 02",
+        ),
+        (
+            "GetState",
+            // seq 300 = varint ac 02 | variant 1
+            h2d(300, Request::GetState),
+            "ac 02 01",
+        ),
+        (
+            "SetBodyPose",
+            // seq 2 | variant 2 | roll 0.1, pitch -0.05, yaw 0, x 0.5, y -0.25, z 0.125
+            h2d(
+                2,
+                Request::SetBodyPose(Pose {
+                    roll_rad: 0.1,
+                    pitch_rad: -0.05,
+                    yaw_rad: 0.0,
+                    x_m: 0.5,
+                    y_m: -0.25,
+                    z_m: 0.125,
+                }),
+            ),
+            "02 02 cd cc cc 3d cd cc 4c bd 00 00 00 00 00 00 00 3f 00 00 80 be 00 00 00 3e",
+        ),
+        (
+            "SetFeet",
+            // seq 3 | variant 3 | FL (0.5, 0.25, -1), FR (0.5, -0.25, -1), RL (-0.5, 0.25, -1),
+            // RR (-0.5, -0.25, -1)
+            h2d(
+                3,
+                Request::SetFeet {
+                    feet_in_body_m: [
+                        [0.5, 0.25, -1.0],
+                        [0.5, -0.25, -1.0],
+                        [-0.5, 0.25, -1.0],
+                        [-0.5, -0.25, -1.0],
+                    ],
+                },
+            ),
+            "03 03 \
+             00 00 00 3f 00 00 80 3e 00 00 80 bf \
+             00 00 00 3f 00 00 80 be 00 00 80 bf \
+             00 00 00 bf 00 00 80 3e 00 00 80 bf \
+             00 00 00 bf 00 00 80 be 00 00 80 bf",
+        ),
+        (
+            "SetJoints",
+            // seq 4 | variant 4 | per leg (0, 0.5, -1)
+            h2d(
+                4,
+                Request::SetJoints {
+                    angles_rad: [
+                        0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0,
+                    ],
+                },
+            ),
+            "04 04 \
+             00 00 00 00 00 00 00 3f 00 00 80 bf \
+             00 00 00 00 00 00 00 3f 00 00 80 bf \
+             00 00 00 00 00 00 00 3f 00 00 80 bf \
+             00 00 00 00 00 00 00 3f 00 00 80 bf",
+        ),
+        (
+            "SetOutputs",
+            // seq 5 | variant 5 | true
+            h2d(5, Request::SetOutputs { enabled: true }),
+            "05 05 01",
+        ),
+        (
+            "SetLinkTimeout",
+            // seq 6 | variant 6 | 500 ms = varint f4 03 | Disable = 1
+            h2d(
+                6,
+                Request::SetLinkTimeout(LinkTimeout {
+                    timeout_ms: 500,
+                    action: LinkLossAction::Disable,
+                }),
+            ),
+            "06 06 f4 03 01",
+        ),
+        (
+            "SetCalibration",
+            // seq 7 | variant 7 | FR = 1, knee = 2 | zero 0.0625 | reversed | 640.0 |
+            // center 1520 = f0 0b | min 1000 = e8 07 | max 2000 = d0 0f
+            h2d(
+                7,
+                Request::SetCalibration {
+                    servo: ServoId {
+                        leg: LegId::FR,
+                        joint: Joint::Knee,
+                    },
+                    calibration: CAL,
+                },
+            ),
+            "07 07 01 02 00 00 80 3d 01 00 00 20 44 f0 0b e8 07 d0 0f",
+        ),
+        (
+            "GetCalibration",
+            // seq 8 | variant 8 | RL = 2, hip = 1
+            h2d(
+                8,
+                Request::GetCalibration {
+                    servo: ServoId {
+                        leg: LegId::RL,
+                        joint: Joint::Hip,
+                    },
+                },
+            ),
+            "08 08 02 01",
+        ),
+        (
+            "SaveCalibration",
+            // seq 9 | variant 9
+            h2d(9, Request::SaveCalibration),
+            "09 09",
+        ),
+        (
+            "SetPoseConfig",
+            // seq 10 | variant 10 | 0.25 m | Zxy = 4 | Clamp = 1
+            h2d(
+                10,
+                Request::SetPoseConfig(PoseConfig {
+                    stance_height_m: 0.25,
+                    order: RotationOrder::Zxy,
+                    policy: ReachPolicy::Clamp,
+                }),
+            ),
+            "0a 0a 00 00 80 3e 04 01",
+        ),
+    ]
+}
+
+/// Every answer (and the nack layouts with fields) with its postcard bytes.
+pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
+    vec![
+        (
+            "Nack UnknownVersion",
+            // variant 0 | Some = 1, seq 1 | reason 0 | supported 0x0100 = 80 02
+            DeviceToHost::Nack {
+                seq: Some(1),
+                reason: NackReason::UnknownVersion { supported: 0x0100 },
+            },
+            "00 01 01 00 80 02",
+        ),
+        (
+            "Nack BadCrc",
+            // variant 0 | None = 0 | reason 1
+            DeviceToHost::Nack {
+                seq: None,
+                reason: NackReason::BadCrc,
+            },
+            "00 00 01",
+        ),
+        (
+            "Nack Unreachable",
+            // variant 0 | Some, seq 11 | reason 5 | RR = 3 | TooFar = 0
+            DeviceToHost::Nack {
+                seq: Some(11),
+                reason: NackReason::Unreachable {
+                    leg: LegId::RR,
+                    fault: ReachFault::TooFar,
+                },
+            },
+            "00 01 0b 05 03 00",
+        ),
+        (
+            "Nack JointLimit",
+            // variant 0 | Some, seq 13 | reason 6 | FR = 1 | hip = 1
+            DeviceToHost::Nack {
+                seq: Some(13),
+                reason: NackReason::JointLimit {
+                    leg: LegId::FR,
+                    joint: Joint::Hip,
+                },
+            },
+            "00 01 0d 06 01 01",
+        ),
+        (
+            "Nack ServoRange",
+            // variant 0 | Some, seq 12 | reason 7 | FL = 0 | knee = 2 | AboveMax = 2
+            DeviceToHost::Nack {
+                seq: Some(12),
+                reason: NackReason::ServoRange {
+                    leg: LegId::FL,
+                    joint: Joint::Knee,
+                    fault: servo::Error::AboveMax,
+                },
+            },
+            "00 01 0c 07 00 02 02",
+        ),
+        (
+            "Nack BadCalibration",
+            // variant 0 | Some, seq 14 | reason 9 | BadGain = 4
+            DeviceToHost::Nack {
+                seq: Some(14),
+                reason: NackReason::BadCalibration(servo::Error::BadGain),
+            },
+            "00 01 0e 09 04",
+        ),
+        (
+            "HelloAck",
+            // variant 1 | seq 1 | version 80 02 | fw 0.1.0 | Fernando2025 = 1 | 128 = 80 01 |
+            // 0.5 m, Zyx = 5, Reject = 0 | 250 ms = fa 01, Hold = 0
+            DeviceToHost::HelloAck {
+                seq: 1,
+                info: DeviceInfo {
+                    version: 0x0100,
+                    firmware: FirmwareVersion {
+                        major: 0,
+                        minor: 1,
+                        patch: 0,
+                    },
+                    robot: RobotPreset::Fernando2025,
+                    max_frame_len: 128,
+                    pose_config: PoseConfig {
+                        stance_height_m: 0.5,
+                        order: RotationOrder::Zyx,
+                        policy: ReachPolicy::Reject,
+                    },
+                    link_timeout: LinkTimeout {
+                        timeout_ms: 250,
+                        action: LinkLossAction::Hold,
+                    },
+                },
+            },
+            "01 01 80 02 00 01 00 01 80 01 00 00 00 3f 05 00 fa 01 00",
+        ),
+        (
+            "Ack",
+            // variant 2 | seq 2 | 12 angles | pulses 3000 = b8 17, 4000 = a0 1f, 2000 = d0 0f,
+            // 0 = 00 | flags 0x05 | frames_ok 1000 = e8 07 | frames_bad 3
+            DeviceToHost::Ack {
+                seq: 2,
+                readback: Readback {
+                    angles_rad: [
+                        0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0,
+                    ],
+                    pulses_half_us: [
+                        3000, 4000, 2000, 3000, 4000, 2000, 3000, 4000, 2000, 3000, 4000, 0,
+                    ],
+                    flags: Flags(Flags::CLAMPED | Flags::OUTPUTS_ENABLED),
+                    frames_ok: 1000,
+                    frames_bad: 3,
+                },
+            },
+            "02 02 \
+             00 00 00 00 00 00 00 3f 00 00 80 bf \
+             00 00 00 00 00 00 00 3f 00 00 80 bf \
+             00 00 00 00 00 00 00 3f 00 00 80 bf \
+             00 00 00 00 00 00 00 3f 00 00 80 bf \
+             b8 17 a0 1f d0 0f b8 17 a0 1f d0 0f b8 17 a0 1f d0 0f b8 17 a0 1f 00 \
+             05 e8 07 03",
+        ),
+        (
+            "Calibration",
+            // variant 3 | seq 3 | FR = 1, knee = 2 | the calibration of SetCalibration
+            DeviceToHost::Calibration {
+                seq: 3,
+                servo: ServoId {
+                    leg: LegId::FR,
+                    joint: Joint::Knee,
+                },
+                calibration: CAL,
+            },
+            "03 03 01 02 00 00 80 3d 01 00 00 20 44 f0 0b e8 07 d0 0f",
+        ),
+    ]
+}
