@@ -60,6 +60,18 @@ pub const fn is_compatible(peer_version: u16) -> bool {
     version_major(peer_version) == version_major(PROTOCOL_VERSION)
 }
 
+/// The minor version both peers use after the handshake: the lower of the two (meaningful only
+/// when the majors agree).
+#[inline]
+pub const fn negotiated_minor(a: u16, b: u16) -> u8 {
+    let (x, y) = (version_minor(a), version_minor(b));
+    if x < y {
+        x
+    } else {
+        y
+    }
+}
+
 /// Largest decoded [`HostToDevice`] frame of this version (postcard bytes + CRC), bytes:
 /// seq (≤ 3) + variant (1) + `SetFeet`/`SetJoints` (48) + CRC (2).
 pub const HOST_TO_DEVICE_MAX_LEN: usize = 3 + 1 + 48 + frame::CRC_LEN;

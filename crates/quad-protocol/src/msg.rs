@@ -221,6 +221,24 @@ pub struct DeviceInfo {
     pub link_timeout: LinkTimeout,
 }
 
+impl DeviceInfo {
+    /// The device's answer to [`Request::Hello`] with sequence number `seq` from a host of
+    /// version `host_version`: [`DeviceToHost::HelloAck`] when the majors agree, else
+    /// [`NackReason::UnknownVersion`] carrying this device's version.
+    pub const fn answer_hello(&self, seq: u16, host_version: u16) -> DeviceToHost {
+        if crate::version_major(host_version) == crate::version_major(self.version) {
+            DeviceToHost::HelloAck { seq, info: *self }
+        } else {
+            DeviceToHost::Nack {
+                seq: Some(seq),
+                reason: NackReason::UnknownVersion {
+                    supported: self.version,
+                },
+            }
+        }
+    }
+}
+
 /// Status bits of a [`Readback`], one byte on the wire. Unknown bits are reserved: senders
 /// write 0, receivers ignore them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
