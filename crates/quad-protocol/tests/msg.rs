@@ -1,4 +1,4 @@
-//! Message helpers: the handshake rule, kin-core error conversion, servo indices, flags.
+//! Message functions: the handshake rule, kin-core error conversion, servo indices, flags.
 
 use kin_core::{IkError, Joint, LegId, ReachPolicy, Robot, RotationOrder, Unreachable};
 use quad_protocol::{
