@@ -17,7 +17,7 @@ use core::fmt;
 /// Below this inverse condition number a configuration counts as near-singular.
 ///
 /// At 0.05 a foot-velocity error is amplified up to 20× more along the worst joint direction
-/// than along the best one. seed 001's initial pose (hip 30°, knee −60°) has ≈ 0.37.
+/// than along the best one. seed 001's initial pose (hip 30°, knee −60°) has ≈ 0.215.
 pub const SINGULARITY_THRESHOLD: f32 = 0.05;
 
 /// The Jacobian cannot be inverted at this configuration.
