@@ -1,0 +1,208 @@
+//! What the device is built for: the robot, how body poses are read, the link-loss failsafe,
+//! where the calibration is stored, and the default servo calibration.
+
+use crate::store::Table;
+use core::fmt;
+use kin_core::body;
+use kin_core::robot::RobotError;
+use kin_core::{BodyConfig, LegId, Math, ReachPolicy, Robot, RotationOrder};
+use quad_protocol::servo::{Calibration, STANDARD_US_PER_RAD};
+use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, RobotPreset, ServoId};
+
+/// Default stance height of [`Robot::fernando2025`]: seed 001's initial pose (eq. 5, α = 60°,
+/// φ = 120°), `H = l0 + (l1 + l2)·sin 60°`, m.
+pub const FERNANDO2025_STANCE_HEIGHT_M: f32 = 0.9294;
+
+/// Default stance height of [`Robot::shahriar2023`]: the height of seed 000's pose sweeps
+/// (`kin_core::motion::laws::SEED000_SWEEP_STANCE_HEIGHT_M`), m.
+pub const SHAHRIAR2023_STANCE_HEIGHT_M: f32 = kin_core::motion::laws::SEED000_SWEEP_STANCE_HEIGHT_M;
+
+/// Default servo travel on either side of the centre pulse, µs: 500–2500 µs, about ±90° at the
+/// standard gain.
+pub const DEFAULT_TRAVEL_US: u16 = 1000;
+
+/// Default centre pulse, µs.
+pub const DEFAULT_CENTER_US: u16 = 1500;
+
+/// Everything the controller is constructed with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Config {
+    /// The preset reported in `HelloAck` ([`RobotPreset::Custom`] for another geometry).
+    pub preset: RobotPreset,
+    /// The geometry the IK runs on.
+    pub robot: Robot,
+    /// How body poses are read at power-on (changed by `SetPoseConfig`, not persisted).
+    pub pose_config: PoseConfig,
+    /// Link-loss failsafe at power-on (changed by `SetLinkTimeout`, not persisted).
+    pub link_timeout: LinkTimeout,
+    /// Firmware release reported in `HelloAck`.
+    pub firmware: FirmwareVersion,
+    /// Storage address of calibration bank A; [`crate::store::STORAGE_LEN`] bytes are used.
+    pub storage_base: u16,
+}
+
+/// Why a [`Config`] or a pose configuration was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// The robot description is invalid.
+    Robot(RobotError),
+    /// The stance height is not a finite length > 0.
+    StanceHeight,
+    /// The preset names a robot other than [`Config::robot`].
+    PresetMismatch,
+    /// The storage banks do not fit below address 65536.
+    StorageBase,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ConfigError::Robot(e) => write!(f, "robot: {e}"),
+            ConfigError::StanceHeight => f.write_str("stance height must be a finite length > 0"),
+            ConfigError::PresetMismatch => f.write_str("preset and robot geometry differ"),
+            ConfigError::StorageBase => f.write_str("calibration storage exceeds 64 KiB"),
+        }
+    }
+}
+
+impl core::error::Error for ConfigError {}
+
+/// Checks a pose configuration: the stance height must be finite and > 0.
+pub fn validate_pose_config(p: &PoseConfig) -> Result<(), ConfigError> {
+    if p.stance_height_m.is_finite() && p.stance_height_m > 0.0 {
+        Ok(())
+    } else {
+        Err(ConfigError::StanceHeight)
+    }
+}
+
+impl Config {
+    /// [`Robot::fernando2025`] at [`FERNANDO2025_STANCE_HEIGHT_M`], seed 001's rotation order
+    /// `zxy`, unreachable poses rejected, no link-loss timeout.
+    pub const fn fernando2025() -> Config {
+        Config {
+            preset: RobotPreset::Fernando2025,
+            robot: Robot::fernando2025(),
+            pose_config: PoseConfig {
+                stance_height_m: FERNANDO2025_STANCE_HEIGHT_M,
+                order: RotationOrder::Zxy,
+                policy: ReachPolicy::Reject,
+            },
+            link_timeout: LinkTimeout {
+                timeout_ms: 0,
+                action: quad_protocol::LinkLossAction::Hold,
+            },
+            firmware: FirmwareVersion {
+                major: 0,
+                minor: 1,
+                patch: 0,
+            },
+            storage_base: 0,
+        }
+    }
+
+    /// [`Robot::shahriar2023`] at [`SHAHRIAR2023_STANCE_HEIGHT_M`], rotation order `zyx`,
+    /// unreachable poses rejected, no link-loss timeout.
+    pub const fn shahriar2023() -> Config {
+        let mut c = Config::fernando2025();
+        c.preset = RobotPreset::Shahriar2023;
+        c.robot = Robot::shahriar2023();
+        c.pose_config.stance_height_m = SHAHRIAR2023_STANCE_HEIGHT_M;
+        c.pose_config.order = RotationOrder::Zyx;
+        c
+    }
+
+    /// The configuration of a preset; `None` for [`RobotPreset::Custom`].
+    pub const fn for_preset(preset: RobotPreset) -> Option<Config> {
+        match preset {
+            RobotPreset::Fernando2025 => Some(Config::fernando2025()),
+            RobotPreset::Shahriar2023 => Some(Config::shahriar2023()),
+            RobotPreset::Custom => None,
+        }
+    }
+
+    /// Checks the robot, the pose configuration, that a named preset matches the robot, and
+    /// that the storage fits.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.robot.validate().map_err(ConfigError::Robot)?;
+        validate_pose_config(&self.pose_config)?;
+        if let Some(r) = self.preset.robot() {
+            if r != self.robot {
+                return Err(ConfigError::PresetMismatch);
+            }
+        }
+        if u32::from(self.storage_base) + u32::from(crate::store::STORAGE_LEN) > 0x1_0000 {
+            return Err(ConfigError::StorageBase);
+        }
+        Ok(())
+    }
+}
+
+/// The calibration used when the storage holds none: each servo centred (1500 µs) on the
+/// joint's angle in the nominal stance of `pose_config`, standard gain
+/// ([`STANDARD_US_PER_RAD`]), travel 500–2500 µs, hip and knee servos of the right legs
+/// reversed (mounted mirrored). When the stance is unreachable the centres sit at angle 0.
+pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> Table {
+    let config = BodyConfig {
+        order: pose_config.order,
+        pivot_m: kin_core::Vec3::ZERO,
+    };
+    let stance = body::inverse_at_stance_with::<M>(
+        robot,
+        &body::Pose::default(),
+        &config,
+        pose_config.stance_height_m,
+        ReachPolicy::Reject,
+    )
+    .map(|s| s.flat())
+    .unwrap_or([0.0; 12]);
+    core::array::from_fn(|i| {
+        let servo = ServoId::ALL[i];
+        let right = matches!(servo.leg, LegId::FR | LegId::RR);
+        Calibration {
+            zero_rad: stance[i],
+            reversed: right && servo.joint != kin_core::Joint::Abduction,
+            us_per_rad: STANDARD_US_PER_RAD,
+            center_us: DEFAULT_CENTER_US,
+            min_us: DEFAULT_CENTER_US - DEFAULT_TRAVEL_US,
+            max_us: DEFAULT_CENTER_US + DEFAULT_TRAVEL_US,
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kin_core::DefaultMath;
+
+    #[test]
+    fn presets_validate() {
+        for p in [RobotPreset::Fernando2025, RobotPreset::Shahriar2023] {
+            let c = Config::for_preset(p).unwrap();
+            assert_eq!(c.validate(), Ok(()));
+            assert_eq!(c.preset, p);
+        }
+        assert!(Config::for_preset(RobotPreset::Custom).is_none());
+        let mut c = Config::fernando2025();
+        c.robot = Robot::shahriar2023();
+        assert_eq!(c.validate(), Err(ConfigError::PresetMismatch));
+        c = Config::fernando2025();
+        c.pose_config.stance_height_m = f32::NAN;
+        assert_eq!(c.validate(), Err(ConfigError::StanceHeight));
+    }
+
+    #[test]
+    fn default_calibration_centres_the_stance() {
+        for c in [Config::fernando2025(), Config::shahriar2023()] {
+            let table = default_calibration::<DefaultMath>(&c.robot, &c.pose_config);
+            for cal in &table {
+                assert_eq!(cal.validate(), Ok(()));
+                assert_eq!(cal.pulse_half_us(cal.zero_rad), Ok(2 * DEFAULT_CENTER_US));
+            }
+            // The stance knee is bent, so its centre is not at angle 0.
+            assert!(table[2].zero_rad < -0.1);
+            assert!(table[5].reversed && !table[3].reversed && !table[2].reversed);
+        }
+    }
+}

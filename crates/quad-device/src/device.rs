@@ -1,0 +1,478 @@
+//! The controller: bytes in → requests → IK, joint limits, servo calibration → outputs →
+//! answer bytes out.
+
+use crate::config::{default_calibration, validate_pose_config, Config, ConfigError};
+use crate::hal::{Clock, ServoOutputs, Storage};
+use crate::store::{Store, Table};
+use core::marker::PhantomData;
+use kin_core::body::{self, BodySolution, Pose};
+use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
+use quad_protocol::servo::Calibration;
+use quad_protocol::{
+    encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,
+    LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
+    MAX_DECODED_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
+};
+
+/// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
+pub const RX_LEN: usize = MAX_DECODED_LEN;
+
+/// Transmit buffer (one encoded answer frame), the protocol's `MAX_FRAME_LEN`.
+pub const TX_LEN: usize = MAX_FRAME_LEN;
+
+/// The joint angles the device holds and the pulses they map to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Held {
+    angles_rad: [f32; 12],
+    pulses_half_us: [u16; 12],
+}
+
+/// The device controller, generic over its outputs `O`, clock `C`, calibration storage `S` and
+/// kin-core math backend `M`.
+///
+/// Behaviour (each point is tested):
+/// - Outputs are stopped at construction and stay stopped until `SetOutputs { enabled: true }`.
+/// - Motion (`SetBodyPose`, `SetFeet`, `SetJoints`) and configuration requests before a
+///   successful `Hello` are refused with [`NackReason::HelloRequired`]; `Hello`, `GetState` and
+///   `GetCalibration` are always answered.
+/// - A motion request is solved completely (IK or joint limits, then the servo mapping of all
+///   twelve joints) before anything changes: an unreachable, out-of-limit, out-of-travel or
+///   non-finite target is nacked and moves nothing. A valid one replaces the held target at once
+///   (no queue) and, while the outputs are enabled, goes to the outputs.
+/// - Motion requests are accepted while the outputs are stopped: the target is held (the
+///   readback then shows pulses 0) and `SetOutputs { enabled: true }` starts from it. At
+///   power-on the held target is the nominal stance (zero body pose), when it maps within the
+///   calibration; otherwise enabling is refused with [`NackReason::InvalidArgument`] until a
+///   motion request succeeds.
+/// - Every pulse written lies within its servo's calibrated `[min_us, max_us]`; a calibration
+///   change that would put the held angle outside the new travel is refused.
+/// - Link loss: when no valid frame arrived for `timeout_ms` (≠ 0), the failsafe holds the
+///   pulses or stops the outputs ([`LinkLossAction`]) and sets [`Flags::FAILSAFE_ACTIVE`],
+///   which the answer to the next valid frame reports once. Stopped outputs stay stopped until
+///   the host enables them again.
+/// - Unreadable frames are answered with a nack without a sequence number (`BadCrc`,
+///   `BadFrame`, `Oversize`) and change nothing but the frame counters.
+pub struct Device<O, C, S, M = DefaultMath> {
+    outputs: O,
+    clock: C,
+    storage: S,
+    config: Config,
+    calibration: Table,
+    store: Store,
+    acc: Accumulator<RX_LEN>,
+    tx: [u8; TX_LEN],
+    held: Option<Held>,
+    clamped: bool,
+    limited: bool,
+    outputs_enabled: bool,
+    hello_done: bool,
+    failsafe: bool,
+    failsafe_armed: bool,
+    calibration_unsaved: bool,
+    calibration_default: bool,
+    last_valid_ms: u32,
+    _math: PhantomData<fn() -> M>,
+}
+
+impl<O, C, S, M> Device<O, C, S, M>
+where
+    O: ServoOutputs,
+    C: Clock,
+    S: Storage,
+    M: Math,
+{
+    /// Powers the device on: stops the outputs, loads the calibration from `storage` (the
+    /// defaults of [`default_calibration`] when none is valid) and holds the nominal stance.
+    ///
+    /// # Errors
+    /// [`Config::validate`]'s error.
+    pub fn new(
+        config: Config,
+        mut outputs: O,
+        clock: C,
+        mut storage: S,
+    ) -> Result<Self, ConfigError> {
+        config.validate()?;
+        outputs.set_enabled(false);
+        let mut calibration = default_calibration::<M>(&config.robot, &config.pose_config);
+        let mut store = Store::new(config.storage_base);
+        let loaded = store.load(&mut storage, &mut calibration);
+        let now = clock.now_ms();
+        let mut device = Device {
+            outputs,
+            clock,
+            storage,
+            config,
+            calibration,
+            store,
+            acc: Accumulator::new(),
+            tx: [0; TX_LEN],
+            held: None,
+            clamped: false,
+            limited: false,
+            outputs_enabled: false,
+            hello_done: false,
+            failsafe: false,
+            failsafe_armed: true,
+            calibration_unsaved: false,
+            calibration_default: !loaded,
+            last_valid_ms: now,
+            _math: PhantomData,
+        };
+        // The stance may not map within a stored calibration: then nothing is held.
+        let _ = device.set_body_pose(&Pose::default());
+        Ok(device)
+    }
+
+    /// Feeds received bytes (any chunking) and sends one answer frame through `tx` for every
+    /// frame that ends in them, in order.
+    pub fn receive(&mut self, mut bytes: &[u8], mut tx: impl FnMut(&[u8])) {
+        loop {
+            let (answer, remaining) = match self.acc.feed::<HostToDevice>(bytes) {
+                Feed::NeedMore => break,
+                Feed::Frame { msg, remaining } => (self.handle(msg), remaining),
+                Feed::BadCrc { remaining } => (nack(None, NackReason::BadCrc), remaining),
+                Feed::BadFrame { remaining, .. } => (nack(None, NackReason::BadFrame), remaining),
+                Feed::Oversize { remaining } => (nack(None, NackReason::Oversize), remaining),
+            };
+            bytes = remaining;
+            // The buffer holds the largest answer; a failure would only drop this answer.
+            if let Ok(frame) = encode_frame(&answer, &mut self.tx) {
+                tx(frame);
+            }
+        }
+    }
+
+    /// Runs the link-loss failsafe; call it from the main loop.
+    pub fn poll(&mut self) {
+        let LinkTimeout { timeout_ms, action } = self.config.link_timeout;
+        if timeout_ms == 0 || !self.failsafe_armed {
+            return;
+        }
+        let silent_ms = self.clock.now_ms().wrapping_sub(self.last_valid_ms);
+        if silent_ms < u32::from(timeout_ms) {
+            return;
+        }
+        self.failsafe = true;
+        self.failsafe_armed = false;
+        if action == LinkLossAction::Disable {
+            self.stop_outputs();
+        }
+    }
+
+    /// Handles one decoded request (what [`Device::receive`] does for every valid frame) and
+    /// returns the answer.
+    pub fn handle(&mut self, msg: HostToDevice) -> DeviceToHost {
+        self.last_valid_ms = self.clock.now_ms();
+        self.failsafe_armed = true;
+        let answer = self.answer(msg);
+        // Reported once, in the answer to the first valid frame after the failsafe acted.
+        self.failsafe = false;
+        answer
+    }
+
+    fn answer(&mut self, msg: HostToDevice) -> DeviceToHost {
+        let seq = msg.seq;
+        let result = match msg.request {
+            Request::Hello { version } => {
+                return if is_compatible(version) {
+                    self.hello_done = true;
+                    DeviceToHost::HelloAck {
+                        seq,
+                        info: self.info(),
+                    }
+                } else {
+                    nack(
+                        Some(seq),
+                        NackReason::UnknownVersion {
+                            supported: PROTOCOL_VERSION,
+                        },
+                    )
+                };
+            }
+            Request::GetState => Ok(()),
+            Request::GetCalibration { servo } => {
+                return DeviceToHost::Calibration {
+                    seq,
+                    servo,
+                    calibration: self.calibration[servo.index()],
+                };
+            }
+            _ if !self.hello_done => Err(NackReason::HelloRequired),
+            Request::SetBodyPose(pose) => self.set_body_pose(&pose),
+            Request::SetFeet { feet_in_body_m } => self.set_feet(&feet_in_body_m),
+            Request::SetJoints { angles_rad } => self.set_joints(&angles_rad),
+            Request::SetOutputs { enabled } => self.set_outputs(enabled),
+            Request::SetLinkTimeout(t) => {
+                self.config.link_timeout = t;
+                Ok(())
+            }
+            Request::SetCalibration { servo, calibration } => {
+                self.set_calibration(servo, calibration)
+            }
+            Request::SaveCalibration => self.save_calibration(),
+            Request::SetPoseConfig(p) => self.set_pose_config(p),
+        };
+        match result {
+            Ok(()) => DeviceToHost::Ack {
+                seq,
+                readback: self.readback(),
+            },
+            Err(reason) => nack(Some(seq), reason),
+        }
+    }
+
+    /// What `HelloAck` reports.
+    pub fn info(&self) -> DeviceInfo {
+        DeviceInfo {
+            version: PROTOCOL_VERSION,
+            firmware: self.config.firmware,
+            robot: self.config.preset,
+            max_frame_len: RX_LEN as u16,
+            pose_config: self.config.pose_config,
+            link_timeout: self.config.link_timeout,
+        }
+    }
+
+    /// The state an `Ack` reports: held angles (zeros when nothing is held), the pulses on the
+    /// outputs (zeros while stopped), flags and frame counters.
+    pub fn readback(&self) -> Readback {
+        let (angles_rad, pulses) = match &self.held {
+            Some(h) => (h.angles_rad, h.pulses_half_us),
+            None => ([0.0; 12], [0; 12]),
+        };
+        let flags = Flags::EMPTY
+            .with(Flags::CLAMPED, self.clamped)
+            .with(Flags::LIMITED, self.limited)
+            .with(Flags::OUTPUTS_ENABLED, self.outputs_enabled)
+            .with(Flags::FAILSAFE_ACTIVE, self.failsafe)
+            .with(Flags::CALIBRATION_UNSAVED, self.calibration_unsaved)
+            .with(Flags::CALIBRATION_DEFAULT, self.calibration_default);
+        Readback {
+            angles_rad,
+            pulses_half_us: if self.outputs_enabled {
+                pulses
+            } else {
+                [0; 12]
+            },
+            flags,
+            frames_ok: self.acc.frames_ok(),
+            frames_bad: self.acc.frames_bad(),
+        }
+    }
+
+    /// The twelve calibrations in RAM.
+    pub fn calibration(&self) -> &Table {
+        &self.calibration
+    }
+
+    /// The current configuration (pose configuration and link timeout as last set).
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// True while the outputs are driven.
+    pub fn outputs_enabled(&self) -> bool {
+        self.outputs_enabled
+    }
+
+    /// The outputs.
+    pub fn outputs(&self) -> &O {
+        &self.outputs
+    }
+
+    /// The storage.
+    pub fn storage(&self) -> &S {
+        &self.storage
+    }
+
+    /// The clock.
+    pub fn clock(&self) -> &C {
+        &self.clock
+    }
+
+    /// Takes the device apart (e.g. to "power it on" again from the same storage in a test).
+    pub fn into_parts(self) -> (O, C, S) {
+        (self.outputs, self.clock, self.storage)
+    }
+
+    fn body_config(&self) -> BodyConfig {
+        BodyConfig {
+            order: self.config.pose_config.order,
+            pivot_m: Vec3::ZERO,
+        }
+    }
+
+    fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
+        let solution = body::inverse_at_stance_with::<M>(
+            &self.config.robot,
+            pose,
+            &self.body_config(),
+            self.config.pose_config.stance_height_m,
+            self.config.pose_config.policy,
+        );
+        self.apply_solution(solution)
+    }
+
+    fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
+        let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
+        let solution = body::inverse_with::<M>(
+            &self.config.robot,
+            &Pose::default(),
+            &self.body_config(),
+            &feet,
+            self.config.pose_config.policy,
+        );
+        self.apply_solution(solution)
+    }
+
+    fn apply_solution(
+        &mut self,
+        solution: Result<BodySolution, IkError>,
+    ) -> Result<(), NackReason> {
+        let solution = solution.map_err(NackReason::from)?;
+        let angles = solution.flat();
+        let clamped = solution.any_clamped();
+        // A clamp to the joint limits puts the angle exactly on a bound.
+        let limits = &self.config.robot.limits;
+        let limited = clamped
+            && ServoId::ALL.iter().any(|s| {
+                let a = angles[s.index()];
+                let j = s.joint as usize;
+                a == limits.min_rad[j] || a == limits.max_rad[j]
+            });
+        self.apply(angles, clamped, limited)
+    }
+
+    fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
+        for s in ServoId::ALL {
+            let a = angles[s.index()];
+            if !a.is_finite() {
+                return Err(NackReason::NonFinite);
+            }
+            if !self.config.robot.limits.admits(s.joint, a) {
+                return Err(NackReason::JointLimit {
+                    leg: s.leg,
+                    joint: s.joint,
+                });
+            }
+        }
+        self.apply(*angles, false, false)
+    }
+
+    /// Maps all twelve angles through the calibration; commits and drives only when all map.
+    fn apply(
+        &mut self,
+        angles_rad: [f32; 12],
+        clamped: bool,
+        limited: bool,
+    ) -> Result<(), NackReason> {
+        let mut pulses_half_us = [0u16; 12];
+        for s in ServoId::ALL {
+            let a = angles_rad[s.index()];
+            if !a.is_finite() {
+                return Err(NackReason::NonFinite);
+            }
+            pulses_half_us[s.index()] =
+                self.calibration[s.index()]
+                    .pulse_half_us(a)
+                    .map_err(|fault| NackReason::ServoRange {
+                        leg: s.leg,
+                        joint: s.joint,
+                        fault,
+                    })?;
+        }
+        self.held = Some(Held {
+            angles_rad,
+            pulses_half_us,
+        });
+        self.clamped = clamped;
+        self.limited = limited;
+        if self.outputs_enabled {
+            self.drive();
+        }
+        Ok(())
+    }
+
+    /// Writes the held pulses to the outputs, after checking each against its calibration;
+    /// stops the outputs instead if any check fails (unreachable by construction).
+    fn drive(&mut self) -> bool {
+        let Some(held) = self.held else {
+            self.stop_outputs();
+            return false;
+        };
+        let all_in_travel = self
+            .calibration
+            .iter()
+            .zip(held.pulses_half_us)
+            .all(|(c, p)| c.min_half_us() <= p && p <= c.max_half_us());
+        if !all_in_travel {
+            self.stop_outputs();
+            return false;
+        }
+        self.outputs.set_pulses(&held.pulses_half_us);
+        true
+    }
+
+    fn stop_outputs(&mut self) {
+        self.outputs.set_enabled(false);
+        self.outputs_enabled = false;
+    }
+
+    fn set_outputs(&mut self, enabled: bool) -> Result<(), NackReason> {
+        if !enabled {
+            self.stop_outputs();
+            return Ok(());
+        }
+        if !self.drive() {
+            return Err(NackReason::InvalidArgument);
+        }
+        if !self.outputs_enabled {
+            self.outputs.set_enabled(true);
+            self.outputs_enabled = true;
+        }
+        Ok(())
+    }
+
+    fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), NackReason> {
+        c.validate().map_err(NackReason::BadCalibration)?;
+        let i = servo.index();
+        if let Some(held) = &mut self.held {
+            let pulse =
+                c.pulse_half_us(held.angles_rad[i])
+                    .map_err(|fault| NackReason::ServoRange {
+                        leg: servo.leg,
+                        joint: servo.joint,
+                        fault,
+                    })?;
+            held.pulses_half_us[i] = pulse;
+        }
+        if self.calibration[i] != c {
+            self.calibration[i] = c;
+            self.calibration_unsaved = true;
+        }
+        if self.outputs_enabled {
+            self.drive();
+        }
+        Ok(())
+    }
+
+    fn save_calibration(&mut self) -> Result<(), NackReason> {
+        self.store
+            .save(&mut self.storage, &self.calibration)
+            .map_err(|_| NackReason::Storage)?;
+        self.calibration_unsaved = false;
+        self.calibration_default = false;
+        Ok(())
+    }
+
+    fn set_pose_config(&mut self, p: PoseConfig) -> Result<(), NackReason> {
+        validate_pose_config(&p).map_err(|_| NackReason::InvalidArgument)?;
+        self.config.pose_config = p;
+        Ok(())
+    }
+}
+
+const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {
+    DeviceToHost::Nack { seq, reason }
+}
