@@ -1,0 +1,36 @@
+//! `cargo xtask avr-bench`: the firmware's IK benchmark in simavr (see
+//! `integration_tests::avr_bench`). Prints a table per backend, then the JSON figures as the
+//! last line of stdout.
+
+use integration_tests::avr_bench;
+
+fn main() {
+    let report = avr_bench::run();
+    println!(
+        "{:<34} {:>9} {:>10} {:>10} {:>11} {:>12} {:>14}",
+        "backend (ELF)", "leg max", "leg mean", "body max", "body mean", "err max °", "vs host rad"
+    );
+    for b in &report.backends {
+        println!(
+            "{:<34} {:>9} {:>10.0} {:>10} {:>11.0} {:>12.2e} {:>14.2e}",
+            b.name,
+            b.leg_max_cycles,
+            b.leg_mean_cycles,
+            b.body_max_cycles,
+            b.body_mean_cycles,
+            b.max_angle_err_deg,
+            b.max_diff_to_host_libm_rad
+        );
+    }
+    println!(
+        "targets: {} body poses + {} leg targets (seed {:#x}); cycles at 16 MHz; bench.elf stack {} B",
+        avr_bench::N_TARGETS,
+        avr_bench::N_TARGETS,
+        avr_bench::SEED,
+        report.bench_stack_bytes
+    );
+    println!(
+        "{}",
+        serde_json::to_string(&report.summary).expect("serialisable figures")
+    );
+}
