@@ -69,6 +69,7 @@ impl Pose {
     }
 
     /// True when all six values are finite.
+    #[inline]
     pub fn is_finite(self) -> bool {
         self.to_array().iter().all(|v| v.is_finite())
     }

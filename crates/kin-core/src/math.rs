@@ -14,7 +14,8 @@
 //! - Firmware may implement [`Math`] itself, e.g. on top of avr-libc's hand-written assembly.
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
-//! minimax fit); they are constants, not tables, so they cost no SRAM on the AVR.
+//! minimax fit); they are constants, not tables (the one table is `atan2`'s four quadrant
+//! offsets, 16 bytes).
 
 /// The few scalar functions the kinematics needs. All angles are in radians.
 pub trait Math {
@@ -97,9 +98,6 @@ impl Math for Fast {
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
         const SIGN: u32 = 0x8000_0000;
-        // |atan2| = offset ± atan(t), indexed by (swap, x < 0): (0, +), (π, −), (π/2, −),
-        // (π/2, +); then the sign of y.
-        const OFFSET: [f32; 4] = [0.0, PI, FRAC_PI_2, FRAC_PI_2];
         let ax = libm::fabsf(x);
         let ay = libm::fabsf(y);
         let swap = ay > ax;
@@ -113,7 +111,11 @@ impl Math for Fast {
         let t = if t > 0.0 { t } else { 0.0 };
         let y_sign = y.to_bits() & SIGN;
         let t_sign = (((swap != x_neg) as u32) << 31) ^ y_sign;
-        let offset = OFFSET[(((swap as usize) << 1) | x_neg as usize) & 3];
+        // |atan2| = offset ± atan(t) by (swap, x < 0): (0, +), (π, −), (π/2, −), (π/2, +); then
+        // the sign of y. A table lookup, not a select, which the compiler would turn into a
+        // branch that random quadrants mispredict.
+        const OFFSET: [f32; 4] = [0.0, PI, FRAC_PI_2, FRAC_PI_2];
+        let offset = OFFSET[((swap as usize) << 1) | x_neg as usize];
         let offset = f32::from_bits(offset.to_bits() | y_sign);
         offset + atan_unit(f32::from_bits(t.to_bits() ^ t_sign))
     }
@@ -124,7 +126,10 @@ impl Math for Fast {
         const INV_FRAC_PI_2: f32 = core::f32::consts::FRAC_2_PI;
         const PIO2_HI: f32 = 1.570_312_5; // exact in 11 bits
         const PIO2_LO: f32 = 4.838_268e-4;
-        let k = libm::roundf(x * INV_FRAC_PI_2);
+        // Round to nearest by adding and subtracting 1.5·2²³ (exact for |x·2/π| < 2²²; beyond,
+        // any nearby integer does as well as libm::roundf): inline, no call, no branch.
+        const ROUND: f32 = 12_582_912.0;
+        let k = (x * INV_FRAC_PI_2 + ROUND) - ROUND;
         let r = (x - k * PIO2_HI) - k * PIO2_LO;
         let r2 = r * r;
         // Minimax on [-π/4, π/4] (scripts/fit_polynomials.py): error < 1e-9 before rounding.

@@ -79,7 +79,7 @@ impl fmt::Display for RotationOrder {
 }
 
 /// Elementary rotation about axis `axis` (0 = x, 1 = y, 2 = z) from `(sin, cos)`.
-#[inline]
+#[inline(always)]
 fn elementary(axis: u8, s: f32, c: f32) -> Mat3 {
     match axis {
         0 => Mat3 {
@@ -125,12 +125,57 @@ pub fn matrix_with<M: Math>(
         M::sin_cos(pitch_rad),
         M::sin_cos(yaw_rad),
     ];
-    let [a, b, c] = order.axes();
-    let m = |axis: u8| {
-        let (s, co) = sc[axis as usize];
-        elementary(axis, s, co)
+    // One monomorphic product per order: the axes are constants, so each arm compiles to the
+    // closed-form matrix of its order (no runtime dispatch inside the product).
+    match order {
+        RotationOrder::Xyz => product::<0, 1, 2>(&sc),
+        RotationOrder::Xzy => product::<0, 2, 1>(&sc),
+        RotationOrder::Yxz => product::<1, 0, 2>(&sc),
+        RotationOrder::Yzx => product::<1, 2, 0>(&sc),
+        RotationOrder::Zxy => product::<2, 0, 1>(&sc),
+        RotationOrder::Zyx => product::<2, 1, 0>(&sc),
+    }
+}
+
+/// `E(A)·E(B)·E(C)` for elementary rotations about the axes `A`, `B`, `C` (0 = x, 1 = y,
+/// 2 = z) with `(sin, cos)` of the roll, pitch and yaw angles in `sc`.
+#[inline(always)]
+fn product<const A: u8, const B: u8, const C: u8>(sc: &[(f32, f32); 3]) -> Mat3 {
+    let (s, co) = sc[C as usize];
+    let m = elementary(C, s, co);
+    let (s, co) = sc[B as usize];
+    let m = rotate_rows(B, s, co, &m);
+    let (s, co) = sc[A as usize];
+    rotate_rows(A, s, co, &m)
+}
+
+/// `elementary(axis, s, c) · m`, touching only the two rows the rotation mixes (a third of the
+/// multiplications of a full matrix product).
+#[inline(always)]
+fn rotate_rows(axis: u8, s: f32, c: f32, m: &Mat3) -> Mat3 {
+    let mix = |p: &[f32; 3], q: &[f32; 3]| -> ([f32; 3], [f32; 3]) {
+        (
+            core::array::from_fn(|j| c * p[j] - s * q[j]),
+            core::array::from_fn(|j| s * p[j] + c * q[j]),
+        )
     };
-    m(a).mul_mat(&m(b)).mul_mat(&m(c))
+    let [r0, r1, r2] = &m.rows;
+    let rows = match axis {
+        0 => {
+            let (n1, n2) = mix(r1, r2);
+            [*r0, n1, n2]
+        }
+        1 => {
+            // Ry mixes z and x: row0 = c·r0 + s·r2, row2 = −s·r0 + c·r2.
+            let (n2, n0) = mix(r2, r0);
+            [n0, *r1, n2]
+        }
+        _ => {
+            let (n0, n1) = mix(r0, r1);
+            [n0, n1, *r2]
+        }
+    };
+    Mat3 { rows }
 }
 
 /// [`matrix_with`] on the [`DefaultMath`] backend.
