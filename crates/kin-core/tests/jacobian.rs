@@ -40,11 +40,6 @@ fn fd_jacobian(robot: &kin_core::Robot, leg: LegId, q: [f64; 3]) -> Matrix3<f64>
     j
 }
 
-fn svd_inverse_condition(j: &Matrix3<f64>) -> f64 {
-    let s = j.svd(false, false).singular_values;
-    s.min() / s.max()
-}
-
 #[test]
 fn analytic_jacobian_equals_finite_differences() {
     let mut rng = Rng(0x1AC);

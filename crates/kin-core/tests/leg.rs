@@ -141,7 +141,7 @@ proptest! {
     ) {
         let robot = robot_of(r, fwd);
         let g = robot.leg;
-        let reach = (g.d_lat_m + g.d_ax_m + g.femur_m + g.tibia_m) as f32 * 1.05;
+        let reach = (g.d_lat_m + g.d_ax_m + g.femur_m + g.tibia_m) * 1.05;
         let target = Vec3::new(x * reach, y * reach, z * reach);
         check_against_oracle(&robot, LegId::ALL[l], target);
     }

@@ -147,19 +147,19 @@ pub fn ik64(robot: &Robot, leg: LegId, p: [f64; 3]) -> Verdict {
     };
     let h = wrap_pi64((-u).atan2(-v) - (l2 * k.sin()).atan2(l1 + l2 * k.cos()));
     let q = [a, h, k];
-    for j in 0..3 {
-        let (lo, hi) = (
+    let limits = |j: usize| {
+        (
             robot.limits.min_rad[j] as f64,
             robot.limits.max_rad[j] as f64,
-        );
-        margin = margin.min((q[j] - lo).abs()).min((q[j] - hi).abs());
+        )
+    };
+    for (j, &qj) in q.iter().enumerate() {
+        let (lo, hi) = limits(j);
+        margin = margin.min((qj - lo).abs()).min((qj - hi).abs());
     }
-    for j in 0..3 {
-        let (lo, hi) = (
-            robot.limits.min_rad[j] as f64,
-            robot.limits.max_rad[j] as f64,
-        );
-        if q[j] < lo || q[j] > hi {
+    for (j, &qj) in q.iter().enumerate() {
+        let (lo, hi) = limits(j);
+        if qj < lo || qj > hi {
             return Verdict {
                 result: Err(Kind64::JointLimit(j)),
                 margin,
