@@ -6,4 +6,5 @@
 
 pub mod cmd;
 pub mod csv_io;
+pub mod plot;
 pub mod robot_file;

@@ -22,6 +22,8 @@ enum Command {
     Ik(cmd::ik::Args),
     Fk(cmd::fk::Args),
     Pose(cmd::pose::Args),
+    Motion(cmd::motion::Args),
+    Check(cmd::check::Args),
 }
 
 fn main() -> ExitCode {
@@ -35,5 +37,7 @@ fn main() -> ExitCode {
         Command::Pose(args) => {
             cmd::run_batch(&args.input.input, |i, o, d| cmd::pose::run(&args, i, o, d))
         }
+        Command::Motion(args) => cmd::motion::run(&args),
+        Command::Check(args) => cmd::check::run(&args),
     }
 }

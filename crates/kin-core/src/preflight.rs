@@ -458,6 +458,17 @@ impl Checker {
         }
     }
 
+    /// Records a sample at `t_s` in which the listed legs could not reach (e.g. a recorded
+    /// sample whose status says so); the other legs' figures are left as they are.
+    pub fn push_unreachable(&mut self, t_s: f32, legs: &[(LegId, Unreachable)]) {
+        let sample = self.report.samples;
+        self.report.samples = sample.saturating_add(1);
+        for &(leg, kind) in legs {
+            self.prev[leg.index()] = None;
+            self.record(sample, t_s, leg, FailureKind::Unreachable(kind));
+        }
+    }
+
     /// Joint margin, singularity and speed of one leg; the first failure among them.
     fn angles_metrics(&mut self, leg: LegId, t_s: f32, q: JointAngles) -> Option<FailureKind> {
         let i = leg.index();

@@ -4,8 +4,10 @@
 //! A new subcommand is a module here with an `Args` struct (`clap::Args`) and a `run` function,
 //! plus one variant in `main.rs`.
 
+pub mod check;
 pub mod fk;
 pub mod ik;
+pub mod motion;
 pub mod pose;
 
 use crate::csv_io::{self, Input, Summary};
