@@ -53,15 +53,58 @@ fn seed001_initial_pose_is_hip_30_knee_minus_60() {
     }
 }
 
-/// Seed 001 eq. 3's link vectors, with Γβ applied to the whole leg (see erratum 5).
-fn seed001_leg(g: &LegGeometry, s: Seed001Angles) -> [Vector3<f64>; 3] {
-    let (b, a, f) = (s.beta_rad as f64, s.alpha_rad as f64, s.phi_rad as f64);
+/// Seed 001 eq. 3's link vectors, with Γβ applied to the whole leg (see erratum 5): the points
+/// A, B, K relative to O for `[β, α, φ]`.
+fn seed001_leg64(g: &LegGeometry, [b, a, f]: [f64; 3]) -> [Vector3<f64>; 3] {
     let (l0, l1, l2) = (g.d_ax_m as f64, g.femur_m as f64, g.tibia_m as f64);
     let gb = Matrix3::new(1.0, 0.0, 0.0, 0.0, b.cos(), -b.sin(), 0.0, b.sin(), b.cos());
     let r_oa = gb * Vector3::new(0.0, 0.0, -l0);
     let r_ab = Vector3::new(-l1 * a.cos(), 0.0, -l1 * a.sin());
     let r_bk = Vector3::new(-l2 * f.cos(), 0.0, -l2 * f.sin());
     [r_oa, r_oa + gb * r_ab, r_oa + gb * (r_ab + r_bk)]
+}
+
+fn seed001_leg(g: &LegGeometry, s: Seed001Angles) -> [Vector3<f64>; 3] {
+    seed001_leg64(g, [s.beta_rad, s.alpha_rad, s.phi_rad].map(|v| v as f64))
+}
+
+/// Seed 001 eq. 4's leg matrix J_i = ∂r_K/∂(β, α, φ). With hip = π/2 − α and knee = α − φ it
+/// is the crate's Jacobian (w.r.t. abduction, hip, knee) times [[1,0,0],[0,−1,0],[0,1,−1]].
+#[test]
+fn seed001_eq4_leg_jacobian_via_adapter() {
+    let robot = Robot::fernando2025();
+    let chain = Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.0, -1.0);
+    let mut rng = Rng(4);
+    for _ in 0..200 {
+        let s = [
+            rng.range(-0.8, 0.8),
+            rng.range(0.0, 2.0),
+            rng.range(0.5, 3.0),
+        ]
+        .map(|v| v as f32 as f64);
+        let step = 1e-6;
+        let mut j_paper = Matrix3::zeros();
+        for c in 0..3 {
+            let (mut sp, mut sm) = (s, s);
+            sp[c] += step;
+            sm[c] -= step;
+            let col = (seed001_leg64(&robot.leg, sp)[2] - seed001_leg64(&robot.leg, sm)[2])
+                / (2.0 * step);
+            j_paper.set_column(c, &col);
+        }
+        let q = paper::from_seed001(Seed001Angles {
+            beta_rad: s[0] as f32,
+            alpha_rad: s[1] as f32,
+            phi_rad: s[2] as f32,
+        });
+        let j = kin_core::jacobian::leg_jacobian(&robot.leg, LegId::FL, q);
+        let j = Matrix3::from_fn(|r, c| j.rows[r][c] as f64);
+        assert!(
+            (j * chain - j_paper).abs().max() <= 1e-5,
+            "{j_paper} vs {}",
+            j * chain
+        );
+    }
 }
 
 proptest! {
