@@ -4,7 +4,9 @@
 //!
 //! All kinematics is `kin-core`'s; this crate only reads, validates and prints.
 
+pub mod client;
 pub mod cmd;
 pub mod csv_io;
+pub mod link;
 pub mod plot;
 pub mod robot_file;

@@ -24,6 +24,8 @@ enum Command {
     Pose(cmd::pose::Args),
     Motion(cmd::motion::Args),
     Check(cmd::check::Args),
+    Stream(cmd::stream::Args),
+    Calibrate(cmd::calibrate::Args),
 }
 
 fn main() -> ExitCode {
@@ -39,5 +41,7 @@ fn main() -> ExitCode {
         }
         Command::Motion(args) => cmd::motion::run(&args),
         Command::Check(args) => cmd::check::run(&args),
+        Command::Stream(args) => cmd::stream::main(&args),
+        Command::Calibrate(args) => cmd::calibrate::main(&args),
     }
 }
