@@ -14,6 +14,7 @@
 //! | one leg IK | `L`, backend u8, leg u8, x y z f32 (hip frame, m) | `l`, status u8, abduction hip knee f32 |
 //! | body pose at the stance | `B`, backend u8, roll pitch yaw x y z f32 | `b`, status u8, 12 × f32 |
 //! | memory | `S` | `s`, static SRAM u16, max stack u16 |
+//! | one primitive | `F`, op u8, a b f32 | `f`, status u8, result f32 |
 //!
 //! Status 0 = solved, 1 = unreachable, 2 = unknown backend. Boot sends `R` once ready.
 //! Robot: [`kin_core::Robot::shahriar2023`] with its knee bend and limits; body poses about
@@ -37,6 +38,9 @@ pub const ROBOT: Robot = Robot::shahriar2023();
 pub type LegFn = fn(&Robot, LegId, Vec3) -> Result<[f32; 3], IkError>;
 /// Solves one body pose with the given backend.
 pub type BodyFn = fn(&Robot, &Pose) -> Result<[f32; 12], IkError>;
+
+/// One float primitive under test, `op(a, b)` (unary ones ignore `b`).
+pub type PrimFn = fn(f32, f32) -> f32;
 
 /// A math backend under test.
 pub struct Backend {
@@ -105,7 +109,12 @@ fn marker(porta: &pac::PORTA, high: bool) {
 
 /// Serves benchmark requests forever (see the module docs). Interrupts must be enabled (the
 /// receiver is interrupt-driven).
-pub fn serve(usart: &mut Usart0, porta: &pac::PORTA, backends: &[Backend]) -> ! {
+pub fn serve(
+    usart: &mut Usart0,
+    porta: &pac::PORTA,
+    backends: &[Backend],
+    prims: &[PrimFn],
+) -> ! {
     // SAFETY: any DDRA value is valid; PA0 becomes an output, low.
     marker(porta, false);
     porta
@@ -154,6 +163,21 @@ pub fn serve(usart: &mut Usart0, porta: &pac::PORTA, backends: &[Backend]) -> ! 
                         send_result(usart, r.as_ref().map(|a| &a[..]), 12);
                     }
                     None => send_status(usart, STATUS_UNKNOWN_BACKEND, 12),
+                }
+            }
+            b'F' => {
+                let op = read_byte(usart) as usize;
+                let (a, b) = (read_f32(usart), read_f32(usart));
+                usart.write(b'f');
+                match prims.get(op) {
+                    Some(f) => {
+                        let (a, b) = core::hint::black_box((a, b));
+                        marker(porta, true);
+                        let r = f(a, b);
+                        marker(porta, false);
+                        send_result(usart, Ok(&[r]), 1);
+                    }
+                    None => send_status(usart, STATUS_UNKNOWN_BACKEND, 1),
                 }
             }
             b'S' => {

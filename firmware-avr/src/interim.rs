@@ -13,7 +13,7 @@
 //!
 //! A request whose bytes stop arriving for [`PARTIAL_TIMEOUT_MS`] is discarded.
 
-use avr_libc_math::AvrLibm;
+use avr_libc_math::AvrFast;
 use firmware_avr::bench;
 use firmware_avr::clock::Clock;
 use firmware_avr::servo::{Servos, CHANNELS};
@@ -95,7 +95,7 @@ impl Interim {
                 let pose = Pose::from_array(core::array::from_fn(|i| {
                     f32::from_le_bytes([b[1 + 4 * i], b[2 + 4 * i], b[3 + 4 * i], b[4 + 4 * i]])
                 }));
-                let r = bench::body_with::<AvrLibm>(&bench::ROBOT, &pose);
+                let r = bench::body_with::<AvrFast>(&bench::ROBOT, &pose);
                 usart.write(b'p');
                 usart.write(if r.is_ok() { 0 } else { 1 });
                 for a in r.unwrap_or([0.0; 12]) {

@@ -55,6 +55,9 @@ pub enum Backend {
     Fast = 1,
     /// kin-core's `Libm` backend (Rust libm); soft-float primitives from whichever ELF.
     Libm = 2,
+    /// avr-libc's `sqrt` and `atan2` with kin-core's `Fast::sin_cos`
+    /// (`avr_libc_math::AvrFast`).
+    AvrFast = 3,
 }
 
 impl Backend {
@@ -64,13 +67,14 @@ impl Backend {
             Backend::AvrLibm => "avr-libc",
             Backend::Fast => "kin-core Fast",
             Backend::Libm => "kin-core Libm",
+            Backend::AvrFast => "avr-libc + Fast::sin_cos",
         }
     }
 }
 
 /// The backend the firmware uses (reported as `leg_ik_cycles`, `body_pose_cycles`,
 /// `max_angle_err_deg`).
-pub const FIRMWARE_BACKEND: Backend = Backend::AvrLibm;
+pub const FIRMWARE_BACKEND: Backend = Backend::AvrFast;
 
 /// SplitMix64 (Steele, Lea, Flood 2014).
 pub struct SplitMix64(u64);
@@ -115,8 +119,8 @@ pub fn targets() -> Targets {
     let mut poses = Vec::new();
     while poses.len() < N_TARGETS {
         let [r, p, y] = POSE_RANGE_DEG.map(|d| rng.uniform(-d, d).to_radians() as f32);
-        let [tx, ty, tz] = [0; 3]
-            .map(|_| rng.uniform(-TRANSLATION_RANGE_M, TRANSLATION_RANGE_M) as f32);
+        let [tx, ty, tz] =
+            [0; 3].map(|_| rng.uniform(-TRANSLATION_RANGE_M, TRANSLATION_RANGE_M) as f32);
         let pose = Pose {
             roll_rad: r,
             pitch_rad: p,
@@ -328,6 +332,20 @@ impl BenchFirmware {
         (c - self.overhead_cycles, Self::angles(&answer))
     }
 
+    /// One float primitive `op(a, b)` of the firmware's table: cycles (overhead removed) and
+    /// the result.
+    pub fn primitive(&mut self, op: u8, a: f32, b: f32) -> (u64, f32) {
+        let mut req = vec![b'F', op];
+        req.extend(a.to_le_bytes());
+        req.extend(b.to_le_bytes());
+        let (c, answer) = self.timed(&req, 6);
+        assert_eq!(&answer[..2], b"f\0", "firmware lacks primitive {op}");
+        (
+            c - self.overhead_cycles,
+            f32::from_le_bytes([answer[2], answer[3], answer[4], answer[5]]),
+        )
+    }
+
     /// Static SRAM and the stack high-water mark, bytes.
     pub fn memory(&mut self) -> (u16, u16) {
         self.emu.write(b"S");
@@ -509,9 +527,40 @@ pub struct Summary {
     pub max_stack_bytes: u64,
 }
 
+/// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
+pub const PRIMITIVES: [&str; 12] = [
+    "add",
+    "mul",
+    "div",
+    "sqrt",
+    "atan2",
+    "sin",
+    "cos",
+    "lt",
+    "Fast::atan2",
+    "Fast::sin_cos",
+    "rotation matrix",
+    "feet in hips",
+];
+
+/// Mean cycles of primitive `op` over a few arguments.
+pub fn primitive_cycles(fw: &mut BenchFirmware, op: u8) -> f64 {
+    let args = [
+        (0.3f32, 0.2f32),
+        (0.4, -0.2),
+        (-0.05, 0.3),
+        (0.21, 0.11),
+        (-0.4, 0.35),
+    ];
+    let total: u64 = args.iter().map(|&(a, b)| fw.primitive(op, a, b).0).sum();
+    total as f64 / args.len() as f64
+}
+
 /// Everything one run measured.
 #[derive(Debug, Clone)]
 pub struct Report {
+    /// Mean cycles of each primitive: (name, `bench.elf`, `bench-libm.elf` when it has it).
+    pub primitives: Vec<(&'static str, f64, Option<f64>)>,
     /// Per backend and ELF.
     pub backends: Vec<BackendFigures>,
     /// Stack high-water mark of `bench.elf` after all its solves, bytes.
@@ -529,7 +578,12 @@ pub fn run() -> Report {
 
     let mut fw = BenchFirmware::boot(&bench_elf);
     let mut backends = Vec::new();
-    for b in [Backend::AvrLibm, Backend::Fast, Backend::Libm] {
+    for b in [
+        Backend::AvrLibm,
+        Backend::Fast,
+        Backend::Libm,
+        Backend::AvrFast,
+    ] {
         backends.push(measure_backend(&mut fw, b, "bench.elf", &targets));
     }
     let (_, bench_stack_bytes) = fw.memory();
@@ -537,7 +591,19 @@ pub fn run() -> Report {
     let libm = measure_backend(&mut fw_libm, Backend::Libm, "bench-libm.elf", &targets);
     backends.push(libm.clone());
 
-    let chosen = &backends[FIRMWARE_BACKEND as usize];
+    let primitives = PRIMITIVES
+        .iter()
+        .enumerate()
+        .map(|(op, &name)| {
+            let op = op as u8;
+            let libm = (op < 5).then(|| primitive_cycles(&mut fw_libm, op));
+            (name, primitive_cycles(&mut fw, op), libm)
+        })
+        .collect();
+    let chosen = backends
+        .iter()
+        .find(|b| b.name.starts_with(FIRMWARE_BACKEND.name()))
+        .expect("the firmware's backend was measured");
     let sizes = elf_sizes(&firmware);
     let (static_reported, stack) = firmware_memory(&firmware, &targets.poses[..4]);
     assert_eq!(
@@ -557,5 +623,6 @@ pub fn run() -> Report {
         },
         backends,
         bench_stack_bytes,
+        primitives,
     }
 }

@@ -18,6 +18,8 @@
 //! program (`RUSTUP_TOOLCHAIN`): each directory's `rust-toolchain.toml` decides, as it does for
 //! a developer typing the same command.
 
+mod avr_bench;
+
 use std::env;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -255,12 +257,13 @@ fn ci(args: &[String]) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-const USAGE: &str = "usage: cargo xtask ci [--list | STEP...]";
+const USAGE: &str = "usage: cargo xtask ci [--list | STEP...] | cargo xtask avr-bench";
 
 fn main() -> ExitCode {
     let args: Vec<String> = env::args().skip(1).collect();
     match args.split_first() {
         Some((cmd, rest)) if cmd == "ci" => ci(rest),
+        Some((cmd, rest)) if cmd == "avr-bench" => avr_bench::run(&workspace_root(), rest),
         Some((cmd, _)) if cmd == "-h" || cmd == "--help" => {
             println!("{USAGE}");
             ExitCode::SUCCESS

@@ -1,20 +1,22 @@
 //! Cycle benchmark on avr-libc's float routines (see `firmware_avr::bench`).
 //!
 //! Backends: 0 = `AvrLibm` (avr-libc math), 1 = kin-core `Fast` (polynomials), 2 = kin-core
-//! `Libm` (Rust libm), all on avr-libc's float primitives (`__mulsf3`, …).
+//! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`/`atan2`, kin-core `Fast::sin_cos`), all
+//! on avr-libc's float primitives (`__mulsf3`, …).
 
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt)]
 
-use avr_libc_math::AvrLibm;
+use avr_libc_math::{AvrFast, AvrLibm};
 
 avr_libc_math::link_avr_libc!();
 use firmware_avr::bench::{self, Backend};
 use firmware_avr::usart::{self, Baud, Usart0};
 use kin_core::math::{Fast, Libm};
+use kin_core::{BodyConfig, Math, Pose, RotationOrder};
 
-static BACKENDS: [Backend; 3] = [
+static BACKENDS: [Backend; 4] = [
     Backend {
         id: 0,
         leg: bench::leg_with::<AvrLibm>,
@@ -30,6 +32,45 @@ static BACKENDS: [Backend; 3] = [
         leg: bench::leg_with::<Libm>,
         body: bench::body_with::<Libm>,
     },
+    Backend {
+        id: 3,
+        leg: bench::leg_with::<AvrFast>,
+        body: bench::body_with::<AvrFast>,
+    },
+];
+
+/// Primitives: 0 add, 1 mul, 2 div, 3 sqrt, 4 atan2, 5 sin, 6 cos, 7 less-than,
+/// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrLibm`:
+/// 10 the rotation matrix (roll = yaw = a, pitch = b), 11 the four feet in their hip frames
+/// (including the matrix).
+static PRIMS: [bench::PrimFn; 12] = [
+    |a, b| a + b,
+    |a, b| a * b,
+    |a, b| a / b,
+    |a, _| AvrLibm::sqrt(a),
+    |a, b| AvrLibm::atan2(a, b),
+    |a, _| AvrLibm::sin_cos(a).0,
+    |a, _| AvrLibm::sin_cos(a).1,
+    |a, b| if a < b { 1.0 } else { 0.0 },
+    |a, b| Fast::atan2(a, b),
+    |a, _| {
+        let (s, c) = Fast::sin_cos(a);
+        s + c
+    },
+    |a, b| {
+        let m = kin_core::rotation::matrix_with::<AvrLibm>(RotationOrder::Zyx, a, b, a);
+        core::hint::black_box(m).rows[0][0]
+    },
+    |a, b| {
+        let robot = core::hint::black_box(bench::ROBOT);
+        let feet = kin_core::body::feet_in_hips_with::<AvrLibm>(
+            &robot,
+            &Pose::rotation(a, b, a),
+            &BodyConfig::default(),
+            &robot.stance_feet(bench::STANCE_HEIGHT_M),
+        );
+        core::hint::black_box(feet)[0].x
+    },
 ];
 
 #[avr_device::entry]
@@ -39,7 +80,7 @@ fn main() -> ! {
     let mut usart = Usart0::new(dp.USART0, Baud::B1000000);
     // SAFETY: the handlers are defined below and touch only their own state.
     unsafe { avr_device::interrupt::enable() };
-    bench::serve(&mut usart, &dp.PORTA, &BACKENDS)
+    bench::serve(&mut usart, &dp.PORTA, &BACKENDS, &PRIMS)
 }
 
 #[avr_device::interrupt(atmega2560)]

@@ -8,12 +8,22 @@
 use firmware_avr::bench::{self, Backend};
 use firmware_avr::usart::{self, Baud, Usart0};
 use kin_core::math::Libm;
+use kin_core::Math;
 
 static BACKENDS: [Backend; 1] = [Backend {
     id: 2,
     leg: bench::leg_with::<Libm>,
     body: bench::body_with::<Libm>,
 }];
+
+/// Primitives (compiler-builtins and Rust libm): 0 add, 1 mul, 2 div, 3 sqrt, 4 atan2.
+static PRIMS: [bench::PrimFn; 5] = [
+    |a, b| a + b,
+    |a, b| a * b,
+    |a, b| a / b,
+    |a, _| Libm::sqrt(a),
+    |a, b| Libm::atan2(a, b),
+];
 
 #[avr_device::entry]
 fn main() -> ! {
@@ -22,7 +32,7 @@ fn main() -> ! {
     let mut usart = Usart0::new(dp.USART0, Baud::B1000000);
     // SAFETY: the handler is defined below and touches only its own state.
     unsafe { avr_device::interrupt::enable() };
-    bench::serve(&mut usart, &dp.PORTA, &BACKENDS)
+    bench::serve(&mut usart, &dp.PORTA, &BACKENDS, &PRIMS)
 }
 
 #[avr_device::interrupt(atmega2560)]

@@ -23,6 +23,14 @@ fn main() {
         );
     }
     println!(
+        "{:<16} {:>16} {:>18}",
+        "primitive", "bench.elf", "bench-libm.elf"
+    );
+    for (name, avr, libm) in &report.primitives {
+        let libm = libm.map_or_else(|| "-".to_string(), |c| format!("{c:.0}"));
+        println!("{name:<16} {avr:>16.0} {libm:>18}");
+    }
+    println!(
         "targets: {} body poses + {} leg targets (seed {:#x}); cycles at 16 MHz; bench.elf stack {} B",
         avr_bench::N_TARGETS,
         avr_bench::N_TARGETS,
