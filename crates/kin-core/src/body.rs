@@ -142,10 +142,14 @@ pub fn feet_in_hips_with<M: Math>(
     let r: Mat3 =
         rotation::matrix_with::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
     let offset = pose.translation() + config.pivot_m;
-    LegId::ALL.map(|leg| {
-        r.transpose_mul_vec(feet_in_world[leg.index()] - offset) + config.pivot_m
-            - robot.hip_in_body(leg)
-    })
+    // A plain loop rather than `LegId::ALL.map(..)`, whose closure the compiler may leave as a
+    // call per leg that returns through memory.
+    let mut out = [Vec3::ZERO; 4];
+    for (i, leg) in LegId::ALL.into_iter().enumerate() {
+        out[i] = r.transpose_mul_vec(feet_in_world[i] - offset) + config.pivot_m
+            - robot.hip_in_body(leg);
+    }
+    out
 }
 
 /// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
@@ -165,6 +169,16 @@ pub fn inverse_with<M: Math>(
         });
     }
     let local = feet_in_hips_with::<M>(robot, pose, config, feet_in_world);
+    if policy == ReachPolicy::Reject {
+        if let Some(angles) = leg::inverse_all_reject::<M>(robot, &local) {
+            return Ok(BodySolution {
+                legs: angles.map(|angles| LegSolution {
+                    angles,
+                    clamped: None,
+                }),
+            });
+        }
+    }
     let mut legs = [LegSolution {
         angles: JointAngles::default(),
         clamped: None,
@@ -226,4 +240,92 @@ pub fn forward(robot: &Robot, pose: &Pose, config: &BodyConfig, angles: &BodyAng
             + config.pivot_m
             + pose.translation()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::robot::KneeBend;
+
+    /// A tiny seeded generator for test inputs (SplitMix64), uniform in `[lo, hi)`.
+    struct Rng(u64);
+    impl Rng {
+        fn uniform(&mut self, lo: f32, hi: f32) -> f32 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^= z >> 31;
+            lo + (hi - lo) * ((z >> 40) as f32 / (1u64 << 24) as f32)
+        }
+    }
+
+    /// The four-leg fast path of the body IK (Reject) gives exactly the per-leg results, and
+    /// the same first error when a leg cannot reach.
+    #[test]
+    fn body_ik_equals_leg_by_leg_ik_bit_for_bit() {
+        let mut rng = Rng(7);
+        let (mut solved, mut rejected) = (0, 0);
+        for robot in [Robot::shahriar2023(), Robot::fernando2025()] {
+            for bend in [KneeBend::Backward, KneeBend::Forward] {
+                let robot = robot.with_knee_bend(bend);
+                let height_m = 0.75 * (robot.leg.femur_m + robot.leg.tibia_m);
+                for order in RotationOrder::ALL {
+                    for _ in 0..200 {
+                        let pose = Pose {
+                            roll_rad: rng.uniform(-0.6, 0.6),
+                            pitch_rad: rng.uniform(-0.6, 0.6),
+                            yaw_rad: rng.uniform(-0.6, 0.6),
+                            x_m: rng.uniform(-0.3, 0.3),
+                            y_m: rng.uniform(-0.3, 0.3),
+                            z_m: rng.uniform(-0.3, 0.3),
+                        };
+                        let config = BodyConfig {
+                            order,
+                            pivot_m: Vec3::new(rng.uniform(-0.1, 0.1), 0.0, rng.uniform(-0.1, 0.1)),
+                        };
+                        let feet = robot.stance_feet(height_m);
+                        let local = feet_in_hips_with::<DefaultMath>(&robot, &pose, &config, &feet);
+                        let one_by_one: Result<[LegSolution; 4], IkError> = (|| {
+                            let mut legs = [LegSolution {
+                                angles: JointAngles::default(),
+                                clamped: None,
+                            }; 4];
+                            for leg in LegId::ALL {
+                                legs[leg.index()] = leg::inverse(
+                                    &robot,
+                                    leg,
+                                    local[leg.index()],
+                                    ReachPolicy::Reject,
+                                )?;
+                            }
+                            Ok(legs)
+                        })(
+                        );
+                        let body = inverse(&robot, &pose, &config, &feet, ReachPolicy::Reject);
+                        match (body, one_by_one) {
+                            (Ok(b), Ok(l)) => {
+                                solved += 1;
+                                for (x, y) in b.legs.iter().zip(&l) {
+                                    assert_eq!(
+                                        x.angles.to_array().map(f32::to_bits),
+                                        y.angles.to_array().map(f32::to_bits)
+                                    );
+                                }
+                            }
+                            (Err(b), Err(l)) => {
+                                rejected += 1;
+                                assert_eq!(b, l);
+                            }
+                            (b, l) => panic!("body {b:?} vs legs {l:?}"),
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            solved > 1000 && rejected > 100,
+            "solved {solved}, rejected {rejected}"
+        );
+    }
 }

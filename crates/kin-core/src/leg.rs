@@ -239,6 +239,75 @@ struct Raw {
     angles: JointAngles,
 }
 
+/// Un-abducted depth of the foot: `w = −√(y² + z² − d_lat²)`, the branch with the foot below
+/// the hip (0 when the foot lies on the offset circle).
+#[inline(always)]
+fn depth<M: Math>(d2: f32, y: f32, z: f32) -> f32 {
+    let w_sq = y * y + z * z - d2;
+    -M::sqrt(if w_sq > 0.0 { w_sq } else { 0.0 })
+}
+
+/// a = angle(y, z) − angle(s·d_lat, w), as one atan2 of cross and dot.
+#[inline(always)]
+fn abduction_angle<M: Math>(sd: f32, y: f32, z: f32, w: f32) -> f32 {
+    M::atan2(sd * z - w * y, sd * y + w * z)
+}
+
+/// `((L1+L2)², (L1−L2)²)`: the squared reach limits of the two-link leg plane.
+#[inline(always)]
+fn reach2(g: &LegGeometry) -> (f32, f32) {
+    let (l1, l2) = (g.femur_m, g.tibia_m);
+    ((l1 + l2) * (l1 + l2), (l1 - l2) * (l1 - l2))
+}
+
+/// The law of cosines for the foot at `(u, v)` in the leg plane, relative to the hip-flexion
+/// joint, with `(L1−L2)² ≤ u² + v² ≤ (L1+L2)²` up to rounding (`moved`: after a projection).
+/// Returns `(D², c, s)` with `c = 2·L1·L2·cos k` and `s = 2·L1·L2·sin k`, for
+/// [`planar_angles`].
+#[inline(always)]
+fn planar_sides<M: Math>(
+    g: &LegGeometry,
+    bend: KneeBend,
+    u: f32,
+    v: f32,
+    moved: bool,
+) -> (f32, f32, f32) {
+    let (l1, l2) = (g.femur_m, g.tibia_m);
+    let (far2, near2) = reach2(g);
+    let dist2 = u * u + v * v;
+    // Scaled by 2·L1·L2 (no division; atan2 is scale-invariant): c = D² − L1² − L2², and
+    // s² = (D² − (L1−L2)²)·((L1+L2)² − D²), the factored form that stays accurate near a
+    // folded or straight knee, where (2·L1·L2)² − c² loses the digits that set the foot's
+    // distance.
+    let two_l1l2 = 2.0 * l1 * l2;
+    let mut c = dist2 - (l1 * l1 + l2 * l2);
+    // Only rounding can push a projected point past ±2·L1·L2 here.
+    if moved {
+        c = c.clamp(-two_l1l2, two_l1l2);
+    }
+    let s_sq = (dist2 - near2) * (far2 - dist2);
+    let s_abs = M::sqrt(if s_sq > 0.0 { s_sq } else { 0.0 });
+    let s = match bend {
+        KneeBend::Backward => -s_abs,
+        KneeBend::Forward => s_abs,
+    };
+    (dist2, c, s)
+}
+
+/// `(hip, knee)` from [`planar_sides`].
+#[inline(always)]
+fn planar_angles<M: Math>(g: &LegGeometry, u: f32, v: f32, sides: (f32, f32, f32)) -> (f32, f32) {
+    let (l1, l2) = (g.femur_m, g.tibia_m);
+    let (dist2, c, s) = sides;
+    let knee = M::atan2(s, c);
+    // hip = angle(−v, −u) − angle(L1 + L2·cos k, L2·sin k), the second vector scaled by 2·L1:
+    // (D² + L1² − L2², s).
+    let (bx, by) = (dist2 + (l1 * l1 - l2 * l2), s);
+    let (ax, ay) = (-v, -u);
+    let hip = M::atan2(bx * ay - by * ax, bx * ax + by * ay);
+    (hip, knee)
+}
+
 /// Solves the abduction and planar problem exactly for a point known to be reachable (after
 /// optional projection). Returns the angles and the foot actually reached when projecting.
 #[inline]
@@ -272,18 +341,14 @@ fn solve<M: Math>(
             z = 0.0;
         }
     }
-    // Un-abducted foot below the hip: w = −√(y² + z² − d_lat²).
-    let w_sq = y * y + z * z - d2;
-    let w = -M::sqrt(if w_sq > 0.0 { w_sq } else { 0.0 });
-    // a = angle(y, z) − angle(s·d_lat, w), as one atan2 of cross and dot.
-    let abduction = M::atan2(sd * z - w * y, sd * y + w * z);
+    let w = depth::<M>(d2, y, z);
+    let abduction = abduction_angle::<M>(sd, y, z, w);
 
     // Planar two-link problem from the hip-flexion joint: (u, v) = (x, w + d_ax).
     let mut u = target.x;
     let mut v = w + g.d_ax_m;
     let dist2 = u * u + v * v;
-    let far2 = (l1 + l2) * (l1 + l2);
-    let near2 = (l1 - l2) * (l1 - l2);
+    let (far2, near2) = reach2(g);
     let planar_fault = if dist2 > far2 {
         Some((Unreachable::TooFar, l1 + l2))
     } else if dist2 < near2 {
@@ -308,30 +373,8 @@ fn solve<M: Math>(
             v = -radius;
         }
     }
-    let dist2 = u * u + v * v;
-    // Law of cosines scaled by 2·L1·L2 (no division; atan2 is scale-invariant):
-    // c = 2·L1·L2·cos k = D² − L1² − L2², s = 2·L1·L2·sin k with
-    // s² = (D² − (L1−L2)²)·((L1+L2)² − D²), the factored form that stays accurate near a
-    // folded or straight knee, where (2·L1·L2)² − c² loses the digits that set the foot's
-    // distance.
-    let two_l1l2 = 2.0 * l1 * l2;
-    let mut c = dist2 - (l1 * l1 + l2 * l2);
-    // Only rounding can push a projected point past ±2·L1·L2 here.
-    if moved {
-        c = c.clamp(-two_l1l2, two_l1l2);
-    }
-    let s_sq = (dist2 - near2) * (far2 - dist2);
-    let s_abs = M::sqrt(if s_sq > 0.0 { s_sq } else { 0.0 });
-    let s = match bend {
-        KneeBend::Backward => -s_abs,
-        KneeBend::Forward => s_abs,
-    };
-    let knee = M::atan2(s, c);
-    // hip = angle(−v, −u) − angle(L1 + L2·cos k, L2·sin k), the second vector scaled by 2·L1:
-    // (D² + L1² − L2², s).
-    let (bx, by) = (dist2 + (l1 * l1 - l2 * l2), s);
-    let (ax, ay) = (-v, -u);
-    let hip = M::atan2(bx * ay - by * ax, bx * ax + by * ay);
+    let sides = planar_sides::<M>(g, bend, u, v, moved);
+    let (hip, knee) = planar_angles::<M>(g, u, v, sides);
 
     let raw = Raw {
         angles: JointAngles::new(abduction, hip, knee),
@@ -443,4 +486,64 @@ pub fn inverse(
     policy: ReachPolicy,
 ) -> Result<LegSolution, IkError> {
     inverse_with::<DefaultMath>(robot, leg, foot_in_hip, policy)
+}
+
+/// The four legs of [`LegId::ALL`] at once under [`ReachPolicy::Reject`], for the full-body
+/// IK: the arithmetic of [`inverse_with`] leg by leg (bit-identical results), written lane by
+/// lane so that the four independent solves interleave instead of running one after the
+/// other. `None` when any leg is not cleanly solvable (non-finite input, outside the
+/// workspace, beyond a joint limit): the caller then solves the legs in order to name the
+/// first failure.
+#[inline]
+pub(crate) fn inverse_all_reject<M: Math>(
+    robot: &Robot,
+    feet_in_hip: &[Vec3; 4],
+) -> Option<[JointAngles; 4]> {
+    let g = &robot.leg;
+    let d2 = g.d_lat_m * g.d_lat_m;
+    let (far2, near2) = reach2(g);
+    let mut ok = true;
+    // One plain array per quantity (not arrays of structs), which the compiler keeps in
+    // registers.
+    let mut w = [0.0f32; 4];
+    let mut abduction = [0.0f32; 4];
+    let mut dist2 = [0.0f32; 4];
+    let mut c = [0.0f32; 4];
+    let mut s = [0.0f32; 4];
+    for (i, p) in feet_in_hip.iter().enumerate() {
+        // Non-short-circuit `&` and float arithmetic: no branch per lane. `q·0` is ±0 for a
+        // finite q and NaN otherwise.
+        let finite = p.x * 0.0 + p.y * 0.0 + p.z * 0.0 == 0.0;
+        ok &= finite & !(p.y * p.y + p.z * p.z < d2);
+        w[i] = depth::<M>(d2, p.y, p.z);
+    }
+    for (i, p) in feet_in_hip.iter().enumerate() {
+        let sd = LegId::ALL[i].side() * g.d_lat_m;
+        abduction[i] = abduction_angle::<M>(sd, p.y, p.z, w[i]);
+        let v = w[i] + g.d_ax_m;
+        let d = p.x * p.x + v * v;
+        ok &= !(d > far2) & !(d < near2);
+    }
+    // Stage by stage across the legs (square roots, then angles), so that the independent
+    // dependency chains sit next to each other in the instruction stream.
+    for (i, p) in feet_in_hip.iter().enumerate() {
+        (dist2[i], c[i], s[i]) = planar_sides::<M>(g, robot.knee_bend, p.x, w[i] + g.d_ax_m, false);
+    }
+    let mut out = [JointAngles::default(); 4];
+    for (i, p) in feet_in_hip.iter().enumerate() {
+        let (hip, knee) = planar_angles::<M>(g, p.x, w[i] + g.d_ax_m, (dist2[i], c[i], s[i]));
+        out[i] = JointAngles::new(abduction[i], hip, knee);
+    }
+    // Within the limits (a NaN fails every comparison, so this also rejects non-finite angles).
+    let (lo, hi) = (&robot.limits.min_rad, &robot.limits.max_rad);
+    for a in &out {
+        let a = a.to_array();
+        ok &= (a[0] >= lo[0]) & (a[0] <= hi[0]) & (a[1] >= lo[1]) & (a[1] <= hi[1]);
+        ok &= (a[2] >= lo[2]) & (a[2] <= hi[2]);
+    }
+    if ok {
+        Some(out)
+    } else {
+        None
+    }
 }
