@@ -24,6 +24,8 @@ enum Command {
     Pose(cmd::pose::Args),
     Motion(cmd::motion::Args),
     Check(cmd::check::Args),
+    Plot(cmd::plot::Args),
+    Accuracy(cmd::accuracy::Args),
     Stream(cmd::stream::Args),
     Calibrate(cmd::calibrate::Args),
 }
@@ -41,6 +43,8 @@ fn main() -> ExitCode {
         }
         Command::Motion(args) => cmd::motion::run(&args),
         Command::Check(args) => cmd::check::run(&args),
+        Command::Plot(args) => cmd::plot::run(&args),
+        Command::Accuracy(args) => cmd::accuracy::run(&args),
         Command::Stream(args) => cmd::stream::main(&args),
         Command::Calibrate(args) => cmd::calibrate::main(&args),
     }

@@ -172,6 +172,60 @@ impl JointSeries {
     }
 }
 
+/// Keeps the elements at even indices.
+fn every_other<T>(v: &mut Vec<T>) {
+    let mut i = 0usize;
+    v.retain(|_| {
+        i += 1;
+        i % 2 == 1
+    });
+}
+
+/// Builds a [`JointSeries`] of at most `2·MAX_POINTS` samples from a stream of unknown length:
+/// keeps every `stride`-th sample and doubles the stride (dropping every other kept sample)
+/// whenever the series fills up.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Decimator {
+    series: JointSeries,
+    stride: u64,
+    seen: u64,
+    last: Option<(f64, Option<[f32; 12]>)>,
+}
+
+impl Decimator {
+    /// An empty decimator.
+    pub fn new() -> Decimator {
+        Decimator {
+            stride: 1,
+            ..Decimator::default()
+        }
+    }
+
+    /// Offers one sample.
+    pub fn push(&mut self, t_s: f64, angles: Option<[f32; 12]>) {
+        if self.seen % self.stride == 0 {
+            self.series.push(t_s, angles);
+            if self.series.t_s.len() >= 2 * MAX_POINTS {
+                every_other(&mut self.series.t_s);
+                every_other(&mut self.series.angles);
+                self.stride *= 2;
+            }
+            self.last = None;
+        } else {
+            self.last = Some((t_s, angles));
+        }
+        self.seen += 1;
+    }
+
+    /// The series, ending with the last sample offered.
+    pub fn finish(mut self) -> JointSeries {
+        if let Some((t, a)) = self.last {
+            self.series.push(t, a);
+        }
+        self.series
+    }
+}
+
 /// Every `step`-th index so that at most [`MAX_POINTS`] remain, plus the last.
 fn decimated(n: usize) -> Vec<usize> {
     let step = n.div_ceil(MAX_POINTS).max(1);
@@ -544,6 +598,20 @@ mod tests {
         let d = decimated(3_600_001);
         assert!(d.len() <= MAX_POINTS + 1);
         assert_eq!(*d.last().unwrap(), 3_600_000);
+    }
+
+    #[test]
+    fn the_decimator_bounds_the_series_and_keeps_the_ends() {
+        let mut d = Decimator::new();
+        for k in 0..1_000_003u32 {
+            d.push(f64::from(k), None);
+        }
+        let s = d.finish();
+        assert!(s.t_s.len() <= 2 * MAX_POINTS + 1, "{}", s.t_s.len());
+        assert!(s.t_s.len() >= MAX_POINTS);
+        assert_eq!(s.t_s[0], 0.0);
+        assert_eq!(*s.t_s.last().unwrap(), 1_000_002.0);
+        assert!(s.t_s.windows(2).all(|w| w[0] < w[1]));
     }
 
     #[test]

@@ -4,11 +4,13 @@
 //! A new subcommand is a module here with an `Args` struct (`clap::Args`) and a `run` function,
 //! plus one variant in `main.rs`.
 
+pub mod accuracy;
 pub mod calibrate;
 pub mod check;
 pub mod fk;
 pub mod ik;
 pub mod motion;
+pub mod plot;
 pub mod pose;
 pub mod stream;
 
