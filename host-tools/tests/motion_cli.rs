@@ -514,3 +514,45 @@ fn gaits_and_the_seed000_rectangle_run_clean() {
         assert!(rows.iter().all(|row| row[col(&h, "status")] == "ok"));
     }
 }
+
+#[test]
+fn check_reads_angle_only_files_and_their_status() {
+    let dir = scratch("angles");
+    let file = dir.join("angles.csv");
+    let mut text = String::from("t_s");
+    for l in ["FL", "FR", "RL", "RR"] {
+        for j in ["abduction", "hip", "knee"] {
+            text += &format!(",{l}_{j}_rad");
+        }
+    }
+    text += ",status\n";
+    let q = "0,0.5235988,-1.0471976";
+    for k in 0..5 {
+        let t = k as f32 * 0.1;
+        if k == 3 {
+            text += &format!("{t}{},RL:too_far\n", ",".repeat(12));
+        } else {
+            text += &format!("{t},{q},{q},{q},{q},ok\n");
+        }
+    }
+    std::fs::write(&file, &text).unwrap();
+    let r = quadctl(&[
+        "check",
+        file.to_str().unwrap(),
+        "--robot",
+        "fernando2025",
+        "--json",
+    ]);
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    let json: serde_json::Value = serde_json::from_str(r.stdout.lines().last().unwrap()).unwrap();
+    let f = &json["report"]["first_failure"];
+    assert_eq!(f["leg"], "RL");
+    assert_eq!(f["sample"], 3);
+    assert_eq!(f["kind"]["Unreachable"], "TooFar");
+    // A reason that cannot be told is refused, naming the line.
+    std::fs::write(&file, text.replace("RL:too_far", "RL:joint_limit")).unwrap();
+    let r = quadctl(&["check", file.to_str().unwrap(), "--robot", "fernando2025"]);
+    assert_eq!(r.code, 2);
+    assert!(r.stderr.contains("angles.csv:5"), "{}", r.stderr);
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -85,14 +85,24 @@ fn speed_limits(s: &str) -> Result<[f32; 3], Error> {
     }
 }
 
-fn unreachable_code(code: &str) -> Unreachable {
-    match code {
+/// The reason of a status cell (`too_far`, …, `joint_limit (knee)`); `None` when it cannot be
+/// told (a `joint_limit` without its joint, or an unknown code).
+fn unreachable_code(code: &str) -> Option<Unreachable> {
+    let code = code.trim();
+    Some(match code {
         "too_far" => Unreachable::TooFar,
         "too_close" => Unreachable::TooClose,
         "inside_offset" => Unreachable::InsideOffset,
-        "joint_limit" => Unreachable::JointLimit(Joint::Abduction),
-        _ => Unreachable::NonFinite,
-    }
+        "non_finite" => Unreachable::NonFinite,
+        other => {
+            let joint = other
+                .strip_prefix("joint_limit")?
+                .trim()
+                .strip_prefix('(')?
+                .strip_suffix(')')?;
+            Unreachable::JointLimit(Joint::ALL.into_iter().find(|j| j.name() == joint.trim())?)
+        }
+    })
 }
 
 /// What was checked, for the header and the JSON.
@@ -225,10 +235,23 @@ fn check_file(args: &Args, file: &Path, limits: [f32; 3]) -> Result<(Report, Sou
                 c.push_angles(t, &q);
             }
             _ => {
-                // "FR:too_far": the leg and reason as `quadctl motion` wrote them.
-                let (leg, code) = row.status.split_once(':').unwrap_or(("FL", "non_finite"));
-                let leg = LegId::parse(leg).unwrap_or(LegId::FL);
-                c.push_unreachable(t, &[(leg, unreachable_code(code))]);
+                // "FR:too_far": the leg and reason as `quadctl motion` wrote them. Without the
+                // feet and pose the sample cannot be solved again, so the reason must be known.
+                let parsed = row
+                    .status
+                    .split_once(':')
+                    .and_then(|(leg, code)| Some((LegId::parse(leg)?, unreachable_code(code)?)));
+                let Some(failure) = parsed else {
+                    return Err(Error::Csv {
+                        at: format!("{}:{}", file.display(), row.line),
+                        message: format!(
+                            "status `{}` without angles, feet and pose: expected `<leg>:<reason>` \
+                             (too_far, too_close, inside_offset, non_finite, joint_limit (<joint>))",
+                            row.status
+                        ),
+                    });
+                };
+                c.push_unreachable(t, &[failure]);
             }
         }
     }
@@ -354,6 +377,17 @@ fn table(r: &Report, s: &Source) -> String {
 mod tests {
     use super::*;
     use kin_core::preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S;
+
+    #[test]
+    fn status_reasons_parse_or_are_refused() {
+        assert_eq!(unreachable_code("too_far"), Some(Unreachable::TooFar));
+        assert_eq!(
+            unreachable_code("joint_limit (knee)"),
+            Some(Unreachable::JointLimit(Joint::Knee))
+        );
+        assert_eq!(unreachable_code("joint_limit"), None);
+        assert_eq!(unreachable_code("tired"), None);
+    }
 
     #[test]
     fn the_default_speed_limit_is_kin_cores() {
