@@ -13,6 +13,11 @@
 //! [`PathKind`] (stride = their distance, apex = the step height). For
 //! a straight command (`ω = 0`) the stance is the paths' linear stance and the Bézier swing
 //! joins it with C1 continuity.
+//!
+//! Precision: the world coordinates are f32. A straight command moves the body away from the
+//! origin without bound, and the resolution of the feet in the world (hence of the IK input
+//! `foot − body`) degrades with the distance: about 60 µm at 700 m (one hour at 0.2 m/s). A
+//! turning command keeps the body on a circle.
 
 use super::path::{AnyPath, FootPath, PathKind, Stride};
 use super::{
