@@ -132,13 +132,14 @@ impl Math for Fast {
         let k = (x * INV_FRAC_PI_2 + ROUND) - ROUND;
         let r = (x - k * PIO2_HI) - k * PIO2_LO;
         let r2 = r * r;
+        let r4 = r2 * r2;
         // Minimax on [-π/4, π/4] (scripts/fit_polynomials.py): error < 1e-9 before rounding.
+        // Estrin's scheme: (a + b·r²) + r⁴·((c + d·r²) + e·r⁴), a short dependency chain.
         let s = r
-            * (1.0
-                + r2 * (-1.666_666_6e-1
-                    + r2 * (8.333_326e-3 + r2 * (-1.983_867_2e-4 + r2 * 2.713_535_5e-6))));
+            * ((1.0 - 1.666_666_6e-1 * r2)
+                + r4 * ((8.333_326e-3 - 1.983_867_2e-4 * r2) + 2.713_535_5e-6 * r4));
         let c =
-            1.0 + r2 * (-0.5 + r2 * (4.166_661_6e-2 + r2 * (-1.388_662e-3 + r2 * 2.437_992_8e-5)));
+            (1.0 - 0.5 * r2) + r4 * ((4.166_661_6e-2 - 1.388_662e-3 * r2) + 2.437_992_8e-5 * r4);
         let q = (k as i32) & 3;
         match q {
             0 => (s, c),
