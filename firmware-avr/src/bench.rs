@@ -109,12 +109,7 @@ fn marker(porta: &pac::PORTA, high: bool) {
 
 /// Serves benchmark requests forever (see the module docs). Interrupts must be enabled (the
 /// receiver is interrupt-driven).
-pub fn serve(
-    usart: &mut Usart0,
-    porta: &pac::PORTA,
-    backends: &[Backend],
-    prims: &[PrimFn],
-) -> ! {
+pub fn serve(usart: &mut Usart0, porta: &pac::PORTA, backends: &[Backend], prims: &[PrimFn]) -> ! {
     // SAFETY: any DDRA value is valid; PA0 becomes an output, low.
     marker(porta, false);
     porta
