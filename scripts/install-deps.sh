@@ -15,6 +15,7 @@ APT_PACKAGES=(
     libelf-dev libclang-dev libzstd-dev zlib1g-dev pkg-config make
     simavr
     libudev-dev
+    fonts-dejavu-core
 )
 NIGHTLY=nightly
 STABLE_COMPONENTS=(clippy rustfmt)

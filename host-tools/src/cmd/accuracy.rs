@@ -386,8 +386,8 @@ mod tests {
             })
             .collect();
         let a = accuracy(&pairs).unwrap();
-        for j in 0..3 {
-            assert!((a.deviation_pct[j] - d[j]).abs() < 1e-9);
+        for (got, want) in a.deviation_pct.iter().zip(d) {
+            assert!((got - want).abs() < 1e-9);
         }
         assert!((a.rsse_pct - 21.3037).abs() < 1e-4, "{}", a.rsse_pct);
         assert_eq!(format!("{:.2}", a.rsse_pct), "21.30");
