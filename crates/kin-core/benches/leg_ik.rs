@@ -143,25 +143,20 @@ fn leg_ik(c: &mut Criterion) {
     group.bench_function("kin_core", |b| {
         let mut i = 0;
         b.iter(|| {
-            let (r, leg, p) = inputs[i];
+            let (r, leg, p) = *black_box(&inputs[i]);
             i = if i + 1 == n { 0 } else { i + 1 };
-            black_box(leg::inverse(
-                &robots[r],
-                leg,
-                black_box(p),
-                ReachPolicy::Reject,
-            ))
+            black_box(leg::inverse(&robots[r], leg, p, ReachPolicy::Reject))
         });
     });
     group.bench_function("kin_core_libm", |b| {
         let mut i = 0;
         b.iter(|| {
-            let (r, leg, p) = inputs[i];
+            let (r, leg, p) = *black_box(&inputs[i]);
             i = if i + 1 == n { 0 } else { i + 1 };
             black_box(leg::inverse_with::<Libm>(
                 &robots[r],
                 leg,
-                black_box(p),
+                p,
                 ReachPolicy::Reject,
             ))
         });
