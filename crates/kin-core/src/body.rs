@@ -169,6 +169,10 @@ pub fn inverse_with<M: Math>(
         });
     }
     let local = feet_in_hips_with::<M>(robot, pose, config, feet_in_world);
+    // Hosts run the four legs interleaved (out-of-order CPUs overlap their dependency chains);
+    // the in-order AVR would gain nothing and carry a second copy of the leg solver (≈ 4 KB
+    // of flash), so it solves them one by one (the same results, bit for bit).
+    #[cfg(not(target_arch = "avr"))]
     if policy == ReachPolicy::Reject {
         if let Some(angles) = leg::inverse_all_reject::<M>(robot, &local) {
             return Ok(BodySolution {

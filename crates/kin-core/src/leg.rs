@@ -494,6 +494,7 @@ pub fn inverse(
 /// other. `None` when any leg is not cleanly solvable (non-finite input, outside the
 /// workspace, beyond a joint limit): the caller then solves the legs in order to name the
 /// first failure.
+#[cfg(not(target_arch = "avr"))]
 #[inline]
 pub(crate) fn inverse_all_reject<M: Math>(
     robot: &Robot,
