@@ -2,8 +2,8 @@
 """Fits the polynomial coefficients of kin-core's `Fast` math backend.
 
 Lawson's iteratively re-weighted least squares converges to the minimax (equi-ripple) fit.
-Prints each fit's coefficients and its maximum error in f64 and when evaluated in f32 Horner
-form. Needs numpy. Run: python3 scripts/fit_polynomials.py
+Prints each fit's coefficients (rounded to f32) and its maximum error in f64; the error of the
+f32 evaluation is checked by kin-core's unit tests (`math::tests`). Needs numpy. Run: python3 scripts/fit_polynomials.py
 """
 import numpy as np
 
@@ -24,14 +24,20 @@ def lawson(f, powers, a, b, iters=300):
 
 
 def main():
-    # atan(t), t in [0, 1], odd degree 15 (fit on [-1, 1] for symmetry).
-    c, err = lawson(np.arctan, [1, 3, 5, 7, 9, 11, 13, 15], -1.0, 1.0)
-    print("atan  ", [float(np.float32(x)) for x in c], "max err", err)
+    # atan(t), t in [0, 1], odd polynomials (fit on [-1, 1] for symmetry): degree 15 for the
+    # hosts' `Fast` backend (math::poly::atan2_deg15), degree 9 for in-order targets such as
+    # the ATmega2560 (math::poly::atan2_deg9).
+    for degree in (15, 9):
+        c, err = lawson(np.arctan, list(range(1, degree + 1, 2)), -1.0, 1.0)
+        print(f"atan deg {degree:2}", [float(np.float32(x)) for x in c], "max err", err)
     q = np.pi / 4
-    c, err = lawson(np.sin, [1, 3, 5, 7, 9], -q, q)
-    print("sin   ", [float(np.float32(x)) for x in c], "max err", err)
-    c, err = lawson(np.cos, [0, 2, 4, 6, 8], -q, q)
-    print("cos   ", [float(np.float32(x)) for x in c], "max err", err)
+    # sin/cos on the reduced range [-pi/4, pi/4]: degree 9/8 (math::poly::sin_cos_deg9) and
+    # degree 5/6 (math::poly::sin_cos_deg5).
+    for sin_powers, cos_powers in (([1, 3, 5, 7, 9], [0, 2, 4, 6, 8]), ([1, 3, 5], [0, 2, 4, 6])):
+        c, err = lawson(np.sin, sin_powers, -q, q)
+        print(f"sin deg {sin_powers[-1]}", [float(np.float32(x)) for x in c], "max err", err)
+        c, err = lawson(np.cos, cos_powers, -q, q)
+        print(f"cos deg {cos_powers[-1]}", [float(np.float32(x)) for x in c], "max err", err)
 
 
 if __name__ == "__main__":

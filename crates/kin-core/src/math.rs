@@ -7,15 +7,18 @@
 //! - [`Fast`] (the default, [`DefaultMath`]): minimax polynomials for `atan2` and `sin`/`cos`
 //!   (absolute error ≤ 3e-7 rad, about one f32 ulp at π; see the tests), `libm` for `sqrt`.
 //!   `atan2` is branch-free (random quadrants cost no mispredictions) and its polynomial is
-//!   evaluated in Estrin's scheme (a short dependency chain); quick on hosts with hardware
+//!   evaluated in Estrin's scheme (a short dependency chain); [`Math::atan2_3`] evaluates the
+//!   three arctangents of a leg together in four SIMD lanes. Quick on hosts with hardware
 //!   floating point. See `BENCHMARKS.md`.
 //! - [`Libm`]: the `libm` crate's correctly rounded-ish `atan2f`, `sinf`, `cosf`, `sqrtf`.
 //!   The reference the others are tested against.
-//! - Firmware may implement [`Math`] itself, e.g. on top of avr-libc's hand-written assembly.
+//! - Firmware may implement [`Math`] itself, e.g. on top of avr-libc's hand-written assembly,
+//!   and pick among the kernels of [`poly`] (the ATmega2560's backend uses
+//!   [`poly::atan2_deg9`] and [`poly::sin_cos_deg5`], which cost fewer software-float
+//!   operations).
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
-//! minimax fit); they are constants, not tables (the one table is `atan2`'s four quadrant
-//! offsets, 16 bytes).
+//! minimax fit); they are constants, not tables.
 
 /// The few scalar functions the kinematics needs. All angles are in radians.
 pub trait Math {
@@ -25,6 +28,18 @@ pub trait Math {
     fn atan2(y: f32, x: f32) -> f32;
     /// `(sin x, cos x)`.
     fn sin_cos(x: f32) -> (f32, f32);
+    /// Three independent arctangents `[atan2(y[0], x[0]), atan2(y[1], x[1]),
+    /// atan2(y[2], x[2])]` (a leg's abduction, knee and hip). A backend may evaluate them
+    /// together, but must return exactly what three [`Math::atan2`] calls return. The default
+    /// makes the three calls.
+    #[inline]
+    fn atan2_3(y: [f32; 3], x: [f32; 3]) -> [f32; 3] {
+        [
+            Self::atan2(y[0], x[0]),
+            Self::atan2(y[1], x[1]),
+            Self::atan2(y[2], x[2]),
+        ]
+    }
 }
 
 /// The backend used by the convenience functions of this crate.
@@ -49,43 +64,11 @@ impl Math for Libm {
     }
 }
 
-/// Polynomial backend: `atan2` from an odd degree-15 minimax polynomial on `[0, 1]` and
-/// `sin`/`cos` from degree-7/8 polynomials after a Cody–Waite reduction to `[-π/4, π/4]`.
+/// Polynomial backend for hosts: [`poly::atan2_deg15`] (three at once with
+/// [`poly::atan2_deg15_x4`]), [`poly::sin_cos_deg9`], `libm` for `sqrt` (one instruction on
+/// hosts).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Fast;
-
-const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
-const PI: f32 = core::f32::consts::PI;
-
-/// atan(t) ≈ t·P(t²) on [0, 1]; fit by `scripts/fit_polynomials.py`.
-const ATAN_COEFFS: [f32; 8] = [
-    0.999_999_34,
-    -0.333_298_6,
-    0.199_465_66,
-    -0.139_086_29,
-    0.096_421_95,
-    -0.055_912_29,
-    0.021_862_93,
-    -0.004_054_559,
-];
-
-/// atan(t) ≈ t·P(t²) on [0, 1], with P evaluated in Estrin's scheme: the same
-/// coefficients as Horner's rule but three multiply–add levels deep instead of seven, which
-/// shortens the dependency chain of the IK.
-#[inline]
-fn atan_unit(t: f32) -> f32 {
-    let c = &ATAN_COEFFS;
-    let s = t * t;
-    let s2 = s * s;
-    let s4 = s2 * s2;
-    let p01 = c[0] + c[1] * s;
-    let p23 = c[2] + c[3] * s;
-    let p45 = c[4] + c[5] * s;
-    let p67 = c[6] + c[7] * s;
-    let q0 = p01 + p23 * s2;
-    let q1 = p45 + p67 * s2;
-    (q0 + q1 * s4) * t
-}
 
 impl Math for Fast {
     #[inline]
@@ -93,15 +76,112 @@ impl Math for Fast {
         libm::sqrtf(x)
     }
 
-    /// Branch-free: the octant is folded into an offset and a sign chosen next to the
-    /// division, so random quadrants cost no mispredicted branches.
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
-        const SIGN: u32 = 0x8000_0000;
+        poly::atan2_deg15(y, x)
+    }
+
+    #[inline]
+    fn sin_cos(x: f32) -> (f32, f32) {
+        poly::sin_cos_deg9(x)
+    }
+
+    /// The three arctangents in four lanes of [`poly::atan2_deg15_x4`] (one SIMD division,
+    /// one polynomial), bit for bit what three [`Fast::atan2`] calls return.
+    #[inline]
+    fn atan2_3(y: [f32; 3], x: [f32; 3]) -> [f32; 3] {
+        let r = poly::atan2_deg15_x4([y[0], y[1], y[2], 0.0], [x[0], x[1], x[2], 1.0]);
+        [r[0], r[1], r[2]]
+    }
+}
+
+const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
+const PI: f32 = core::f32::consts::PI;
+
+/// The polynomial kernels behind [`Fast`], and cheaper ones for targets without hardware
+/// floating point, for a firmware's own [`Math`] backend to pick from.
+///
+/// | kernel | max abs error (tests) | suits |
+/// |---|---|---|
+/// | [`atan2_deg15`], [`atan2_deg15_x4`] | 3e-7 rad | hosts: branch-free, Estrin, 4 SIMD lanes |
+/// | [`atan2_deg9`] | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
+/// | [`sin_cos_deg9`] | 2e-7 | hosts: branch-free |
+/// | [`sin_cos_deg5`] | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
+pub mod poly {
+    use super::{FRAC_PI_2, PI};
+
+    const SIGN: u32 = 0x8000_0000;
+    const ABS: u32 = 0x7fff_ffff;
+
+    /// `atan(t) ≈ t·P(t²)` on `[0, 1]`, odd degree 15 (`scripts/fit_polynomials.py`).
+    pub const ATAN_DEG15: [f32; 8] = [
+        0.999_999_34,
+        -0.333_298_6,
+        0.199_465_66,
+        -0.139_086_29,
+        0.096_421_95,
+        -0.055_912_29,
+        0.021_862_93,
+        -0.004_054_559,
+    ];
+
+    /// `atan(t) ≈ t·P(t²)` on `[0, 1]`, odd degree 9 (`scripts/fit_polynomials.py`): minimax
+    /// error 1.14e-5 rad.
+    pub const ATAN_DEG9: [f32; 5] = [
+        0.999_866_3,
+        -0.330_304_77,
+        0.180_159_23,
+        -0.085_156_25,
+        0.020_845_061,
+    ];
+
+    /// `sin r ≈ r·P(r²)` on `[-π/4, π/4]`, degree 9.
+    const SIN_DEG9: [f32; 5] = [
+        1.0,
+        -1.666_666_6e-1,
+        8.333_326e-3,
+        -1.983_867_2e-4,
+        2.713_535_5e-6,
+    ];
+    /// `cos r ≈ P(r²)` on `[-π/4, π/4]`, degree 8.
+    const COS_DEG8: [f32; 5] = [1.0, -0.5, 4.166_661_6e-2, -1.388_662e-3, 2.437_992_8e-5];
+    /// `sin r ≈ r·P(r²)` on `[-π/4, π/4]`, degree 5: minimax error 5.6e-7.
+    const SIN_DEG5: [f32; 3] = [0.999_995, -0.166_601_61, 8.121_557_5e-3];
+    /// `cos r ≈ P(r²)` on `[-π/4, π/4]`, degree 6: minimax error 2.8e-8.
+    const COS_DEG6: [f32; 4] = [1.0, -0.499_998_57, 4.165_502_6e-2, -1.358_590_8e-3];
+
+    /// `atan t` for `t ∈ [-1, 1]`, degree 15, in Estrin's scheme: the same coefficients as
+    /// Horner's rule but three multiply–add levels deep instead of seven (a short dependency
+    /// chain on superscalar CPUs).
+    #[inline(always)]
+    pub fn atan_deg15(t: f32) -> f32 {
+        let c = &ATAN_DEG15;
+        let s = t * t;
+        let s2 = s * s;
+        let s4 = s2 * s2;
+        let p01 = c[0] + c[1] * s;
+        let p23 = c[2] + c[3] * s;
+        let p45 = c[4] + c[5] * s;
+        let p67 = c[6] + c[7] * s;
+        let q0 = p01 + p23 * s2;
+        let q1 = p45 + p67 * s2;
+        (q0 + q1 * s4) * t
+    }
+
+    /// `atan t` for `t ∈ [-1, 1]`, degree 9, Horner's rule (the fewest operations).
+    #[inline(always)]
+    pub fn atan_deg9(t: f32) -> f32 {
+        let c = &ATAN_DEG9;
+        let s = t * t;
+        (c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * c[4])))) * t
+    }
+
+    /// One lane of [`atan2_deg15`]: no branch, no table. The octant becomes an offset
+    /// (0, π, π/2) chosen by bit masks and the signs of `t` and of the result.
+    #[inline(always)]
+    fn atan2_deg15_lane(y: f32, x: f32) -> f32 {
         let ax = libm::fabsf(x);
         let ay = libm::fabsf(y);
-        let swap = ay > ax;
-        let x_neg = x.is_sign_negative();
         // Written as comparisons (not f32::min/max) so that they compile to minss/maxss.
         let num = if ay < ax { ay } else { ax };
         let den = if ay > ax { ay } else { ax };
@@ -109,20 +189,103 @@ impl Math for Fast {
         // atan2(±0, ±0): 0/0 is NaN, which this comparison maps to t = 0, giving ±0 or ±π by
         // the signs, as libm does.
         let t = if t > 0.0 { t } else { 0.0 };
+        let swap = (ay > ax) as u32;
+        let x_neg = x.to_bits() >> 31;
         let y_sign = y.to_bits() & SIGN;
-        let t_sign = (((swap != x_neg) as u32) << 31) ^ y_sign;
         // |atan2| = offset ± atan(t) by (swap, x < 0): (0, +), (π, −), (π/2, −), (π/2, +); then
-        // the sign of y. A table lookup, not a select, which the compiler would turn into a
-        // branch that random quadrants mispredict.
-        const OFFSET: [f32; 4] = [0.0, PI, FRAC_PI_2, FRAC_PI_2];
-        let offset = OFFSET[((swap as usize) << 1) | x_neg as usize];
-        let offset = f32::from_bits(offset.to_bits() | y_sign);
-        offset + atan_unit(f32::from_bits(t.to_bits() ^ t_sign))
+        // the sign of y.
+        let t_sign = ((swap ^ x_neg) << 31) ^ y_sign;
+        let swap_mask = 0u32.wrapping_sub(swap);
+        let x_neg_mask = 0u32.wrapping_sub(x_neg);
+        let offset = (FRAC_PI_2.to_bits() & swap_mask) | (PI.to_bits() & x_neg_mask & !swap_mask);
+        let offset = f32::from_bits(offset | y_sign);
+        offset + atan_deg15(f32::from_bits(t.to_bits() ^ t_sign))
     }
 
+    /// Four-quadrant arctangent, odd degree-15 polynomial: absolute error ≤ 3e-7 rad,
+    /// `atan2(±0, ±0)` as libm (±0 or ±π). Branch-free, so random quadrants cost no
+    /// mispredictions.
     #[inline]
-    fn sin_cos(x: f32) -> (f32, f32) {
-        // Quadrant k = round(x / (π/2)); r = x − k·π/2 in two parts (Cody–Waite).
+    pub fn atan2_deg15(y: f32, x: f32) -> f32 {
+        atan2_deg15_lane(y, x)
+    }
+
+    /// [`atan2_deg15`] of four pairs at once, bit for bit: straight-line lane-wise code that
+    /// the compiler turns into SIMD (one `divps`, one polynomial) where the target has it.
+    #[inline]
+    pub fn atan2_deg15_x4(y: [f32; 4], x: [f32; 4]) -> [f32; 4] {
+        let mut out = [0.0; 4];
+        for i in 0..4 {
+            out[i] = atan2_deg15_lane(y[i], x[i]);
+        }
+        out
+    }
+
+    /// Four-quadrant arctangent, odd degree-9 polynomial: absolute error ≤ 1.2e-5 rad
+    /// (0.0007°), `atan2(±0, ±0)` as libm (±0 or ±π). For CPUs with software floating point:
+    /// one division, 6 multiplications, at most 5 additions, and the octant found by integer
+    /// comparisons of the bit patterns (no float comparison, no table).
+    #[inline]
+    pub fn atan2_deg9(y: f32, x: f32) -> f32 {
+        let (yb, xb) = (y.to_bits(), x.to_bits());
+        let (ay, ax) = (yb & ABS, xb & ABS);
+        // For non-negative floats the bit patterns order as the values do.
+        let swap = ay > ax;
+        let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+        let p = if den == 0 {
+            0.0
+        } else {
+            atan_deg9(f32::from_bits(num) / f32::from_bits(den))
+        };
+        let r = match (swap, xb & SIGN != 0) {
+            (false, false) => p,
+            (false, true) => PI - p,
+            (true, false) => FRAC_PI_2 - p,
+            (true, true) => FRAC_PI_2 + p,
+        };
+        // r ≥ 0 in every octant: the sign of y goes on by its bit.
+        f32::from_bits(r.to_bits() | (yb & SIGN))
+    }
+
+    /// `(sin x, cos x)` with degree-9/8 polynomials after a Cody–Waite reduction to
+    /// `[-π/4, π/4]`; absolute error ≤ 2e-7. Branch-free.
+    #[inline]
+    pub fn sin_cos_deg9(x: f32) -> (f32, f32) {
+        let (k, r) = reduce(x);
+        let r2 = r * r;
+        let r4 = r2 * r2;
+        // Estrin's scheme: (a + b·r²) + r⁴·((c + d·r²) + e·r⁴), a short dependency chain.
+        let (s, c) = (&SIN_DEG9, &COS_DEG8);
+        let sin = r * ((s[0] + s[1] * r2) + r4 * ((s[2] + s[3] * r2) + s[4] * r4));
+        let cos = (c[0] + c[1] * r2) + r4 * ((c[2] + c[3] * r2) + c[4] * r4);
+        quadrant(k, sin, cos)
+    }
+
+    /// `(sin x, cos x)` with degree-5/6 polynomials on `[-π/4, π/4]` (Horner), absolute error
+    /// ≤ 7e-7; arguments within ±π/4 (body rotations) skip the range reduction, found by an
+    /// integer comparison. For CPUs with software floating point.
+    #[inline]
+    pub fn sin_cos_deg5(x: f32) -> (f32, f32) {
+        const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
+        let (k, r) = if x.to_bits() & ABS <= FRAC_PI_4_BITS {
+            (0.0, x)
+        } else {
+            reduce(x)
+        };
+        let r2 = r * r;
+        let (s, c) = (&SIN_DEG5, &COS_DEG6);
+        let sin = r * (s[0] + r2 * (s[1] + r2 * s[2]));
+        let cos = c[0] + r2 * (c[1] + r2 * (c[2] + r2 * c[3]));
+        if k == 0.0 {
+            (sin, cos)
+        } else {
+            quadrant(k, sin, cos)
+        }
+    }
+
+    /// Quadrant `k = round(x / (π/2))` and `r = x − k·π/2` in two parts (Cody–Waite).
+    #[inline(always)]
+    fn reduce(x: f32) -> (f32, f32) {
         const INV_FRAC_PI_2: f32 = core::f32::consts::FRAC_2_PI;
         const PIO2_HI: f32 = 1.570_312_5; // exact in 11 bits
         const PIO2_LO: f32 = 4.838_268e-4;
@@ -130,22 +293,17 @@ impl Math for Fast {
         // any nearby integer does as well as libm::roundf): inline, no call, no branch.
         const ROUND: f32 = 12_582_912.0;
         let k = (x * INV_FRAC_PI_2 + ROUND) - ROUND;
-        let r = (x - k * PIO2_HI) - k * PIO2_LO;
-        let r2 = r * r;
-        let r4 = r2 * r2;
-        // Minimax on [-π/4, π/4] (scripts/fit_polynomials.py): error < 1e-9 before rounding.
-        // Estrin's scheme: (a + b·r²) + r⁴·((c + d·r²) + e·r⁴), a short dependency chain.
-        let s = r
-            * ((1.0 - 1.666_666_6e-1 * r2)
-                + r4 * ((8.333_326e-3 - 1.983_867_2e-4 * r2) + 2.713_535_5e-6 * r4));
-        let c =
-            (1.0 - 0.5 * r2) + r4 * ((4.166_661_6e-2 - 1.388_662e-3 * r2) + 2.437_992_8e-5 * r4);
-        let q = (k as i32) & 3;
-        match q {
-            0 => (s, c),
-            1 => (c, -s),
-            2 => (-s, -c),
-            _ => (-c, s),
+        (k, (x - k * PIO2_HI) - k * PIO2_LO)
+    }
+
+    /// `(sin x, cos x)` from those of the reduced argument in quadrant `k`.
+    #[inline(always)]
+    fn quadrant(k: f32, sin: f32, cos: f32) -> (f32, f32) {
+        match (k as i32) & 3 {
+            0 => (sin, cos),
+            1 => (cos, -sin),
+            2 => (-sin, -cos),
+            _ => (-cos, sin),
         }
     }
 }
@@ -181,6 +339,8 @@ pub fn wrap_two_pi(angle_rad: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    extern crate std;
+    use std::vec;
 
     #[test]
     fn fast_atan2_matches_f64_everywhere() {
@@ -246,6 +406,140 @@ mod tests {
                 .max((c as f64 - (x as f64).cos()).abs());
         }
         assert!(worst < 2.0e-7, "worst sin/cos error {worst}");
+    }
+
+    /// Largest |atan2 − f64 atan2| of `f` over a 720-step circle at several radii, rad.
+    fn worst_atan2_error(f: impl Fn(f32, f32) -> f32) -> f64 {
+        let mut worst = 0.0f64;
+        for i in 0..=720 {
+            for r in [1e-3f32, 0.3, 1.0, 7.0] {
+                let ang = -PI + (i as f32) * (2.0 * PI / 720.0);
+                let (y, x) = (r * libm::sinf(ang), r * libm::cosf(ang));
+                let got = f(y, x) as f64;
+                let want = (y as f64).atan2(x as f64);
+                let mut d = (got - want).abs();
+                if d > core::f64::consts::PI {
+                    d = 2.0 * core::f64::consts::PI - d;
+                }
+                worst = worst.max(d);
+            }
+        }
+        worst
+    }
+
+    /// Error bound of [`poly::atan2_deg9`] (the fit's 1.14e-5 plus f32 rounding).
+    const ATAN2_DEG9_TOL_RAD: f64 = 1.2e-5;
+
+    #[test]
+    fn atan2_deg9_matches_f64_everywhere() {
+        let worst = worst_atan2_error(poly::atan2_deg9);
+        assert!(worst < ATAN2_DEG9_TOL_RAD, "worst atan2_deg9 error {worst}");
+        // A dense sweep of t = y/x in the first octant, where the polynomial is evaluated.
+        let mut worst = 0.0f64;
+        for i in 0..=100_000 {
+            let t = i as f32 / 100_000.0;
+            let d = (poly::atan2_deg9(t, 1.0) as f64 - (t as f64).atan()).abs();
+            worst = worst.max(d);
+        }
+        assert!(worst < ATAN2_DEG9_TOL_RAD, "worst atan_deg9 error {worst}");
+    }
+
+    #[test]
+    fn polynomial_atan2_signed_zeros_and_axes_match_libm() {
+        let cases = [
+            (0.0f32, 0.0f32),
+            (-0.0, 0.0),
+            (0.0, -0.0),
+            (-0.0, -0.0),
+            (0.0, 2.0),
+            (-0.0, 2.0),
+            (0.0, -2.0),
+            (-0.0, -2.0),
+            (2.0, 0.0),
+            (2.0, -0.0),
+            (-2.0, 0.0),
+            (-2.0, -0.0),
+            (1.0, 1.0),
+            (-1.0, -1.0),
+            (1.0, -1.0),
+            (-1.0, 1.0),
+        ];
+        for (y, x) in cases {
+            let want = libm::atan2f(y, x);
+            for (name, got, tol) in [
+                ("deg15", poly::atan2_deg15(y, x), 3.0e-7),
+                ("deg9", poly::atan2_deg9(y, x), ATAN2_DEG9_TOL_RAD as f32),
+            ] {
+                assert!(
+                    (got - want).abs() < tol,
+                    "{name} atan2({y}, {x}) = {got}, libm {want}"
+                );
+                assert_eq!(
+                    got.is_sign_negative(),
+                    want.is_sign_negative(),
+                    "{name} atan2({y}, {x})"
+                );
+            }
+        }
+        // Exact on the axes.
+        assert_eq!(poly::atan2_deg9(0.0, -1.0), PI);
+        assert_eq!(poly::atan2_deg9(1.0, 0.0), FRAC_PI_2);
+        assert_eq!(poly::atan2_deg9(-1.0, 0.0), -FRAC_PI_2);
+    }
+
+    /// `atan2_3` (four SIMD lanes in `Fast`) returns exactly three `atan2` calls, including
+    /// signed zeros, axes, tiny and huge arguments and NaN-free degenerate pairs.
+    #[test]
+    fn fast_atan2_3_is_three_atan2_bit_for_bit() {
+        let mut vals = vec![
+            0.0f32, -0.0, 1.0, -1.0, 1e-30, -1e-30, 3e30, -3e30, 0.5, -2.5,
+        ];
+        let mut state = 0x1234_5678_9abc_def0u64;
+        for _ in 0..200 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            vals.push((state >> 40) as f32 / (1u64 << 23) as f32 - 1.0);
+        }
+        let bits = |a: [f32; 3]| a.map(f32::to_bits);
+        for (i, &a) in vals.iter().enumerate() {
+            for (j, &b) in vals.iter().enumerate() {
+                let c = vals[(i * 7 + j * 3) % vals.len()];
+                let d = vals[(i + j * 11) % vals.len()];
+                let (y, x) = ([a, c, b], [b, d, a]);
+                let want = [0, 1, 2].map(|k| Fast::atan2(y[k], x[k]));
+                assert_eq!(bits(Fast::atan2_3(y, x)), bits(want), "y {y:?} x {x:?}");
+                assert_eq!(
+                    bits(Libm::atan2_3(y, x)),
+                    bits([0, 1, 2].map(|k| Libm::atan2(y[k], x[k])))
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn sin_cos_deg5_matches_f64() {
+        let mut worst = 0.0f64;
+        for i in -40_000..=40_000 {
+            let x = i as f32 * 0.00025; // ±10 rad, across the ±π/4 switch
+            let (s, c) = poly::sin_cos_deg5(x);
+            worst = worst
+                .max((s as f64 - (x as f64).sin()).abs())
+                .max((c as f64 - (x as f64).cos()).abs());
+        }
+        assert!(worst < 7.0e-7, "worst sin/cos error {worst}");
+        // Both sides of π/4 agree (the reduction is skipped on one side only).
+        let q = core::f32::consts::FRAC_PI_4;
+        let (below, above) = (
+            f32::from_bits(q.to_bits() - 1),
+            f32::from_bits(q.to_bits() + 1),
+        );
+        for x in [below, q, above, -below, -q, -above] {
+            let (s, c) = poly::sin_cos_deg5(x);
+            assert!((s as f64 - (x as f64).sin()).abs() < 7.0e-7, "sin {x}");
+            assert!((c as f64 - (x as f64).cos()).abs() < 7.0e-7, "cos {x}");
+        }
+        assert_eq!(poly::sin_cos_deg5(0.0), (0.0, 1.0));
     }
 
     #[test]

@@ -21,7 +21,7 @@
 #![no_std]
 #![cfg(target_arch = "avr")]
 
-use kin_core::math::Fast;
+use kin_core::math::poly;
 use kin_core::Math;
 
 /// Links avr-libc's `libm.a` ahead of compiler-builtins; invoke once in each binary that uses
@@ -67,10 +67,15 @@ impl Math for AvrLibm {
     }
 }
 
-/// The fastest correct mix measured in simavr (see `BENCHMARKS.md`): avr-libc's `sqrt` and
-/// `atan2`, and kin-core's polynomial [`Fast::sin_cos`] (one shared range reduction for both:
-/// about 4,100 cycles against 7,300 for avr-libc's `sin` plus `cos`). All float arithmetic on
-/// avr-libc's primitives.
+/// The fastest mix measured in simavr (see `BENCHMARKS.md`), the firmware's backend:
+/// avr-libc's `sqrt` (327 cycles), kin-core's [`poly::atan2_deg9`] (about 2,200 cycles against
+/// 3,000 for avr-libc's `atan2`; error ≤ 1.2e-5 rad) and [`poly::sin_cos_deg5`] (about 2,000
+/// cycles for both within ±π/4, 3,300 beyond, against 7,200 for avr-libc's `sin` plus `cos`;
+/// error ≤ 7e-7). All float arithmetic on avr-libc's primitives.
+///
+/// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by
+/// at most about 1.5e-5 rad (the degree-9 arctangent's error plus rounding); see the readback
+/// bound in `BENCHMARKS.md`.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct AvrFast;
 
@@ -82,11 +87,11 @@ impl Math for AvrFast {
 
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
-        AvrLibm::atan2(y, x)
+        poly::atan2_deg9(y, x)
     }
 
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
-        Fast::sin_cos(x)
+        poly::sin_cos_deg5(x)
     }
 }
