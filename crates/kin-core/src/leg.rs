@@ -4,8 +4,8 @@
 //! All positions are in the **hip frame** of the leg: origin at the hip (abduction-axis) mount,
 //! axes parallel to the body frame (x forward, y left, z up), metres.
 
-use crate::math::{DefaultMath, Math};
-use crate::robot::{Joint, JointAngles, KneeBend, LegGeometry, LegId, Robot};
+use crate::math::{cmp, DefaultMath, Math};
+use crate::robot::{Joint, JointAngles, JointLimits, KneeBend, LegGeometry, LegId, Robot};
 use crate::vec::Vec3;
 use core::fmt;
 
@@ -233,162 +233,456 @@ pub fn forward_dh(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
     pos
 }
 
-/// Intermediate values of the analytic IK, before limits.
+/// The leg IK with the per-robot constants computed once: squared link lengths and reach
+/// limits, `d_lat²`, the joint-limit interval. The free functions [`inverse_with`] and
+/// [`inverse`] build one per call; a caller that solves many targets of one robot (a device's
+/// control loop, the body IK) keeps one:
+///
+/// ```
+/// use kin_core::{leg, LegId, ReachPolicy, Robot, Vec3};
+/// let solver = leg::Solver::new(&Robot::shahriar2023());
+/// let q = solver.inverse(LegId::FL, Vec3::new(0.05, 0.044, -0.45), ReachPolicy::Reject)?;
+/// # Ok::<(), kin_core::IkError>(())
+/// ```
+///
+/// Results are bit for bit those of the free functions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Solver {
+    geometry: LegGeometry,
+    limits: JointLimits,
+    knee_bend: KneeBend,
+    consts: Consts,
+}
+
+/// Constants of the leg IK derived from the link lengths.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Consts {
+    /// `d_lat²`.
+    d_lat_sq: f32,
+    /// `(L1 + L2)²` and `(L1 − L2)²`: the squared reach limits of the leg plane.
+    far_sq: f32,
+    near_sq: f32,
+    /// `L1² + L2²` and `L1² − L2²`: the law of cosines.
+    sum_sq: f32,
+    diff_sq: f32,
+    /// `d_ax = 0` (seed 000's leg): the hip-flexion joint lies on the abduction axis, and the
+    /// planar distance needs no extra term.
+    d_ax_zero: bool,
+}
+
+impl Consts {
+    #[inline(always)]
+    fn of(g: &LegGeometry) -> Consts {
+        let (l1, l2) = (g.femur_m, g.tibia_m);
+        Consts {
+            d_lat_sq: g.d_lat_m * g.d_lat_m,
+            far_sq: (l1 + l2) * (l1 + l2),
+            near_sq: (l1 - l2) * (l1 - l2),
+            sum_sq: l1 * l1 + l2 * l2,
+            diff_sq: l1 * l1 - l2 * l2,
+            d_ax_zero: g.d_ax_m.to_bits() & 0x7fff_ffff == 0,
+        }
+    }
+}
+
+/// What a solve reads: borrowed from a [`Solver`], or from a [`Robot`] with the constants
+/// computed on the spot (the free functions), so that neither copies the robot.
 #[derive(Clone, Copy)]
-struct Raw {
-    angles: JointAngles,
+struct View<'a> {
+    geometry: &'a LegGeometry,
+    limits: &'a JointLimits,
+    knee_bend: KneeBend,
+    c: &'a Consts,
+}
+
+/// The quantities of one solve before the three arctangents: the angles are
+/// `atan2(y[i], x[i])` for abduction, knee, hip.
+#[derive(Clone, Copy)]
+struct Pending {
+    y: [f32; 3],
+    x: [f32; 3],
 }
 
 /// Un-abducted depth of the foot: `w = −√(y² + z² − d_lat²)`, the branch with the foot below
-/// the hip (0 when the foot lies on the offset circle).
+/// the hip (0 when the foot lies on the offset circle), from `r² = y² + z²`; with `w²`.
 #[inline(always)]
-fn depth<M: Math>(d2: f32, y: f32, z: f32) -> f32 {
-    let w_sq = y * y + z * z - d2;
-    -M::sqrt(if w_sq > 0.0 { w_sq } else { 0.0 })
+fn depth<M: Math>(d_lat_sq: f32, r_sq: f32) -> (f32, f32) {
+    let w_sq = r_sq - d_lat_sq;
+    let w_sq = if cmp::gt_zero(w_sq) { w_sq } else { 0.0 };
+    (-M::sqrt(w_sq), w_sq)
 }
 
-/// a = angle(y, z) − angle(s·d_lat, w), as one atan2 of cross and dot.
-#[inline(always)]
-fn abduction_angle<M: Math>(sd: f32, y: f32, z: f32, w: f32) -> f32 {
-    M::atan2(sd * z - w * y, sd * y + w * z)
-}
-
-/// `((L1+L2)², (L1−L2)²)`: the squared reach limits of the two-link leg plane.
-#[inline(always)]
-fn reach2(g: &LegGeometry) -> (f32, f32) {
-    let (l1, l2) = (g.femur_m, g.tibia_m);
-    ((l1 + l2) * (l1 + l2), (l1 - l2) * (l1 - l2))
-}
-
-/// The law of cosines for the foot at `(u, v)` in the leg plane, relative to the hip-flexion
-/// joint, with `(L1−L2)² ≤ u² + v² ≤ (L1+L2)²` up to rounding (`moved`: after a projection).
-/// Returns `(D², c, s)` with `c = 2·L1·L2·cos k` and `s = 2·L1·L2·sin k`, for
-/// [`planar_angles`].
-#[inline(always)]
-fn planar_sides<M: Math>(
-    g: &LegGeometry,
-    bend: KneeBend,
-    u: f32,
-    v: f32,
-    moved: bool,
-) -> (f32, f32, f32) {
-    let (l1, l2) = (g.femur_m, g.tibia_m);
-    let (far2, near2) = reach2(g);
-    let dist2 = u * u + v * v;
-    // Scaled by 2·L1·L2 (no division; atan2 is scale-invariant): c = D² − L1² − L2², and
-    // s² = (D² − (L1−L2)²)·((L1+L2)² − D²), the factored form that stays accurate near a
-    // folded or straight knee, where (2·L1·L2)² − c² loses the digits that set the foot's
-    // distance.
-    let two_l1l2 = 2.0 * l1 * l2;
-    let mut c = dist2 - (l1 * l1 + l2 * l2);
-    // Only rounding can push a projected point past ±2·L1·L2 here.
-    if moved {
-        c = c.clamp(-two_l1l2, two_l1l2);
-    }
-    let s_sq = (dist2 - near2) * (far2 - dist2);
-    let s_abs = M::sqrt(if s_sq > 0.0 { s_sq } else { 0.0 });
-    let s = match bend {
-        KneeBend::Backward => -s_abs,
-        KneeBend::Forward => s_abs,
-    };
-    (dist2, c, s)
-}
-
-/// `(hip, knee)` from [`planar_sides`].
-#[inline(always)]
-fn planar_angles<M: Math>(g: &LegGeometry, u: f32, v: f32, sides: (f32, f32, f32)) -> (f32, f32) {
-    let (l1, l2) = (g.femur_m, g.tibia_m);
-    let (dist2, c, s) = sides;
-    let knee = M::atan2(s, c);
-    // hip = angle(−v, −u) − angle(L1 + L2·cos k, L2·sin k), the second vector scaled by 2·L1:
-    // (D² + L1² − L2², s).
-    let (bx, by) = (dist2 + (l1 * l1 - l2 * l2), s);
-    let (ax, ay) = (-v, -u);
-    let hip = M::atan2(bx * ay - by * ax, bx * ax + by * ay);
-    (hip, knee)
-}
-
-/// Solves the abduction and planar problem exactly for a point known to be reachable (after
-/// optional projection). Returns the angles and the foot actually reached when projecting.
-#[inline]
-fn solve<M: Math>(
-    g: &LegGeometry,
-    side: f32,
-    bend: KneeBend,
-    target: Vec3,
-    policy: ReachPolicy,
-) -> Result<(Raw, Option<(Unreachable, Vec3)>), Unreachable> {
-    let (l1, l2) = (g.femur_m, g.tibia_m);
-    let sd = side * g.d_lat_m;
-    let (mut y, mut z) = (target.y, target.z);
-    let mut first: Option<Unreachable> = None;
-
-    // Abduction: the foot's (y, z) must lie at distance ≥ d_lat from the abduction axis.
-    let r2 = y * y + z * z;
-    let d2 = g.d_lat_m * g.d_lat_m;
-    if r2 < d2 {
-        if policy == ReachPolicy::Reject {
-            return Err(Unreachable::InsideOffset);
-        }
-        first = Some(Unreachable::InsideOffset);
-        let r = M::sqrt(r2);
-        if r > 0.0 {
-            let k = g.d_lat_m / r;
-            y *= k;
-            z *= k;
+impl Consts {
+    /// `(v, v²)` of the in-plane foot height `v = w + d_ax` below the hip-flexion joint, from
+    /// [`depth`]'s `(w, w²)`: `(w, w²)` itself when `d_ax = 0` (a multiplication and an addition
+    /// fewer).
+    #[inline(always)]
+    fn height(&self, d_ax_m: f32, (w, w_sq): (f32, f32)) -> (f32, f32) {
+        if self.d_ax_zero {
+            (w, w_sq)
         } else {
-            y = sd;
-            z = 0.0;
+            let v = w + d_ax_m;
+            (v, v * v)
         }
     }
-    let w = depth::<M>(d2, y, z);
-    let abduction = abduction_angle::<M>(sd, y, z, w);
+}
 
-    // Planar two-link problem from the hip-flexion joint: (u, v) = (x, w + d_ax).
-    let mut u = target.x;
-    let mut v = w + g.d_ax_m;
-    let dist2 = u * u + v * v;
-    let (far2, near2) = reach2(g);
-    let planar_fault = if dist2 > far2 {
-        Some((Unreachable::TooFar, l1 + l2))
-    } else if dist2 < near2 {
-        Some((Unreachable::TooClose, libm::fabsf(l1 - l2)))
-    } else {
-        None
-    };
-    let mut moved = first.is_some();
-    if let Some((kind, radius)) = planar_fault {
-        if policy == ReachPolicy::Reject {
-            return Err(kind);
+impl Solver {
+    /// The constants of `robot`'s legs (all legs are alike).
+    #[inline]
+    pub fn new(robot: &Robot) -> Solver {
+        Solver {
+            geometry: robot.leg,
+            limits: robot.limits,
+            knee_bend: robot.knee_bend,
+            consts: Consts::of(&robot.leg),
         }
-        first.get_or_insert(kind);
-        moved = true;
-        let dist = M::sqrt(dist2);
-        if dist > 0.0 {
-            let k = radius / dist;
-            u *= k;
-            v *= k;
+    }
+
+    /// The leg geometry.
+    #[inline]
+    pub fn geometry(&self) -> &LegGeometry {
+        &self.geometry
+    }
+
+    #[inline(always)]
+    fn view(&self) -> View<'_> {
+        View {
+            geometry: &self.geometry,
+            limits: &self.limits,
+            knee_bend: self.knee_bend,
+            c: &self.consts,
+        }
+    }
+
+    /// Analytic leg IK: the foot target in the hip frame → joint angles; see
+    /// [`inverse_with`](fn@inverse_with), which this is with the constants prepared.
+    #[inline]
+    pub fn inverse_with<M: Math>(
+        &self,
+        leg: LegId,
+        foot_in_hip: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<LegSolution, IkError> {
+        self.view().inverse_with::<M>(leg, foot_in_hip, policy)
+    }
+
+    /// [`Solver::inverse_with`] on the [`DefaultMath`] backend.
+    #[inline]
+    pub fn inverse(
+        &self,
+        leg: LegId,
+        foot_in_hip: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<LegSolution, IkError> {
+        self.inverse_with::<DefaultMath>(leg, foot_in_hip, policy)
+    }
+
+    /// The four legs of [`LegId::ALL`] at once under [`ReachPolicy::Reject`], for the
+    /// full-body IK: the arithmetic of [`Solver::inverse_with`] leg by leg (bit-identical
+    /// results), written stage by stage across the legs so that the four independent solves
+    /// interleave instead of running one after the other. `None` when any leg is not cleanly
+    /// solvable (non-finite input, outside the workspace, beyond a joint limit): the caller
+    /// then solves the legs in order to name the first failure.
+    #[cfg(not(target_arch = "avr"))]
+    #[inline]
+    pub(crate) fn inverse_all_reject<M: Math>(
+        &self,
+        feet_in_hip: &[Vec3; 4],
+    ) -> Option<[JointAngles; 4]> {
+        self.view().inverse_all_reject::<M>(feet_in_hip)
+    }
+}
+
+impl View<'_> {
+    /// True when all three angles lie within the joint limits (false for any NaN).
+    #[inline(always)]
+    fn admits(&self, q: JointAngles) -> bool {
+        #[cfg(target_arch = "avr")]
+        {
+            let (lo, hi) = (&self.limits.min_rad, &self.limits.max_rad);
+            let within = |x, j: usize| cmp::bits::within(x, cmp::bits::interval(lo[j], hi[j]));
+            within(q.abduction_rad, 0) && within(q.hip_rad, 1) && within(q.knee_rad, 2)
+        }
+        #[cfg(not(target_arch = "avr"))]
+        {
+            let (lo, hi) = (&self.limits.min_rad, &self.limits.max_rad);
+            let a = q.to_array();
+            (a[0] >= lo[0])
+                & (a[0] <= hi[0])
+                & (a[1] >= lo[1])
+                & (a[1] <= hi[1])
+                & (a[2] >= lo[2])
+                & (a[2] <= hi[2])
+        }
+    }
+
+    /// The rest of a solve after the reach checks, up to the arctangents: the foot's `(y, z)`
+    /// lies at least `d_lat` from the abduction axis, `w` is its depth from [`depth`], and
+    /// `(u, v)` (`dist2 = u² + v²`) lies within the reach of the leg plane up to rounding
+    /// (`moved`: after a projection).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn pending<M: Math>(
+        &self,
+        sd: f32,
+        y: f32,
+        z: f32,
+        w: f32,
+        u: f32,
+        v: f32,
+        dist2: f32,
+        moved: bool,
+    ) -> Pending {
+        // a = angle(y, z) − angle(s·d_lat, w), as one atan2 of cross and dot.
+        let (abd_y, abd_x) = (sd * z - w * y, sd * y + w * z);
+        // The law of cosines, scaled by 2·L1·L2 (no division; atan2 is scale-invariant):
+        // c = D² − L1² − L2², and s² = (D² − (L1−L2)²)·((L1+L2)² − D²), the factored form that
+        // stays accurate near a folded or straight knee, where (2·L1·L2)² − c² loses the digits
+        // that set the foot's distance.
+        let mut c = dist2 - self.c.sum_sq;
+        // Only rounding can push a projected point past ±2·L1·L2 here.
+        if moved {
+            let two_l1l2 = 2.0 * self.geometry.femur_m * self.geometry.tibia_m;
+            c = c.clamp(-two_l1l2, two_l1l2);
+        }
+        let s_sq = (dist2 - self.c.near_sq) * (self.c.far_sq - dist2);
+        let s_abs = M::sqrt(if cmp::gt_zero(s_sq) { s_sq } else { 0.0 });
+        let s = match self.knee_bend {
+            KneeBend::Backward => -s_abs,
+            KneeBend::Forward => s_abs,
+        };
+        // hip = angle(−v, −u) − angle(L1 + L2·cos k, L2·sin k), the second vector scaled by
+        // 2·L1: (D² + L1² − L2², s).
+        let (bx, by) = (dist2 + self.c.diff_sq, s);
+        let (ax, ay) = (-v, -u);
+        Pending {
+            y: [abd_y, s, bx * ay - by * ax],
+            x: [abd_x, c, bx * ax + by * ay],
+        }
+    }
+
+    /// Solves the abduction and planar problem exactly for a point known to be reachable
+    /// (after optional projection), for the leg with `sd = s·d_lat`. Returns the angles and,
+    /// when projecting, the first reason and the foot actually reached.
+    #[inline(always)]
+    fn solve<M: Math>(
+        &self,
+        sd: f32,
+        target: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<(JointAngles, Option<(Unreachable, Vec3)>), Unreachable> {
+        let g = &self.geometry;
+        let (mut y, mut z) = (target.y, target.z);
+        let mut first: Option<Unreachable> = None;
+
+        // Abduction: the foot's (y, z) must lie at distance ≥ d_lat from the abduction axis.
+        let mut r_sq = y * y + z * z;
+        if cmp::lt_nonneg(r_sq, self.c.d_lat_sq) {
+            if policy == ReachPolicy::Reject {
+                return Err(Unreachable::InsideOffset);
+            }
+            first = Some(Unreachable::InsideOffset);
+            let r = M::sqrt(r_sq);
+            if cmp::gt_zero(r) {
+                let k = g.d_lat_m / r;
+                y *= k;
+                z *= k;
+            } else {
+                y = sd;
+                z = 0.0;
+            }
+            r_sq = y * y + z * z;
+        }
+        let depth = depth::<M>(self.c.d_lat_sq, r_sq);
+        let w = depth.0;
+
+        // Planar two-link problem from the hip-flexion joint: (u, v) = (x, w + d_ax).
+        let mut u = target.x;
+        let (mut v, v_sq) = self.c.height(g.d_ax_m, depth);
+        let mut dist2 = u * u + v_sq;
+        let (l1, l2) = (g.femur_m, g.tibia_m);
+        let planar_fault = if cmp::lt_nonneg(self.c.far_sq, dist2) {
+            Some((Unreachable::TooFar, l1 + l2))
+        } else if cmp::lt_nonneg(dist2, self.c.near_sq) {
+            Some((Unreachable::TooClose, libm::fabsf(l1 - l2)))
         } else {
-            u = 0.0;
-            v = -radius;
+            None
+        };
+        let mut moved = first.is_some();
+        if let Some((kind, radius)) = planar_fault {
+            if policy == ReachPolicy::Reject {
+                return Err(kind);
+            }
+            first.get_or_insert(kind);
+            moved = true;
+            let dist = M::sqrt(dist2);
+            if cmp::gt_zero(dist) {
+                let k = radius / dist;
+                u *= k;
+                v *= k;
+            } else {
+                u = 0.0;
+                v = -radius;
+            }
+            dist2 = u * u + v * v;
+        }
+        let p = self.pending::<M>(sd, y, z, w, u, v, dist2, moved);
+        let [abduction, knee, hip] = M::atan2_3(p.y, p.x);
+        let angles = JointAngles::new(abduction, hip, knee);
+        let reached = if moved {
+            let (sa, ca) = M::sin_cos(abduction);
+            Some((
+                first.unwrap_or(Unreachable::TooFar),
+                abduct(sa, ca, Vec3::new(u, sd, v - g.d_ax_m)),
+            ))
+        } else {
+            None
+        };
+        Ok((angles, reached))
+    }
+
+    /// The first joint of `q` outside its limits (any joint for a NaN angle).
+    #[inline(always)]
+    fn first_violation(&self, q: JointAngles) -> Option<Joint> {
+        if self.admits(q) {
+            return None;
+        }
+        Joint::ALL.into_iter().find(|&j| {
+            #[cfg(target_arch = "avr")]
+            let ok = cmp::bits::within(
+                q.get(j),
+                cmp::bits::interval(
+                    self.limits.min_rad[j as usize],
+                    self.limits.max_rad[j as usize],
+                ),
+            );
+            #[cfg(not(target_arch = "avr"))]
+            let ok = self.limits.admits(j, q.get(j));
+            !ok
+        })
+    }
+
+    /// [`Solver::inverse_with`].
+    #[inline]
+    fn inverse_with<M: Math>(
+        &self,
+        leg: LegId,
+        foot_in_hip: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<LegSolution, IkError> {
+        let err = |kind| IkError { leg, kind };
+        if !(cmp::finite(foot_in_hip.x) && cmp::finite(foot_in_hip.y) && cmp::finite(foot_in_hip.z))
+        {
+            return Err(err(Unreachable::NonFinite));
+        }
+        // Far outside the workspace a clamped answer depends only on the target's direction;
+        // shrinking such a target keeps its squares clear of f32 overflow (|p| ≳ 1.8e19 m),
+        // which would otherwise turn a finite target into NaN angles. (Computed only under
+        // Clamp: the Reject path, the hot one, stays free of it.)
+        let target = match policy {
+            ReachPolicy::Clamp => {
+                let m = libm::fmaxf(
+                    libm::fabsf(foot_in_hip.x),
+                    libm::fmaxf(libm::fabsf(foot_in_hip.y), libm::fabsf(foot_in_hip.z)),
+                );
+                if m > FAR_M {
+                    foot_in_hip * (FAR_M / m)
+                } else {
+                    foot_in_hip
+                }
+            }
+            ReachPolicy::Reject => foot_in_hip,
+        };
+        let side_d_lat = if leg.is_left() {
+            self.geometry.d_lat_m
+        } else {
+            -self.geometry.d_lat_m
+        };
+        let (mut angles, reached) = self.solve::<M>(side_d_lat, target, policy).map_err(err)?;
+        let Some(joint) = self.first_violation(angles) else {
+            // Within the limits also means finite: a NaN fails every comparison.
+            return Ok(LegSolution {
+                angles,
+                clamped: reached.map(|(kind, p)| Clamp {
+                    kind,
+                    distance_m: distance(p, foot_in_hip),
+                }),
+            });
+        };
+        if policy == ReachPolicy::Reject {
+            return Err(err(Unreachable::JointLimit(joint)));
+        }
+        let mut a = angles.to_array();
+        for (i, v) in a.iter_mut().enumerate() {
+            *v = v.clamp(self.limits.min_rad[i], self.limits.max_rad[i]);
+        }
+        angles = JointAngles::from_array(a);
+        let foot = forward_with::<M>(self.geometry, leg, angles);
+        let clamped = Some(Clamp {
+            kind: reached.map_or(Unreachable::JointLimit(joint), |(kind, _)| kind),
+            distance_m: distance(foot, foot_in_hip),
+        });
+        if !angles.is_finite() {
+            // Unreachable by construction; kept so that no NaN can ever leave this function.
+            return Err(err(Unreachable::NonFinite));
+        }
+        Ok(LegSolution { angles, clamped })
+    }
+
+    /// [`Solver::inverse_all_reject`].
+    #[cfg(not(target_arch = "avr"))]
+    #[inline]
+    fn inverse_all_reject<M: Math>(&self, feet_in_hip: &[Vec3; 4]) -> Option<[JointAngles; 4]> {
+        let g = &self.geometry;
+        let mut ok = true;
+        // One plain array per quantity (not arrays of structs), which the compiler keeps in
+        // registers.
+        let mut w = [0.0f32; 4];
+        let mut w_sq = [0.0f32; 4];
+        let mut v = [0.0f32; 4];
+        let mut dist2 = [0.0f32; 4];
+        for (i, p) in feet_in_hip.iter().enumerate() {
+            // Non-short-circuit `&` and float arithmetic: no branch per lane. `q·0` is ±0 for a
+            // finite q and NaN otherwise.
+            let finite = p.x * 0.0 + p.y * 0.0 + p.z * 0.0 == 0.0;
+            let r_sq = p.y * p.y + p.z * p.z;
+            ok &= finite & !(r_sq < self.c.d_lat_sq);
+            (w[i], w_sq[i]) = depth::<M>(self.c.d_lat_sq, r_sq);
+        }
+        for (i, p) in feet_in_hip.iter().enumerate() {
+            let v_sq;
+            (v[i], v_sq) = self.c.height(g.d_ax_m, (w[i], w_sq[i]));
+            dist2[i] = p.x * p.x + v_sq;
+            ok &= !(dist2[i] > self.c.far_sq) & !(dist2[i] < self.c.near_sq);
+        }
+        // Stage by stage across the legs (square roots, then angles), so that the independent
+        // dependency chains sit next to each other in the instruction stream.
+        let pending: [Pending; 4] = core::array::from_fn(|i| {
+            let p = &feet_in_hip[i];
+            let sd = if LegId::ALL[i].is_left() {
+                g.d_lat_m
+            } else {
+                -g.d_lat_m
+            };
+            self.pending::<M>(sd, p.y, p.z, w[i], p.x, v[i], dist2[i], false)
+        });
+        let mut out = [JointAngles::default(); 4];
+        for (o, p) in out.iter_mut().zip(&pending) {
+            let [abduction, knee, hip] = M::atan2_3(p.y, p.x);
+            *o = JointAngles::new(abduction, hip, knee);
+        }
+        // Within the limits (a NaN fails every comparison, so this also rejects non-finite
+        // angles).
+        for a in &out {
+            ok &= self.admits(*a);
+        }
+        if ok {
+            Some(out)
+        } else {
+            None
         }
     }
-    let sides = planar_sides::<M>(g, bend, u, v, moved);
-    let (hip, knee) = planar_angles::<M>(g, u, v, sides);
-
-    let raw = Raw {
-        angles: JointAngles::new(abduction, hip, knee),
-    };
-    let reached = if moved {
-        let (sa, ca) = M::sin_cos(abduction);
-        Some((
-            first.unwrap_or(Unreachable::TooFar),
-            abduct(sa, ca, Vec3::new(u, sd, v - g.d_ax_m)),
-        ))
-    } else {
-        None
-    };
-    Ok((raw, reached))
 }
 
 /// Under [`ReachPolicy::Clamp`], targets farther than this along any axis (m) are first
@@ -418,7 +712,7 @@ fn distance(a: Vec3, b: Vec3) -> f32 {
 ///
 /// Never returns NaN: non-finite input gives [`Unreachable::NonFinite`]; out-of-workspace
 /// targets give a typed error under [`ReachPolicy::Reject`] or a reported clamp under
-/// [`ReachPolicy::Clamp`].
+/// [`ReachPolicy::Clamp`]. Computes the robot's constants each call; [`Solver`] keeps them.
 #[inline]
 pub fn inverse_with<M: Math>(
     robot: &Robot,
@@ -426,55 +720,13 @@ pub fn inverse_with<M: Math>(
     foot_in_hip: Vec3,
     policy: ReachPolicy,
 ) -> Result<LegSolution, IkError> {
-    let err = |kind| IkError { leg, kind };
-    if !foot_in_hip.is_finite() {
-        return Err(err(Unreachable::NonFinite));
-    }
-    let g = &robot.leg;
-    // Far outside the workspace a clamped answer depends only on the target's direction;
-    // shrinking such a target keeps its squares clear of f32 overflow (|p| ≳ 1.8e19 m), which
-    // would otherwise turn a finite target into NaN angles.
-    // (Computed only under Clamp: the Reject path, the hot one, stays free of it.)
-    let target = match policy {
-        ReachPolicy::Clamp => {
-            let m = libm::fmaxf(
-                libm::fabsf(foot_in_hip.x),
-                libm::fmaxf(libm::fabsf(foot_in_hip.y), libm::fabsf(foot_in_hip.z)),
-            );
-            if m > FAR_M {
-                foot_in_hip * (FAR_M / m)
-            } else {
-                foot_in_hip
-            }
-        }
-        ReachPolicy::Reject => foot_in_hip,
+    let view = View {
+        geometry: &robot.leg,
+        limits: &robot.limits,
+        knee_bend: robot.knee_bend,
+        c: &Consts::of(&robot.leg),
     };
-    let (raw, reached) = solve::<M>(g, leg.side(), robot.knee_bend, target, policy).map_err(err)?;
-    let mut angles = raw.angles;
-    let mut clamped = reached.map(|(kind, p)| Clamp {
-        kind,
-        distance_m: distance(p, foot_in_hip),
-    });
-    if let Some(joint) = robot.limits.first_violation(angles) {
-        if policy == ReachPolicy::Reject {
-            return Err(err(Unreachable::JointLimit(joint)));
-        }
-        let mut a = angles.to_array();
-        for (i, v) in a.iter_mut().enumerate() {
-            *v = v.clamp(robot.limits.min_rad[i], robot.limits.max_rad[i]);
-        }
-        angles = JointAngles::from_array(a);
-        let reached = forward_with::<M>(g, leg, angles);
-        clamped = Some(Clamp {
-            kind: clamped.map_or(Unreachable::JointLimit(joint), |c| c.kind),
-            distance_m: distance(reached, foot_in_hip),
-        });
-    }
-    if !angles.is_finite() {
-        // Unreachable by construction; kept so that no NaN can ever leave this function.
-        return Err(err(Unreachable::NonFinite));
-    }
-    Ok(LegSolution { angles, clamped })
+    view.inverse_with::<M>(leg, foot_in_hip, policy)
 }
 
 /// [`inverse_with`] on the [`DefaultMath`] backend.
@@ -486,65 +738,4 @@ pub fn inverse(
     policy: ReachPolicy,
 ) -> Result<LegSolution, IkError> {
     inverse_with::<DefaultMath>(robot, leg, foot_in_hip, policy)
-}
-
-/// The four legs of [`LegId::ALL`] at once under [`ReachPolicy::Reject`], for the full-body
-/// IK: the arithmetic of [`inverse_with`] leg by leg (bit-identical results), written lane by
-/// lane so that the four independent solves interleave instead of running one after the
-/// other. `None` when any leg is not cleanly solvable (non-finite input, outside the
-/// workspace, beyond a joint limit): the caller then solves the legs in order to name the
-/// first failure.
-#[cfg(not(target_arch = "avr"))]
-#[inline]
-pub(crate) fn inverse_all_reject<M: Math>(
-    robot: &Robot,
-    feet_in_hip: &[Vec3; 4],
-) -> Option<[JointAngles; 4]> {
-    let g = &robot.leg;
-    let d2 = g.d_lat_m * g.d_lat_m;
-    let (far2, near2) = reach2(g);
-    let mut ok = true;
-    // One plain array per quantity (not arrays of structs), which the compiler keeps in
-    // registers.
-    let mut w = [0.0f32; 4];
-    let mut abduction = [0.0f32; 4];
-    let mut dist2 = [0.0f32; 4];
-    let mut c = [0.0f32; 4];
-    let mut s = [0.0f32; 4];
-    for (i, p) in feet_in_hip.iter().enumerate() {
-        // Non-short-circuit `&` and float arithmetic: no branch per lane. `q·0` is ±0 for a
-        // finite q and NaN otherwise.
-        let finite = p.x * 0.0 + p.y * 0.0 + p.z * 0.0 == 0.0;
-        ok &= finite & !(p.y * p.y + p.z * p.z < d2);
-        w[i] = depth::<M>(d2, p.y, p.z);
-    }
-    for (i, p) in feet_in_hip.iter().enumerate() {
-        let sd = LegId::ALL[i].side() * g.d_lat_m;
-        abduction[i] = abduction_angle::<M>(sd, p.y, p.z, w[i]);
-        let v = w[i] + g.d_ax_m;
-        let d = p.x * p.x + v * v;
-        ok &= !(d > far2) & !(d < near2);
-    }
-    // Stage by stage across the legs (square roots, then angles), so that the independent
-    // dependency chains sit next to each other in the instruction stream.
-    for (i, p) in feet_in_hip.iter().enumerate() {
-        (dist2[i], c[i], s[i]) = planar_sides::<M>(g, robot.knee_bend, p.x, w[i] + g.d_ax_m, false);
-    }
-    let mut out = [JointAngles::default(); 4];
-    for (i, p) in feet_in_hip.iter().enumerate() {
-        let (hip, knee) = planar_angles::<M>(g, p.x, w[i] + g.d_ax_m, (dist2[i], c[i], s[i]));
-        out[i] = JointAngles::new(abduction[i], hip, knee);
-    }
-    // Within the limits (a NaN fails every comparison, so this also rejects non-finite angles).
-    let (lo, hi) = (&robot.limits.min_rad, &robot.limits.max_rad);
-    for a in &out {
-        let a = a.to_array();
-        ok &= (a[0] >= lo[0]) & (a[0] <= hi[0]) & (a[1] >= lo[1]) & (a[1] <= hi[1]);
-        ok &= (a[2] >= lo[2]) & (a[2] <= hi[2]);
-    }
-    if ok {
-        Some(out)
-    } else {
-        None
-    }
 }

@@ -103,10 +103,10 @@ const PI: f32 = core::f32::consts::PI;
 ///
 /// | kernel | max abs error (tests) | suits |
 /// |---|---|---|
-/// | [`atan2_deg15`], [`atan2_deg15_x4`] | 3e-7 rad | hosts: branch-free, Estrin, 4 SIMD lanes |
-/// | [`atan2_deg9`] | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
-/// | [`sin_cos_deg9`] | 2e-7 | hosts: branch-free |
-/// | [`sin_cos_deg5`] | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
+/// | [`atan2_deg15`](poly::atan2_deg15), [`atan2_deg15_x4`](poly::atan2_deg15_x4) | 3e-7 rad | hosts: branch-free, Estrin, 4 SIMD lanes |
+/// | [`atan2_deg9`](poly::atan2_deg9) | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
+/// | [`sin_cos_deg9`](poly::sin_cos_deg9) | 2e-7 | hosts: branch-free |
+/// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
 pub mod poly {
     use super::{FRAC_PI_2, PI};
 
@@ -304,6 +304,95 @@ pub mod poly {
             1 => (cos, -sin),
             2 => (-sin, -cos),
             _ => (-cos, sin),
+        }
+    }
+}
+
+/// Comparisons of floats with the semantics of the float operators (NaN included), computed
+/// on the ATmega2560 by integer comparisons of the bit patterns (a software-float comparison
+/// is a library call of about 70 cycles; these are a few instructions) and with the float
+/// operators elsewhere.
+pub(crate) mod cmp {
+    /// Bits of +∞; larger patterns with a clear sign bit are NaNs.
+    const INF: u32 = 0x7f80_0000;
+
+    /// `x > 0.0`.
+    #[inline(always)]
+    pub(crate) fn gt_zero(x: f32) -> bool {
+        if cfg!(target_arch = "avr") {
+            bits::gt_zero(x)
+        } else {
+            x > 0.0
+        }
+    }
+
+    /// `a < b` for `a`, `b` that are each `≥ +0` (sign bit clear: squares, sums of squares,
+    /// distances) or NaN.
+    #[inline(always)]
+    pub(crate) fn lt_nonneg(a: f32, b: f32) -> bool {
+        if cfg!(target_arch = "avr") {
+            bits::lt_nonneg(a, b)
+        } else {
+            a < b
+        }
+    }
+
+    /// `x.is_finite()` from the exponent bits (core's `is_finite` is a float comparison).
+    #[inline(always)]
+    pub(crate) fn finite(x: f32) -> bool {
+        x.to_bits() & INF != INF
+    }
+
+    /// The integer forms, compiled everywhere so that the host tests hold them to the float
+    /// operators (outside tests, hosts use only some of them).
+    #[cfg_attr(not(any(test, target_arch = "avr")), allow(dead_code))]
+    pub(crate) mod bits {
+        use super::INF;
+
+        /// `x > 0.0`: the patterns `1 ..= INF` (positive subnormals to +∞).
+        #[inline(always)]
+        pub(crate) fn gt_zero(x: f32) -> bool {
+            x.to_bits().wrapping_sub(1) < INF
+        }
+
+        /// `a < b` for `a`, `b` with a clear sign bit or NaN: non-negative floats order as
+        /// their patterns; a NaN `b` (pattern above INF, or sign set) fails the second test, a
+        /// NaN `a` the first.
+        #[inline(always)]
+        pub(crate) fn lt_nonneg(a: f32, b: f32) -> bool {
+            let (a, b) = (a.to_bits(), b.to_bits());
+            a < b && b <= INF
+        }
+
+        /// A key that orders non-NaN floats as `<` does, with −0 = +0 (sign–magnitude to
+        /// two's complement); positive NaNs sort above +∞, negative NaNs below −∞.
+        #[inline(always)]
+        pub(crate) fn key(x: f32) -> i32 {
+            let b = x.to_bits() as i32;
+            if b < 0 {
+                i32::MIN.wrapping_sub(b)
+            } else {
+                b
+            }
+        }
+
+        /// Keys `(lo, hi)` of a closed interval for [`within`]; an interval with a NaN bound
+        /// admits nothing, as the float comparisons do.
+        #[inline]
+        pub(crate) fn interval(lo: f32, hi: f32) -> (i32, i32) {
+            let nan = |v: f32| v.to_bits() & 0x7fff_ffff > INF;
+            if nan(lo) || nan(hi) {
+                (i32::MAX, i32::MIN)
+            } else {
+                (key(lo), key(hi))
+            }
+        }
+
+        /// `lo <= x && x <= hi` for the keys of [`interval`] (a NaN `x` fails one of the two).
+        #[inline(always)]
+        pub(crate) fn within(x: f32, (lo, hi): (i32, i32)) -> bool {
+            let k = key(x);
+            lo <= k && k <= hi
         }
     }
 }
@@ -540,6 +629,57 @@ mod tests {
             assert!((c as f64 - (x as f64).cos()).abs() < 7.0e-7, "cos {x}");
         }
         assert_eq!(poly::sin_cos_deg5(0.0), (0.0, 1.0));
+    }
+
+    /// The integer comparisons used on the ATmega2560 equal the float operators on special
+    /// values and on random bit patterns (NaNs of both signs included).
+    #[test]
+    fn bit_comparisons_equal_float_comparisons() {
+        use cmp::bits;
+        let mut vals = vec![
+            0.0f32,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::from_bits(0x8000_0001),
+            1.0,
+            -1.0,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+            f32::from_bits(0x7f80_0001),
+            f32::from_bits(0xff80_0001),
+            f32::from_bits(0x7fff_ffff),
+            f32::from_bits(0xffff_ffff),
+        ];
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..300 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            vals.push(f32::from_bits((state >> 32) as u32));
+        }
+        for &a in &vals {
+            assert_eq!(bits::gt_zero(a), a > 0.0, "{a:e} > 0");
+            assert_eq!(cmp::finite(a), a.is_finite(), "finite {a:e}");
+            for &b in &vals {
+                let nonneg = |v: f32| v.is_sign_positive() || v.is_nan();
+                if nonneg(a) && nonneg(b) {
+                    assert_eq!(bits::lt_nonneg(a, b), a < b, "{a:e} < {b:e}");
+                }
+                for &x in vals.iter().step_by(7) {
+                    assert_eq!(
+                        bits::within(x, bits::interval(a, b)),
+                        x >= a && x <= b,
+                        "{a:e} <= {x:e} <= {b:e}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
