@@ -7,7 +7,7 @@
 //! | `deps`         | `scripts/install-deps.sh`: Debian packages and rustup components      |
 //! | `fmt`          | `cargo fmt --all --check`                                             |
 //! | `clippy`       | `cargo clippy --workspace --all-targets -- -D warnings`               |
-//! | `avr-kin-core` | no_std build of kin-core for `avr-none` (atmega2560), nightly + build-std=core |
+//! | `avr-kin-core` | no_std build of kin-core, quad-protocol and quad-device for `avr-none` (atmega2560), nightly + build-std=core |
 //! | `firmware`     | `cargo build --release` in `firmware-avr/` (when that directory exists) |
 //! | `test`         | `cargo test --workspace`                                              |
 //! | `doc`          | `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`     |
@@ -113,6 +113,10 @@ fn ci_steps(root: &Path) -> Vec<Step> {
                 "build",
                 "-p",
                 "kin-core",
+                "-p",
+                "quad-protocol",
+                "-p",
+                "quad-device",
                 "--release",
                 "--target",
                 "avr-none",
