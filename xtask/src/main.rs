@@ -334,7 +334,7 @@ mod tests {
         let avr = steps.iter().find(|s| s.name == "avr-kin-core").unwrap();
         assert_eq!(
             avr.display(),
-            "RUSTFLAGS=\"-C target-cpu=atmega2560\" cargo +nightly build -p kin-core --release \
+            "RUSTFLAGS=\"-C target-cpu=atmega2560\" cargo +nightly build -p kin-core -p quad-protocol -p quad-device --release \
              --target avr-none -Z build-std=core --target-dir target/avr"
         );
     }
