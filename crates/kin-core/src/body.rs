@@ -352,6 +352,17 @@ impl Solver {
                 });
             }
         }
+        self.legs_one_by_one::<M>(local, policy)
+    }
+
+    /// The four leg solves in order FL, FR, RL, RR, stopping at the first failure (on hosts,
+    /// the fallback of the interleaved path that names the failing leg).
+    #[inline]
+    fn legs_one_by_one<M: Math>(
+        &self,
+        local: &[Vec3; 4],
+        policy: ReachPolicy,
+    ) -> Result<BodySolution, IkError> {
         // One expression, so that each leg's solution is written in place (no copies of the
         // 64-byte result through memory).
         let solve = |leg: LegId| self.leg.inverse_with::<M>(leg, local[leg.index()], policy);

@@ -292,15 +292,7 @@ struct View<'a> {
     geometry: &'a LegGeometry,
     limits: &'a JointLimits,
     knee_bend: KneeBend,
-    c: &'a Consts,
-}
-
-/// The quantities of one solve before the three arctangents: the angles are
-/// `atan2(y[i], x[i])` for abduction, knee, hip.
-#[derive(Clone, Copy)]
-struct Pending {
-    y: [f32; 3],
-    x: [f32; 3],
+    c: Consts,
 }
 
 /// Un-abducted depth of the foot: `w = −√(y² + z² − d_lat²)`, the branch with the foot below
@@ -351,7 +343,7 @@ impl Solver {
             geometry: &self.geometry,
             limits: &self.limits,
             knee_bend: self.knee_bend,
-            c: &self.consts,
+            c: self.consts,
         }
     }
 
@@ -417,25 +409,19 @@ impl View<'_> {
         }
     }
 
-    /// The rest of a solve after the reach checks, up to the arctangents: the foot's `(y, z)`
-    /// lies at least `d_lat` from the abduction axis, `w` is its depth from [`depth`], and
-    /// `(u, v)` (`dist2 = u² + v²`) lies within the reach of the leg plane up to rounding
-    /// (`moved`: after a projection).
+    /// The arguments of the abduction's `atan2`: a = angle(y, z) − angle(s·d_lat, w), as one
+    /// atan2 of cross and dot (the foot's `(y, z)` lies at least `d_lat` from the abduction
+    /// axis, `w` is its depth from [`depth`], `sd = s·d_lat`).
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn pending<M: Math>(
-        &self,
-        sd: f32,
-        y: f32,
-        z: f32,
-        w: f32,
-        u: f32,
-        v: f32,
-        dist2: f32,
-        moved: bool,
-    ) -> Pending {
-        // a = angle(y, z) − angle(s·d_lat, w), as one atan2 of cross and dot.
-        let (abd_y, abd_x) = (sd * z - w * y, sd * y + w * z);
+    fn abduction_yx(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
+        (sd * z - w * y, sd * y + w * z)
+    }
+
+    /// The arguments of the knee's and the hip's `atan2`, `([knee_y, hip_y], [knee_x, hip_x])`,
+    /// for the foot at `(u, v)` in the leg plane (`dist2 = u² + v²`) within the reach up to
+    /// rounding (`moved`: after a projection).
+    #[inline(always)]
+    fn planar_yx<M: Math>(&self, u: f32, v: f32, dist2: f32, moved: bool) -> ([f32; 2], [f32; 2]) {
         // The law of cosines, scaled by 2·L1·L2 (no division; atan2 is scale-invariant):
         // c = D² − L1² − L2², and s² = (D² − (L1−L2)²)·((L1+L2)² − D²), the factored form that
         // stays accurate near a folded or straight knee, where (2·L1·L2)² − c² loses the digits
@@ -456,10 +442,7 @@ impl View<'_> {
         // 2·L1: (D² + L1² − L2², s).
         let (bx, by) = (dist2 + self.c.diff_sq, s);
         let (ax, ay) = (-v, -u);
-        Pending {
-            y: [abd_y, s, bx * ay - by * ax],
-            x: [abd_x, c, bx * ax + by * ay],
-        }
+        ([s, bx * ay - by * ax], [c, bx * ax + by * ay])
     }
 
     /// Solves the abduction and planar problem exactly for a point known to be reachable
@@ -527,8 +510,9 @@ impl View<'_> {
             }
             dist2 = u * u + v * v;
         }
-        let p = self.pending::<M>(sd, y, z, w, u, v, dist2, moved);
-        let [abduction, knee, hip] = M::atan2_3(p.y, p.x);
+        let (abd_y, abd_x) = Self::abduction_yx(sd, y, z, w);
+        let ([knee_y, hip_y], [knee_x, hip_x]) = self.planar_yx::<M>(u, v, dist2, moved);
+        let [abduction, knee, hip] = M::atan2_3([abd_y, knee_y, hip_y], [abd_x, knee_x, hip_x]);
         let angles = JointAngles::new(abduction, hip, knee);
         let reached = if moved {
             let (sa, ca) = M::sin_cos(abduction);
@@ -564,7 +548,7 @@ impl View<'_> {
     }
 
     /// [`Solver::inverse_with`].
-    #[inline]
+    #[cfg_attr(not(target_arch = "avr"), inline(always))]
     fn inverse_with<M: Math>(
         &self,
         leg: LegId,
@@ -642,6 +626,7 @@ impl View<'_> {
         let mut w_sq = [0.0f32; 4];
         let mut v = [0.0f32; 4];
         let mut dist2 = [0.0f32; 4];
+        let mut abduction = [0.0f32; 4];
         for (i, p) in feet_in_hip.iter().enumerate() {
             // Non-short-circuit `&` and float arithmetic: no branch per lane. `q·0` is ±0 for a
             // finite q and NaN otherwise.
@@ -651,26 +636,31 @@ impl View<'_> {
             (w[i], w_sq[i]) = depth::<M>(self.c.d_lat_sq, r_sq);
         }
         for (i, p) in feet_in_hip.iter().enumerate() {
+            let sd = if LegId::ALL[i].is_left() {
+                g.d_lat_m
+            } else {
+                -g.d_lat_m
+            };
+            let (abd_y, abd_x) = Self::abduction_yx(sd, p.y, p.z, w[i]);
+            abduction[i] = M::atan2(abd_y, abd_x);
             let v_sq;
             (v[i], v_sq) = self.c.height(g.d_ax_m, (w[i], w_sq[i]));
             dist2[i] = p.x * p.x + v_sq;
             ok &= !(dist2[i] > self.c.far_sq) & !(dist2[i] < self.c.near_sq);
         }
         // Stage by stage across the legs (square roots, then angles), so that the independent
-        // dependency chains sit next to each other in the instruction stream.
-        let pending: [Pending; 4] = core::array::from_fn(|i| {
-            let p = &feet_in_hip[i];
-            let sd = if LegId::ALL[i].is_left() {
-                g.d_lat_m
-            } else {
-                -g.d_lat_m
-            };
-            self.pending::<M>(sd, p.y, p.z, w[i], p.x, v[i], dist2[i], false)
-        });
+        // dependency chains sit next to each other in the instruction stream; the abductions
+        // above start as soon as their depths are known. (The same `atan2` calls as
+        // `Math::atan2_3` makes: bit for bit the leg-by-leg results.)
+        let mut planar = [([0.0f32; 2], [0.0f32; 2]); 4];
+        for (i, p) in feet_in_hip.iter().enumerate() {
+            planar[i] = self.planar_yx::<M>(p.x, v[i], dist2[i], false);
+        }
         let mut out = [JointAngles::default(); 4];
-        for (o, p) in out.iter_mut().zip(&pending) {
-            let [abduction, knee, hip] = M::atan2_3(p.y, p.x);
-            *o = JointAngles::new(abduction, hip, knee);
+        for (i, ([knee_y, hip_y], [knee_x, hip_x])) in planar.iter().enumerate() {
+            let knee = M::atan2(*knee_y, *knee_x);
+            let hip = M::atan2(*hip_y, *hip_x);
+            out[i] = JointAngles::new(abduction[i], hip, knee);
         }
         // Within the limits (a NaN fails every comparison, so this also rejects non-finite
         // angles).
@@ -724,7 +714,7 @@ pub fn inverse_with<M: Math>(
         geometry: &robot.leg,
         limits: &robot.limits,
         knee_bend: robot.knee_bend,
-        c: &Consts::of(&robot.leg),
+        c: Consts::of(&robot.leg),
     };
     view.inverse_with::<M>(leg, foot_in_hip, policy)
 }

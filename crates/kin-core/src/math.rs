@@ -7,8 +7,7 @@
 //! - [`Fast`] (the default, [`DefaultMath`]): minimax polynomials for `atan2` and `sin`/`cos`
 //!   (absolute error ≤ 3e-7 rad, about one f32 ulp at π; see the tests), `libm` for `sqrt`.
 //!   `atan2` is branch-free (random quadrants cost no mispredictions) and its polynomial is
-//!   evaluated in Estrin's scheme (a short dependency chain); [`Math::atan2_3`] evaluates the
-//!   three arctangents of a leg together in four SIMD lanes. Quick on hosts with hardware
+//!   evaluated in Estrin's scheme (a short dependency chain). Quick on hosts with hardware
 //!   floating point. See `BENCHMARKS.md`.
 //! - [`Libm`]: the `libm` crate's correctly rounded-ish `atan2f`, `sinf`, `cosf`, `sqrtf`.
 //!   The reference the others are tested against.
@@ -30,14 +29,26 @@ pub trait Math {
     fn sin_cos(x: f32) -> (f32, f32);
     /// Three independent arctangents `[atan2(y[0], x[0]), atan2(y[1], x[1]),
     /// atan2(y[2], x[2])]` (a leg's abduction, knee and hip). A backend may evaluate them
-    /// together, but must return exactly what three [`Math::atan2`] calls return. The default
-    /// makes the three calls.
-    #[inline]
+    /// together (e.g. in SIMD lanes), but must return exactly what three [`Math::atan2`] calls
+    /// return. The default makes the three calls (always inlined: the arrays must not pass
+    /// through memory, which costs store-forwarding stalls on x86-64).
+    #[inline(always)]
     fn atan2_3(y: [f32; 3], x: [f32; 3]) -> [f32; 3] {
         [
             Self::atan2(y[0], x[0]),
             Self::atan2(y[1], x[1]),
             Self::atan2(y[2], x[2]),
+        ]
+    }
+    /// Four independent arctangents (one joint of the four legs), exactly what four
+    /// [`Math::atan2`] calls return. The default makes the four calls.
+    #[inline]
+    fn atan2_4(y: [f32; 4], x: [f32; 4]) -> [f32; 4] {
+        [
+            Self::atan2(y[0], x[0]),
+            Self::atan2(y[1], x[1]),
+            Self::atan2(y[2], x[2]),
+            Self::atan2(y[3], x[3]),
         ]
     }
 }
@@ -64,9 +75,11 @@ impl Math for Libm {
     }
 }
 
-/// Polynomial backend for hosts: [`poly::atan2_deg15`] (three at once with
-/// [`poly::atan2_deg15_x4`]), [`poly::sin_cos_deg9`], `libm` for `sqrt` (one instruction on
-/// hosts).
+/// Polynomial backend for hosts: [`poly::atan2_deg15`], [`poly::sin_cos_deg9`], `libm` for
+/// `sqrt` (one instruction on hosts). It keeps the default [`Math::atan2_3`] and
+/// [`Math::atan2_4`]: the compiler schedules (and partly vectorizes) the independent scalar
+/// calls faster than an explicit four-lane `atan2` on the measured x86-64 host (see
+/// `BENCHMARKS.md`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Fast;
 
@@ -85,14 +98,6 @@ impl Math for Fast {
     fn sin_cos(x: f32) -> (f32, f32) {
         poly::sin_cos_deg9(x)
     }
-
-    /// The three arctangents in four lanes of [`poly::atan2_deg15_x4`] (one SIMD division,
-    /// one polynomial), bit for bit what three [`Fast::atan2`] calls return.
-    #[inline]
-    fn atan2_3(y: [f32; 3], x: [f32; 3]) -> [f32; 3] {
-        let r = poly::atan2_deg15_x4([y[0], y[1], y[2], 0.0], [x[0], x[1], x[2], 1.0]);
-        [r[0], r[1], r[2]]
-    }
 }
 
 const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
@@ -103,7 +108,7 @@ const PI: f32 = core::f32::consts::PI;
 ///
 /// | kernel | max abs error (tests) | suits |
 /// |---|---|---|
-/// | [`atan2_deg15`](poly::atan2_deg15), [`atan2_deg15_x4`](poly::atan2_deg15_x4) | 3e-7 rad | hosts: branch-free, Estrin, 4 SIMD lanes |
+/// | [`atan2_deg15`](poly::atan2_deg15) | 3e-7 rad | hosts: branch-free, Estrin |
 /// | [`atan2_deg9`](poly::atan2_deg9) | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
 /// | [`sin_cos_deg9`](poly::sin_cos_deg9) | 2e-7 | hosts: branch-free |
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
@@ -176,10 +181,12 @@ pub mod poly {
         (c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * c[4])))) * t
     }
 
-    /// One lane of [`atan2_deg15`]: no branch, no table. The octant becomes an offset
-    /// (0, π, π/2) chosen by bit masks and the signs of `t` and of the result.
-    #[inline(always)]
-    fn atan2_deg15_lane(y: f32, x: f32) -> f32 {
+    /// Four-quadrant arctangent, odd degree-15 polynomial: absolute error ≤ 3e-7 rad,
+    /// `atan2(±0, ±0)` as libm (±0 or ±π). Branch-free, so random quadrants cost no
+    /// mispredictions: the octant's offset comes from a 4-entry table (a select would become a
+    /// branch).
+    #[inline]
+    pub fn atan2_deg15(y: f32, x: f32) -> f32 {
         let ax = libm::fabsf(x);
         let ay = libm::fabsf(y);
         // Written as comparisons (not f32::min/max) so that they compile to minss/maxss.
@@ -193,32 +200,13 @@ pub mod poly {
         let x_neg = x.to_bits() >> 31;
         let y_sign = y.to_bits() & SIGN;
         // |atan2| = offset ± atan(t) by (swap, x < 0): (0, +), (π, −), (π/2, −), (π/2, +); then
-        // the sign of y.
+        // the sign of y. A table lookup, not a select, which the compiler would turn into a
+        // branch that random quadrants mispredict.
+        const OFFSET: [f32; 4] = [0.0, PI, FRAC_PI_2, FRAC_PI_2];
         let t_sign = ((swap ^ x_neg) << 31) ^ y_sign;
-        let swap_mask = 0u32.wrapping_sub(swap);
-        let x_neg_mask = 0u32.wrapping_sub(x_neg);
-        let offset = (FRAC_PI_2.to_bits() & swap_mask) | (PI.to_bits() & x_neg_mask & !swap_mask);
-        let offset = f32::from_bits(offset | y_sign);
+        let offset = OFFSET[((swap << 1) | x_neg) as usize];
+        let offset = f32::from_bits(offset.to_bits() | y_sign);
         offset + atan_deg15(f32::from_bits(t.to_bits() ^ t_sign))
-    }
-
-    /// Four-quadrant arctangent, odd degree-15 polynomial: absolute error ≤ 3e-7 rad,
-    /// `atan2(±0, ±0)` as libm (±0 or ±π). Branch-free, so random quadrants cost no
-    /// mispredictions.
-    #[inline]
-    pub fn atan2_deg15(y: f32, x: f32) -> f32 {
-        atan2_deg15_lane(y, x)
-    }
-
-    /// [`atan2_deg15`] of four pairs at once, bit for bit: straight-line lane-wise code that
-    /// the compiler turns into SIMD (one `divps`, one polynomial) where the target has it.
-    #[inline]
-    pub fn atan2_deg15_x4(y: [f32; 4], x: [f32; 4]) -> [f32; 4] {
-        let mut out = [0.0; 4];
-        for i in 0..4 {
-            out[i] = atan2_deg15_lane(y[i], x[i]);
-        }
-        out
     }
 
     /// Four-quadrant arctangent, odd degree-9 polynomial: absolute error ≤ 1.2e-5 rad
@@ -576,7 +564,7 @@ mod tests {
         assert_eq!(poly::atan2_deg9(-1.0, 0.0), -FRAC_PI_2);
     }
 
-    /// `atan2_3` (four SIMD lanes in `Fast`) returns exactly three `atan2` calls, including
+    /// `atan2_3` and `atan2_4` return exactly three and four `atan2` calls, including
     /// signed zeros, axes, tiny and huge arguments and NaN-free degenerate pairs.
     #[test]
     fn fast_atan2_3_is_three_atan2_bit_for_bit() {
