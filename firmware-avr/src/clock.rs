@@ -30,8 +30,19 @@ impl Clock {
 
     /// Milliseconds since [`Clock::new`].
     pub fn now_ms(&self) -> u32 {
-        interrupt::free(|cs| MILLIS.borrow(cs).get())
+        now_ms()
     }
+}
+
+impl quad_device::Clock for Clock {
+    fn now_ms(&self) -> u32 {
+        now_ms()
+    }
+}
+
+/// Milliseconds since the clock was started by [`Clock::new`] (0 before).
+pub fn now_ms() -> u32 {
+    interrupt::free(|cs| MILLIS.borrow(cs).get())
 }
 
 /// Advances the clock by one millisecond; call from the `TIMER2_COMPA` interrupt.

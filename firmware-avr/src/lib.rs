@@ -1,12 +1,14 @@
 //! # firmware-avr — the hardware shell of the quadruped's ATmega2560 (Arduino Mega 2560)
 //!
 //! Everything that touches registers lives here; the device's behaviour (decode → IK →
-//! calibration → outputs) lives in portable crates and is plugged in by the binaries.
+//! calibration → outputs) lives in the portable crate `quad-device`, which [`app`] runs.
 //!
 //! | module | what |
 //! |---|---|
-//! | [`servo`] | 12 servo outputs on the output-compare units of Timer1/3/4/5 (50 Hz, 0.5 µs ticks), `embedded_hal::pwm::SetDutyCycle` per channel |
-//! | [`clock`] | millisecond clock on Timer2 |
+//! | [`app`] | bring-up and main loop around the device controller (`quad_device::Device`) |
+//! | [`servo`] | 12 servo outputs on the output-compare units of Timer1/3/4/5 (50 Hz, 0.5 µs ticks), `embedded_hal::pwm::SetDutyCycle` per channel, `quad_device::ServoOutputs` |
+//! | [`clock`] | millisecond clock on Timer2 (`quad_device::Clock`) |
+//! | [`eeprom`] | the EEPROM as calibration storage (`quad_device::Storage`) |
 //! | [`usart`] | USART0: interrupt-driven receive into a bounded ring buffer, polled transmit |
 //! | [`watchdog`] | watchdog enable/feed and the reset cause |
 //! | [`stack`] | SRAM painting at boot and the high-water mark of the stack |
@@ -14,17 +16,23 @@
 //!
 //! The CPU clock is [`F_CPU_HZ`] (the Mega's 16 MHz crystal).
 //!
+//! Binaries: `firmware` (115,200 baud) and `firmware-1mbaud` (1,000,000 baud) run [`app::run`];
+//! `bench` and `bench-libm` serve the cycle benchmark ([`bench`]).
+//!
 //! Interrupt handlers must be defined in the binary crate (a handler in a library is not
-//! pulled in by the linker): each binary forwards `USART0_RX` to [`usart::on_rx_interrupt`]
-//! and `TIMER2_COMPA` to [`clock::on_tick_interrupt`].
+//! pulled in by the linker): each binary forwards `USART0_RX` to [`usart::on_rx_interrupt`],
+//! `TIMER2_COMPA` to [`clock::on_tick_interrupt`] and `EE_READY` to
+//! [`eeprom::on_ready_interrupt`] (the firmware binaries through [`forward_interrupts!`]).
 
 #![no_std]
 #![feature(asm_experimental_arch)]
 #![deny(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod app;
 pub mod bench;
 pub mod clock;
+pub mod eeprom;
 pub mod servo;
 pub mod stack;
 pub mod usart;

@@ -26,6 +26,14 @@
 //! [`Servos::enable`]. A channel whose pulse width is 0 stays low even when enabled. Pulse
 //! widths are double-buffered by the hardware (OCRn is taken over at the start of a period), so
 //! a change never produces a runt or doubled pulse.
+//!
+//! **Whole poses per period.** The four timers are started together (the synchronous prescaler
+//! reset of GTCCR) and run in lockstep. [`Servos::set_all_pulse_ticks`] writes the twelve
+//! compare registers with interrupts off, between the end of the longest pulse and the last
+//! [`WRITE_GUARD_TICKS`] of a period, so every period shows either the old or the new widths
+//! on all twelve pins, never a mix.
+//! [`Servos::enable`] and [`Servos::disable`] (re)connect the compare units only after the
+//! longest pulse of the period has ended: switching never cuts a pulse short or starts one late.
 
 use crate::pac;
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
@@ -41,6 +49,18 @@ pub const TICKS_PER_US: u16 = 2;
 
 /// Period of the servo signal, µs.
 pub const PERIOD_US: u32 = 20_000;
+
+/// Ticks at the end of each period in which the compare registers are not written (writing all
+/// twelve takes about 150 cycles, 19 ticks; the margin also covers timers that are a few ticks
+/// apart, as in simulators that ignore GTCCR).
+pub const WRITE_GUARD_TICKS: u16 = 64;
+
+/// Ticks after the longest pulse before the compare units may be switched.
+const QUIET_MARGIN_TICKS: u16 = 16;
+
+/// GTCCR bits: timer synchronisation mode, prescaler reset of Timer0/1/3/4/5.
+const GTCCR_TSM: u8 = 1 << 7;
+const GTCCR_PSRSYNC: u8 = 1 << 0;
 
 /// TCCRnA: WGMn1 (mode 14 = WGM 1110, low two bits `10`).
 const TCCRA_MODE14: u8 = 0b0000_0010;
@@ -104,16 +124,20 @@ pub struct Servos {
     portl: pac::PORTL,
     /// Pulse width of each channel, ticks (0 = no pulse).
     pulse_ticks: [u16; CHANNELS],
+    /// The longest pulse the hardware may still be producing in this or the next period, ticks.
+    longest_ticks: u16,
     enabled: bool,
 }
 
 impl Servos {
     /// Takes the four timers and the four ports of their pins, drives the twelve pins low as
-    /// outputs and starts the timers; outputs stay disabled (compare units disconnected) until
+    /// outputs and starts the timers together (`tc0` lends its GTCCR register, which controls
+    /// the shared prescaler); outputs stay disabled (compare units disconnected) until
     /// [`Servos::enable`]. The other pins of the ports keep their state (PE0/PE1 belong to
     /// USART0, which overrides them).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
+        tc0: &pac::TC0,
         tc1: pac::TC1,
         tc3: pac::TC3,
         tc4: pac::TC4,
@@ -161,10 +185,15 @@ impl Servos {
                     .write(|w| unsafe { w.bits(TCCRB_MODE14_PRESCALE8) });
             }};
         }
+        // Halt the shared prescaler while the timers are set up, then release it: all four
+        // count from 0 on the same prescaler edge.
+        tc0.gtccr()
+            .write(|w| unsafe { w.bits(GTCCR_TSM | GTCCR_PSRSYNC) });
         init!(tc1, tccr1a, tccr1b, icr1, tcnt1);
         init!(tc3, tccr3a, tccr3b, icr3, tcnt3);
         init!(tc4, tccr4a, tccr4b, icr4, tcnt4);
         init!(tc5, tccr5a, tccr5b, icr5, tcnt5);
+        tc0.gtccr().write(|w| unsafe { w.bits(0) });
 
         Servos {
             tc1,
@@ -176,6 +205,7 @@ impl Servos {
             porth,
             portl,
             pulse_ticks: [0; CHANNELS],
+            longest_ticks: 0,
             enabled: false,
         }
     }
@@ -185,20 +215,59 @@ impl Servos {
         self.enabled
     }
 
-    /// Connects the compare units of every channel with a non-zero pulse width.
+    /// Connects the compare units of every channel with a non-zero pulse width, after the
+    /// longest pulse of the current period (the first pulse is complete). Waits at most one
+    /// period.
     pub fn enable(&mut self) {
-        self.enabled = true;
-        for t in 0..4 {
-            self.apply_connections(t);
-        }
+        self.switch_outputs(true);
     }
 
-    /// Disconnects every compare unit: all twelve pins low from now on (a pulse in progress is
-    /// cut short).
+    /// Disconnects every compare unit: all twelve pins low from the end of the longest pulse of
+    /// the current period on (no pulse is cut short; waits at most one period). The panic
+    /// handler uses [`force_all_low`], which does not wait.
     pub fn disable(&mut self) {
-        self.enabled = false;
-        for t in 0..4 {
-            self.apply_connections(t);
+        self.switch_outputs(false);
+    }
+
+    fn switch_outputs(&mut self, enabled: bool) {
+        self.at_quiet_moment(|s| {
+            s.enabled = enabled;
+            for t in 0..4 {
+                s.apply_connections(t);
+            }
+        });
+    }
+
+    /// True when every timer is in the window `(after, before)` of its period. The timers run
+    /// in lockstep on the chip; checking all four keeps the window right where they do not
+    /// (simulators that ignore GTCCR, or reconfigure a timer's phase).
+    fn all_in_window(&self, after: u16, before: u16) -> bool {
+        let inside = |t: u16| t > after && t < before;
+        inside(self.tc1.tcnt1().read().bits())
+            && inside(self.tc3.tcnt3().read().bits())
+            && inside(self.tc4.tcnt4().read().bits())
+            && inside(self.tc5.tcnt5().read().bits())
+    }
+
+    /// Runs `f` with interrupts off at a moment when no pulse is in progress on any channel and
+    /// the period does not end within [`WRITE_GUARD_TICKS`]: spins (interrupts on) until then,
+    /// at most one period. With pulses so long that no such moment exists, runs `f` at once.
+    fn at_quiet_moment(&mut self, f: impl FnOnce(&mut Self)) {
+        let after = self.longest_ticks.saturating_add(QUIET_MARGIN_TICKS);
+        let before = PERIOD_TICKS - WRITE_GUARD_TICKS;
+        if after >= before {
+            avr_device::interrupt::free(|_| f(self));
+            return;
+        }
+        let mut f = Some(f);
+        while f.is_some() {
+            avr_device::interrupt::free(|_| {
+                if self.all_in_window(after, before) {
+                    if let Some(f) = f.take() {
+                        f(self);
+                    }
+                }
+            });
         }
     }
 
@@ -223,6 +292,7 @@ impl Servos {
             return Err(Error::PulseTooLong);
         }
         let was_zero = self.pulse_ticks[channel] == 0;
+        self.longest_ticks = self.longest_ticks.max(ticks);
         self.pulse_ticks[channel] = ticks;
         if ticks > 0 {
             // Fast PWM: the pin is high for OCR + 1 ticks; OCR = TOP keeps it high.
@@ -234,13 +304,34 @@ impl Servos {
         Ok(())
     }
 
-    /// Sets all twelve pulse widths; nothing changes when any of them is refused.
+    /// Sets all twelve pulse widths so that they take effect in the same period (see the
+    /// module docs); nothing changes when any of them is refused. The compare registers are
+    /// written between pulses (waiting, interrupts on, while a pulse is in progress or the
+    /// period ends within [`WRITE_GUARD_TICKS`]: at most the longest pulse, ≤ 2.7 ms for a
+    /// servo). The chip takes them over at the next period either way; writing between pulses
+    /// also keeps simulators right that apply a compare register at once (simavr does).
     pub fn set_all_pulse_ticks(&mut self, ticks: &[u16; CHANNELS]) -> Result<(), Error> {
         if ticks.iter().any(|&t| t > PERIOD_TICKS) {
             return Err(Error::PulseTooLong);
         }
-        for (channel, &t) in ticks.iter().enumerate() {
-            self.set_pulse_ticks(channel, t)?;
+        let old = self.pulse_ticks;
+        let longest_old = old.iter().copied().max().unwrap_or(0);
+        let longest_new = ticks.iter().copied().max().unwrap_or(0);
+        self.longest_ticks = self.longest_ticks.max(longest_new);
+        self.at_quiet_moment(|s| {
+            for (channel, &t) in ticks.iter().enumerate() {
+                if t > 0 {
+                    s.write_ocr(channel, t - 1);
+                }
+            }
+        });
+        self.pulse_ticks = *ticks;
+        self.longest_ticks = longest_old.max(longest_new);
+        for t in 0..4 {
+            let changed = (0..3).any(|u| (old[3 * t + u] == 0) != (ticks[3 * t + u] == 0));
+            if changed {
+                self.apply_connections(t);
+            }
         }
         Ok(())
     }
@@ -339,6 +430,25 @@ pub fn force_all_low(dp: &pac::Peripherals) {
     dp.PORTL
         .portl()
         .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[3]) });
+}
+
+impl quad_device::ServoOutputs for Servos {
+    /// All twelve at once ([`Servos::set_all_pulse_ticks`]). The controller only passes widths
+    /// within the servos' calibrated travel (≤ 2,700 µs); a width beyond one period, which it
+    /// never passes, stops the outputs rather than being ignored.
+    fn set_pulses(&mut self, pulses_half_us: &[u16; CHANNELS]) {
+        if self.set_all_pulse_ticks(pulses_half_us).is_err() {
+            self.disable();
+        }
+    }
+
+    fn set_enabled(&mut self, enabled: bool) {
+        if enabled {
+            self.enable();
+        } else {
+            self.disable();
+        }
+    }
 }
 
 /// One servo channel, borrowed from [`Servos`].

@@ -64,8 +64,10 @@ impl Usart0 {
     /// Configures USART0 and enables the receiver, its interrupt and the transmitter
     /// (interrupts must be enabled by the caller).
     pub fn new(usart: pac::USART0, baud: Baud) -> Usart0 {
-        usart.ubrr0().write(|w| w.set(baud.ubrr()));
+        // U2X before UBRR: the chip does not care, but simavr derives the line rate when UBRR
+        // is written and would otherwise run at half the rate.
         usart.ucsr0a().write(|w| w.u2x0().set_bit());
+        usart.ubrr0().write(|w| w.set(baud.ubrr()));
         usart
             .ucsr0c()
             .write(|w| w.ucsz0().chr8().usbs0().stop1().upm0().disabled());
@@ -86,6 +88,20 @@ impl Usart0 {
             r.head = ((r.head as usize + 1) % RX_CAPACITY) as u8;
             r.len -= 1;
             Some(b)
+        })
+    }
+
+    /// Moves the received bytes, oldest first, into `buf` (as many as fit); returns how many.
+    pub fn read_into(&mut self, buf: &mut [u8]) -> usize {
+        interrupt::free(|cs| {
+            let mut r = RX.borrow(cs).borrow_mut();
+            let n = (r.len as usize).min(buf.len());
+            for b in buf.iter_mut().take(n) {
+                *b = r.buf[r.head as usize];
+                r.head = ((r.head as usize + 1) % RX_CAPACITY) as u8;
+            }
+            r.len -= n as u8;
+            n
         })
     }
 

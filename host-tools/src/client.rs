@@ -94,6 +94,19 @@ impl ClientConfig {
         }
     }
 
+    /// For the firmware in simavr ([`crate::link::emulator`]), in simulated time: 20 ms of
+    /// turnaround (one servo period; a body-pose solve takes about 7 ms), 1 s of handshake
+    /// patience.
+    pub fn emulator() -> ClientConfig {
+        ClientConfig {
+            retries: DEFAULT_RETRIES,
+            session_retries: SESSION_RETRIES,
+            turnaround: Duration::from_millis(20),
+            save_time: Duration::from_secs(1),
+            hello_patience: Duration::from_secs(1),
+        }
+    }
+
     /// For a real port: 50 ms of turnaround (USB latency and the device's IK), 4 s of
     /// handshake patience.
     pub fn serial() -> ClientConfig {

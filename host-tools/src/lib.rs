@@ -7,6 +7,7 @@
 pub mod client;
 pub mod cmd;
 pub mod csv_io;
+pub mod emu;
 pub mod link;
 pub mod plot;
 pub mod robot_file;

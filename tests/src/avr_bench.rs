@@ -13,10 +13,13 @@
 //!   forward kinematics (written from the chain formula in kin-core's crate docs), started
 //!   from the host's f32 solution, to a residual below [`REFERENCE_RESIDUAL_M`].
 
-use crate::avr::{firmware_elf, Emu, MARKER_PIN};
+use host_tools::client::{Client, ClientConfig};
+use host_tools::emu::{build, elf, Mega2560, MARKER_PIN};
+use host_tools::link::emulator::{EmulatorConfig, EmulatorLink};
 use kin_core::math::Libm;
 use kin_core::{body, BodyConfig, LegId, Pose, ReachPolicy, Robot, Vec3};
 use nalgebra::{Matrix3, Rotation3, Vector3};
+use quad_protocol::{DeviceToHost, PoseConfig, Request};
 use serde::Serialize;
 use std::path::Path;
 
@@ -247,7 +250,7 @@ fn max_abs_diff(a: &[f32], b: &[f64]) -> f64 {
 
 /// A benchmark firmware (`bench.elf` or `bench-libm.elf`) running in simavr.
 pub struct BenchFirmware {
-    emu: Emu,
+    emu: Mega2560,
     /// Cycles of an empty marker window, subtracted from every measurement.
     pub overhead_cycles: u64,
 }
@@ -255,7 +258,7 @@ pub struct BenchFirmware {
 impl BenchFirmware {
     /// Boots `elf` and waits for its ready byte.
     pub fn boot(elf: &Path) -> BenchFirmware {
-        let mut emu = Emu::new(elf);
+        let mut emu = Mega2560::new(elf).unwrap_or_else(|e| panic!("{e}"));
         let ready = emu
             .read_exact(1, 1_000_000)
             .expect("benchmark firmware sends 'R' at boot");
@@ -273,7 +276,7 @@ impl BenchFirmware {
     /// Sends `request`, runs until `answer_len` bytes came back, and returns the cycles the
     /// marker pin was high.
     fn timed(&mut self, request: &[u8], answer_len: usize) -> (u64, Vec<u8>) {
-        self.emu.write(request);
+        self.emu.uart_write(request);
         let (port, bit) = MARKER_PIN;
         let end = self.emu.cycle() + REQUEST_TIMEOUT_CYCLES;
         let mut rise = None;
@@ -282,7 +285,7 @@ impl BenchFirmware {
         let mut out = Vec::new();
         while out.len() < answer_len || cycles.is_none() {
             assert!(self.emu.cycle() < end, "benchmark request timed out");
-            self.emu.step();
+            self.emu.step().unwrap_or_else(|e| panic!("{e}"));
             let now = self.emu.pin(port, bit);
             if now != high {
                 if now {
@@ -292,7 +295,7 @@ impl BenchFirmware {
                 }
                 high = now;
             }
-            out.extend(self.emu.take_output());
+            out.extend(self.emu.uart_take().into_iter().map(|(_, b)| b));
         }
         assert_eq!(out.len(), answer_len, "benchmark answer length");
         (cycles.unwrap_or(0), out)
@@ -348,7 +351,7 @@ impl BenchFirmware {
 
     /// Static SRAM and the stack high-water mark, bytes.
     pub fn memory(&mut self) -> (u16, u16) {
-        self.emu.write(b"S");
+        self.emu.uart_write(b"S");
         let a = self
             .emu
             .read_exact(5, REQUEST_TIMEOUT_CYCLES)
@@ -434,76 +437,51 @@ pub fn measure_backend(
     }
 }
 
-/// Sizes of an ELF's allocated sections, bytes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ElfSizes {
-    /// `.text` + `.data` (the data's initial values live in flash).
-    pub flash_bytes: u64,
-    /// `.data` + `.bss` + `.noinit`.
-    pub sram_static_bytes: u64,
+pub use host_tools::emu::elf::ElfSizes;
+
+/// Flash and static SRAM of an ELF (`host_tools::emu::elf`).
+pub fn elf_sizes(path: &Path) -> ElfSizes {
+    elf::sizes(path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Reads the section sizes of a 32-bit little-endian ELF.
-pub fn elf_sizes(elf: &Path) -> ElfSizes {
-    let b = std::fs::read(elf).expect("read ELF");
-    assert_eq!(&b[..4], b"\x7fELF", "not an ELF");
-    let u16_at = |o: usize| u16::from_le_bytes([b[o], b[o + 1]]) as usize;
-    let u32_at = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]) as usize;
-    let (shoff, shentsize, shnum, shstrndx) =
-        (u32_at(0x20), u16_at(0x2E), u16_at(0x30), u16_at(0x32));
-    let section = |i: usize| {
-        let h = shoff + i * shentsize;
-        (u32_at(h), u32_at(h + 16), u32_at(h + 20))
-    };
-    let strtab = section(shstrndx).1;
-    let name = |off: usize| {
-        let s = &b[strtab + off..];
-        String::from_utf8_lossy(&s[..s.iter().position(|&c| c == 0).unwrap_or(0)]).into_owned()
-    };
-    let (mut flash, mut sram) = (0, 0);
-    for i in 0..shnum {
-        let (n, _, size) = section(i);
-        match name(n).as_str() {
-            ".text" => flash += size as u64,
-            ".data" => {
-                flash += size as u64;
-                sram += size as u64;
-            }
-            ".bss" | ".noinit" => sram += size as u64,
-            _ => {}
-        }
-    }
-    ElfSizes {
-        flash_bytes: flash,
-        sram_static_bytes: sram,
-    }
-}
+/// The stack paint byte of the firmware (`firmware_avr::stack::PAINT`).
+pub const STACK_PAINT: u8 = 0xC5;
 
-/// Boots the release firmware, runs body poses through its IK, and returns its static SRAM
-/// and stack high-water mark as the firmware itself reports them, bytes.
-pub fn firmware_memory(elf: &Path, poses: &[Pose]) -> (u16, u16) {
-    let mut emu = Emu::new(elf);
-    emu.run_us(crate::avr::BOOT_US);
+/// Boots the release firmware in the emulator, sets the benchmark's stance (height
+/// [`STANCE_HEIGHT_M`], order zyx), runs body poses through its IK over the wire protocol,
+/// and returns its static SRAM (from the ELF) and its stack high-water mark by the firmware's
+/// own method (the SRAM painted at boot, read here), bytes.
+pub fn firmware_memory(elf_path: &Path, poses: &[Pose]) -> (u16, u16) {
+    let link = EmulatorLink::boot(elf_path, EmulatorConfig::new(115_200))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut client = Client::new(link, ClientConfig::emulator());
+    client.hello().unwrap_or_else(|e| panic!("{e}"));
+    client
+        .ack(Request::SetPoseConfig(PoseConfig {
+            stance_height_m: STANCE_HEIGHT_M,
+            order: kin_core::RotationOrder::Zyx,
+            policy: ReachPolicy::Reject,
+        }))
+        .unwrap_or_else(|e| panic!("{e}"));
     for pose in poses {
-        let mut req = vec![b'P'];
-        for v in pose.to_array() {
-            req.extend(v.to_le_bytes());
-        }
-        emu.write(&req);
-        let a = emu
-            .read_exact(2 + 48, REQUEST_TIMEOUT_CYCLES)
-            .expect("firmware answers a pose");
-        assert_eq!(&a[..2], b"p\0", "firmware solves the pose");
+        let answer = client
+            .request(Request::SetBodyPose(*pose))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            matches!(answer, DeviceToHost::Ack { .. }),
+            "firmware solves the pose: {answer:?}"
+        );
     }
-    emu.write(b"S");
-    let a = emu
-        .read_exact(12, REQUEST_TIMEOUT_CYCLES)
-        .expect("firmware answers a status request");
-    assert_eq!(a[0], b's');
-    (
-        u16::from_le_bytes([a[1], a[2]]),
-        u16::from_le_bytes([a[3], a[4]]),
-    )
+    let image = elf::Elf::read(elf_path).unwrap_or_else(|e| panic!("{e}"));
+    let heap_start = image
+        .data_symbol("__heap_start")
+        .expect("the ELF defines __heap_start");
+    let sizes = image.sizes();
+    let stack = client
+        .link()
+        .mcu()
+        .painted_stack_bytes(heap_start, STACK_PAINT);
+    (sizes.sram_static_bytes as u16, stack)
 }
 
 /// The figures of the firmware issue, in its JSON field order.
@@ -572,9 +550,10 @@ pub struct Report {
 /// Builds the release ELFs and measures everything.
 pub fn run() -> Report {
     let targets = targets();
-    let bench_elf = firmware_elf("bench");
-    let libm_elf = firmware_elf("bench-libm");
-    let firmware = firmware_elf("firmware");
+    let elf_of = |bin| build::firmware_elf(bin).unwrap_or_else(|e| panic!("{e}"));
+    let bench_elf = elf_of(build::BENCH);
+    let libm_elf = elf_of(build::BENCH_LIBM);
+    let firmware = elf_of(build::FIRMWARE);
 
     let mut fw = BenchFirmware::boot(&bench_elf);
     let mut backends = Vec::new();
@@ -605,11 +584,7 @@ pub fn run() -> Report {
         .find(|b| b.name.starts_with(FIRMWARE_BACKEND.name()))
         .expect("the firmware's backend was measured");
     let sizes = elf_sizes(&firmware);
-    let (static_reported, stack) = firmware_memory(&firmware, &targets.poses[..4]);
-    assert_eq!(
-        static_reported as u64, sizes.sram_static_bytes,
-        "static SRAM: firmware's own figure vs the ELF's sections"
-    );
+    let (_, stack) = firmware_memory(&firmware, &targets.poses[..4]);
     Report {
         summary: Summary {
             leg_ik_cycles: chosen.leg_max_cycles,

@@ -74,6 +74,12 @@ pub struct Device<O, C, S, M = DefaultMath> {
     _math: PhantomData<fn() -> M>,
 }
 
+// The request handlers are `#[inline(never)]` on purpose: inlined into one function (as LTO
+// does on the ATmega2560), their locals make a stack frame of several hundred bytes, beyond the
+// AVR's 63-byte frame-pointer displacement. Every access then costs about 8 instructions, which
+// doubled the firmware's flash, and the LLVM AVR backend miscompiled one such access (it saved
+// SREG in r0 while r0 still held a `mul` result: a wrong calibration index). Small frames avoid
+// both; `firmware-avr`'s emulator tests scan the ELF for that pattern.
 impl<O, C, S, M> Device<O, C, S, M>
 where
     O: ServoOutputs,
@@ -162,6 +168,7 @@ where
 
     /// Handles one decoded request (what [`Device::receive`] does for every valid frame) and
     /// returns the answer.
+    #[inline(never)]
     pub fn handle(&mut self, msg: HostToDevice) -> DeviceToHost {
         self.last_valid_ms = self.clock.now_ms();
         self.failsafe_armed = true;
@@ -171,6 +178,7 @@ where
         answer
     }
 
+    #[inline(never)]
     fn answer(&mut self, msg: HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
         let result = match msg.request {
@@ -223,6 +231,7 @@ where
     }
 
     /// What `HelloAck` reports.
+    #[inline(never)]
     pub fn info(&self) -> DeviceInfo {
         DeviceInfo {
             version: PROTOCOL_VERSION,
@@ -236,6 +245,7 @@ where
 
     /// The state an `Ack` reports: held angles (zeros when nothing is held), the pulses on the
     /// outputs (zeros while stopped), flags and frame counters.
+    #[inline(never)]
     pub fn readback(&self) -> Readback {
         let (angles_rad, pulses) = match &self.held {
             Some(h) => (h.angles_rad, h.pulses_half_us),
@@ -303,6 +313,7 @@ where
         }
     }
 
+    #[inline(never)]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
         let solution = body::inverse_at_stance_with::<M>(
             &self.config.robot,
@@ -314,6 +325,7 @@ where
         self.apply_solution(solution)
     }
 
+    #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
         let solution = body::inverse_with::<M>(
@@ -326,6 +338,7 @@ where
         self.apply_solution(solution)
     }
 
+    #[inline(never)]
     fn apply_solution(
         &mut self,
         solution: Result<BodySolution, IkError>,
@@ -344,6 +357,7 @@ where
         self.apply(angles, clamped, limited)
     }
 
+    #[inline(never)]
     fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
         for s in ServoId::ALL {
             let a = angles[s.index()];
@@ -361,6 +375,7 @@ where
     }
 
     /// Maps all twelve angles through the calibration; commits and drives only when all map.
+    #[inline(never)]
     fn apply(
         &mut self,
         angles_rad: [f32; 12],
@@ -434,6 +449,7 @@ where
         Ok(())
     }
 
+    #[inline(never)]
     fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), NackReason> {
         c.validate().map_err(NackReason::BadCalibration)?;
         let i = servo.index();
@@ -457,6 +473,7 @@ where
         Ok(())
     }
 
+    #[inline(never)]
     fn save_calibration(&mut self) -> Result<(), NackReason> {
         self.store
             .save(&mut self.storage, &self.calibration)

@@ -5,11 +5,14 @@
 //! - [`sim::SimLink`]: a simulated UART running the `quad-device` controller in-process, with the
 //!   timing of a real line on a virtual clock and seeded fault injection.
 //!
+//! - [`emulator::EmulatorLink`]: the real firmware ELF in simavr in-process, behind its USART0,
+//!   on the emulated MCU's clock, with the same fault injection and a check of the pulses on
+//!   the twelve servo pins against the readbacks.
+//!
 //! A link moves bytes and tells the time; framing, sequence numbers and retries are the
-//! [`crate::client`]'s. A third implementation (the firmware in an AVR simulator) only has to
-//! push bytes into the simulated USART, run the simulator until bytes come out or the timeout
-//! passes in *simulated* time, and report that time from [`Link::now`].
+//! [`crate::client`]'s.
 
+pub mod emulator;
 pub mod serial;
 pub mod sim;
 

@@ -1,0 +1,119 @@
+//! The firmware proper: hardware bring-up and the main loop around the device controller
+//! ([`quad_device::Device`]), shared by the `firmware` binaries (which differ only in their
+//! line rate).
+//!
+//! ```text
+//! USART0 RX interrupt ─▶ ring buffer ─▶ Device::receive ─▶ answer frames ─▶ USART0 TX (polled)
+//!                                            │
+//!                      Timer1/3/4/5 compare outputs ◀─ ServoOutputs      Clock ◀─ Timer2 (1 kHz)
+//!                                                       Storage ◀─ EEPROM (EE_READY interrupt)
+//! main loop: feed the watchdog, hand received bytes to the controller, Device::poll (failsafe)
+//! ```
+//!
+//! - Robot and defaults: [`DEVICE_CONFIG`], [`quad_device::Config::shahriar2023`] (seed 000's
+//!   robot, the one with the Arduino Mega): body poses in rotation order zyx at its default
+//!   stance height, unreachable targets rejected, no link-loss timeout until the host sets one.
+//! - Math: [`avr_libc_math::AvrFast`] (avr-libc `sqrt`/`atan2`, kin-core's `Fast::sin_cos`),
+//!   the fastest backend measured (`cargo xtask avr-bench`).
+//! - Outputs stay low until the host sends `SetOutputs { enabled: true }`.
+//! - Watchdog: [`WATCHDOG_TIMEOUT`], fed by the main loop and during EEPROM writes. A hung main
+//!   loop resets the MCU; the reset leaves every pin an input (no pulses) and the device comes
+//!   back with its outputs off, waiting for a new handshake.
+
+use crate::clock::Clock;
+use crate::eeprom::Eeprom;
+use crate::servo::Servos;
+use crate::usart::{Baud, Usart0};
+use crate::watchdog::{self, Timeout, Watchdog};
+use avr_libc_math::AvrFast;
+use quad_device::{Config, Device};
+
+/// What the device runs: seed 000's robot with the controller's defaults.
+pub const DEVICE_CONFIG: Config = Config::shahriar2023();
+
+/// Watchdog timeout: far above the longest main-loop iteration (one body-pose solve, about
+/// 7 ms, plus sending its answer, 8 ms at 115,200 baud).
+pub const WATCHDOG_TIMEOUT: Timeout = Timeout::Ms250;
+
+/// Received bytes handed to the controller per call.
+const CHUNK: usize = 16;
+
+/// The controller as built for this board.
+pub type BoardDevice = Device<Servos, Clock, Eeprom, AvrFast>;
+
+/// Brings the board up and runs the device forever at `baud`.
+pub fn run(baud: Baud) -> ! {
+    crate::stack::paint();
+    let Some(dp) = crate::pac::Peripherals::take() else {
+        panic!()
+    };
+    // Clears the reset flags (a set WDRF would keep the watchdog from being reconfigured).
+    let _reset_cause = watchdog::take_reset_cause(&dp.CPU);
+    let mut watchdog = Watchdog::enable(dp.WDT, WATCHDOG_TIMEOUT);
+    let servos = Servos::new(
+        &dp.TC0, dp.TC1, dp.TC3, dp.TC4, dp.TC5, dp.PORTB, dp.PORTE, dp.PORTH, dp.PORTL,
+    );
+    let clock = Clock::new(dp.TC2);
+    let mut usart = Usart0::new(dp.USART0, baud);
+    let eeprom = Eeprom::new(dp.EEPROM);
+    // SAFETY: the binaries define the handlers (`forward_interrupts!`); each touches only its
+    // own module's state.
+    unsafe { avr_device::interrupt::enable() };
+
+    let mut device = new_device(servos, clock, eeprom);
+    loop {
+        watchdog.feed();
+        serve(&mut device, &mut usart);
+    }
+}
+
+/// Powers the controller on. Out of line so that its temporaries (the calibration table and
+/// the controller as it is built) do not stay in [`run`]'s stack frame for good.
+///
+/// The configuration is a validated constant (quad-device's tests): construction cannot fail;
+/// if it did, the panic handler keeps the outputs low.
+#[inline(never)]
+fn new_device(servos: Servos, clock: Clock, eeprom: Eeprom) -> BoardDevice {
+    match BoardDevice::new(DEVICE_CONFIG, servos, clock, eeprom) {
+        Ok(device) => device,
+        Err(_) => panic!(),
+    }
+}
+
+/// One pass of the main loop: received bytes to the controller, answers out, failsafe check.
+///
+/// Kept out of line: inlined into [`run`], whose stack frame holds the whole controller, every
+/// access to a local would need a frame pointer beyond the AVR's 63-byte displacement (about
+/// 8 instructions per access) — it doubled the firmware's flash.
+#[inline(never)]
+fn serve(device: &mut BoardDevice, usart: &mut Usart0) {
+    let mut chunk = [0u8; CHUNK];
+    let n = usart.read_into(&mut chunk);
+    if n > 0 {
+        device.receive(&chunk[..n], |frame| usart.write_all(frame));
+    }
+    device.poll();
+}
+
+/// Defines the interrupt handlers of a binary that calls [`run`] (handlers must live in the
+/// binary crate to be linked): `USART0_RX`, `TIMER2_COMPA` and `EE_READY`. The binary needs
+/// `#![feature(abi_avr_interrupt)]`.
+#[macro_export]
+macro_rules! forward_interrupts {
+    () => {
+        #[avr_device::interrupt(atmega2560)]
+        fn USART0_RX() {
+            $crate::usart::on_rx_interrupt();
+        }
+
+        #[avr_device::interrupt(atmega2560)]
+        fn TIMER2_COMPA() {
+            $crate::clock::on_tick_interrupt();
+        }
+
+        #[avr_device::interrupt(atmega2560)]
+        fn EE_READY() {
+            $crate::eeprom::on_ready_interrupt();
+        }
+    };
+}
