@@ -28,6 +28,7 @@ enum Command {
     Accuracy(cmd::accuracy::Args),
     Stream(cmd::stream::Args),
     Calibrate(cmd::calibrate::Args),
+    Demo(cmd::demo::Args),
 }
 
 fn main() -> ExitCode {
@@ -47,5 +48,6 @@ fn main() -> ExitCode {
         Command::Accuracy(args) => cmd::accuracy::run(&args),
         Command::Stream(args) => cmd::stream::main(&args),
         Command::Calibrate(args) => cmd::calibrate::main(&args),
+        Command::Demo(args) => cmd::demo::main(&args),
     }
 }
