@@ -645,3 +645,50 @@ fn angle_tolerance_bounds_the_firmware_against_the_host() {
         "AVR_ANGLE_TOLERANCE_RAD {AVR_ANGLE_TOLERANCE_RAD:e} is far looser than {worst:e}"
     );
 }
+
+#[test]
+fn flash_script_writes_the_built_elf_with_the_wiring_bootloader_protocol() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace root")
+        .to_owned();
+    for (baud, bin) in [
+        ("115200", build::FIRMWARE),
+        ("1000000", build::FIRMWARE_1MBAUD),
+    ] {
+        let mut cmd = Command::new("bash");
+        cmd.current_dir(&root).args([
+            "scripts/flash.sh",
+            "--baud",
+            baud,
+            "--dry-run",
+            "/dev/ttyACM0",
+        ]);
+        // As from a shell: no settings of the cargo running this test.
+        for (key, _) in std::env::vars() {
+            if (key.starts_with("CARGO_") && key != "CARGO_HOME")
+                || key.starts_with("RUSTC")
+                || key == "RUSTFLAGS"
+                || key == "RUSTUP_TOOLCHAIN"
+                || key == "CARGO"
+            {
+                cmd.env_remove(key);
+            }
+        }
+        let out = cmd.output().expect("bash runs");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let elf = firmware(bin);
+        assert_eq!(
+            stdout.lines().last().unwrap_or(""),
+            format!(
+                "avrdude -c wiring -p atmega2560 -P /dev/ttyACM0 -b 115200 -D -U flash:w:{}:e",
+                elf.display()
+            )
+        );
+    }
+}
