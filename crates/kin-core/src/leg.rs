@@ -386,6 +386,13 @@ impl Solver {
     }
 }
 
+/// `lo <= x && x <= hi` by integer keys (no software-float comparison).
+#[cfg(target_arch = "avr")]
+#[inline(always)]
+fn within_limit(x: f32, lo: f32, hi: f32) -> bool {
+    cmp::bits::within(x, cmp::bits::interval(lo, hi))
+}
+
 impl View<'_> {
     /// True when all three angles lie within the joint limits (false for any NaN).
     #[inline(always)]
@@ -393,8 +400,9 @@ impl View<'_> {
         #[cfg(target_arch = "avr")]
         {
             let (lo, hi) = (&self.limits.min_rad, &self.limits.max_rad);
-            let within = |x, j: usize| cmp::bits::within(x, cmp::bits::interval(lo[j], hi[j]));
-            within(q.abduction_rad, 0) && within(q.hip_rad, 1) && within(q.knee_rad, 2)
+            within_limit(q.abduction_rad, lo[0], hi[0])
+                && within_limit(q.hip_rad, lo[1], hi[1])
+                && within_limit(q.knee_rad, lo[2], hi[2])
         }
         #[cfg(not(target_arch = "avr"))]
         {
@@ -534,12 +542,10 @@ impl View<'_> {
         }
         Joint::ALL.into_iter().find(|&j| {
             #[cfg(target_arch = "avr")]
-            let ok = cmp::bits::within(
+            let ok = within_limit(
                 q.get(j),
-                cmp::bits::interval(
-                    self.limits.min_rad[j as usize],
-                    self.limits.max_rad[j as usize],
-                ),
+                self.limits.min_rad[j as usize],
+                self.limits.max_rad[j as usize],
             );
             #[cfg(not(target_arch = "avr"))]
             let ok = self.limits.admits(j, q.get(j));
@@ -590,7 +596,7 @@ impl View<'_> {
                 angles,
                 clamped: reached.map(|(kind, p)| Clamp {
                     kind,
-                    distance_m: distance(p, foot_in_hip),
+                    distance_m: distance::<M>(p, foot_in_hip),
                 }),
             });
         };
@@ -605,7 +611,7 @@ impl View<'_> {
         let foot = forward_with::<M>(self.geometry, leg, angles);
         let clamped = Some(Clamp {
             kind: reached.map_or(Unreachable::JointLimit(joint), |(kind, _)| kind),
-            distance_m: distance(foot, foot_in_hip),
+            distance_m: distance::<M>(foot, foot_in_hip),
         });
         if !angles.is_finite() {
             // Unreachable by construction; kept so that no NaN can ever leave this function.
@@ -679,18 +685,19 @@ impl View<'_> {
 /// shrunk towards the hip to this distance.
 const FAR_M: f32 = 1.0e6;
 
-/// `|a − b|` without overflowing the squares of far targets.
+/// `|a − b|` without overflowing the squares of far targets, with the backend's square root
+/// (on the ATmega2560 that keeps a second one, libm's, out of the firmware).
 #[inline]
-fn distance(a: Vec3, b: Vec3) -> f32 {
+fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     let d = a - b;
     let m = libm::fmaxf(
         libm::fabsf(d.x),
         libm::fmaxf(libm::fabsf(d.y), libm::fabsf(d.z)),
     );
     if m > FAR_M {
-        m * (d * (1.0 / m)).norm()
+        m * M::sqrt((d * (1.0 / m)).norm_squared())
     } else {
-        d.norm()
+        M::sqrt(d.norm_squared())
     }
 }
 

@@ -72,13 +72,14 @@ impl Math for AvrLibm {
 }
 
 /// The fastest mix measured in simavr (see `BENCHMARKS.md`), the firmware's backend:
-/// avr-libc's `sqrt` (327 cycles), kin-core's [`poly::atan2_deg9`] (about 2,200 cycles against
-/// 3,000 for avr-libc's `atan2`; error ≤ 1.2e-5 rad) and [`poly::sin_cos_deg5`] (about 2,000
-/// cycles for both within ±π/4, 3,300 beyond, against 7,200 for avr-libc's `sin` plus `cos`;
-/// error ≤ 7e-7). All float arithmetic on avr-libc's primitives.
+/// avr-libc's `sqrt` (327 cycles), kin-core's [`poly::atan2_fixed`] (about 1,400 cycles
+/// against 3,000 for avr-libc's `atan2`: one float division, the polynomial in 16-bit fixed
+/// point on the hardware multiplier; error ≤ 3.5e-5 rad) and [`poly::sin_cos_deg5`] (about
+/// 2,000 cycles for both within ±π/4, 3,300 beyond, against 7,200 for avr-libc's `sin` plus
+/// `cos`; error ≤ 7e-7). All float arithmetic on avr-libc's primitives.
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by
-/// at most about 1.5e-5 rad (the degree-9 arctangent's error plus rounding); see the readback
+/// at most about 4e-5 rad (the fixed-point arctangent's error plus rounding); see the readback
 /// bound in `BENCHMARKS.md`.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct AvrFast;
@@ -91,7 +92,7 @@ impl Math for AvrFast {
 
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
-        poly::atan2_deg9(y, x)
+        poly::atan2_fixed(y, x)
     }
 
     #[inline]
