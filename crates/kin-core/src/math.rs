@@ -273,7 +273,12 @@ pub mod poly {
     /// Formats: `t` in Q24 (`T`, from the float's mantissa) and Q16, `s = t²` in Q16, the
     /// Horner levels in Q20…Q16 (as magnitudes, the signs being known), the result in Q29
     /// (π < 2²).
-    #[inline]
+    ///
+    /// Never inlined on the AVR: its `mul` instructions stay in this function's own small stack
+    /// frame, clear of an LLVM AVR miscompilation in frames beyond 63 bytes (see the
+    /// firmware's emulator test `no_mul_result_is_clobbered_by_a_frame_pointer_adjustment`).
+    #[cfg_attr(target_arch = "avr", inline(never))]
+    #[cfg_attr(not(target_arch = "avr"), inline)]
     pub fn atan2_fixed(y: f32, x: f32) -> f32 {
         const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
         const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
