@@ -482,7 +482,7 @@ fn example_robot_files_equal_the_presets() {
 }
 
 #[test]
-fn readme_main_command_prints_the_table() {
+fn readme_pose_table_command_prints_the_table() {
     let run = quadctl(
         &[
             "pose",
