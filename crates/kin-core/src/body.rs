@@ -148,7 +148,13 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
 /// # Ok::<(), kin_core::IkError>(())
 /// ```
 ///
-/// Results are bit for bit those of the free functions.
+/// Results are bit for bit those of the free functions. [`Solver::new`] is a `const fn`, so a
+/// firmware can build its solver at compile time:
+///
+/// ```
+/// use kin_core::{body, Robot};
+/// const SOLVER: body::Solver = body::Solver::new(&Robot::shahriar2023());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Solver {
     leg: leg::Solver,
@@ -169,7 +175,7 @@ fn is_zero(v: Vec3) -> bool {
 impl Solver {
     /// The constants of `robot`.
     #[inline]
-    pub fn new(robot: &Robot) -> Solver {
+    pub const fn new(robot: &Robot) -> Solver {
         let half_width_m = 0.5 * robot.body_width_m;
         Solver {
             leg: leg::Solver::new(robot),

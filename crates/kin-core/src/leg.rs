@@ -245,7 +245,7 @@ pub fn forward_dh(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
 /// # Ok::<(), kin_core::IkError>(())
 /// ```
 ///
-/// Results are bit for bit those of the free functions.
+/// Results are bit for bit those of the free functions. [`Solver::new`] is a `const fn`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Solver {
     geometry: LegGeometry,
@@ -272,7 +272,7 @@ struct Consts {
 
 impl Consts {
     #[inline(always)]
-    fn of(g: &LegGeometry) -> Consts {
+    const fn of(g: &LegGeometry) -> Consts {
         let (l1, l2) = (g.femur_m, g.tibia_m);
         Consts {
             d_lat_sq: g.d_lat_m * g.d_lat_m,
@@ -322,7 +322,7 @@ impl Consts {
 impl Solver {
     /// The constants of `robot`'s legs (all legs are alike).
     #[inline]
-    pub fn new(robot: &Robot) -> Solver {
+    pub const fn new(robot: &Robot) -> Solver {
         Solver {
             geometry: robot.leg,
             limits: robot.limits,
