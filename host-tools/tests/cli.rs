@@ -1,53 +1,15 @@
 //! Black-box tests of the `quadctl` binary: batch commands, robot files, malformed input.
 
+mod common;
+
+use common::{quadctl, repo_root};
 use kin_core::{LegId, Robot};
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
 /// Position tolerance for round trips through the printed f32 values, metres.
 const TOL_M: f32 = 2.0e-6;
 /// Angle tolerance against f64 hand-derived values, radians.
 const TOL_RAD: f32 = 1.0e-5;
-
-struct Run {
-    stdout: String,
-    stderr: String,
-    code: i32,
-}
-
-fn quadctl(args: &[&str], stdin: &str) -> Run {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_quadctl"))
-        .args(args)
-        .current_dir(repo_root())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("quadctl starts");
-    let written = child
-        .stdin
-        .take()
-        .expect("stdin piped")
-        .write_all(stdin.as_bytes());
-    // quadctl may exit (e.g. on a bad robot file) before reading its input.
-    if let Err(e) = written {
-        assert_eq!(e.kind(), std::io::ErrorKind::BrokenPipe, "stdin: {e}");
-    }
-    let out = child.wait_with_output().expect("quadctl finishes");
-    Run {
-        stdout: String::from_utf8(out.stdout).expect("utf-8 stdout"),
-        stderr: String::from_utf8(out.stderr).expect("utf-8 stderr"),
-        code: out.status.code().expect("exit code"),
-    }
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("workspace root")
-        .to_owned()
-}
 
 fn temp_file(name: &str, text: &str) -> PathBuf {
     let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);

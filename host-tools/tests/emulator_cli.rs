@@ -1,47 +1,9 @@
 //! Black-box tests of `quadctl stream --emulator` and `quadctl demo`: the real firmware in
 //! simavr (built from `firmware-avr/` by the command itself; a test fails when it cannot be).
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+mod common;
 
-struct Run {
-    stdout: String,
-    stderr: String,
-    code: i32,
-}
-
-fn quadctl(args: &[&str], stdin: &str) -> Run {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_quadctl"))
-        .args(args)
-        .current_dir(repo_root())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("quadctl starts");
-    let written = child
-        .stdin
-        .take()
-        .expect("stdin piped")
-        .write_all(stdin.as_bytes());
-    if let Err(e) = written {
-        assert_eq!(e.kind(), std::io::ErrorKind::BrokenPipe, "stdin: {e}");
-    }
-    let out = child.wait_with_output().expect("quadctl finishes");
-    Run {
-        stdout: String::from_utf8(out.stdout).expect("utf-8 stdout"),
-        stderr: String::from_utf8(out.stderr).expect("utf-8 stderr"),
-        code: out.status.code().expect("exit code"),
-    }
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("workspace root")
-        .to_owned()
-}
+use common::quadctl;
 
 const POSES: &str = "roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m
 0,0,0,0,0,0

@@ -1,30 +1,14 @@
 //! Black-box tests of `quadctl motion`, `check`, `plot` and `accuracy`.
 
+mod common;
+
+use common::{last_line_json, quadctl};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// Largest allowed change of a joint angle over one period, rad (issue 5).
 const PERIODIC_TOL_RAD: f32 = 1e-4;
 /// Largest allowed drift of a stance foot in the printed world coordinates, m.
 const FOOT_TOL_M: f32 = 1e-6;
-
-struct Run {
-    stdout: String,
-    stderr: String,
-    code: i32,
-}
-
-fn quadctl(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_quadctl"))
-        .args(args)
-        .output()
-        .expect("quadctl runs");
-    Run {
-        stdout: String::from_utf8(out.stdout).expect("utf-8"),
-        stderr: String::from_utf8(out.stderr).expect("utf-8"),
-        code: out.status.code().expect("exit code"),
-    }
-}
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -73,16 +57,19 @@ fn num(row: &[String], i: usize) -> f32 {
 
 #[test]
 fn motion_csv_has_the_documented_columns_and_the_seed001_roll_is_periodic() {
-    let r = quadctl(&[
-        "motion",
-        "roll-sway",
-        "--robot",
-        "fernando2025",
-        "--duration-s",
-        "40",
-        "--rate-hz",
-        "10",
-    ]);
+    let r = quadctl(
+        &[
+            "motion",
+            "roll-sway",
+            "--robot",
+            "fernando2025",
+            "--duration-s",
+            "40",
+            "--rate-hz",
+            "10",
+        ],
+        "",
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(
         r.stderr.is_empty(),
@@ -140,18 +127,21 @@ fn output_file_appears_complete_and_bad_input_leaves_nothing() {
     let dir = scratch("output");
     let out = dir.join("yaw.csv");
     let o = out.to_str().unwrap();
-    let r = quadctl(&[
-        "motion",
-        "yaw-turn",
-        "--robot",
-        "fernando2025",
-        "--duration-s",
-        "12",
-        "--rate-hz",
-        "20",
-        "--output",
-        o,
-    ]);
+    let r = quadctl(
+        &[
+            "motion",
+            "yaw-turn",
+            "--robot",
+            "fernando2025",
+            "--duration-s",
+            "12",
+            "--rate-hz",
+            "20",
+            "--output",
+            o,
+        ],
+        "",
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(r.stdout.is_empty());
     assert_eq!(entries(&dir), vec!["yaw.csv"]);
@@ -249,7 +239,7 @@ fn output_file_appears_complete_and_bad_input_leaves_nothing() {
         let mut a = vec!["motion"];
         a.extend_from_slice(args);
         a.extend_from_slice(&["--robot", "fernando2025", "--output", o]);
-        let r = quadctl(&a);
+        let r = quadctl(&a, "");
         assert_ne!(r.code, 0, "{args:?} accepted");
         assert!(r.stderr.contains(named), "{args:?}: {}", r.stderr);
         assert_eq!(entries(&dir), vec!["yaw.csv"], "{args:?} left a file");
@@ -267,18 +257,21 @@ fn check_passes_seed001_yaw_turn_from_a_file_and_as_a_law() {
     let dir = scratch("check");
     let out = dir.join("yaw.csv");
     let o = out.to_str().unwrap();
-    let r = quadctl(&[
-        "motion",
-        "yaw-turn",
-        "--robot",
-        "fernando2025",
-        "--duration-s",
-        "6",
-        "--rate-hz",
-        "100",
-        "--output",
-        o,
-    ]);
+    let r = quadctl(
+        &[
+            "motion",
+            "yaw-turn",
+            "--robot",
+            "fernando2025",
+            "--duration-s",
+            "6",
+            "--rate-hz",
+            "100",
+            "--output",
+            o,
+        ],
+        "",
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     for args in [
         vec!["check", o, "--robot", "fernando2025", "--json"],
@@ -291,11 +284,10 @@ fn check_passes_seed001_yaw_turn_from_a_file_and_as_a_law() {
             "--json",
         ],
     ] {
-        let r = quadctl(&args);
+        let r = quadctl(&args, "");
         assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
         assert!(r.stdout.contains("result: PASS"), "{}", r.stdout);
-        let json: serde_json::Value =
-            serde_json::from_str(r.stdout.lines().last().unwrap()).unwrap();
+        let json = last_line_json(&r);
         assert_eq!(json["ok"], true);
         assert_eq!(json["report"]["samples"], 601);
         for l in json["report"]["legs"].as_array().unwrap() {
@@ -309,36 +301,42 @@ fn check_passes_seed001_yaw_turn_from_a_file_and_as_a_law() {
 
 #[test]
 fn check_fails_a_too_fast_motion_and_names_the_first_failure() {
-    let r = quadctl(&[
-        "check",
-        "--motion",
-        "trot",
-        "--robot",
-        "shahriar2023",
-        "--stance-height-m",
-        "0.4",
-        "--forward-m-s",
-        "0.2",
-        "--max-joint-speed-rad-s",
-        "0.5",
-        "--json",
-    ]);
+    let r = quadctl(
+        &[
+            "check",
+            "--motion",
+            "trot",
+            "--robot",
+            "shahriar2023",
+            "--stance-height-m",
+            "0.4",
+            "--forward-m-s",
+            "0.2",
+            "--max-joint-speed-rad-s",
+            "0.5",
+            "--json",
+        ],
+        "",
+    );
     assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("result: FAIL"));
-    let json: serde_json::Value = serde_json::from_str(r.stdout.lines().last().unwrap()).unwrap();
+    let json = last_line_json(&r);
     assert_eq!(json["ok"], false);
     let f = &json["report"]["first_failure"];
     assert!(f["kind"]["JointSpeed"].is_object(), "{f}");
     // Bad check arguments.
-    let r = quadctl(&[
-        "check",
-        "--motion",
-        "trot",
-        "--robot",
-        "shahriar2023",
-        "--max-joint-speed-rad-s",
-        "0",
-    ]);
+    let r = quadctl(
+        &[
+            "check",
+            "--motion",
+            "trot",
+            "--robot",
+            "shahriar2023",
+            "--max-joint-speed-rad-s",
+            "0",
+        ],
+        "",
+    );
     assert_eq!(r.code, 2);
     assert!(r.stderr.contains("--max-joint-speed-rad-s"), "{}", r.stderr);
 }
@@ -348,54 +346,66 @@ fn plots_are_written_as_svg_and_png() {
     let dir = scratch("plot");
     let csv = dir.join("pitch.csv");
     let svg = dir.join("pitch.svg");
-    let r = quadctl(&[
-        "motion",
-        "pitch-sway",
-        "--robot",
-        "fernando2025",
-        "--duration-s",
-        "20",
-        "--rate-hz",
-        "20",
-        "--output",
-        csv.to_str().unwrap(),
-        "--plot",
-        svg.to_str().unwrap(),
-    ]);
+    let r = quadctl(
+        &[
+            "motion",
+            "pitch-sway",
+            "--robot",
+            "fernando2025",
+            "--duration-s",
+            "20",
+            "--rate-hz",
+            "20",
+            "--output",
+            csv.to_str().unwrap(),
+            "--plot",
+            svg.to_str().unwrap(),
+        ],
+        "",
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("<svg") && text.contains("knee angle") && text.contains("FL"));
     let png = dir.join("views.png");
-    let r = quadctl(&[
-        "plot",
-        csv.to_str().unwrap(),
-        "--output",
-        png.to_str().unwrap(),
-        "--robot",
-        "fernando2025",
-        "--at-s",
-        "0,5,15",
-    ]);
+    let r = quadctl(
+        &[
+            "plot",
+            csv.to_str().unwrap(),
+            "--output",
+            png.to_str().unwrap(),
+            "--robot",
+            "fernando2025",
+            "--at-s",
+            "0,5,15",
+        ],
+        "",
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
     let joints = dir.join("joints.png");
-    let r = quadctl(&[
-        "plot",
-        csv.to_str().unwrap(),
-        "--output",
-        joints.to_str().unwrap(),
-    ]);
+    let r = quadctl(
+        &[
+            "plot",
+            csv.to_str().unwrap(),
+            "--output",
+            joints.to_str().unwrap(),
+        ],
+        "",
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(std::fs::metadata(&joints).unwrap().len() > 10_000);
-    let r = quadctl(&[
-        "plot",
-        csv.to_str().unwrap(),
-        "--output",
-        dir.join("v.svg").to_str().unwrap(),
-        "--at-s",
-        "1",
-    ]);
+    let r = quadctl(
+        &[
+            "plot",
+            csv.to_str().unwrap(),
+            "--output",
+            dir.join("v.svg").to_str().unwrap(),
+            "--at-s",
+            "1",
+        ],
+        "",
+    );
     assert_eq!(r.code, 2);
     assert!(r.stderr.contains("--robot"), "{}", r.stderr);
     let _ = std::fs::remove_dir_all(dir);
@@ -422,25 +432,28 @@ fn accuracy_reproduces_seed000_per_joint_figures() {
     std::fs::write(&t, ts).unwrap();
     std::fs::write(&m, ms).unwrap();
     let plot = dir.join("acc.svg");
-    let r = quadctl(&[
-        "accuracy",
-        "--target",
-        t.to_str().unwrap(),
-        "--measured",
-        m.to_str().unwrap(),
-        "--robot",
-        "shahriar2023",
-        "--plot",
-        plot.to_str().unwrap(),
-        "--json",
-    ]);
+    let r = quadctl(
+        &[
+            "accuracy",
+            "--target",
+            t.to_str().unwrap(),
+            "--measured",
+            m.to_str().unwrap(),
+            "--robot",
+            "shahriar2023",
+            "--plot",
+            plot.to_str().unwrap(),
+            "--json",
+        ],
+        "",
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(
         r.stdout.contains("21.30 %") && r.stdout.contains("78.70 %"),
         "{}",
         r.stdout
     );
-    let json: serde_json::Value = serde_json::from_str(r.stdout.lines().last().unwrap()).unwrap();
+    let json = last_line_json(&r);
     let dev = &json["deviation_pct"];
     for (k, want) in ["abduction", "hip", "knee"].iter().zip(d) {
         assert!(
@@ -456,13 +469,16 @@ fn accuracy_reproduces_seed000_per_joint_figures() {
     assert!(std::fs::read_to_string(&plot).unwrap().contains("<svg"));
     // Row counts must match.
     std::fs::write(&m, "abduction_rad,hip_rad,knee_rad\n0.3,0.6,-1.2\n").unwrap();
-    let r = quadctl(&[
-        "accuracy",
-        "--target",
-        t.to_str().unwrap(),
-        "--measured",
-        m.to_str().unwrap(),
-    ]);
+    let r = quadctl(
+        &[
+            "accuracy",
+            "--target",
+            t.to_str().unwrap(),
+            "--measured",
+            m.to_str().unwrap(),
+        ],
+        "",
+    );
     assert_eq!(r.code, 2);
     assert!(r.stderr.contains("rows"), "{}", r.stderr);
     let _ = std::fs::remove_dir_all(dir);
@@ -507,7 +523,7 @@ fn gaits_and_the_seed000_rectangle_run_clean() {
         let mut a = vec!["motion"];
         a.extend_from_slice(&args);
         a.extend_from_slice(&["--duration-s", "3", "--rate-hz", "50"]);
-        let r = quadctl(&a);
+        let r = quadctl(&a, "");
         assert_eq!(r.code, 0, "{args:?}: {}", r.stderr);
         let (h, rows) = parse(&r.stdout);
         assert_eq!(rows.len(), 151);
@@ -536,22 +552,28 @@ fn check_reads_angle_only_files_and_their_status() {
         }
     }
     std::fs::write(&file, &text).unwrap();
-    let r = quadctl(&[
-        "check",
-        file.to_str().unwrap(),
-        "--robot",
-        "fernando2025",
-        "--json",
-    ]);
+    let r = quadctl(
+        &[
+            "check",
+            file.to_str().unwrap(),
+            "--robot",
+            "fernando2025",
+            "--json",
+        ],
+        "",
+    );
     assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
-    let json: serde_json::Value = serde_json::from_str(r.stdout.lines().last().unwrap()).unwrap();
+    let json = last_line_json(&r);
     let f = &json["report"]["first_failure"];
     assert_eq!(f["leg"], "RL");
     assert_eq!(f["sample"], 3);
     assert_eq!(f["kind"]["Unreachable"], "TooFar");
     // A reason that cannot be told is refused, naming the line.
     std::fs::write(&file, text.replace("RL:too_far", "RL:joint_limit")).unwrap();
-    let r = quadctl(&["check", file.to_str().unwrap(), "--robot", "fernando2025"]);
+    let r = quadctl(
+        &["check", file.to_str().unwrap(), "--robot", "fernando2025"],
+        "",
+    );
     assert_eq!(r.code, 2);
     assert!(r.stderr.contains("angles.csv:5"), "{}", r.stderr);
     let _ = std::fs::remove_dir_all(dir);

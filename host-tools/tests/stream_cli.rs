@@ -1,52 +1,8 @@
 //! Black-box tests of `quadctl stream` and `quadctl calibrate` on the simulated device.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+mod common;
 
-struct Run {
-    stdout: String,
-    stderr: String,
-    code: i32,
-}
-
-fn quadctl(args: &[&str], stdin: &str) -> Run {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_quadctl"))
-        .args(args)
-        .current_dir(repo_root())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("quadctl starts");
-    let written = child
-        .stdin
-        .take()
-        .expect("stdin piped")
-        .write_all(stdin.as_bytes());
-    if let Err(e) = written {
-        assert_eq!(e.kind(), std::io::ErrorKind::BrokenPipe, "stdin: {e}");
-    }
-    let out = child.wait_with_output().expect("quadctl finishes");
-    Run {
-        stdout: String::from_utf8(out.stdout).expect("utf-8 stdout"),
-        stderr: String::from_utf8(out.stderr).expect("utf-8 stderr"),
-        code: out.status.code().expect("exit code"),
-    }
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("workspace root")
-        .to_owned()
-}
-
-/// The JSON object on the last line of stdout.
-fn summary(run: &Run) -> serde_json::Value {
-    let last = run.stdout.lines().last().expect("a last line");
-    serde_json::from_str(last).expect("the last line is JSON")
-}
+use common::{last_line_json, quadctl, repo_root};
 
 const KEYS: [&str; 9] = [
     "sent",
@@ -78,7 +34,7 @@ fn stream_sim_on_the_example_poses() {
         "",
     );
     assert_eq!(run.code, 0, "{}", run.stderr);
-    let s = summary(&run);
+    let s = last_line_json(&run);
     for k in KEYS {
         assert!(s.get(k).is_some(), "key {k} in {s}");
     }
@@ -121,7 +77,7 @@ fn stream_with_faults_is_reproducible_and_reads_stdin() {
     let b = quadctl(&args, &poses);
     assert_eq!(a.code, 0, "{}", a.stderr);
     assert_eq!(a.stdout, b.stdout);
-    let s = summary(&a);
+    let s = last_line_json(&a);
     assert_eq!(s["sent"], 8);
     assert_eq!(
         s["acked"].as_u64().unwrap() + s["nacked"].as_u64().unwrap() + s["lost"].as_u64().unwrap(),
@@ -181,7 +137,7 @@ fn stream_reports_malformed_records_and_goes_on() {
     );
     assert_eq!(r.code, 1, "{}", r.stderr);
     assert!(r.stderr.contains("<stdin>:3:"), "{}", r.stderr);
-    let s = summary(&r);
+    let s = last_line_json(&r);
     assert_eq!(
         (s["sent"].as_u64(), s["acked"].as_u64()),
         (Some(2), Some(2))
@@ -219,64 +175,49 @@ fn calibrate_get_set_save_through_a_simulated_eeprom() {
         .unwrap()
         .replace("center_us = 1500", "center_us = 1520");
     let file = dir.join("trim.toml");
-    std::fs::write(&file, format!("{line}\n")).unwrap();
-    let set = quadctl(
-        &[
+    let file_s = file.to_str().unwrap();
+    // `calibrate set` of the trim file, saved to the EEPROM or not.
+    let set = |save: bool| {
+        let mut args = vec![
             "calibrate",
             "--sim",
             "--sim-storage",
             eeprom_s,
             "set",
-            file.to_str().unwrap(),
-            "--save",
-        ],
-        "",
-    );
-    assert_eq!(set.code, 0, "{}", set.stderr);
-    assert!(set.stdout.contains(&line), "{}", set.stdout);
+            file_s,
+        ];
+        if save {
+            args.push("--save");
+        }
+        quadctl(&args, "")
+    };
+    std::fs::write(&file, format!("{line}\n")).unwrap();
+    let run = set(true);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains(&line), "{}", run.stdout);
     // A new run powers the simulated device on from the EEPROM image.
     let again = get();
     assert!(again.stdout.contains(&line), "{}", again.stdout);
     // Without --save a set is gone at the next power-on.
     let other = line.replace("center_us = 1520", "center_us = 1530");
     std::fs::write(&file, format!("{other}\n")).unwrap();
-    let set = quadctl(
-        &[
-            "calibrate",
-            "--sim",
-            "--sim-storage",
-            eeprom_s,
-            "set",
-            file.to_str().unwrap(),
-        ],
-        "",
-    );
-    assert_eq!(set.code, 0, "{}", set.stderr);
-    assert!(set.stdout.contains(&other));
+    let run = set(false);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains(&other));
     assert!(get().stdout.contains(&line));
     // A travel that excludes the held stance angle is refused by the device.
     let bad = "FR_knee = { zero_rad = 1.0, reversed = true, us_per_rad = 636.0, center_us = 2000, min_us = 2000, max_us = 2500 }";
     std::fs::write(&file, format!("{bad}\n")).unwrap();
-    let set = quadctl(
-        &[
-            "calibrate",
-            "--sim",
-            "--sim-storage",
-            eeprom_s,
-            "set",
-            file.to_str().unwrap(),
-        ],
-        "",
-    );
-    assert_eq!(set.code, 2);
+    let run = set(false);
+    assert_eq!(run.code, 2);
     assert!(
-        set.stderr.contains("FR_knee") && set.stderr.contains("servo range"),
+        run.stderr.contains("FR_knee") && run.stderr.contains("servo range"),
         "{}",
-        set.stderr
+        run.stderr
     );
     // An invalid file is refused before anything is sent.
     std::fs::write(&file, "FR_knee = { zero_rad = 0.0 }\n").unwrap();
-    let set = quadctl(&["calibrate", "--sim", "set", file.to_str().unwrap()], "");
-    assert_eq!(set.code, 2);
+    let run = quadctl(&["calibrate", "--sim", "set", file_s], "");
+    assert_eq!(run.code, 2);
     let _ = std::fs::remove_dir_all(&dir);
 }

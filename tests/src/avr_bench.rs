@@ -58,8 +58,8 @@ pub enum Backend {
     Fast = 1,
     /// kin-core's `Libm` backend (Rust libm); soft-float primitives from whichever ELF.
     Libm = 2,
-    /// avr-libc's `sqrt` and `atan2` with kin-core's `Fast::sin_cos`
-    /// (`avr_libc_math::AvrFast`).
+    /// The firmware's backend (`avr_libc_math::AvrFast`): avr-libc's `sqrt`, kin-core's
+    /// `poly::atan2_fixed` and `poly::sin_cos_deg5`.
     AvrFast = 3,
 }
 
@@ -70,7 +70,7 @@ impl Backend {
             Backend::AvrLibm => "avr-libc",
             Backend::Fast => "kin-core Fast",
             Backend::Libm => "kin-core Libm",
-            Backend::AvrFast => "avr-libc + Fast::sin_cos",
+            Backend::AvrFast => "AvrFast",
         }
     }
 }
@@ -506,7 +506,7 @@ pub struct Summary {
 }
 
 /// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
-pub const PRIMITIVES: [&str; 12] = [
+pub const PRIMITIVES: [&str; 15] = [
     "add",
     "mul",
     "div",
@@ -519,6 +519,9 @@ pub const PRIMITIVES: [&str; 12] = [
     "Fast::sin_cos",
     "rotation matrix",
     "feet in hips",
+    "poly::atan2_fixed",
+    "poly::atan2_deg9",
+    "poly::sin_cos_deg5",
 ];
 
 /// Mean cycles of primitive `op` over a few arguments.

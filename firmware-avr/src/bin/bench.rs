@@ -1,8 +1,8 @@
 //! Cycle benchmark on avr-libc's float routines (see `firmware_avr::bench`).
 //!
 //! Backends: 0 = `AvrLibm` (avr-libc math), 1 = kin-core `Fast` (polynomials), 2 = kin-core
-//! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`/`atan2`, kin-core `Fast::sin_cos`), all
-//! on avr-libc's float primitives (`__mulsf3`, …).
+//! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`, kin-core `poly::atan2_fixed` and
+//! `poly::sin_cos_deg5`), all on avr-libc's float primitives (`__mulsf3`, …).
 
 #![no_std]
 #![no_main]
@@ -13,7 +13,7 @@ use avr_libc_math::{AvrFast, AvrLibm};
 avr_libc_math::link_avr_libc!();
 use firmware_avr::bench::{self, Backend};
 use firmware_avr::usart::{self, Baud, Usart0};
-use kin_core::math::{Fast, Libm};
+use kin_core::math::{poly, Fast, Libm};
 use kin_core::{BodyConfig, Math, Pose, RotationOrder};
 
 static BACKENDS: [Backend; 4] = [
@@ -42,8 +42,9 @@ static BACKENDS: [Backend; 4] = [
 /// Primitives: 0 add, 1 mul, 2 div, 3 sqrt, 4 atan2, 5 sin, 6 cos, 7 less-than,
 /// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrLibm`:
 /// 10 the rotation matrix (roll = yaw = a, pitch = b), 11 the four feet in their hip frames
-/// (including the matrix).
-static PRIMS: [bench::PrimFn; 12] = [
+/// (including the matrix); kin-core's kernels for `AvrFast`: 12 `poly::atan2_fixed`,
+/// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5` (sum of both).
+static PRIMS: [bench::PrimFn; 15] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -70,6 +71,12 @@ static PRIMS: [bench::PrimFn; 12] = [
             &robot.stance_feet(bench::STANCE_HEIGHT_M),
         );
         core::hint::black_box(feet)[0].x
+    },
+    |a, b| poly::atan2_fixed(a, b),
+    |a, b| poly::atan2_deg9(a, b),
+    |a, _| {
+        let (s, c) = poly::sin_cos_deg5(a);
+        s + c
     },
 ];
 
