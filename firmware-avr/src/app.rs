@@ -61,20 +61,23 @@ pub fn run(baud: Baud) -> ! {
     unsafe { avr_device::interrupt::enable() };
 
     let mut device = new_device(servos, clock, eeprom);
+    // In place: the controller exists once, in this frame.
+    device.boot();
     loop {
         watchdog.feed();
         serve(&mut device, &mut usart);
     }
 }
 
-/// Powers the controller on. Out of line so that its temporaries (the calibration table and
-/// the controller as it is built) do not stay in [`run`]'s stack frame for good.
+/// Builds the controller, stopped and not yet booted ([`BoardDevice::stopped`]): [`run`]
+/// boots it where it lies, so that no second copy of it is ever on the stack. Out of line so
+/// that the temporaries of its construction do not stay in [`run`]'s stack frame for good.
 ///
 /// The configuration is a validated constant (quad-device's tests): construction cannot fail;
 /// if it did, the panic handler keeps the outputs low.
 #[inline(never)]
 fn new_device(servos: Servos, clock: Clock, eeprom: Eeprom) -> BoardDevice {
-    match BoardDevice::new(DEVICE_CONFIG, servos, clock, eeprom) {
+    match BoardDevice::stopped(DEVICE_CONFIG, servos, clock, eeprom) {
         Ok(device) => device,
         Err(_) => panic!(),
     }

@@ -139,10 +139,23 @@ impl Config {
     }
 }
 
+/// The calibration a controller holds from [`crate::Device::stopped`] until
+/// [`crate::Device::boot`]: all zeros, an empty travel (0 µs) that no angle maps into. Zeros so
+/// that it costs a memset, not a 180-byte table copied into SRAM at reset.
+pub(crate) const UNBOOTED_CALIBRATION: Table = [Calibration {
+    zero_rad: 0.0,
+    reversed: false,
+    us_per_rad: 0.0,
+    center_us: 0,
+    min_us: 0,
+    max_us: 0,
+}; 12];
+
 /// The calibration used when the storage holds none: each servo centred (1500 µs) on the
 /// joint's angle in the nominal stance of `pose_config`, standard gain
 /// ([`STANDARD_US_PER_RAD`]), travel 500–2500 µs, hip and knee servos of the right legs
 /// reversed (mounted mirrored). When the stance is unreachable the centres sit at angle 0.
+#[inline(never)] // solves the stance IK: its temporaries in a frame of their own
 pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> Table {
     let config = BodyConfig {
         order: pose_config.order,

@@ -1,7 +1,9 @@
 //! The controller: bytes in → requests → IK, joint limits, servo calibration → outputs →
 //! answer bytes out.
 
-use crate::config::{default_calibration, validate_pose_config, Config, ConfigError};
+use crate::config::{
+    default_calibration, validate_pose_config, Config, ConfigError, UNBOOTED_CALIBRATION,
+};
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use core::marker::PhantomData;
@@ -89,28 +91,41 @@ where
 {
     /// Powers the device on: stops the outputs, loads the calibration from `storage` (the
     /// defaults of [`default_calibration`] when none is valid) and holds the nominal stance.
+    /// The same as [`Device::stopped`] followed by [`Device::boot`].
     ///
     /// # Errors
     /// [`Config::validate`]'s error.
-    pub fn new(
+    pub fn new(config: Config, outputs: O, clock: C, storage: S) -> Result<Self, ConfigError> {
+        let mut device = Self::stopped(config, outputs, clock, storage)?;
+        device.boot();
+        Ok(device)
+    }
+
+    /// The first half of [`Device::new`]: validates `config`, stops the outputs and builds the
+    /// controller, holding nothing; call [`Device::boot`] next (until then no angle maps
+    /// into any servo's calibration). Cheap (no IK, no storage
+    /// access), so that the caller can build the controller in its final place and then
+    /// [`Device::boot`] it there — the 8 KB of SRAM of the ATmega2560 have no room for a second
+    /// copy.
+    ///
+    /// # Errors
+    /// [`Config::validate`]'s error.
+    pub fn stopped(
         config: Config,
         mut outputs: O,
         clock: C,
-        mut storage: S,
+        storage: S,
     ) -> Result<Self, ConfigError> {
         config.validate()?;
         outputs.set_enabled(false);
-        let mut calibration = default_calibration::<M>(&config.robot, &config.pose_config);
-        let mut store = Store::new(config.storage_base);
-        let loaded = store.load(&mut storage, &mut calibration);
         let now = clock.now_ms();
-        let mut device = Device {
+        Ok(Device {
             outputs,
             clock,
             storage,
+            calibration: UNBOOTED_CALIBRATION,
+            store: Store::new(config.storage_base),
             config,
-            calibration,
-            store,
             acc: Accumulator::new(),
             tx: [0; TX_LEN],
             held: None,
@@ -121,32 +136,52 @@ where
             failsafe: false,
             failsafe_armed: true,
             calibration_unsaved: false,
-            calibration_default: !loaded,
+            calibration_default: true,
             last_valid_ms: now,
             _math: PhantomData,
-        };
+        })
+    }
+
+    /// The second half of [`Device::new`], once, on a controller from [`Device::stopped`]:
+    /// loads the calibration from storage (the defaults of [`default_calibration`] when none is
+    /// valid) and holds
+    /// the nominal stance (zero body pose) when it maps within that calibration.
+    #[inline(never)]
+    pub fn boot(&mut self) {
+        self.calibration = default_calibration::<M>(&self.config.robot, &self.config.pose_config);
+        let loaded = self.store.load(&mut self.storage, &mut self.calibration);
+        self.calibration_default = !loaded;
         // The stance may not map within a stored calibration: then nothing is held.
-        let _ = device.set_body_pose(&Pose::default());
-        Ok(device)
+        let _ = self.set_body_pose(&Pose::default());
     }
 
     /// Feeds received bytes (any chunking) and sends one answer frame through `tx` for every
     /// frame that ends in them, in order.
     pub fn receive(&mut self, mut bytes: &[u8], mut tx: impl FnMut(&[u8])) {
-        loop {
-            let (answer, remaining) = match self.acc.feed::<HostToDevice>(bytes) {
-                Feed::NeedMore => break,
-                Feed::Frame { msg, remaining } => (self.handle(msg), remaining),
-                Feed::BadCrc { remaining } => (nack(None, NackReason::BadCrc), remaining),
-                Feed::BadFrame { remaining, .. } => (nack(None, NackReason::BadFrame), remaining),
-                Feed::Oversize { remaining } => (nack(None, NackReason::Oversize), remaining),
-            };
+        while let Some((frame_len, remaining)) = self.receive_one(bytes) {
             bytes = remaining;
-            // The buffer holds the largest answer; a failure would only drop this answer.
-            if let Ok(frame) = encode_frame(&answer, &mut self.tx) {
+            if let Some(frame) = self.tx.get(..frame_len) {
                 tx(frame);
             }
         }
+    }
+
+    /// Consumes `bytes` up to the end of the first frame in them, handles it and encodes the
+    /// answer into the transmit buffer: its length (0 when it could not be encoded) and the
+    /// bytes left; `None` when no frame ended in `bytes`. Out of line, as are the decoder and
+    /// the encoder it calls (one instance each): the caller's closure is the only generic part
+    /// left inline.
+    #[inline(never)]
+    fn receive_one<'a>(&mut self, bytes: &'a [u8]) -> Option<(usize, &'a [u8])> {
+        let (answer, remaining) = match feed_request(&mut self.acc, bytes) {
+            Feed::NeedMore => return None,
+            Feed::Frame { msg, remaining } => (self.handle(msg), remaining),
+            Feed::BadCrc { remaining } => (nack(None, NackReason::BadCrc), remaining),
+            Feed::BadFrame { remaining, .. } => (nack(None, NackReason::BadFrame), remaining),
+            Feed::Oversize { remaining } => (nack(None, NackReason::Oversize), remaining),
+        };
+        // The buffer holds the largest answer; a failure would only drop this answer.
+        Some((encode_answer(&answer, &mut self.tx), remaining))
     }
 
     /// Runs the link-loss failsafe; call it from the main loop.
@@ -488,6 +523,19 @@ where
         self.config.pose_config = p;
         Ok(())
     }
+}
+
+/// The accumulator's decoder for requests: the one instance of `HostToDevice`'s deserializer.
+#[inline(never)]
+fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<'a, HostToDevice> {
+    acc.feed::<HostToDevice>(bytes)
+}
+
+/// Encodes `answer` into `out`: the frame's length, 0 when it does not fit. The one instance of
+/// `DeviceToHost`'s serializer.
+#[inline(never)]
+fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
+    encode_frame(answer, out).map_or(0, <[u8]>::len)
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {
