@@ -20,6 +20,7 @@ use kin_core::math::Libm;
 use kin_core::{body, BodyConfig, LegId, Pose, ReachPolicy, Robot, Vec3};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use quad_protocol::{DeviceToHost, PoseConfig, Request};
+use seeded_rng::SplitMix64;
 use serde::Serialize;
 use std::path::Path;
 
@@ -79,31 +80,6 @@ impl Backend {
 /// `max_angle_err_deg`).
 pub const FIRMWARE_BACKEND: Backend = Backend::AvrFast;
 
-/// SplitMix64 (Steele, Lea, Flood 2014).
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// A generator with the given seed.
-    pub fn new(seed: u64) -> Self {
-        SplitMix64(seed)
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi)`.
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        let unit = (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-        lo + (hi - lo) * unit
-    }
-}
-
 /// The seeded targets.
 #[derive(Debug, Clone)]
 pub struct Targets {
@@ -121,9 +97,9 @@ pub fn targets() -> Targets {
     let mut rng = SplitMix64::new(SEED);
     let mut poses = Vec::new();
     while poses.len() < N_TARGETS {
-        let [r, p, y] = POSE_RANGE_DEG.map(|d| rng.uniform(-d, d).to_radians() as f32);
+        let [r, p, y] = POSE_RANGE_DEG.map(|d| rng.range(-d, d).to_radians() as f32);
         let [tx, ty, tz] =
-            [0; 3].map(|_| rng.uniform(-TRANSLATION_RANGE_M, TRANSLATION_RANGE_M) as f32);
+            [0; 3].map(|_| rng.range(-TRANSLATION_RANGE_M, TRANSLATION_RANGE_M) as f32);
         let pose = Pose {
             roll_rad: r,
             pitch_rad: p,

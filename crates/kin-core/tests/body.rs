@@ -141,7 +141,7 @@ proptest! {
         let pose = Pose { roll_rad: rpy[0], pitch_rad: rpy[1], yaw_rad: rpy[2],
                           x_m: shift[0], y_m: shift[1], z_m: shift[2] };
         let config = BodyConfig { order: RotationOrder::ALL[o], pivot_m: Vec3::from_array(pivot) };
-        let mut rng = Rng(seed);
+        let mut rng = SplitMix64::new(seed);
         let angles = LegId::ALL.map(|_| random_angles(&mut rng, &robot, 0.05));
         let feet = body::forward(&robot, &pose, &config, &angles);
         let res = body::inverse(&robot, &pose, &config, &feet, ReachPolicy::Reject);
@@ -312,7 +312,7 @@ fn nominal_stance_is_zero_abduction() {
 /// differences of the f64 rotation.
 #[test]
 fn angular_velocity_matches_rotation_derivative() {
-    let mut rng = Rng(0xA11);
+    let mut rng = SplitMix64::new(0xA11);
     for order in RotationOrder::ALL {
         for _ in 0..50 {
             let q = [(); 3].map(|_| rng.range(-1.0, 1.0));

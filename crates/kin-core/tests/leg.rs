@@ -212,7 +212,7 @@ const THETA1_TOL_RAD: f64 = 2.0e-5;
 /// done right, and the foot is reached.
 #[test]
 fn seed000_quadrants_theta1_matches_algorithm1_done_right() {
-    let mut rng = Rng(0x5EED_0000);
+    let mut rng = SplitMix64::new(0x5EED_0000);
     let mut per_quadrant = [0usize; 4];
     for bend in [KneeBend::Backward, KneeBend::Forward] {
         let robot = shahriar_full_turn(bend);
@@ -305,7 +305,7 @@ const DH_TOL_M: f64 = 2.0e-6;
 /// `forward_dh`) equals the f64 oracle.
 #[test]
 fn dh_form_equals_closed_form() {
-    let mut rng = Rng(0xD4);
+    let mut rng = SplitMix64::new(0xD4);
     for (_, robot) in presets() {
         for leg_id in LegId::ALL {
             for _ in 0..500 {
@@ -367,7 +367,7 @@ fn dh_form_equals_closed_form() {
 /// foot equal to `leg::forward`.
 #[test]
 fn joint_points_have_link_lengths() {
-    let mut rng = Rng(0x1057);
+    let mut rng = SplitMix64::new(0x1057);
     for (_, robot) in presets() {
         let g = robot.leg;
         for leg_id in LegId::ALL {
@@ -395,7 +395,7 @@ fn seed000_fifty_random_points_all_solve() {
     let robot = Robot::shahriar2023();
     let g = robot.leg;
     let bound = (g.d_lat_m + g.femur_m) as f64;
-    let mut rng = Rng(50);
+    let mut rng = SplitMix64::new(50);
     for leg_id in LegId::ALL {
         let mut solved = 0;
         let mut drawn = 0;

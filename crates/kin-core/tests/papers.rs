@@ -74,7 +74,7 @@ fn seed001_leg(g: &LegGeometry, s: Seed001Angles) -> [Vector3<f64>; 3] {
 fn seed001_eq4_leg_jacobian_via_adapter() {
     let robot = Robot::fernando2025();
     let chain = Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.0, -1.0);
-    let mut rng = Rng(4);
+    let mut rng = SplitMix64::new(4);
     for _ in 0..200 {
         let s = [
             rng.range(-0.8, 0.8),
@@ -185,7 +185,7 @@ fn side_view(robot: &Robot, foot: Vector3<f64>) -> (f64, f64) {
 fn erratum_seed000_eq4_15_lc_squared() {
     let robot = Robot::shahriar2023();
     let (lb, lc) = (robot.leg.femur_m as f64, robot.leg.tibia_m as f64);
-    let mut rng = Rng(415);
+    let mut rng = SplitMix64::new(415);
     let (mut nan, mut wrong) = (0, 0);
     for _ in 0..500 {
         let leg_id = LegId::ALL[(rng.next_u64() % 4) as usize];
@@ -304,7 +304,7 @@ fn erratum_seed000_dh_chain_puts_la_in_the_leg_plane() {
         d_ax_m: preset.leg.d_ax_m + preset.leg.d_lat_m,
         ..preset.leg
     };
-    let mut rng = Rng(36);
+    let mut rng = SplitMix64::new(36);
     let mut worst_r_orthogonality = f64::INFINITY;
     for _ in 0..300 {
         let t = [(); 3].map(|_| rng.range(-PI, PI) as f32 as f64);
@@ -767,7 +767,7 @@ fn seed000_eq4_12_uses_the_tilted_z() {
 #[test]
 fn seed000_adapter_angles_are_link_directions() {
     let robot = Robot::shahriar2023();
-    let mut rng = Rng(2);
+    let mut rng = SplitMix64::new(2);
     for _ in 0..200 {
         let leg_id = LegId::ALL[(rng.next_u64() % 4) as usize];
         let q = random_angles(&mut rng, &robot, 0.0);

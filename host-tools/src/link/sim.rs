@@ -45,45 +45,8 @@ pub const EEPROM_LEN: usize = 4096;
 /// Default receive FIFO of the simulated device, bytes.
 pub const DEFAULT_RX_FIFO_LEN: usize = 64;
 
-/// SplitMix64: a small seeded generator for fault injection and test data.
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    /// A generator seeded with `seed`.
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in `[lo, hi)`.
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    /// Uniform in `0..n` (`n > 0`).
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n.max(1)
-    }
-
-    /// True with probability `p`; draws nothing when `p` is 0.
-    pub fn chance(&mut self, p: f64) -> bool {
-        p > 0.0 && self.unit() < p
-    }
-}
+/// The seeded generator of fault injection and test data (SplitMix64).
+pub use seeded_rng::SplitMix64 as Rng;
 
 /// The simulated servo outputs: what is on the twelve pins.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -571,13 +534,5 @@ mod tests {
         assert_eq!(run(7), run(7));
         assert_ne!(run(7).0, run(8).0);
         assert!(run(7).1.dropped > 0 && run(7).1.truncated > 0);
-    }
-
-    #[test]
-    fn rng_is_uniform_enough() {
-        let mut r = Rng::new(3);
-        let mean = (0..10_000).map(|_| r.unit()).sum::<f64>() / 10_000.0;
-        assert!((mean - 0.5).abs() < 0.02, "{mean}");
-        assert!((0..1000).all(|_| r.below(7) < 7));
     }
 }

@@ -193,34 +193,13 @@ pub fn w_of(g: &LegGeometry, q: [f64; 3]) -> f64 {
     -(g.d_ax_m as f64) - (g.femur_m as f64) * q[1].cos() - (g.tibia_m as f64) * (q[1] + q[2]).cos()
 }
 
-/// SplitMix64: a tiny seeded generator for the deterministic (non-proptest) sweeps.
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// Next raw 64 bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [lo, hi).
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-}
+/// The seeded generator of the deterministic (non-proptest) sweeps.
+pub use seeded_rng::SplitMix64;
 
 /// Uniform joint angles within the robot's limits, shrunk by `inset_rad` at each end.
-pub fn random_angles(rng: &mut Rng, robot: &Robot, inset_rad: f64) -> JointAngles {
+pub fn random_angles(rng: &mut SplitMix64, robot: &Robot, inset_rad: f64) -> JointAngles {
     let l = robot.limits;
-    let pick = |rng: &mut Rng, j: usize| {
+    let pick = |rng: &mut SplitMix64, j: usize| {
         rng.range(
             l.min_rad[j] as f64 + inset_rad,
             l.max_rad[j] as f64 - inset_rad,
