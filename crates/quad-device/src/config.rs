@@ -155,13 +155,42 @@ pub(crate) const UNBOOTED_CALIBRATION: Table = [Calibration {
 /// joint's angle in the nominal stance of `pose_config`, standard gain
 /// ([`STANDARD_US_PER_RAD`]), travel 500–2500 µs, hip and knee servos of the right legs
 /// reversed (mounted mirrored). When the stance is unreachable the centres sit at angle 0.
-#[inline(never)] // solves the stance IK: its temporaries in a frame of their own
 pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> Table {
+    let mut table = UNBOOTED_CALIBRATION;
+    write_default_calibration::<M>(robot, pose_config, &mut table);
+    table
+}
+
+/// [`default_calibration`] written in place (no table-sized temporary on the stack).
+#[inline(never)]
+pub(crate) fn write_default_calibration<M: Math>(
+    robot: &Robot,
+    pose_config: &PoseConfig,
+    table: &mut Table,
+) {
+    let stance = stance_angles::<M>(robot, pose_config);
+    for ((c, servo), zero_rad) in table.iter_mut().zip(ServoId::ALL).zip(stance) {
+        let right = matches!(servo.leg, LegId::FR | LegId::RR);
+        *c = Calibration {
+            zero_rad,
+            reversed: right && servo.joint != kin_core::Joint::Abduction,
+            us_per_rad: STANDARD_US_PER_RAD,
+            center_us: DEFAULT_CENTER_US,
+            min_us: DEFAULT_CENTER_US - DEFAULT_TRAVEL_US,
+            max_us: DEFAULT_CENTER_US + DEFAULT_TRAVEL_US,
+        };
+    }
+}
+
+/// The twelve joint angles of the nominal stance of `pose_config` (zeros when unreachable).
+/// Out of line: the body solution stays in a frame of its own.
+#[inline(never)]
+fn stance_angles<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> [f32; 12] {
     let config = BodyConfig {
         order: pose_config.order,
         pivot_m: kin_core::Vec3::ZERO,
     };
-    let stance = body::inverse_at_stance_with::<M>(
+    body::inverse_at_stance_with::<M>(
         robot,
         &body::Pose::default(),
         &config,
@@ -169,19 +198,7 @@ pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> 
         ReachPolicy::Reject,
     )
     .map(|s| s.flat())
-    .unwrap_or([0.0; 12]);
-    core::array::from_fn(|i| {
-        let servo = ServoId::ALL[i];
-        let right = matches!(servo.leg, LegId::FR | LegId::RR);
-        Calibration {
-            zero_rad: stance[i],
-            reversed: right && servo.joint != kin_core::Joint::Abduction,
-            us_per_rad: STANDARD_US_PER_RAD,
-            center_us: DEFAULT_CENTER_US,
-            min_us: DEFAULT_CENTER_US - DEFAULT_TRAVEL_US,
-            max_us: DEFAULT_CENTER_US + DEFAULT_TRAVEL_US,
-        }
-    })
+    .unwrap_or([0.0; 12])
 }
 
 #[cfg(test)]

@@ -2,25 +2,28 @@
 //! answer bytes out.
 
 use crate::config::{
-    default_calibration, validate_pose_config, Config, ConfigError, UNBOOTED_CALIBRATION,
+    validate_pose_config, write_default_calibration, Config, ConfigError, UNBOOTED_CALIBRATION,
 };
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use core::marker::PhantomData;
 use kin_core::body::{self, BodySolution, Pose};
 use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
+use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,
     LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
-    MAX_DECODED_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
+    DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
 pub const RX_LEN: usize = MAX_DECODED_LEN;
 
-/// Transmit buffer (one encoded answer frame), the protocol's `MAX_FRAME_LEN`.
-pub const TX_LEN: usize = MAX_FRAME_LEN;
+/// The longest answer frame on the wire, bytes: it is encoded into the receive buffer (free
+/// once the request is decoded), so it must fit there.
+pub const TX_LEN: usize = encoded_len_max(DEVICE_TO_HOST_MAX_LEN);
+const _: () = assert!(TX_LEN <= RX_LEN);
 
 /// The joint angles the device holds and the pulses they map to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -62,7 +65,6 @@ pub struct Device<O, C, S, M = DefaultMath> {
     calibration: Table,
     store: Store,
     acc: Accumulator<RX_LEN>,
-    tx: [u8; TX_LEN],
     held: Option<Held>,
     clamped: bool,
     limited: bool,
@@ -90,7 +92,7 @@ where
     M: Math,
 {
     /// Powers the device on: stops the outputs, loads the calibration from `storage` (the
-    /// defaults of [`default_calibration`] when none is valid) and holds the nominal stance.
+    /// defaults of [`default_calibration`](crate::default_calibration) when none is valid) and holds the nominal stance.
     /// The same as [`Device::stopped`] followed by [`Device::boot`].
     ///
     /// # Errors
@@ -127,7 +129,6 @@ where
             store: Store::new(config.storage_base),
             config,
             acc: Accumulator::new(),
-            tx: [0; TX_LEN],
             held: None,
             clamped: false,
             limited: false,
@@ -143,12 +144,16 @@ where
     }
 
     /// The second half of [`Device::new`], once, on a controller from [`Device::stopped`]:
-    /// loads the calibration from storage (the defaults of [`default_calibration`] when none is
+    /// loads the calibration from storage (the defaults of [`default_calibration`](crate::default_calibration) when none is
     /// valid) and holds
     /// the nominal stance (zero body pose) when it maps within that calibration.
     #[inline(never)]
     pub fn boot(&mut self) {
-        self.calibration = default_calibration::<M>(&self.config.robot, &self.config.pose_config);
+        write_default_calibration::<M>(
+            &self.config.robot,
+            &self.config.pose_config,
+            &mut self.calibration,
+        );
         let loaded = self.store.load(&mut self.storage, &mut self.calibration);
         self.calibration_default = !loaded;
         // The stance may not map within a stored calibration: then nothing is held.
@@ -160,14 +165,14 @@ where
     pub fn receive(&mut self, mut bytes: &[u8], mut tx: impl FnMut(&[u8])) {
         while let Some((frame_len, remaining)) = self.receive_one(bytes) {
             bytes = remaining;
-            if let Some(frame) = self.tx.get(..frame_len) {
+            if let Some(frame) = self.acc.scratch().and_then(|b| b.get(..frame_len)) {
                 tx(frame);
             }
         }
     }
 
     /// Consumes `bytes` up to the end of the first frame in them, handles it and encodes the
-    /// answer into the transmit buffer: its length (0 when it could not be encoded) and the
+    /// answer into the accumulator's buffer (free between frames): its length (0 when it could not be encoded) and the
     /// bytes left; `None` when no frame ended in `bytes`. Out of line, as are the decoder and
     /// the encoder it calls (one instance each): the caller's closure is the only generic part
     /// left inline.
@@ -180,8 +185,12 @@ where
             Feed::BadFrame { remaining, .. } => (nack(None, NackReason::BadFrame), remaining),
             Feed::Oversize { remaining } => (nack(None, NackReason::Oversize), remaining),
         };
-        // The buffer holds the largest answer; a failure would only drop this answer.
-        Some((encode_answer(&answer, &mut self.tx), remaining))
+        // The buffer holds the largest answer (`TX_LEN`); a failure would only drop this answer.
+        let len = match self.acc.scratch() {
+            Some(buf) => encode_answer(&answer, buf),
+            None => 0,
+        };
+        Some((len, remaining))
     }
 
     /// Runs the link-loss failsafe; call it from the main loop.

@@ -35,10 +35,10 @@
 //!
 //! ## Memory
 //! A [`Device`] holds one receive buffer ([`device::RX_LEN`] = 128 B + 13 B of accumulator
-//! state), one transmit buffer ([`device::TX_LEN`] = 131 B), the calibration table (12 × 15 B),
-//! the held angles and pulses (73 B), the configuration with the robot (66 B) and a few flags:
-//! 608 B on the ATmega2560 (alignment 1; a compile-time assertion in AVR builds keeps it
-//! ≤ 640 B). Saving or loading the calibration streams 15-byte records.
+//! state; the answer frame, at most [`device::TX_LEN`] = 104 B, is encoded there once the
+//! request is decoded), the calibration table (12 × 15 B), the held angles and pulses (73 B),
+//! the configuration with the robot (66 B) and a few flags: 477 B on the ATmega2560 (alignment
+//! 1; a compile-time assertion in AVR builds keeps it ≤ 480 B). Saving or loading the calibration streams 15-byte records.
 
 #![no_std]
 #![forbid(unsafe_code)]
@@ -83,7 +83,7 @@ pub mod avr_size {
     }
 
     /// Upper bound of `size_of::<Device>()` on the ATmega2560, bytes.
-    const DEVICE_SRAM_MAX: usize = 640;
+    const DEVICE_SRAM_MAX: usize = 480;
     const _: () = assert!(core::mem::size_of::<Device<Null, Null, Null>>() <= DEVICE_SRAM_MAX);
 
     /// Runs the controller on `bytes` (instantiates its code for the target).

@@ -355,6 +355,17 @@ impl<const N: usize> Accumulator<N> {
         self.code != 0
     }
 
+    /// The buffer as scratch space between frames (`None` while a frame is partly received):
+    /// a device with little RAM encodes its answer here, since a frame's bytes are no longer
+    /// needed once [`Accumulator::feed`] has reported it.
+    pub fn scratch(&mut self) -> Option<&mut [u8; N]> {
+        if self.in_frame() {
+            None
+        } else {
+            Some(&mut self.buf)
+        }
+    }
+
     fn push(&mut self, byte: u8) {
         if self.len < N {
             self.buf[self.len] = byte;
