@@ -2,7 +2,6 @@
 //! joint angles, and the Cartesian foot error through forward kinematics.
 
 use super::motion::Error;
-use super::RobotArgs;
 use crate::plot;
 use kin_core::paper;
 use kin_core::{leg, JointAngles, LegId, Robot};
@@ -251,19 +250,7 @@ pub fn run(args: &Args) -> ExitCode {
 fn run_inner(args: &Args) -> Result<(), Error> {
     let robot: Option<Robot> = match &args.robot {
         None => None,
-        Some(spec) => Some(
-            RobotArgs {
-                robot: spec.clone(),
-            }
-            .load(None)
-            .map_err(|e| match e {
-                super::Error::Robot(e) => Error::Robot(e),
-                other => Error::Csv {
-                    at: "--robot".to_owned(),
-                    message: other.to_string(),
-                },
-            })?,
-        ),
+        Some(spec) => Some(crate::robot_file::resolve(spec).map_err(Error::Robot)?),
     };
     let target = read_samples(&args.target, args.leg)?;
     let measured = read_samples(&args.measured, args.leg)?;

@@ -194,13 +194,7 @@ fn check_file(args: &Args, file: &Path, limits: [f32; 3]) -> Result<(Report, Sou
             law: "a motion file",
         });
     }
-    let robot = args.law_args.robot.load(None).map_err(|e| match e {
-        super::Error::Robot(e) => Error::Robot(e),
-        other => Error::Csv {
-            at: "--robot".to_owned(),
-            message: other.to_string(),
-        },
-    })?;
+    let robot = crate::robot_file::resolve(&args.law_args.robot.robot).map_err(Error::Robot)?;
     let mut csv = MotionCsv::open(file)?;
     let order: RotationOrder = args
         .law_args

@@ -377,13 +377,7 @@ impl LawArgs {
     /// Builds and validates the motion.
     pub fn build(&self, law: Law) -> Result<AnyMotion, Error> {
         self.check_applicable(law)?;
-        let robot = self.robot.load(None).map_err(|e| match e {
-            super::Error::Robot(e) => Error::Robot(e),
-            other => Error::Io {
-                context: "--robot".to_owned(),
-                source: io::Error::other(other.to_string()),
-            },
-        })?;
+        let robot = crate::robot_file::resolve(&self.robot.robot).map_err(Error::Robot)?;
         let order = |default: RotationOrder| self.rotation_order.map_or(default, Into::into);
         Ok(match law {
             Law::RollSway | Law::PitchSway | Law::YawSway => {

@@ -3,7 +3,6 @@
 
 use super::motion::{Error, MotionCsv};
 use super::pose::Order;
-use super::RobotArgs;
 use crate::plot::{self, Decimator, Snapshot};
 use kin_core::{BodyConfig, JointAngles, RotationOrder, Vec3};
 use std::path::PathBuf;
@@ -98,17 +97,7 @@ fn run_inner(args: &Args) -> Result<(), Error> {
         option: "--at-s without --robot",
         law: "the robot views (they need the robot's geometry)",
     })?;
-    let robot = RobotArgs {
-        robot: robot_spec.clone(),
-    }
-    .load(None)
-    .map_err(|e| match e {
-        super::Error::Robot(e) => Error::Robot(e),
-        other => Error::Csv {
-            at: "--robot".to_owned(),
-            message: other.to_string(),
-        },
-    })?;
+    let robot = crate::robot_file::resolve(robot_spec).map_err(Error::Robot)?;
     let mut csv = MotionCsv::open(&args.file)?;
     let order: RotationOrder = args
         .rotation_order
