@@ -65,6 +65,26 @@ fn seed001_stance_height_comes_from_the_initial_pose() {
     assert!((expected - 0.9294).abs() < 1e-4);
 }
 
+/// Preflight of `motion` over `[0, period_s]` at 100 Hz with the default joint speed limit:
+/// prints its minima under `label`, asserts it passes and that no leg nears a singularity.
+fn assert_preflight_passes(motion: &impl Motion, period_s: f32, label: &str) {
+    let report = preflight::check(
+        motion,
+        &Sweep::new(0.0, period_s, 100.0).unwrap(),
+        [preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S; 3],
+    )
+    .unwrap();
+    let (leg, ic) = report.min_inverse_condition().unwrap();
+    let (_, ws) = report.min_workspace_margin().unwrap();
+    let (_, jm) = report.min_joint_margin().unwrap();
+    println!(
+        "{label} preflight: min inverse condition {:.4} ({leg} at {:.2} s), min workspace margin {:.4} m, min joint margin {:.4} rad",
+        ic.value, ic.t_s, ws.value, jm.value
+    );
+    assert!(report.ok(), "{:?}", report.first_failure);
+    assert!(ic.value > SINGULARITY_THRESHOLD);
+}
+
 fn check_sway(axis: Axis) {
     let sway = Sway::new(SwayParams::seed001(axis)).unwrap();
     let period = sway.period_s().unwrap();
@@ -99,25 +119,7 @@ fn check_sway(axis: Axis) {
     assert!(worst_periodic < PERIODIC_TOL_RAD, "{worst_periodic}");
     assert!(worst_foot <= FOOT_TOL_M, "{worst_foot}");
 
-    let report = preflight::check(
-        &sway,
-        &Sweep::new(0.0, period, 100.0).unwrap(),
-        [preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S; 3],
-    )
-    .unwrap();
-    let (leg, ic) = report.min_inverse_condition().unwrap();
-    let (_, ws) = report.min_workspace_margin().unwrap();
-    let (_, jm) = report.min_joint_margin().unwrap();
-    println!(
-        "seed 001 {} sway preflight: min inverse condition {:.4} ({leg} at {:.2} s), min workspace margin {:.4} m, min joint margin {:.4} rad",
-        axis.name(),
-        ic.value,
-        ic.t_s,
-        ws.value,
-        jm.value
-    );
-    assert!(report.ok(), "{:?}", report.first_failure);
-    assert!(ic.value > SINGULARITY_THRESHOLD);
+    assert_preflight_passes(&sway, period, &format!("seed 001 {} sway", axis.name()));
 }
 
 #[test]
@@ -369,21 +371,7 @@ fn seed001_yaw_turn_eq9_11_stance_fixed_swing_on_eq10_periodic_not_singular() {
     assert!(worst_drift <= FOOT_TOL_M, "{worst_drift}");
     assert!(worst_swing <= FOOT_TOL_M, "{worst_swing}");
 
-    let report = preflight::check(
-        &turn,
-        &Sweep::new(0.0, period, 100.0).unwrap(),
-        [preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S; 3],
-    )
-    .unwrap();
-    let (leg, ic) = report.min_inverse_condition().unwrap();
-    let (_, ws) = report.min_workspace_margin().unwrap();
-    let (_, jm) = report.min_joint_margin().unwrap();
-    println!(
-        "seed 001 yaw turn preflight: min inverse condition {:.4} ({leg} at {:.2} s), min workspace margin {:.4} m, min joint margin {:.4} rad",
-        ic.value, ic.t_s, ws.value, jm.value
-    );
-    assert!(report.ok(), "{:?}", report.first_failure);
-    assert!(ic.value > SINGULARITY_THRESHOLD);
+    assert_preflight_passes(&turn, period, "seed 001 yaw turn");
 }
 
 #[test]

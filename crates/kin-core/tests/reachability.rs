@@ -33,6 +33,19 @@ fn kind(robot: &Robot, leg_id: LegId, p: Vec3) -> Unreachable {
     e.kind
 }
 
+/// The error of body IK on `feet` at the zero pose and default configuration, rejecting
+/// unreachable targets (the pose must be refused).
+fn rejected_at_rest(robot: &Robot, feet: &[Vec3; 4]) -> IkError {
+    body::inverse(
+        robot,
+        &Pose::default(),
+        &BodyConfig::default(),
+        feet,
+        ReachPolicy::Reject,
+    )
+    .unwrap_err()
+}
+
 /// Foot in the hip frame of the zero-abduction leg plane at height `z` and forward offset `x`.
 fn in_plane(robot: &Robot, leg_id: LegId, x: f32, z: f32) -> Vec3 {
     Vec3::new(x, leg_id.side() * robot.leg.d_lat_m, z)
@@ -189,14 +202,7 @@ fn body_non_finite_in_each_input() {
                 let mut a = f[leg_id.index()].to_array();
                 a[i] = bad;
                 f[leg_id.index()] = Vec3::from_array(a);
-                let e = body::inverse(
-                    &robot,
-                    &Pose::default(),
-                    &BodyConfig::default(),
-                    &f,
-                    ReachPolicy::Reject,
-                )
-                .unwrap_err();
+                let e = rejected_at_rest(&robot, &f);
                 assert_eq!(
                     e,
                     IkError {
@@ -215,14 +221,7 @@ fn body_rejects_pose_and_names_the_leg() {
     let robot = Robot::fernando2025();
     let mut feet = robot.stance_feet(0.9);
     feet[LegId::RL.index()].z = -2.0;
-    let e = body::inverse(
-        &robot,
-        &Pose::default(),
-        &BodyConfig::default(),
-        &feet,
-        ReachPolicy::Reject,
-    )
-    .unwrap_err();
+    let e = rejected_at_rest(&robot, &feet);
     assert_eq!(
         e,
         IkError {
@@ -232,14 +231,7 @@ fn body_rejects_pose_and_names_the_leg() {
     );
     feet[LegId::FR.index()].y = 0.0; // inside no offset for fernando2025, but too close? no:
     feet[LegId::FR.index()].z = -2.0;
-    let e = body::inverse(
-        &robot,
-        &Pose::default(),
-        &BodyConfig::default(),
-        &feet,
-        ReachPolicy::Reject,
-    )
-    .unwrap_err();
+    let e = rejected_at_rest(&robot, &feet);
     assert_eq!(e.leg, LegId::FR);
     // Under Clamp the same pose solves, reporting the clamped legs.
     let sol = body::inverse(
