@@ -29,7 +29,12 @@ def main():
     # the ATmega2560 (math::poly::atan2_deg9).
     for degree in (15, 9):
         c, err = lawson(np.arctan, list(range(1, degree + 1, 2)), -1.0, 1.0)
-        print(f"atan deg {degree:2}", [float(np.float32(x)) for x in c], "max err", err)
+        c = [float(np.float32(x)) for x in c]
+        print(f"atan deg {degree:2}", c, "max err", err)
+    # The degree-9 coefficients' magnitudes in the fixed-point formats of
+    # math::poly::atan2_fixed's Horner levels (Q16, Q16, Q17, Q18, Q20): ATAN_DEG9_Q.
+    q = [int(np.floor(abs(x) * 2.0**f + 0.5)) for x, f in zip(c, (16, 16, 17, 18, 20))]
+    print("atan deg  9 fixed", q)
     q = np.pi / 4
     # sin/cos on the reduced range [-pi/4, pi/4]: degree 9/8 (math::poly::sin_cos_deg9) and
     # degree 5/6 (math::poly::sin_cos_deg5).

@@ -13,7 +13,7 @@
 //!   The reference the others are tested against.
 //! - Firmware may implement [`Math`] itself, e.g. on top of avr-libc's hand-written assembly,
 //!   and pick among the kernels of [`poly`] (the ATmega2560's backend uses
-//!   [`poly::atan2_deg9`] and [`poly::sin_cos_deg5`], which cost fewer software-float
+//!   [`poly::atan2_fixed`] and [`poly::sin_cos_deg5`], which cost far fewer software-float
 //!   operations).
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
@@ -110,6 +110,7 @@ const PI: f32 = core::f32::consts::PI;
 /// |---|---|---|
 /// | [`atan2_deg15`](poly::atan2_deg15) | 3e-7 rad | hosts: branch-free, Estrin |
 /// | [`atan2_deg9`](poly::atan2_deg9) | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
+/// | [`atan2_fixed`](poly::atan2_fixed) | 3.5e-5 rad (0.002°) | CPUs with software floats and an integer multiplier (the ATmega2560): 1 float division, the polynomial in 16-bit fixed point |
 /// | [`sin_cos_deg9`](poly::sin_cos_deg9) | 2e-7 | hosts: branch-free |
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
 pub mod poly {
@@ -265,7 +266,7 @@ pub mod poly {
     /// Four-quadrant arctangent for CPUs without hardware floating point: one float division
     /// `t = min(|x|,|y|) / max(|x|,|y|)`, then [`ATAN_DEG9`] evaluated in 16-bit fixed point
     /// (six 16 × 16-bit products), the octant added in fixed point, and one integer-to-float
-    /// conversion: about 1,300 cycles on the ATmega2560 against 2,200 for [`atan2_deg9`] in
+    /// conversion: about 1,400 cycles on the ATmega2560 against 2,200 for [`atan2_deg9`] in
     /// software floats. Absolute error ≤ 3.5e-5 rad (0.002°): the degree-9 fit's 1.1e-5 plus
     /// the 16-bit quantization of `t²` and of the Horner levels (tests). `atan2(±0, ±0)` as libm
     /// (±0 or ±π); exact on the axes.
