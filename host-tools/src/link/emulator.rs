@@ -30,7 +30,7 @@
 //! too. See [`PulseStats`].
 
 use super::sim::Rng;
-use super::{Faults, Link, LinkError};
+use super::{Fault, FaultStats, Faults, Link, LinkError};
 use crate::emu::{
     self, build, cycles_to_duration, duration_to_cycles, duration_to_cycles_ceil, EmuError,
     Mega2560, Pulse, CYCLES_PER_TICK, PERIOD_CYCLES, SERVO_PINS,
@@ -153,6 +153,18 @@ pub struct LineStats {
     pub truncated: u64,
     /// Stalls.
     pub stalls: u64,
+}
+
+impl FaultStats for LineStats {
+    fn count(&mut self, fault: Fault) {
+        match fault {
+            Fault::Stall => self.stalls += 1,
+            Fault::Truncate => self.truncated += 1,
+            Fault::Duplicate => self.duplicated += 1,
+            Fault::Drop => self.dropped += 1,
+            Fault::Flip => self.flipped += 1,
+        }
+    }
 }
 
 /// The pin check so far (see the module docs).
@@ -536,39 +548,21 @@ impl EmulatorLink {
         let frame = std::mem::take(&mut self.d2h_frame);
         let f = self.config.faults;
         let bc = self.byte_cycles;
-        let mut shift = 0;
-        if self.rng.chance(f.stall) {
-            self.stats.stalls += 1;
-            shift = duration_to_cycles(Duration::from_secs_f64(f.stall_ms * 1e-3));
-        }
-        let mut bytes = &frame[..];
-        if bytes.len() > 1 && self.rng.chance(f.trunc) {
-            self.stats.truncated += 1;
-            bytes = &bytes[..1 + self.rng.below(bytes.len() as u64 - 1) as usize];
-        }
-        let copies = if self.rng.chance(f.dup) {
-            self.stats.duplicated += 1;
-            2
+        let plan = f.plan_frame(&mut self.rng, &frame, &mut self.stats);
+        let shift = if plan.stall {
+            duration_to_cycles(Duration::from_secs_f64(f.stall_ms * 1e-3))
         } else {
-            1
+            0
         };
-        let span = bytes.len() as u64 * bc;
-        for copy in 0..copies {
-            for &(t, b) in bytes {
+        let span = plan.bytes.len() as u64 * bc;
+        for copy in 0..plan.copies {
+            for &(t, b) in plan.bytes {
                 let mut arrival = t + shift + copy * span;
                 arrival = arrival.max(self.d2h_last + if self.d2h_last > 0 { bc } else { 0 });
                 self.d2h_last = arrival;
-                if self.rng.chance(f.drop) {
-                    self.stats.dropped += 1;
-                    continue;
+                if let Some(b) = f.pass_byte(&mut self.rng, b, &mut self.stats) {
+                    self.d2h.push_back((arrival, b));
                 }
-                let b = if self.rng.chance(f.flip) {
-                    self.stats.flipped += 1;
-                    b ^ (1 << self.rng.below(8))
-                } else {
-                    b
-                };
-                self.d2h.push_back((arrival, b));
             }
         }
     }
@@ -580,37 +574,18 @@ impl Link for EmulatorLink {
         let f = self.config.faults;
         let bc = self.byte_cycles;
         let mut start = self.mcu.cycle().max(self.h2d_free);
-        if self.rng.chance(f.stall) {
-            self.stats.stalls += 1;
+        let plan = f.plan_frame(&mut self.rng, bytes, &mut self.stats);
+        if plan.stall {
             start += duration_to_cycles(Duration::from_secs_f64(f.stall_ms * 1e-3));
         }
-        let mut frame = bytes;
-        if frame.len() > 1 && self.rng.chance(f.trunc) {
-            self.stats.truncated += 1;
-            frame = &frame[..1 + self.rng.below(frame.len() as u64 - 1) as usize];
-        }
-        let copies = if self.rng.chance(f.dup) {
-            self.stats.duplicated += 1;
-            2
-        } else {
-            1
-        };
         let mut t = start;
-        for _ in 0..copies {
-            for &b in frame {
+        for _ in 0..plan.copies {
+            for &b in plan.bytes {
                 let slot = t;
                 t += bc;
-                if self.rng.chance(f.drop) {
-                    self.stats.dropped += 1;
-                    continue;
+                if let Some(b) = f.pass_byte(&mut self.rng, b, &mut self.stats) {
+                    self.h2d.push_back((slot, b));
                 }
-                let b = if self.rng.chance(f.flip) {
-                    self.stats.flipped += 1;
-                    b ^ (1 << self.rng.below(8))
-                } else {
-                    b
-                };
-                self.h2d.push_back((slot, b));
             }
         }
         self.h2d_free = t;

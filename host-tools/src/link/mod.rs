@@ -16,6 +16,7 @@ pub mod emulator;
 pub mod serial;
 pub mod sim;
 
+use sim::Rng;
 use std::fmt;
 use std::io;
 use std::str::FromStr;
@@ -142,6 +143,87 @@ impl Faults {
             && self.trunc == 0.0
             && self.stall == 0.0
     }
+
+    /// Draws the per-frame faults of `frame`, always in the order stall, cut, duplicate, so that
+    /// a seed injects the same faults on every link.
+    pub(crate) fn plan_frame<'a, T>(
+        &self,
+        rng: &mut Rng,
+        frame: &'a [T],
+        stats: &mut impl FaultStats,
+    ) -> FramePlan<'a, T> {
+        let stall = rng.chance(self.stall);
+        if stall {
+            stats.count(Fault::Stall);
+        }
+        let mut bytes = frame;
+        if bytes.len() > 1 && rng.chance(self.trunc) {
+            stats.count(Fault::Truncate);
+            bytes = &bytes[..1 + rng.below(bytes.len() as u64 - 1) as usize];
+        }
+        let copies = if rng.chance(self.dup) {
+            stats.count(Fault::Duplicate);
+            2
+        } else {
+            1
+        };
+        FramePlan {
+            stall,
+            bytes,
+            copies,
+        }
+    }
+
+    /// Passes one byte through the per-byte faults: `None` when it is dropped, else the byte,
+    /// with one random bit flipped with probability `flip`.
+    pub(crate) fn pass_byte(
+        &self,
+        rng: &mut Rng,
+        b: u8,
+        stats: &mut impl FaultStats,
+    ) -> Option<u8> {
+        if rng.chance(self.drop) {
+            stats.count(Fault::Drop);
+            return None;
+        }
+        Some(if rng.chance(self.flip) {
+            stats.count(Fault::Flip);
+            b ^ (1 << rng.below(8))
+        } else {
+            b
+        })
+    }
+}
+
+/// One kind of injected fault.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Fault {
+    /// The line stalled before a frame.
+    Stall,
+    /// A frame was cut.
+    Truncate,
+    /// A frame was sent twice.
+    Duplicate,
+    /// A byte was lost.
+    Drop,
+    /// A bit of a byte was flipped.
+    Flip,
+}
+
+/// Link statistics that count the injected faults.
+pub(crate) trait FaultStats {
+    /// Counts one `fault`.
+    fn count(&mut self, fault: Fault);
+}
+
+/// What fault injection does to one frame ([`Faults::plan_frame`]).
+pub(crate) struct FramePlan<'a, T> {
+    /// The line stalls for `stall_ms` before the frame.
+    pub stall: bool,
+    /// What is sent: the frame, or its first bytes when cut.
+    pub bytes: &'a [T],
+    /// 2 when the frame is sent twice back to back, else 1.
+    pub copies: u64,
 }
 
 /// A `--faults` value that could not be read.

@@ -29,7 +29,7 @@
 //! random number of bytes) and a duplication (the frame is sent twice); then per byte a drop
 //! (its line time passes, nothing arrives) and a bit flip.
 
-use super::{byte_time, Faults, Link, LinkError};
+use super::{byte_time, Fault, FaultStats, Faults, Link, LinkError};
 use kin_core::DefaultMath;
 use quad_device::{Clock, Config, ConfigError, Device, ServoOutputs, Storage};
 use std::cell::Cell;
@@ -233,40 +233,33 @@ fn transmit(
     mut start_ns: u64,
     frame: &[u8],
 ) -> u64 {
-    if rng.chance(faults.stall) {
-        stats.stalls += 1;
+    let plan = faults.plan_frame(rng, frame, stats);
+    if plan.stall {
         start_ns += (faults.stall_ms * 1e6) as u64;
     }
-    let mut bytes = frame;
-    if bytes.len() > 1 && rng.chance(faults.trunc) {
-        stats.truncated += 1;
-        bytes = &bytes[..1 + rng.below(bytes.len() as u64 - 1) as usize];
-    }
-    let copies = if rng.chance(faults.dup) {
-        stats.duplicated += 1;
-        2
-    } else {
-        1
-    };
     let mut t = start_ns.max(line.free_ns);
-    for _ in 0..copies {
-        for &b in bytes {
+    for _ in 0..plan.copies {
+        for &b in plan.bytes {
             t += byte_ns;
-            if rng.chance(faults.drop) {
-                stats.dropped += 1;
-                continue;
+            if let Some(b) = faults.pass_byte(rng, b, stats) {
+                line.queue.push_back((t, b));
             }
-            let b = if rng.chance(faults.flip) {
-                stats.flipped += 1;
-                b ^ (1 << rng.below(8))
-            } else {
-                b
-            };
-            line.queue.push_back((t, b));
         }
     }
     line.free_ns = t;
     t
+}
+
+impl FaultStats for SimStats {
+    fn count(&mut self, fault: Fault) {
+        match fault {
+            Fault::Stall => self.stalls += 1,
+            Fault::Truncate => self.truncated += 1,
+            Fault::Duplicate => self.duplicated += 1,
+            Fault::Drop => self.dropped += 1,
+            Fault::Flip => self.flipped += 1,
+        }
+    }
 }
 
 /// The simulated UART link (see the module docs).
