@@ -238,13 +238,7 @@ pub struct FootError {
 
 /// `quadctl accuracy`.
 pub fn run(args: &Args) -> ExitCode {
-    match run_inner(args) {
-        Ok(()) => ExitCode::from(super::EXIT_OK),
-        Err(e) => {
-            eprintln!("quadctl: error: {e}");
-            ExitCode::from(super::EXIT_FATAL)
-        }
-    }
+    super::motion::exit_status(run_inner(args))
 }
 
 fn run_inner(args: &Args) -> Result<(), Error> {

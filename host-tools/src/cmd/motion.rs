@@ -694,6 +694,18 @@ pub fn write_motion<T: Motion>(
     Ok(w)
 }
 
+/// The exit status of a command that either succeeds ([`super::EXIT_OK`]) or fails: the error
+/// on stderr and [`super::EXIT_FATAL`].
+pub(super) fn exit_status(result: Result<(), Error>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::from(super::EXIT_OK),
+        Err(e) => {
+            eprintln!("quadctl: error: {e}");
+            ExitCode::from(super::EXIT_FATAL)
+        }
+    }
+}
+
 /// `quadctl motion`.
 pub fn run(args: &Args) -> ExitCode {
     match run_inner(args) {
