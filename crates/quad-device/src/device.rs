@@ -12,9 +12,9 @@ use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,
-    LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
-    DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    decode_request_payload, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost,
+    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback,
+    Request, ServoId, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -534,10 +534,11 @@ where
     }
 }
 
-/// The accumulator's decoder for requests: the one instance of `HostToDevice`'s deserializer.
+/// The accumulator with the protocol's compact request decoder
+/// ([`quad_protocol::decode_request_payload`]: postcard's results, a fraction of its code).
 #[inline(never)]
 fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<'a, HostToDevice> {
-    acc.feed::<HostToDevice>(bytes)
+    acc.feed_with(bytes, decode_request_payload)
 }
 
 /// Encodes `answer` into `out`: the frame's length, 0 when it does not fit. The one instance of

@@ -209,6 +209,19 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
 /// [`Error::TooShort`], [`Error::BadCrc`], or a decode error ([`Error::Truncated`],
 /// [`Error::UnknownVariant`], [`Error::BadEncoding`], [`Error::TrailingBytes`]).
 pub fn decode_payload<T: DeserializeOwned>(decoded: &[u8]) -> Result<T, Error> {
+    let body = check_crc(decoded)?;
+    let (msg, rest) = postcard::take_from_bytes::<T>(body)?;
+    if !rest.is_empty() {
+        return Err(Error::TrailingBytes);
+    }
+    Ok(msg)
+}
+
+/// The postcard bytes of a decoded frame (postcard bytes ‖ CRC) whose CRC matches.
+///
+/// # Errors
+/// [`Error::TooShort`], [`Error::BadCrc`].
+pub(crate) fn check_crc(decoded: &[u8]) -> Result<&[u8], Error> {
     if decoded.len() < CRC_LEN + 1 {
         return Err(Error::TooShort);
     }
@@ -216,11 +229,7 @@ pub fn decode_payload<T: DeserializeOwned>(decoded: &[u8]) -> Result<T, Error> {
     if crc::checksum(body).to_be_bytes() != [trailer[0], trailer[1]] {
         return Err(Error::BadCrc);
     }
-    let (msg, rest) = postcard::take_from_bytes::<T>(body)?;
-    if !rest.is_empty() {
-        return Err(Error::TrailingBytes);
-    }
-    Ok(msg)
+    Ok(body)
 }
 
 /// What [`Accumulator::feed`] found. Every variant but `NeedMore` carries the bytes after the
@@ -378,13 +387,23 @@ impl<const N: usize> Accumulator<N> {
     /// Consumes `input` up to and including the first delimiter that ends a non-empty frame,
     /// and reports that frame; or consumes everything and returns [`Feed::NeedMore`].
     pub fn feed<'a, T: DeserializeOwned>(&mut self, input: &'a [u8]) -> Feed<'a, T> {
+        self.feed_with(input, decode_payload::<T>)
+    }
+
+    /// [`Accumulator::feed`] with another decoder of the frame (postcard bytes ‖ CRC) in place
+    /// of [`decode_payload`], e.g. [`crate::decode_request_payload`].
+    pub fn feed_with<'a, T>(
+        &mut self,
+        input: &'a [u8],
+        decode: fn(&[u8]) -> Result<T, Error>,
+    ) -> Feed<'a, T> {
         for (i, &byte) in input.iter().enumerate() {
             if byte == DELIMITER {
                 if self.code == 0 {
                     continue; // empty frame
                 }
                 let remaining = &input[i + 1..];
-                let result = self.finish::<T>();
+                let result = self.finish(decode);
                 self.reset();
                 return match result {
                     Ok(msg) => {
@@ -420,13 +439,13 @@ impl<const N: usize> Accumulator<N> {
         Feed::NeedMore
     }
 
-    fn finish<T: DeserializeOwned>(&self) -> Result<T, Error> {
+    fn finish<T>(&self, decode: fn(&[u8]) -> Result<T, Error>) -> Result<T, Error> {
         if self.overflow {
             return Err(Error::Oversize);
         }
         if self.block_left != 0 {
             return Err(Error::Cobs);
         }
-        decode_payload(&self.buf[..self.len])
+        decode(&self.buf[..self.len])
     }
 }

@@ -26,11 +26,13 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+mod compact;
 pub mod crc;
 pub mod frame;
 pub mod msg;
 pub mod servo;
 
+pub use compact::decode_request_payload;
 pub use frame::{
     decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
