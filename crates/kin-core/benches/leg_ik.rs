@@ -189,7 +189,7 @@ fn leg_ik(c: &mut Criterion) {
         .iter()
         .map(|t| {
             t.angles_rad
-                .map(|a| a + rng.uniform(-K_START_OFFSET_RAD, K_START_OFFSET_RAD))
+                .map(|a| a + rng.range(-K_START_OFFSET_RAD, K_START_OFFSET_RAD))
         })
         .collect();
     let goals: Vec<Isometry3<f64>> = targets

@@ -30,30 +30,7 @@ pub const POSE_RANGE_DEG: [f64; 3] = [28.0, 21.0, 21.0];
 /// Stance height of the body-pose benchmark: seed 000 Table 4 body height `bh`, m.
 pub const STANCE_HEIGHT_SHAHRIAR_M: f32 = 0.277;
 
-/// SplitMix64 (Steele, Lea, Flood 2014): a tiny, well-mixed, seedable generator.
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// A generator with the given seed.
-    pub fn new(seed: u64) -> Self {
-        SplitMix64(seed)
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi)`.
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        let unit = (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-        lo + (hi - lo) * unit
-    }
-}
+pub use seeded_rng::SplitMix64;
 
 /// One reachable leg target.
 #[derive(Debug, Clone, Copy)]
@@ -104,7 +81,7 @@ pub fn leg_targets() -> Vec<LegTarget> {
         let q: [f64; 3] = core::array::from_fn(|j| {
             let lo = robot.limits.min_rad[j] as f64 + LIMIT_MARGIN_RAD;
             let hi = robot.limits.max_rad[j] as f64 - LIMIT_MARGIN_RAD;
-            rng.uniform(lo, hi)
+            rng.range(lo, hi)
         });
         i += 1;
         let (p, w) = foot_in_hip_f64(robot, leg, q);
@@ -131,7 +108,7 @@ pub fn body_poses() -> Vec<kin_core::Pose> {
     let mut rng = SplitMix64::new(SEED ^ 0xB0D7);
     (0..N_POSES)
         .map(|_| {
-            let [r, p, y] = POSE_RANGE_DEG.map(|deg| rng.uniform(-deg, deg).to_radians() as f32);
+            let [r, p, y] = POSE_RANGE_DEG.map(|deg| rng.range(-deg, deg).to_radians() as f32);
             kin_core::Pose::rotation(r, p, y)
         })
         .collect()
