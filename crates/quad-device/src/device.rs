@@ -12,9 +12,9 @@ use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    decode_request_payload, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost,
-    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback,
-    Request, ServoId, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    decode_request_payload, encode_answer_frame, is_compatible, Accumulator, DeviceInfo,
+    DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig,
+    Readback, Request, ServoId, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -541,11 +541,12 @@ fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<'a, 
     acc.feed_with(bytes, decode_request_payload)
 }
 
-/// Encodes `answer` into `out`: the frame's length, 0 when it does not fit. The one instance of
-/// `DeviceToHost`'s serializer.
+/// Encodes `answer` into `out` with the protocol's compact encoder
+/// ([`quad_protocol::encode_answer_frame`]: `encode_frame`'s bytes, a fraction of its code):
+/// the frame's length, 0 when it does not fit.
 #[inline(never)]
 fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
-    encode_frame(answer, out).map_or(0, <[u8]>::len)
+    encode_answer_frame(answer, out).map_or(0, <[u8]>::len)
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {

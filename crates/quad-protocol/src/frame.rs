@@ -110,7 +110,7 @@ impl From<postcard::Error> for Error {
 }
 
 /// A postcard flavor that updates the CRC and COBS-encodes each byte straight into a slice.
-struct CobsCrcSlice<'b> {
+pub(crate) struct CobsCrcSlice<'b> {
     out: &'b mut [u8],
     /// Next free position.
     pos: usize,
@@ -122,7 +122,7 @@ struct CobsCrcSlice<'b> {
 }
 
 impl<'b> CobsCrcSlice<'b> {
-    fn new(out: &'b mut [u8]) -> Result<Self, postcard::Error> {
+    pub(crate) fn new(out: &'b mut [u8]) -> Result<Self, postcard::Error> {
         if out.len() < 2 {
             return Err(postcard::Error::SerializeBufferFull);
         }

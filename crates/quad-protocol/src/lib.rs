@@ -32,7 +32,7 @@ pub mod frame;
 pub mod msg;
 pub mod servo;
 
-pub use compact::decode_request_payload;
+pub use compact::{decode_request_payload, encode_answer_frame};
 pub use frame::{
     decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
