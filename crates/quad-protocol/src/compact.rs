@@ -19,6 +19,7 @@ use postcard::ser_flavors::Flavor;
 ///
 /// # Errors
 /// As [`crate::decode_payload`].
+#[inline(never)] // keeps the message's temporaries out of the caller's stack frame
 pub fn decode_request_payload(decoded: &[u8]) -> Result<HostToDevice, Error> {
     let mut r = Reader(check_crc(decoded)?);
     let msg = r.request()?;
@@ -242,10 +243,17 @@ impl Reader<'_> {
 
     fn f32s<const N: usize>(&mut self) -> Result<[f32; N], Error> {
         let mut out = [0.0; N];
-        for x in &mut out {
+        self.fill_f32(&mut out)?;
+        Ok(out)
+    }
+
+    /// One loop for every array length.
+    #[inline(never)]
+    fn fill_f32(&mut self, out: &mut [f32]) -> Result<(), Error> {
+        for x in out {
             *x = self.f32()?;
         }
-        Ok(out)
+        Ok(())
     }
 
     fn servo(&mut self) -> Result<ServoId, Error> {
