@@ -241,13 +241,7 @@ impl Reader<'_> {
         Ok(f32::from_le_bytes(b))
     }
 
-    fn f32s<const N: usize>(&mut self) -> Result<[f32; N], Error> {
-        let mut out = [0.0; N];
-        self.fill_f32(&mut out)?;
-        Ok(out)
-    }
-
-    /// One loop for every array length.
+    /// Reads `out.len()` floats.
     #[inline(never)]
     fn fill_f32(&mut self, out: &mut [f32]) -> Result<(), Error> {
         for x in out {
@@ -264,32 +258,40 @@ impl Reader<'_> {
 
     fn request(&mut self) -> Result<HostToDevice, Error> {
         let seq = self.u16()?;
-        let request = match self.variant(11)? {
+        let variant = self.variant(11)?;
+        // The three float-only payloads go through one buffer (one stack slot).
+        let mut f = [0.0f32; 12];
+        let request = match variant {
             0 => Request::Hello {
                 version: self.u16()?,
             },
             1 => Request::GetState,
             2 => {
-                let [roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m] = self.f32s()?;
+                self.fill_f32(&mut f[..6])?;
                 Request::SetBodyPose(Pose {
-                    roll_rad,
-                    pitch_rad,
-                    yaw_rad,
-                    x_m,
-                    y_m,
-                    z_m,
+                    roll_rad: f[0],
+                    pitch_rad: f[1],
+                    yaw_rad: f[2],
+                    x_m: f[3],
+                    y_m: f[4],
+                    z_m: f[5],
                 })
             }
             3 => {
-                let mut feet_in_body_m = [[0.0; 3]; 4];
-                for f in &mut feet_in_body_m {
-                    *f = self.f32s()?;
+                self.fill_f32(&mut f)?;
+                Request::SetFeet {
+                    feet_in_body_m: [
+                        [f[0], f[1], f[2]],
+                        [f[3], f[4], f[5]],
+                        [f[6], f[7], f[8]],
+                        [f[9], f[10], f[11]],
+                    ],
                 }
-                Request::SetFeet { feet_in_body_m }
             }
-            4 => Request::SetJoints {
-                angles_rad: self.f32s()?,
-            },
+            4 => {
+                self.fill_f32(&mut f)?;
+                Request::SetJoints { angles_rad: f }
+            }
             5 => Request::SetOutputs {
                 enabled: self.bool()?,
             },
