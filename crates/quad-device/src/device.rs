@@ -154,10 +154,16 @@ where
             &self.config.pose_config,
             &mut self.calibration,
         );
-        let loaded = self.store.load(&mut self.storage, &mut self.calibration);
-        self.calibration_default = !loaded;
+        self.calibration_default = !self.load_calibration();
         // The stance may not map within a stored calibration: then nothing is held.
         let _ = self.set_body_pose(&Pose::default());
+    }
+
+    /// Loads the calibration from storage (true when a valid one was found). Out of line: the
+    /// record buffers stay out of [`Device::boot`]'s frame, which the stance IK's stack adds to.
+    #[inline(never)]
+    fn load_calibration(&mut self) -> bool {
+        self.store.load(&mut self.storage, &mut self.calibration)
     }
 
     /// Feeds received bytes (any chunking) and sends one answer frame through `tx` for every
