@@ -186,19 +186,48 @@ pub(crate) fn write_default_calibration<M: Math>(
 /// Out of line: the body solution stays in a frame of its own.
 #[inline(never)]
 fn stance_angles<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> [f32; 12] {
-    let config = BodyConfig {
-        order: pose_config.order,
-        pivot_m: kin_core::Vec3::ZERO,
-    };
-    body::inverse_at_stance_with::<M>(
+    body_inverse::<M>(
         robot,
         &body::Pose::default(),
-        &config,
-        pose_config.stance_height_m,
+        pose_config,
+        BodyFeet::Stance,
         ReachPolicy::Reject,
     )
     .map(|s| s.flat())
     .unwrap_or([0.0; 12])
+}
+
+/// Where [`body_inverse`] holds the feet.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum BodyFeet<'a> {
+    /// At the nominal stance of the pose configuration's height.
+    Stance,
+    /// At these points of the world frame, m.
+    World(&'a [kin_core::Vec3; 4]),
+}
+
+/// The device's one body IK (kin-core's [`body::Solver`]) for the boot stance, `SetBodyPose`
+/// and `SetFeet`, about the body centre in `pose_config`'s rotation order: one instance of the
+/// solver's constants and leg solves in the firmware instead of one per request.
+#[inline(never)]
+pub(crate) fn body_inverse<M: Math>(
+    robot: &Robot,
+    pose: &body::Pose,
+    pose_config: &PoseConfig,
+    feet: BodyFeet<'_>,
+    policy: ReachPolicy,
+) -> Result<body::BodySolution, kin_core::IkError> {
+    let solver = body::Solver::new(robot);
+    let config = BodyConfig {
+        order: pose_config.order,
+        pivot_m: kin_core::Vec3::ZERO,
+    };
+    match feet {
+        BodyFeet::Stance => {
+            solver.inverse_at_stance_with::<M>(pose, &config, pose_config.stance_height_m, policy)
+        }
+        BodyFeet::World(feet) => solver.inverse_with::<M>(pose, &config, feet, policy),
+    }
 }
 
 #[cfg(test)]

@@ -2,13 +2,14 @@
 //! answer bytes out.
 
 use crate::config::{
-    validate_pose_config, write_default_calibration, Config, ConfigError, UNBOOTED_CALIBRATION,
+    body_inverse, validate_pose_config, write_default_calibration, BodyFeet, Config, ConfigError,
+    UNBOOTED_CALIBRATION,
 };
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use core::marker::PhantomData;
-use kin_core::body::{self, BodySolution, Pose};
-use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
+use kin_core::body::{BodySolution, Pose};
+use kin_core::{DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
@@ -356,34 +357,25 @@ where
         (self.outputs, self.clock, self.storage)
     }
 
-    fn body_config(&self) -> BodyConfig {
-        BodyConfig {
-            order: self.config.pose_config.order,
-            pivot_m: Vec3::ZERO,
-        }
-    }
-
     #[inline(never)]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
-        let solution = body::inverse_at_stance_with::<M>(
-            &self.config.robot,
-            pose,
-            &self.body_config(),
-            self.config.pose_config.stance_height_m,
-            self.config.pose_config.policy,
-        );
-        self.apply_solution(solution)
+        self.solve_body(pose, BodyFeet::Stance)
     }
 
     #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
-        let solution = body::inverse_with::<M>(
+        self.solve_body(&Pose::default(), BodyFeet::World(&feet))
+    }
+
+    fn solve_body(&mut self, pose: &Pose, feet: BodyFeet<'_>) -> Result<(), NackReason> {
+        let pose_config = &self.config.pose_config;
+        let solution = body_inverse::<M>(
             &self.config.robot,
-            &Pose::default(),
-            &self.body_config(),
-            &feet,
-            self.config.pose_config.policy,
+            pose,
+            pose_config,
+            feet,
+            pose_config.policy,
         );
         self.apply_solution(solution)
     }
