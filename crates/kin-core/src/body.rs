@@ -336,6 +336,18 @@ impl Solver {
         self.inverse_at_stance_with::<DefaultMath>(pose, config, stance_height_m, policy)
     }
 
+    /// The four leg solves of feet already in their hips' frames (from
+    /// [`Solver::feet_in_hips_with`] or [`Solver::stance_feet_in_hips_with`]):
+    /// [`Solver::inverse_with`] is [`check_finite`], [`Solver::feet_in_hips_with`] and this.
+    #[inline]
+    pub fn inverse_in_hips_with<M: Math>(
+        &self,
+        feet_in_hips: &[Vec3; 4],
+        policy: ReachPolicy,
+    ) -> Result<BodySolution, IkError> {
+        self.legs::<M>(feet_in_hips, policy)
+    }
+
     /// The four leg solves of a body pose.
     #[inline(always)]
     fn legs<M: Math>(
@@ -383,9 +395,13 @@ impl Solver {
     }
 }
 
-/// `NonFinite` (named on FL) when the pose or the pivot is not finite.
+/// `NonFinite` (named on FL) when the pose or the pivot is not finite: the first check of
+/// [`Solver::inverse_with`] and [`Solver::inverse_at_stance_with`].
+///
+/// # Errors
+/// `NonFinite` on [`LegId::FL`].
 #[inline(always)]
-fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
+pub fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = config.pivot_m;
     let finite = pose.to_array().iter().all(|&v| cmp::finite(v))
         && cmp::finite(p.x)

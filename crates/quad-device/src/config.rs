@@ -218,16 +218,30 @@ pub(crate) fn body_inverse<M: Math>(
     policy: ReachPolicy,
 ) -> Result<body::BodySolution, kin_core::IkError> {
     let solver = body::Solver::new(robot);
+    let local = body_feet_in_hips::<M>(&solver, pose, pose_config, feet)?;
+    solver.inverse_in_hips_with::<M>(&local, policy)
+}
+
+/// The first half of [`body_inverse`], out of line so that each half keeps a small stack
+/// frame: the feet in each leg's hip frame.
+#[inline(never)]
+fn body_feet_in_hips<M: Math>(
+    solver: &body::Solver,
+    pose: &body::Pose,
+    pose_config: &PoseConfig,
+    feet: BodyFeet<'_>,
+) -> Result<[kin_core::Vec3; 4], kin_core::IkError> {
     let config = BodyConfig {
         order: pose_config.order,
         pivot_m: kin_core::Vec3::ZERO,
     };
-    match feet {
+    body::check_finite(pose, &config)?;
+    Ok(match feet {
         BodyFeet::Stance => {
-            solver.inverse_at_stance_with::<M>(pose, &config, pose_config.stance_height_m, policy)
+            solver.stance_feet_in_hips_with::<M>(pose, &config, pose_config.stance_height_m)
         }
-        BodyFeet::World(feet) => solver.inverse_with::<M>(pose, &config, feet, policy),
-    }
+        BodyFeet::World(feet) => solver.feet_in_hips_with::<M>(pose, &config, feet),
+    })
 }
 
 #[cfg(test)]
