@@ -202,7 +202,8 @@ fn stance_angles<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> [f32; 12] 
 pub(crate) enum BodyFeet<'a> {
     /// At the nominal stance of the pose configuration's height.
     Stance,
-    /// At these points of the world frame, m.
+    /// At these points of the world frame, m, with the body at the zero pose (the pose
+    /// argument is not read).
     World(&'a [kin_core::Vec3; 4]),
 }
 
@@ -219,7 +220,17 @@ pub(crate) fn body_inverse<M: Math>(
 ) -> Result<body::BodySolution, kin_core::IkError> {
     let solver = body::Solver::new(robot);
     let local = body_feet_in_hips::<M>(&solver, pose, pose_config, feet)?;
-    solver.inverse_in_hips_with::<M>(&local, policy)
+    body_legs::<M>(&solver, &local, policy)
+}
+
+/// The second half of [`body_inverse`], out of line (a small stack frame): the leg solves.
+#[inline(never)]
+fn body_legs<M: Math>(
+    solver: &body::Solver,
+    feet_in_hips: &[kin_core::Vec3; 4],
+    policy: ReachPolicy,
+) -> Result<body::BodySolution, kin_core::IkError> {
+    solver.inverse_in_hips_with::<M>(feet_in_hips, policy)
 }
 
 /// The first half of [`body_inverse`], out of line so that each half keeps a small stack
@@ -240,7 +251,9 @@ fn body_feet_in_hips<M: Math>(
         BodyFeet::Stance => {
             solver.stance_feet_in_hips_with::<M>(pose, &config, pose_config.stance_height_m)
         }
-        BodyFeet::World(feet) => solver.feet_in_hips_with::<M>(pose, &config, feet),
+        BodyFeet::World(feet) => {
+            solver.feet_in_hips_with::<M>(&body::Pose::default(), &config, feet)
+        }
     })
 }
 
