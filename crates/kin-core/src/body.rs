@@ -260,7 +260,9 @@ impl Solver {
         let pivot = !is_zero(c);
         let t = pose.translation();
         // K = Rᵀ·(t + c) + H·r₂ − c.
-        let k = if !pivot && is_zero(t) {
+        // The ATmega2560 keeps only the general arm (-168 B of flash): the same feet, but for
+        // the sign of a component that is zero in both.
+        let k = if !cfg!(target_arch = "avr") && !pivot && is_zero(t) {
             r2 * stance_height_m
         } else {
             let g = if pivot { t + c } else { t };
