@@ -162,6 +162,7 @@ where
 
     /// Loads the calibration from storage (true when a valid one was found). Out of line: the
     /// record buffers stay out of [`Device::boot`]'s frame, which the stance IK's stack adds to.
+    #[cfg_attr(target_arch = "avr", optimize(size))]
     #[inline(never)]
     fn load_calibration(&mut self) -> bool {
         self.store.load(&mut self.storage, &mut self.calibration)
@@ -515,6 +516,7 @@ where
         Ok(())
     }
 
+    #[cfg_attr(target_arch = "avr", optimize(size))]
     #[inline(never)]
     fn save_calibration(&mut self) -> Result<(), NackReason> {
         self.store

@@ -41,6 +41,9 @@
 //! 1; a compile-time assertion in AVR builds keeps it ≤ 480 B). Saving or loading the calibration streams 15-byte records.
 
 #![no_std]
+// The firmware (nightly) instantiates the generic storage code with its own opt-level "s";
+// `#[optimize(size)]` on it saves flash there (hosts build without the attribute).
+#![cfg_attr(target_arch = "avr", feature(optimize_attribute))]
 #![forbid(unsafe_code)]
 
 pub mod config;
