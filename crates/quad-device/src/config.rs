@@ -246,9 +246,9 @@ fn body_feet_in_hips<M: Math>(
         order: pose_config.order,
         pivot_m: kin_core::Vec3::ZERO,
     };
-    body::check_finite(pose, &config)?;
     Ok(match feet {
         BodyFeet::Stance => {
+            body::check_finite(pose, &config)?;
             solver.stance_feet_in_hips_with::<M>(pose, &config, pose_config.stance_height_m)
         }
         BodyFeet::World(feet) => {

@@ -455,15 +455,16 @@ where
     /// Writes the held pulses to the outputs, after checking each against its calibration;
     /// stops the outputs instead if any check fails (unreachable by construction).
     fn drive(&mut self) -> bool {
-        let Some(held) = self.held else {
+        // Borrowed, not copied (72 bytes).
+        let Some(held) = &self.held else {
             self.stop_outputs();
             return false;
         };
         let all_in_travel = self
             .calibration
             .iter()
-            .zip(held.pulses_half_us)
-            .all(|(c, p)| c.min_half_us() <= p && p <= c.max_half_us());
+            .zip(&held.pulses_half_us)
+            .all(|(c, &p)| c.min_half_us() <= p && p <= c.max_half_us());
         if !all_in_travel {
             self.stop_outputs();
             return false;
