@@ -555,6 +555,7 @@ impl View<'_> {
 
     /// [`Solver::inverse_with`].
     #[cfg_attr(not(target_arch = "avr"), inline(always))]
+    #[cfg_attr(target_arch = "avr", inline(never))]
     fn inverse_with<M: Math>(
         &self,
         leg: LegId,

@@ -230,6 +230,25 @@ fn body_legs<M: Math>(
     feet_in_hips: &[kin_core::Vec3; 4],
     policy: ReachPolicy,
 ) -> Result<body::BodySolution, kin_core::IkError> {
+    // The ATmega2560: the legs in a loop around kin-core's out-of-line leg solve (-148 B of
+    // flash against its four unrolled calls); hosts keep the solver's own path (the same
+    // results).
+    #[cfg(target_arch = "avr")]
+    {
+        let mut out = body::BodySolution {
+            legs: [kin_core::LegSolution {
+                angles: kin_core::JointAngles::default(),
+                clamped: None,
+            }; 4],
+        };
+        for (i, leg) in LegId::ALL.into_iter().enumerate() {
+            out.legs[i] = solver
+                .leg()
+                .inverse_with::<M>(leg, feet_in_hips[i], policy)?;
+        }
+        Ok(out)
+    }
+    #[cfg(not(target_arch = "avr"))]
     solver.inverse_in_hips_with::<M>(feet_in_hips, policy)
 }
 
