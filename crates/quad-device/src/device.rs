@@ -358,17 +358,18 @@ where
         (self.outputs, self.clock, self.storage)
     }
 
-    #[inline(never)]
+    #[inline]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
         self.solve_body(pose, BodyFeet::Stance)
     }
 
-    #[inline(never)]
+    #[inline(always)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
         self.solve_body(&Pose::default(), BodyFeet::World(&feet))
     }
 
+    #[inline(never)]
     fn solve_body(&mut self, pose: &Pose, feet: BodyFeet<'_>) -> Result<(), NackReason> {
         let pose_config = &self.config.pose_config;
         let solution = body_inverse::<M>(
@@ -381,7 +382,7 @@ where
         self.apply_solution(solution)
     }
 
-    #[inline(never)]
+    #[inline]
     fn apply_solution(
         &mut self,
         solution: Result<BodySolution, IkError>,
