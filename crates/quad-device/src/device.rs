@@ -84,7 +84,9 @@ pub struct Device<O, C, S, M = DefaultMath> {
 // AVR's 63-byte frame-pointer displacement. Every access then costs about 8 instructions, which
 // doubled the firmware's flash, and the LLVM AVR backend miscompiled one such access (it saved
 // SREG in r0 while r0 still held a `mul` result: a wrong calibration index). Small frames avoid
-// both; `firmware-avr`'s emulator tests scan the ELF for that pattern.
+// both; `firmware-avr`'s emulator tests scan the ELF for that pattern. The exceptions, inlined
+// into `answer` because that saves flash (-288 B) within the stack budget: `set_body_pose`,
+// `set_feet` (both calling the one out-of-line `solve_body`), `set_joints` and `info`.
 impl<O, C, S, M> Device<O, C, S, M>
 where
     O: ServoOutputs,
@@ -283,7 +285,7 @@ where
     }
 
     /// What `HelloAck` reports.
-    #[inline(never)]
+    #[inline(always)]
     pub fn info(&self) -> DeviceInfo {
         DeviceInfo {
             version: PROTOCOL_VERSION,
@@ -401,7 +403,7 @@ where
         self.apply(angles, clamped, limited)
     }
 
-    #[inline(never)]
+    #[inline(always)]
     fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
         for s in ServoId::ALL {
             let a = angles[s.index()];
