@@ -85,7 +85,7 @@ pub struct Device<O, C, S, M = DefaultMath> {
 // doubled the firmware's flash, and the LLVM AVR backend miscompiled one such access (it saved
 // SREG in r0 while r0 still held a `mul` result: a wrong calibration index). Small frames avoid
 // both; `firmware-avr`'s emulator tests scan the ELF for that pattern. The exceptions, inlined
-// into `answer` because that saves flash (-288 B) within the stack budget: `set_body_pose`,
+// into `answer` because that saves flash (-292 B) within the stack budget: `set_body_pose`,
 // `set_feet` (both calling the one out-of-line `solve_body`), `set_joints` and `info`.
 impl<O, C, S, M> Device<O, C, S, M>
 where
@@ -183,10 +183,10 @@ where
 
     /// Consumes `bytes` up to the end of the first frame in them, handles it and encodes the
     /// answer into the accumulator's buffer (free between frames): its length (0 when it could not be encoded) and the
-    /// bytes left; `None` when no frame ended in `bytes`. Out of line, as are the decoder and
-    /// the encoder it calls (one instance each): the caller's closure is the only generic part
-    /// left inline.
-    #[inline(never)]
+    /// bytes left; `None` when no frame ended in `bytes`. Inlined into [`Device::receive`]
+    /// (-64 B of flash; the firmware has one instance of it, with one closure); the decoder and
+    /// the encoder it calls stay out of line (one instance each).
+    #[inline(always)]
     fn receive_one<'a>(&mut self, bytes: &'a [u8]) -> Option<(usize, &'a [u8])> {
         let (answer, remaining) = match feed_request(&mut self.acc, bytes) {
             Feed::NeedMore => return None,
