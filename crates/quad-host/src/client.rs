@@ -33,7 +33,7 @@
 //! - a pose the host rejects (unreachable, joint limit, non-finite, beyond a servo's travel)
 //!   must be nacked with the same reason, leg and kind.
 
-use crate::link::{byte_time, Link, LinkError};
+use crate::link::{self, byte_time, Link};
 use kin_core::body::{self, Pose};
 use kin_core::{BodyConfig, DefaultMath, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo::Calibration;
@@ -43,7 +43,6 @@ use quad_protocol::{
     MAX_DECODED_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 use serde::Serialize;
-use std::fmt;
 use std::time::Duration;
 
 /// Bound on |device angle − host angle| for the ATmega2560 firmware, whose math backend
@@ -121,6 +120,28 @@ impl ClientConfig {
             hello_patience: Duration::from_secs(4),
         }
     }
+
+    /// The configuration that suits `target`, with `retries` resends per streamed request.
+    pub fn for_target(target: &link::Target, retries: u32) -> ClientConfig {
+        let config = match target {
+            link::Target::Sim { config, .. } => ClientConfig::sim(config.compute),
+            link::Target::Emulator { .. } => ClientConfig::emulator(),
+            link::Target::Serial { .. } => ClientConfig::serial(),
+        };
+        ClientConfig { retries, ..config }
+    }
+}
+
+impl AngleCheck {
+    /// The check that suits `target`: the same bits for the simulated controller (the host's
+    /// math), [`AVR_ANGLE_TOLERANCE_RAD`] for the ATmega2560's.
+    pub fn for_target(target: &link::Target) -> AngleCheck {
+        if target.runs_host_math() {
+            AngleCheck::Exact
+        } else {
+            AngleCheck::Within(AVR_ANGLE_TOLERANCE_RAD)
+        }
+    }
 }
 
 /// What the client saw on the link.
@@ -172,17 +193,20 @@ pub struct Exchange {
 }
 
 /// Why a session request failed.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
-pub enum ClientError {
+pub enum Error {
     /// The link failed.
-    Link(LinkError),
+    #[error(transparent)]
+    Link(#[from] link::Error),
     /// No answer after every attempt.
+    #[error("no answer to {request} after every retry")]
     NoAnswer {
         /// The request's name.
         request: &'static str,
     },
     /// The device refused.
+    #[error("the device refused {request}: {reason}")]
     Refused {
         /// The request's name.
         request: &'static str,
@@ -190,6 +214,7 @@ pub enum ClientError {
         reason: NackReason,
     },
     /// An answer of the wrong kind.
+    #[error("unexpected answer to {request}: {}", answer_name(answer))]
     Unexpected {
         /// The request's name.
         request: &'static str,
@@ -197,11 +222,19 @@ pub enum ClientError {
         answer: Box<DeviceToHost>,
     },
     /// The device speaks another major protocol version.
+    #[error(
+        "the device speaks protocol {}.{}, this host {}.{}",
+        device >> 8,
+        device & 0xFF,
+        PROTOCOL_VERSION >> 8,
+        PROTOCOL_VERSION & 0xFF
+    )]
     Version {
         /// The device's version.
         device: u16,
     },
     /// The device runs another robot than the host was asked for.
+    #[error("the device runs robot {device:?}, the host was given {host:?}")]
     Robot {
         /// The device's robot.
         device: RobotPreset,
@@ -210,50 +243,57 @@ pub enum ClientError {
     },
 }
 
-impl fmt::Display for ClientError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ClientError::Link(e) => write!(f, "{e}"),
-            ClientError::NoAnswer { request } => {
-                write!(f, "no answer to {request} after every retry")
-            }
-            ClientError::Refused { request, reason } => {
-                write!(f, "the device refused {request}: {reason}")
-            }
-            ClientError::Unexpected { request, answer } => {
-                write!(f, "unexpected answer to {request}: {answer:?}")
-            }
-            ClientError::Version { device } => write!(
-                f,
-                "the device speaks protocol {}.{}, this host {}.{}",
-                device >> 8,
-                device & 0xFF,
-                PROTOCOL_VERSION >> 8,
-                PROTOCOL_VERSION & 0xFF
-            ),
-            ClientError::Robot { device, host } => {
-                write!(
-                    f,
-                    "the device runs robot {device:?}, the host was given {host:?}"
-                )
-            }
-        }
+/// Short name of an answer, for messages.
+pub fn answer_name(a: &DeviceToHost) -> &'static str {
+    match a {
+        DeviceToHost::Nack { .. } => "Nack",
+        DeviceToHost::HelloAck { .. } => "HelloAck",
+        DeviceToHost::Ack { .. } => "Ack",
+        DeviceToHost::Calibration { .. } => "Calibration",
     }
 }
 
-impl std::error::Error for ClientError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            ClientError::Link(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
-impl From<LinkError> for ClientError {
-    fn from(e: LinkError) -> Self {
-        ClientError::Link(e)
-    }
+/// Why a pose's answer disagreed with the host (see [`PoseStream::send`]).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Mismatch {
+    /// A readback angle differs from the host's beyond the [`AngleCheck`].
+    #[error("{servo}: device angle {device_rad} rad, host {host_rad} rad")]
+    Angle {
+        /// The joint.
+        servo: ServoId,
+        /// The device's angle, rad.
+        device_rad: f32,
+        /// The host's, rad.
+        host_rad: f32,
+    },
+    /// A readback pulse differs from the calibration's mapping of the device's angle.
+    #[error("{servo}: device pulse {device_half_us} half-µs, host mapping {host_half_us:?}")]
+    Pulse {
+        /// The joint.
+        servo: ServoId,
+        /// The device's pulse, half-µs.
+        device_half_us: u16,
+        /// The host's mapping, half-µs (`None`: beyond the servo's travel).
+        host_half_us: Option<u16>,
+    },
+    /// The device acked a pose the host rejects.
+    #[error("device acked, host rejects: {0}")]
+    AckedHostRejects(NackReason),
+    /// The device nacked a pose the host solves.
+    #[error("device nacked ({0}), host solves")]
+    NackedHostSolves(NackReason),
+    /// Both nacked, for different reasons.
+    #[error("device nacked ({device}), host rejects with {host}")]
+    Reasons {
+        /// The device's reason.
+        device: NackReason,
+        /// The host's.
+        host: NackReason,
+    },
+    /// An answer of another kind than an ack or a nack.
+    #[error("unexpected answer {}", answer_name(.0))]
+    Unexpected(DeviceToHost),
 }
 
 /// Short name of a request, for messages.
@@ -343,7 +383,7 @@ impl<L: Link> Client<L> {
         &mut self,
         request: Request,
         check: impl FnMut(&DeviceToHost) -> Verdict,
-    ) -> Result<Exchange, LinkError> {
+    ) -> Result<Exchange, link::Error> {
         self.exchange_with(request, self.config.retries, check)
     }
 
@@ -356,7 +396,7 @@ impl<L: Link> Client<L> {
         request: Request,
         retries: u32,
         mut check: impl FnMut(&DeviceToHost) -> Verdict,
-    ) -> Result<Exchange, LinkError> {
+    ) -> Result<Exchange, link::Error> {
         self.seq = self.seq.wrapping_add(1);
         let seq = self.seq;
         let mut buf = [0u8; MAX_FRAME_LEN];
@@ -406,7 +446,7 @@ impl<L: Link> Client<L> {
         seq: u16,
         deadline: Duration,
         nack_from: Duration,
-    ) -> Result<Wait, LinkError> {
+    ) -> Result<Wait, link::Error> {
         let mut buf = [0u8; 256];
         loop {
             let input = std::mem::take(&mut self.pending);
@@ -451,32 +491,32 @@ impl<L: Link> Client<L> {
     /// of the request is an error.
     ///
     /// # Errors
-    /// [`ClientError::NoAnswer`], [`ClientError::Refused`], or the link's error.
-    pub fn request(&mut self, request: Request) -> Result<DeviceToHost, ClientError> {
+    /// [`Error::NoAnswer`], [`Error::Refused`], or the link's error.
+    pub fn request(&mut self, request: Request) -> Result<DeviceToHost, Error> {
         let name = request_name(&request);
         let retries = self.config.session_retries;
         match self
             .exchange_with(request, retries, |_| Verdict::Accept)?
             .outcome
         {
-            Outcome::Accepted(DeviceToHost::Nack { reason, .. }) => Err(ClientError::Refused {
+            Outcome::Accepted(DeviceToHost::Nack { reason, .. }) => Err(Error::Refused {
                 request: name,
                 reason,
             }),
             Outcome::Accepted(answer) | Outcome::Rejected(answer) => Ok(answer),
-            Outcome::Lost => Err(ClientError::NoAnswer { request: name }),
+            Outcome::Lost => Err(Error::NoAnswer { request: name }),
         }
     }
 
     /// A request answered by an `Ack`; returns its readback.
     ///
     /// # Errors
-    /// As [`Client::request`], or [`ClientError::Unexpected`].
-    pub fn ack(&mut self, request: Request) -> Result<Readback, ClientError> {
+    /// As [`Client::request`], or [`Error::Unexpected`].
+    pub fn ack(&mut self, request: Request) -> Result<Readback, Error> {
         let name = request_name(&request);
         match self.request(request)? {
             DeviceToHost::Ack { readback, .. } => Ok(readback),
-            other => Err(ClientError::Unexpected {
+            other => Err(Error::Unexpected {
                 request: name,
                 answer: Box::new(other),
             }),
@@ -486,9 +526,9 @@ impl<L: Link> Client<L> {
     /// The handshake, repeated for up to [`ClientConfig::hello_patience`].
     ///
     /// # Errors
-    /// [`ClientError::Version`] for another major version, [`ClientError::NoAnswer`] when
+    /// [`Error::Version`] for another major version, [`Error::NoAnswer`] when
     /// nothing answered in time, or the link's error.
-    pub fn hello(&mut self) -> Result<DeviceInfo, ClientError> {
+    pub fn hello(&mut self) -> Result<DeviceInfo, Error> {
         let until = self.link.now() + self.config.hello_patience;
         loop {
             let request = Request::Hello {
@@ -503,16 +543,16 @@ impl<L: Link> Client<L> {
                 Outcome::Accepted(DeviceToHost::Nack {
                     reason: NackReason::UnknownVersion { supported },
                     ..
-                }) => return Err(ClientError::Version { device: supported }),
+                }) => return Err(Error::Version { device: supported }),
                 Outcome::Accepted(other) => {
-                    return Err(ClientError::Unexpected {
+                    return Err(Error::Unexpected {
                         request: "Hello",
                         answer: Box::new(other),
                     })
                 }
                 Outcome::Rejected(_) | Outcome::Lost if self.link.now() < until => {}
                 Outcome::Rejected(_) | Outcome::Lost => {
-                    return Err(ClientError::NoAnswer { request: "Hello" })
+                    return Err(Error::NoAnswer { request: "Hello" })
                 }
             }
         }
@@ -521,15 +561,15 @@ impl<L: Link> Client<L> {
     /// One servo's calibration.
     ///
     /// # Errors
-    /// As [`Client::request`], or [`ClientError::Unexpected`].
-    pub fn calibration(&mut self, servo: ServoId) -> Result<Calibration, ClientError> {
+    /// As [`Client::request`], or [`Error::Unexpected`].
+    pub fn calibration(&mut self, servo: ServoId) -> Result<Calibration, Error> {
         match self.request(Request::GetCalibration { servo })? {
             DeviceToHost::Calibration {
                 servo: s,
                 calibration,
                 ..
             } if s == servo => Ok(calibration),
-            other => Err(ClientError::Unexpected {
+            other => Err(Error::Unexpected {
                 request: "GetCalibration",
                 answer: Box::new(other),
             }),
@@ -540,7 +580,7 @@ impl<L: Link> Client<L> {
     ///
     /// # Errors
     /// As [`Client::calibration`].
-    pub fn calibrations(&mut self) -> Result<[Calibration; 12], ClientError> {
+    pub fn calibrations(&mut self) -> Result<[Calibration; 12], Error> {
         let mut table = [Calibration::STANDARD; 12];
         for s in ServoId::ALL {
             table[s.index()] = self.calibration(s)?;
@@ -618,7 +658,7 @@ pub enum PoseResult {
     /// No answer.
     Lost,
     /// The answer disagreed with the host after every retry.
-    Mismatch(String),
+    Mismatch(Mismatch),
 }
 
 /// Body poses streamed to the device, each checked against the host's own kin-core.
@@ -637,8 +677,8 @@ impl<L: Link> PoseStream<L> {
     /// Handshake, robot check, pose configuration, calibration read-back, outputs on.
     ///
     /// # Errors
-    /// Any [`ClientError`] of these steps.
-    pub fn connect(client: Client<L>, setup: StreamSetup) -> Result<PoseStream<L>, ClientError> {
+    /// Any [`Error`] of these steps.
+    pub fn connect(client: Client<L>, setup: StreamSetup) -> Result<PoseStream<L>, Error> {
         let mut s = PoseStream {
             client,
             setup,
@@ -668,10 +708,10 @@ impl<L: Link> PoseStream<L> {
         Ok(s)
     }
 
-    fn setup(&mut self) -> Result<(), ClientError> {
+    fn setup(&mut self) -> Result<(), Error> {
         let info = self.client.hello()?;
         if info.robot != self.setup.preset {
-            return Err(ClientError::Robot {
+            return Err(Error::Robot {
                 device: info.robot,
                 host: self.setup.preset,
             });
@@ -689,7 +729,7 @@ impl<L: Link> PoseStream<L> {
         self.calibration = self.client.calibrations()?;
         let rb = self.client.ack(Request::SetOutputs { enabled: true })?;
         if !rb.flags.contains(Flags::OUTPUTS_ENABLED) {
-            return Err(ClientError::Unexpected {
+            return Err(Error::Unexpected {
                 request: "SetOutputs",
                 answer: Box::new(DeviceToHost::Ack {
                     seq: 0,
@@ -760,7 +800,7 @@ impl<L: Link> PoseStream<L> {
     ///
     /// # Errors
     /// What disagrees.
-    pub fn check_readback(&self, rb: &Readback, want: &[f32; 12]) -> Result<f32, String> {
+    pub fn check_readback(&self, rb: &Readback, want: &[f32; 12]) -> Result<f32, Mismatch> {
         check_readback(self.setup.check, &self.calibration, rb, want)
     }
 
@@ -778,7 +818,7 @@ impl<L: Link> PoseStream<L> {
     ///
     /// # Errors
     /// Link failures, and the errors of a new handshake after a device reset.
-    pub fn send(&mut self, pose: &Pose) -> Result<PoseResult, ClientError> {
+    pub fn send(&mut self, pose: &Pose) -> Result<PoseResult, Error> {
         let expected = self.expected(pose);
         if self.started.is_none() {
             self.started = Some(self.client.link.now());
@@ -818,7 +858,7 @@ impl<L: Link> PoseStream<L> {
             }
             (Outcome::Accepted(other), _) => {
                 self.stats.readback_mismatches += 1;
-                PoseResult::Mismatch(format!("unexpected answer {other:?}"))
+                PoseResult::Mismatch(Mismatch::Unexpected(other))
             }
             (Outcome::Rejected(answer), _) => {
                 self.stats.readback_mismatches += 1;
@@ -835,7 +875,7 @@ impl<L: Link> PoseStream<L> {
         Ok(result)
     }
 
-    fn exchange_pose(&mut self, pose: &Pose, expected: Expected) -> Result<Exchange, ClientError> {
+    fn exchange_pose(&mut self, pose: &Pose, expected: Expected) -> Result<Exchange, Error> {
         let rejected_before = self.client.counters.rejected;
         let (check, calibration) = (self.setup.check, self.calibration);
         let exchange = self
@@ -850,22 +890,26 @@ impl<L: Link> PoseStream<L> {
         Ok(exchange)
     }
 
-    fn describe_mismatch(&self, answer: &DeviceToHost, expected: &Expected) -> String {
+    fn describe_mismatch(&self, answer: &DeviceToHost, expected: &Expected) -> Mismatch {
         match (answer, expected) {
-            (DeviceToHost::Ack { readback, .. }, Expected::Angles(want)) => self
-                .check_readback(readback, want)
-                .err()
-                .unwrap_or_default(),
+            (DeviceToHost::Ack { readback, .. }, Expected::Angles(want)) => {
+                match self.check_readback(readback, want) {
+                    Err(m) => m,
+                    // The check refused it on an earlier attempt; this copy passes.
+                    Ok(_) => Mismatch::Unexpected(*answer),
+                }
+            }
             (DeviceToHost::Ack { .. }, Expected::Nack(reason)) => {
-                format!("device acked, host rejects: {reason}")
+                Mismatch::AckedHostRejects(*reason)
             }
             (DeviceToHost::Nack { reason, .. }, Expected::Angles(_)) => {
-                format!("device nacked ({reason}), host solves")
+                Mismatch::NackedHostSolves(*reason)
             }
-            (DeviceToHost::Nack { reason, .. }, Expected::Nack(want)) => {
-                format!("device nacked ({reason}), host rejects with {want}")
-            }
-            (other, _) => format!("unexpected answer {other:?}"),
+            (DeviceToHost::Nack { reason, .. }, Expected::Nack(want)) => Mismatch::Reasons {
+                device: *reason,
+                host: *want,
+            },
+            (other, _) => Mismatch::Unexpected(*other),
         }
     }
 
@@ -927,7 +971,7 @@ pub fn check_readback(
     calibration: &[Calibration; 12],
     rb: &Readback,
     want: &[f32; 12],
-) -> Result<f32, String> {
+) -> Result<f32, Mismatch> {
     let mut max_err = 0.0f32;
     for (i, (&got, &w)) in rb.angles_rad.iter().zip(want).enumerate() {
         let err = (got - w).abs();
@@ -936,10 +980,11 @@ pub fn check_readback(
             AngleCheck::Within(tol) => err <= tol,
         };
         if !ok {
-            return Err(format!(
-                "{}: device angle {got} rad, host {w} rad",
-                ServoId::ALL[i]
-            ));
+            return Err(Mismatch::Angle {
+                servo: ServoId::ALL[i],
+                device_rad: got,
+                host_rad: w,
+            });
         }
         max_err = max_err.max(err);
     }
@@ -951,10 +996,11 @@ pub fn check_readback(
             Some(0)
         };
         if want != Some(p) {
-            return Err(format!(
-                "{}: device pulse {p} half-µs, host mapping {want:?}",
-                ServoId::ALL[i]
-            ));
+            return Err(Mismatch::Pulse {
+                servo: ServoId::ALL[i],
+                device_half_us: p,
+                host_half_us: want,
+            });
         }
     }
     Ok(max_err)

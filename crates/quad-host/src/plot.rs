@@ -41,7 +41,7 @@ pub const MAX_POINTS: usize = 4000;
 /// Why a figure could not be drawn.
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[non_exhaustive]
-pub enum PlotError {
+pub enum Error {
     /// The file extension is neither `.svg` nor `.png`.
     Format(String),
     /// No usable font was found.
@@ -52,27 +52,27 @@ pub enum PlotError {
     Empty(&'static str),
 }
 
-impl fmt::Display for PlotError {
+impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PlotError::Format(p) => {
+            Error::Format(p) => {
                 write!(f, "plot file `{p}` must end in .svg or .png")
             }
-            PlotError::Font(m) => write!(f, "{m}"),
-            PlotError::Draw(m) => write!(f, "cannot draw the plot: {m}"),
-            PlotError::Empty(what) => write!(f, "nothing to plot: {what}"),
+            Error::Font(m) => write!(f, "{m}"),
+            Error::Draw(m) => write!(f, "cannot draw the plot: {m}"),
+            Error::Empty(what) => write!(f, "nothing to plot: {what}"),
         }
     }
 }
 
-impl std::error::Error for PlotError {}
+impl std::error::Error for Error {}
 
-fn draw_err<E: std::fmt::Debug>(e: E) -> PlotError {
-    PlotError::Draw(format!("{e:?}"))
+fn draw_err<E: std::fmt::Display>(e: E) -> Error {
+    Error::Draw(e.to_string())
 }
 
 /// Registers the font once per process.
-fn ensure_font() -> Result<(), PlotError> {
+fn ensure_font() -> Result<(), Error> {
     static FONT: OnceLock<Result<(), String>> = OnceLock::new();
     FONT.get_or_init(|| {
         let from_env = std::env::var_os("QUADCTL_FONT");
@@ -100,7 +100,7 @@ fn ensure_font() -> Result<(), PlotError> {
         })
     })
     .clone()
-    .map_err(PlotError::Font)
+    .map_err(Error::Font)
 }
 
 enum Kind {
@@ -108,7 +108,7 @@ enum Kind {
     Png,
 }
 
-fn kind(path: &Path) -> Result<Kind, PlotError> {
+fn kind(path: &Path) -> Result<Kind, Error> {
     match path
         .extension()
         .and_then(|e| e.to_str())
@@ -117,7 +117,7 @@ fn kind(path: &Path) -> Result<Kind, PlotError> {
     {
         Some("svg") => Ok(Kind::Svg),
         Some("png") => Ok(Kind::Png),
-        _ => Err(PlotError::Format(path.display().to_string())),
+        _ => Err(Error::Format(path.display().to_string())),
     }
 }
 
@@ -269,9 +269,9 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 const JOINT_NAMES: [&str; 3] = ["abduction", "hip", "knee"];
 
 /// The joint angles of a motion over time, one panel per joint (degrees), four legs each.
-pub fn joint_angles(path: &Path, title: &str, series: &JointSeries) -> Result<(), PlotError> {
+pub fn joint_angles(path: &Path, title: &str, series: &JointSeries) -> Result<(), Error> {
     if series.t_s.is_empty() {
-        return Err(PlotError::Empty("no samples"));
+        return Err(Error::Empty("no samples"));
     }
     let idx = decimated(series.t_s.len());
     on_canvas!(path, (1000, 900), draw_joints(title, series, &idx))
@@ -282,7 +282,7 @@ fn draw_joints<DB: DrawingBackend>(
     title: &str,
     series: &JointSeries,
     idx: &[usize],
-) -> Result<(), PlotError> {
+) -> Result<(), Error> {
     {
         let root = root.titled(title, ("sans-serif", 22)).map_err(draw_err)?;
         let panels = root.split_evenly((3, 1));
@@ -391,9 +391,9 @@ pub fn robot_views(
     robot: &Robot,
     config: &BodyConfig,
     snapshots: &[Snapshot],
-) -> Result<(), PlotError> {
+) -> Result<(), Error> {
     if snapshots.is_empty() {
-        return Err(PlotError::Empty("no instant to draw"));
+        return Err(Error::Empty("no instant to draw"));
     }
     let drawings: Vec<Drawing> = snapshots
         .iter()
@@ -441,7 +441,7 @@ fn draw_views<DB: DrawingBackend>(
     snapshots: &[Snapshot],
     drawings: &[Drawing],
     frame: &ViewFrame,
-) -> Result<(), PlotError> {
+) -> Result<(), Error> {
     let views: [(&str, usize, usize); 3] = [
         ("top (x forward, y left)", 0, 1),
         ("side (x forward, z up)", 0, 2),
@@ -517,9 +517,9 @@ pub fn target_vs_measured(
     labels: [&str; 3],
     target: &[[f32; 3]],
     measured: &[[f32; 3]],
-) -> Result<(), PlotError> {
+) -> Result<(), Error> {
     if target.is_empty() {
-        return Err(PlotError::Empty("no samples"));
+        return Err(Error::Empty("no samples"));
     }
     let idx = decimated(target.len());
     on_canvas!(
@@ -536,7 +536,7 @@ fn draw_accuracy<DB: DrawingBackend>(
     target: &[[f32; 3]],
     measured: &[[f32; 3]],
     idx: &[usize],
-) -> Result<(), PlotError> {
+) -> Result<(), Error> {
     {
         let root = root.titled(title, ("sans-serif", 22)).map_err(draw_err)?;
         let panels = root.split_evenly((3, 1));
@@ -638,6 +638,6 @@ mod tests {
                 angles: vec![None],
             },
         );
-        assert!(matches!(e, Err(PlotError::Format(_))));
+        assert!(matches!(e, Err(Error::Format(_))));
     }
 }

@@ -23,22 +23,18 @@
 //! file's `knee_bend`. Unknown keys, missing lengths, negative or non-finite lengths and limits
 //! with `min > max` are refused with a message naming the key.
 
+use crate::names;
 use kin_core::robot::RobotError;
 use kin_core::{JointLimits, KneeBend, LegGeometry, Robot};
-use serde::Deserialize;
-use std::fmt;
+use serde::{Deserialize, Deserializer};
 use std::io;
 use std::path::{Path, PathBuf};
 
-/// The knee bend as written in a robot file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum KneeBendName {
-    /// knee ≤ 0.
-    #[default]
-    Backward,
-    /// knee ≥ 0.
-    Forward,
+/// `knee_bend = "backward" | "forward"`, through [`names::knee_bend`].
+fn knee_bend<'de, D: Deserializer<'de>>(d: D) -> Result<KneeBend, D::Error> {
+    let name = String::deserialize(d)?;
+    names::knee_bend(&name)
+        .ok_or_else(|| serde::de::Error::unknown_variant(&name, &names::KNEE_BEND_NAMES))
 }
 
 /// The `[limits]` table: `[min, max]` per joint, rad.
@@ -60,8 +56,8 @@ struct RobotFile {
     tibia_m: f32,
     body_length_m: f32,
     body_width_m: f32,
-    #[serde(default)]
-    knee_bend: KneeBendName,
+    #[serde(default, deserialize_with = "knee_bend")]
+    knee_bend: KneeBend,
     #[serde(default)]
     limits: LimitsTable,
 }
@@ -89,109 +85,90 @@ impl RobotFile {
                 min_rad: entries.map(|e| e[0]),
                 max_rad: entries.map(|e| e[1]),
             },
-            knee_bend: match self.knee_bend {
-                KneeBendName::Backward => KneeBend::Backward,
-                KneeBendName::Forward => KneeBend::Forward,
-            },
+            knee_bend: self.knee_bend,
         }
     }
 }
 
-/// Why the text of a robot file was refused.
-#[derive(Debug)]
+/// Why a robot file or a `--robot` argument was refused.
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
-pub enum ParseError {
-    /// Not valid TOML, or a key is missing, unknown or of the wrong type.
-    Toml(toml::de::Error),
-    /// The values were read but [`Robot::validate`] refused them.
-    Invalid(RobotError),
-}
-
-impl fmt::Display for ParseError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ParseError::Toml(e) => write!(f, "{}", e.to_string().trim_end()),
-            ParseError::Invalid(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-impl std::error::Error for ParseError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            ParseError::Toml(e) => Some(e),
-            ParseError::Invalid(e) => Some(e),
-        }
-    }
-}
-
-/// Parses and validates the text of a robot file (see the module docs for the keys).
-pub fn parse(text: &str) -> Result<Robot, ParseError> {
-    let file: RobotFile = toml::from_str(text).map_err(ParseError::Toml)?;
-    let robot = file.into_robot();
-    robot.validate().map_err(ParseError::Invalid)?;
-    Ok(robot)
-}
-
-/// Why `--robot` could not be resolved.
-#[derive(Debug)]
-#[non_exhaustive]
-pub enum LoadError {
+pub enum Error {
     /// Not a preset name, and the file could not be read.
+    #[error(
+        "`{}` is not a preset ({}) and cannot be read as a robot file: {source}",
+        path.display(),
+        Robot::PRESETS.join(", ")
+    )]
     Read {
         /// The path tried.
         path: PathBuf,
         /// The I/O error.
         source: io::Error,
     },
-    /// The file was read but its content was refused.
-    Parse {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong in it.
-        source: ParseError,
+    /// Not valid TOML, or a key is missing, unknown or of the wrong type.
+    #[error("{}{}", file(path), source.to_string().trim_end())]
+    Toml {
+        /// The file, when the text came from one.
+        path: Option<PathBuf>,
+        /// The TOML error (it names the key and the line).
+        source: toml::de::Error,
+    },
+    /// The values were read but [`Robot::validate`] refused them.
+    #[error("{}{source}", file(path))]
+    Invalid {
+        /// The file, when the text came from one.
+        path: Option<PathBuf>,
+        /// kin-core's reason, naming the key.
+        source: RobotError,
     },
 }
 
-impl fmt::Display for LoadError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+/// The `robot file `PATH`: ` prefix of a message, when there is a file.
+fn file(path: &Option<PathBuf>) -> String {
+    path.as_ref()
+        .map(|p| format!("robot file `{}`: ", p.display()))
+        .unwrap_or_default()
+}
+
+impl Error {
+    fn in_file(self, file: &Path) -> Error {
         match self {
-            LoadError::Read { path, source } => write!(
-                f,
-                "`{}` is not a preset ({}) and cannot be read as a robot file: {source}",
-                path.display(),
-                Robot::PRESETS.join(", ")
-            ),
-            LoadError::Parse { path, source } => {
-                write!(f, "robot file `{}`: {source}", path.display())
-            }
+            Error::Toml { source, .. } => Error::Toml {
+                path: Some(file.to_owned()),
+                source,
+            },
+            Error::Invalid { source, .. } => Error::Invalid {
+                path: Some(file.to_owned()),
+                source,
+            },
+            other => other,
         }
     }
 }
 
-impl std::error::Error for LoadError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            LoadError::Read { source, .. } => Some(source),
-            LoadError::Parse { source, .. } => Some(source),
-        }
-    }
+/// Parses and validates the text of a robot file (see the module docs for the keys).
+pub fn parse(text: &str) -> Result<Robot, Error> {
+    let file: RobotFile =
+        toml::from_str(text).map_err(|source| Error::Toml { path: None, source })?;
+    let robot = file.into_robot();
+    robot
+        .validate()
+        .map_err(|source| Error::Invalid { path: None, source })?;
+    Ok(robot)
 }
 
 /// Reads and validates a robot file.
-pub fn load_file(path: &Path) -> Result<Robot, LoadError> {
-    let text = std::fs::read_to_string(path).map_err(|source| LoadError::Read {
+pub fn load_file(path: &Path) -> Result<Robot, Error> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
         path: path.to_owned(),
         source,
     })?;
-    parse(&text).map_err(|source| LoadError::Parse {
-        path: path.to_owned(),
-        source,
-    })
+    parse(&text).map_err(|e| e.in_file(path))
 }
 
 /// Resolves a `--robot` argument: a preset name ([`Robot::PRESETS`]) or else a TOML file path.
-pub fn resolve(spec: &str) -> Result<Robot, LoadError> {
+pub fn resolve(spec: &str) -> Result<Robot, Error> {
     match Robot::preset(spec) {
         Some(robot) => Ok(robot),
         None => load_file(Path::new(spec)),
@@ -234,7 +211,10 @@ mod tests {
         let err = parse(&text).expect_err("negative femur");
         assert!(matches!(
             err,
-            ParseError::Invalid(RobotError::BadLength("femur_m"))
+            Error::Invalid {
+                source: RobotError::BadLength("femur_m"),
+                ..
+            }
         ));
         assert!(err.to_string().contains("femur_m"), "{err}");
     }
@@ -258,7 +238,10 @@ mod tests {
         let err = parse(&text).expect_err("min > max");
         assert!(matches!(
             err,
-            ParseError::Invalid(RobotError::BadLimit(kin_core::Joint::Hip))
+            Error::Invalid {
+                source: RobotError::BadLimit(kin_core::Joint::Hip),
+                ..
+            }
         ));
     }
 

@@ -14,6 +14,11 @@
 //!
 //! Numbers are written with Rust's shortest round-trip formatting of `f32` (`{}`), so parsing a
 //! printed value as `f32` gives back the same value; `-0` is printed as `0`.
+//!
+//! The motion CSV (`quadctl motion`'s output, read by `check`, `plot` and `stream`-side tools)
+//! has its own reader and writer in [`motion`].
+
+pub mod motion;
 
 use kin_core::LegId;
 use std::fmt;
@@ -97,6 +102,32 @@ pub enum RowError {
         /// The text found.
         text: String,
     },
+    /// Fewer fields than a column the header names needs.
+    TooFewFields {
+        /// Fields needed.
+        needed: usize,
+        /// Fields found.
+        found: usize,
+    },
+    /// A field of a header-addressed file (motion, angles) is not a number.
+    BadNumber {
+        /// 1-based field number.
+        field: usize,
+        /// The text found.
+        text: String,
+    },
+    /// A field of a header-addressed file must be a finite number.
+    BadFinite {
+        /// 1-based field number.
+        field: usize,
+        /// The text found.
+        text: String,
+    },
+    /// The `t_s` field is not a number.
+    BadTime {
+        /// 1-based field number.
+        field: usize,
+    },
     /// A field is not one of `FL`, `FR`, `RL`, `RR`.
     NotALeg {
         /// 1-based field number.
@@ -130,6 +161,16 @@ impl fmt::Display for RowError {
                 f,
                 "field {field} ({column}): `{text}` is not a finite number"
             ),
+            RowError::TooFewFields { needed, found } => {
+                write!(f, "expected at least {needed} fields, found {found}")
+            }
+            RowError::BadNumber { field, text } => {
+                write!(f, "field {field}: `{text}` is not a number")
+            }
+            RowError::BadFinite { field, text } => {
+                write!(f, "field {field}: `{text}` is not a finite number")
+            }
+            RowError::BadTime { field } => write!(f, "field {field}: t_s is not a number"),
             RowError::NotALeg {
                 field,
                 column,
@@ -168,6 +209,54 @@ pub enum Error {
         /// The header expected.
         expected: String,
     },
+    /// Reading a named input failed.
+    Read {
+        /// Input name.
+        input: String,
+        /// The I/O error.
+        source: io::Error,
+    },
+    /// A header-addressed file (motion, angles) has no header.
+    Empty {
+        /// Input name.
+        input: String,
+        /// What the header must hold.
+        expected: &'static str,
+    },
+    /// The header lacks a column.
+    MissingColumn {
+        /// Input name.
+        input: String,
+        /// 1-based line of the header.
+        line: usize,
+        /// The column.
+        column: String,
+        /// The format expected.
+        format: &'static str,
+    },
+    /// A record of a header-addressed file that cannot be used (such files stop at the first).
+    Row {
+        /// Input name.
+        input: String,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        error: RowError,
+    },
+    /// An output file could not be created.
+    Create {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: io::Error,
+    },
+    /// Writing an output failed.
+    Write {
+        /// The file; `None` for stdout.
+        path: Option<PathBuf>,
+        /// The I/O error.
+        source: io::Error,
+    },
 }
 
 impl fmt::Display for Error {
@@ -187,6 +276,27 @@ impl fmt::Display for Error {
                 "{input}:{line}: header `{found}` does not match the expected `{expected}` \
                  (nothing was processed)"
             ),
+            Error::Read { input, source } => write!(f, "cannot read `{input}`: {source}"),
+            Error::Empty { input, expected } => {
+                write!(f, "{input}: empty file: expected a header {expected}")
+            }
+            Error::MissingColumn {
+                input,
+                line,
+                column,
+                format,
+            } => write!(
+                f,
+                "{input}:{line}: header has no `{column}` column (expected {format})"
+            ),
+            Error::Row { input, line, error } => write!(f, "{input}:{line}: {error}"),
+            Error::Create { path, source } => {
+                write!(f, "cannot create `{}`: {source}", path.display())
+            }
+            Error::Write { path: Some(p), source } => {
+                write!(f, "cannot write `{}`: {source}", p.display())
+            }
+            Error::Write { path: None, source } => write!(f, "cannot write the output: {source}"),
         }
     }
 }
@@ -194,8 +304,13 @@ impl fmt::Display for Error {
 impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            Error::Open { source, .. } | Error::Io(source) => Some(source),
-            Error::Header { .. } => None,
+            Error::Open { source, .. }
+            | Error::Io(source)
+            | Error::Read { source, .. }
+            | Error::Create { source, .. }
+            | Error::Write { source, .. } => Some(source),
+            Error::Row { error, .. } => Some(error),
+            _ => None,
         }
     }
 }

@@ -5,10 +5,10 @@
 //! Needs the Debian packages and toolchain components that `scripts/install-deps.sh` installs;
 //! without them the build fails and [`firmware_elf`] returns its output as the error.
 
-use std::fmt;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::sync::OnceLock;
+use std::io;
+use std::process::{Command, ExitStatus};
+use std::sync::{Arc, OnceLock};
 
 /// The firmware at 115,200 baud.
 pub const FIRMWARE: &str = "firmware";
@@ -28,26 +28,47 @@ pub fn firmware_for_baud(baud: u32) -> Option<&'static str> {
     }
 }
 
-/// Why the firmware could not be built.
-#[derive(Debug, Clone)]
-pub struct BuildError(pub String);
+/// The hint every build error ends with.
+const PREREQUISITES: &str = "(install the prerequisites with scripts/install-deps.sh)";
 
-impl fmt::Display for BuildError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}\n(install the prerequisites with scripts/install-deps.sh)",
-            self.0
-        )
-    }
+/// Why the firmware could not be built.
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// `cargo build --release` ran and failed.
+    #[error(
+        "`cd {} && cargo build --release` failed ({status}):\n{stdout}{stderr}\n{PREREQUISITES}",
+        dir.display()
+    )]
+    Failed {
+        /// The firmware workspace.
+        dir: PathBuf,
+        /// How cargo exited.
+        status: ExitStatus,
+        /// Its standard output.
+        stdout: String,
+        /// Its standard error (the compiler's messages).
+        stderr: String,
+    },
+    /// cargo could not be started.
+    #[error("cannot run cargo in {}: {source}\n{PREREQUISITES}", dir.display())]
+    Spawn {
+        /// The firmware workspace.
+        dir: PathBuf,
+        /// Why (shared: the build runs once per process and its result is cloned).
+        source: Arc<io::Error>,
+    },
+    /// The build passed but did not produce this ELF.
+    #[error("{} was not produced\n{PREREQUISITES}", .0.display())]
+    Missing(PathBuf),
 }
 
-impl std::error::Error for BuildError {}
-
-/// The firmware workspace, `firmware-avr/` next to this crate.
+/// The firmware workspace, `firmware-avr/` at the root of the workspace that holds this
+/// crate (`crates/quad-host`).
 pub fn firmware_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
+        .ancestors()
+        .nth(2)
         .map_or_else(|| PathBuf::from("firmware-avr"), |p| p.join("firmware-avr"))
 }
 
@@ -85,8 +106,8 @@ fn cargo_proxy() -> PathBuf {
 
 /// Runs the build once per process (all binaries at once; cargo does nothing when they are up
 /// to date) and returns the result of that one run.
-fn build_once() -> &'static Result<(), BuildError> {
-    static BUILT: OnceLock<Result<(), BuildError>> = OnceLock::new();
+fn build_once() -> &'static Result<(), Error> {
+    static BUILT: OnceLock<Result<(), Error>> = OnceLock::new();
     BUILT.get_or_init(|| {
         let dir = firmware_dir();
         let mut cmd = Command::new(cargo_proxy());
@@ -100,17 +121,16 @@ fn build_once() -> &'static Result<(), BuildError> {
         }
         match cmd.output() {
             Ok(out) if out.status.success() => Ok(()),
-            Ok(out) => Err(BuildError(format!(
-                "`cd {} && cargo build --release` failed ({}):\n{}{}",
-                dir.display(),
-                out.status,
-                String::from_utf8_lossy(&out.stdout),
-                String::from_utf8_lossy(&out.stderr)
-            ))),
-            Err(e) => Err(BuildError(format!(
-                "cannot run cargo in {}: {e}",
-                dir.display()
-            ))),
+            Ok(out) => Err(Error::Failed {
+                dir,
+                status: out.status,
+                stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+                stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+            }),
+            Err(e) => Err(Error::Spawn {
+                dir,
+                source: Arc::new(e),
+            }),
         }
     })
 }
@@ -119,13 +139,13 @@ fn build_once() -> &'static Result<(), BuildError> {
 /// of binary `bin` ([`FIRMWARE`], [`FIRMWARE_1MBAUD`], [`BENCH`] or [`BENCH_LIBM`]).
 ///
 /// # Errors
-/// The build's output when it fails, or a message when the ELF was not produced.
-pub fn firmware_elf(bin: &str) -> Result<PathBuf, BuildError> {
+/// The build's output when it fails, or [`Error::Missing`] when the ELF was not produced.
+pub fn firmware_elf(bin: &str) -> Result<PathBuf, Error> {
     build_once().clone()?;
     let elf = elf_path(bin);
     if elf.is_file() {
         Ok(elf)
     } else {
-        Err(BuildError(format!("{} was not produced", elf.display())))
+        Err(Error::Missing(elf))
     }
 }

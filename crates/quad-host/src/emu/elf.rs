@@ -2,23 +2,47 @@
 //! flash and static SRAM figures, and the addresses of linker symbols such as `__heap_start`
 //! (the end of the static data, where the firmware's stack paint begins).
 
-use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// AVR data addresses in the ELF carry this offset (avr-gcc's `.data` at 0x800000).
 pub const DATA_OFFSET: u32 = 0x80_0000;
 
 /// Why an ELF could not be read.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ElfError(pub String);
-
-impl fmt::Display for ElfError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The file could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file is not a 32-bit little-endian ELF, or is cut short.
+    #[error("{}: {what}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        what: Format,
+    },
 }
 
-impl std::error::Error for ElfError {}
+/// What is wrong with the bytes of an ELF.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Format {
+    /// No ELF magic.
+    #[error("not an ELF file")]
+    NotElf,
+    /// Another class or byte order.
+    #[error("not a 32-bit little-endian ELF")]
+    NotLe32,
+    /// A header points past the end of the file.
+    #[error("truncated ELF")]
+    Truncated,
+}
 
 /// Sizes of an ELF's allocated sections, bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,29 +65,34 @@ impl Elf {
     ///
     /// # Errors
     /// When the file cannot be read or is not such an ELF.
-    pub fn read(path: &Path) -> Result<Elf, ElfError> {
-        let bytes = std::fs::read(path)
-            .map_err(|e| ElfError(format!("cannot read {}: {e}", path.display())))?;
-        Elf::parse(bytes).map_err(|e| ElfError(format!("{}: {e}", path.display())))
+    pub fn read(path: &Path) -> Result<Elf, Error> {
+        let bytes = std::fs::read(path).map_err(|source| Error::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        Elf::parse(bytes).map_err(|what| Error::Format {
+            path: path.to_owned(),
+            what,
+        })
     }
 
-    fn parse(bytes: Vec<u8>) -> Result<Elf, String> {
+    fn parse(bytes: Vec<u8>) -> Result<Elf, Format> {
         if bytes.len() < 0x34 || &bytes[..4] != b"\x7fELF" {
-            return Err("not an ELF file".into());
+            return Err(Format::NotElf);
         }
         if bytes[4] != 1 || bytes[5] != 1 {
-            return Err("not a 32-bit little-endian ELF".into());
+            return Err(Format::NotLe32);
         }
         let b = &bytes;
-        let get = |o: usize, n: usize| -> Result<usize, String> {
-            let s = b.get(o..o + n).ok_or("truncated ELF")?;
+        let get = |o: usize, n: usize| -> Result<usize, Format> {
+            let s = b.get(o..o + n).ok_or(Format::Truncated)?;
             Ok(s.iter()
                 .rev()
                 .fold(0usize, |acc, &x| (acc << 8) | x as usize))
         };
         let (shoff, shentsize, shnum, shstrndx) =
             (get(0x20, 4)?, get(0x2E, 2)?, get(0x30, 2)?, get(0x32, 2)?);
-        let header = |i: usize| -> Result<(usize, usize, usize, usize), String> {
+        let header = |i: usize| -> Result<(usize, usize, usize, usize), Format> {
             let h = shoff + i * shentsize;
             Ok((
                 get(h, 4)?,
@@ -140,6 +169,6 @@ fn cstr(b: &[u8], off: usize) -> String {
 ///
 /// # Errors
 /// When it cannot be read.
-pub fn sizes(path: &Path) -> Result<ElfSizes, ElfError> {
+pub fn sizes(path: &Path) -> Result<ElfSizes, Error> {
     Ok(Elf::read(path)?.sizes())
 }

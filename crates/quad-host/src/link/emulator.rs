@@ -29,17 +29,15 @@
 //! pulse while both say the outputs are off, or at power-on before any answer, is an error
 //! too. See [`PulseStats`].
 
-use super::sim::Rng;
-use super::{Fault, FaultStats, Faults, Link, LinkError};
+use super::{Faults, LineStats, Link};
 use crate::emu::{
     self, build, cycles_to_duration, duration_to_cycles, duration_to_cycles_ceil, EmuError,
     Mega2560, Pulse, CYCLES_PER_TICK, PERIOD_CYCLES, SERVO_PINS,
 };
 use quad_protocol::{Accumulator, DeviceToHost, Feed, Flags, MAX_DECODED_LEN};
+use seeded_rng::SplitMix64;
 use serde::Serialize;
 use std::collections::VecDeque;
-use std::fmt;
-use std::io;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -84,87 +82,36 @@ impl EmulatorConfig {
     }
 }
 
-/// Why the emulator could not start.
-#[derive(Debug)]
+/// Why the emulator could not start or run.
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
-pub enum EmulatorError {
+pub enum Error {
     /// The firmware could not be built.
-    Build(build::BuildError),
+    #[error(transparent)]
+    Build(#[from] build::Error),
     /// No firmware is built for this line rate (and no ELF was given).
+    #[error(
+        "no firmware is built for {0} baud (115200: firmware, 1000000: firmware-1mbaud); \
+         give one with --elf"
+    )]
     NoFirmwareForBaud(u32),
     /// simavr failed.
-    Emu(EmuError),
+    #[error(transparent)]
+    Emu(#[from] EmuError),
     /// The firmware did not switch its receiver on within [`BOOT_LIMIT`].
+    #[error(
+        "the firmware did not enable its USART0 receiver within {} s of simulated time",
+        BOOT_LIMIT.as_secs_f64()
+    )]
     NoBoot,
     /// The firmware's line rate differs from the host's.
+    #[error("the firmware listens at {firmware:.0} baud, the host sends at {host} baud")]
     Baud {
         /// The firmware's, bit/s.
         firmware: f64,
         /// The host's, bit/s.
         host: u32,
     },
-}
-
-impl fmt::Display for EmulatorError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            EmulatorError::Build(e) => write!(f, "{e}"),
-            EmulatorError::NoFirmwareForBaud(b) => write!(
-                f,
-                "no firmware is built for {b} baud (115200: firmware, 1000000: firmware-1mbaud); \
-                 give one with --elf"
-            ),
-            EmulatorError::Emu(e) => write!(f, "{e}"),
-            EmulatorError::NoBoot => write!(
-                f,
-                "the firmware did not enable its USART0 receiver within {} s of simulated time",
-                BOOT_LIMIT.as_secs_f64()
-            ),
-            EmulatorError::Baud { firmware, host } => write!(
-                f,
-                "the firmware listens at {firmware:.0} baud, the host sends at {host} baud"
-            ),
-        }
-    }
-}
-
-impl std::error::Error for EmulatorError {}
-
-impl From<EmuError> for EmulatorError {
-    fn from(e: EmuError) -> Self {
-        EmulatorError::Emu(e)
-    }
-}
-
-/// What the emulated line did.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
-pub struct LineStats {
-    /// Bytes the host sent (before faults).
-    pub h2d_bytes: u64,
-    /// Bytes the firmware sent (before faults).
-    pub d2h_bytes: u64,
-    /// Bytes dropped by fault injection.
-    pub dropped: u64,
-    /// Bytes with a flipped bit.
-    pub flipped: u64,
-    /// Frames sent twice.
-    pub duplicated: u64,
-    /// Frames cut.
-    pub truncated: u64,
-    /// Stalls.
-    pub stalls: u64,
-}
-
-impl FaultStats for LineStats {
-    fn count(&mut self, fault: Fault) {
-        match fault {
-            Fault::Stall => self.stalls += 1,
-            Fault::Truncate => self.truncated += 1,
-            Fault::Duplicate => self.duplicated += 1,
-            Fault::Drop => self.dropped += 1,
-            Fault::Flip => self.flipped += 1,
-        }
-    }
 }
 
 /// The pin check so far (see the module docs).
@@ -329,7 +276,7 @@ pub struct EmulatorLink {
     byte_cycles: u64,
     /// The firmware's line rate, bit/s.
     firmware_baud: f64,
-    rng: Rng,
+    rng: SplitMix64,
     /// Host → device bytes, with the cycle from which each may enter the line.
     h2d: VecDeque<(u64, u8)>,
     /// When the host → device line is next free.
@@ -352,11 +299,11 @@ impl EmulatorLink {
     /// 115,200, `firmware-1mbaud` at 1,000,000 baud).
     ///
     /// # Errors
-    /// See [`EmulatorError`].
-    pub fn boot_built(config: EmulatorConfig) -> Result<EmulatorLink, EmulatorError> {
+    /// See [`Error`].
+    pub fn boot_built(config: EmulatorConfig) -> Result<EmulatorLink, Error> {
         let bin = build::firmware_for_baud(config.baud)
-            .ok_or(EmulatorError::NoFirmwareForBaud(config.baud))?;
-        let elf = build::firmware_elf(bin).map_err(EmulatorError::Build)?;
+            .ok_or(Error::NoFirmwareForBaud(config.baud))?;
+        let elf = build::firmware_elf(bin).map_err(Error::Build)?;
         EmulatorLink::boot(&elf, config)
     }
 
@@ -364,8 +311,8 @@ impl EmulatorLink {
     /// would be lost, as on the board).
     ///
     /// # Errors
-    /// See [`EmulatorError`].
-    pub fn boot(elf: &Path, config: EmulatorConfig) -> Result<EmulatorLink, EmulatorError> {
+    /// See [`Error`].
+    pub fn boot(elf: &Path, config: EmulatorConfig) -> Result<EmulatorLink, Error> {
         let mut mcu = Mega2560::new(elf)?;
         if let Some(image) = &config.eeprom {
             mcu.set_eeprom(image);
@@ -377,12 +324,12 @@ impl EmulatorLink {
                 break b;
             }
             if mcu.cycle() > limit {
-                return Err(EmulatorError::NoBoot);
+                return Err(Error::NoBoot);
             }
             mcu.step()?;
         };
         if (firmware_baud - f64::from(config.baud)).abs() > BAUD_TOLERANCE * firmware_baud {
-            return Err(EmulatorError::Baud {
+            return Err(Error::Baud {
                 firmware: firmware_baud,
                 host: config.baud,
             });
@@ -392,7 +339,7 @@ impl EmulatorLink {
         let mut link = EmulatorLink {
             mcu,
             elf: elf.to_path_buf(),
-            rng: Rng::new(config.seed),
+            rng: SplitMix64::new(config.seed),
             config,
             byte_cycles,
             firmware_baud,
@@ -456,7 +403,7 @@ impl EmulatorLink {
     ///
     /// # Errors
     /// When the CPU stopped.
-    pub fn idle(&mut self, d: Duration) -> Result<(), LinkError> {
+    pub fn idle(&mut self, d: Duration) -> Result<(), super::Error> {
         let end = self.mcu.cycle() + duration_to_cycles_ceil(d);
         while self.mcu.cycle() < end {
             self.advance()?;
@@ -469,7 +416,7 @@ impl EmulatorLink {
     ///
     /// # Errors
     /// When the CPU stopped.
-    pub fn next_pulses(&mut self) -> Result<[Option<Pulse>; 12], LinkError> {
+    pub fn next_pulses(&mut self) -> Result<[Option<Pulse>; 12], super::Error> {
         let start = self.mcu.cycle();
         let end = start + 3 * PERIOD_CYCLES;
         let mut seen: [Option<Pulse>; 12] = [None; 12];
@@ -485,21 +432,21 @@ impl EmulatorLink {
         Ok(seen)
     }
 
-    fn emu_error(e: EmuError) -> LinkError {
-        LinkError::Io(io::Error::other(e))
+    fn emu_error(e: EmuError) -> super::Error {
+        super::Error::Emulator(Error::Emu(e))
     }
 
     /// One instruction, with the line on both sides and the pin check.
-    fn advance(&mut self) -> Result<(), LinkError> {
+    fn advance(&mut self) -> Result<(), super::Error> {
         self.step_once(None)
     }
 
-    fn advance_with(&mut self, tap: &mut Vec<Pulse>) -> Result<(), LinkError> {
+    fn advance_with(&mut self, tap: &mut Vec<Pulse>) -> Result<(), super::Error> {
         self.step_once(Some(tap))
     }
 
     /// One instruction; completed pulses are also copied to `tap`.
-    fn step_once(&mut self, mut tap: Option<&mut Vec<Pulse>>) -> Result<(), LinkError> {
+    fn step_once(&mut self, mut tap: Option<&mut Vec<Pulse>>) -> Result<(), super::Error> {
         let now = self.mcu.cycle();
         while let Some(&(t, b)) = self.h2d.front() {
             if t > now {
@@ -569,7 +516,7 @@ impl EmulatorLink {
 }
 
 impl Link for EmulatorLink {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), super::Error> {
         self.stats.h2d_bytes += bytes.len() as u64;
         let f = self.config.faults;
         let bc = self.byte_cycles;
@@ -592,7 +539,7 @@ impl Link for EmulatorLink {
         Ok(())
     }
 
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, super::Error> {
         // Rounded up: the caller's clock must reach its deadline (a deadline a fraction of a
         // cycle away would otherwise never pass).
         let deadline = self.mcu.cycle() + duration_to_cycles_ceil(timeout);
@@ -625,5 +572,49 @@ impl Link for EmulatorLink {
 
     fn baud(&self) -> u32 {
         self.config.baud
+    }
+
+    fn emulator(&mut self) -> Option<&mut EmulatorLink> {
+        Some(self)
+    }
+}
+
+/// An [`EmulatorLink`] whose EEPROM image is written back to a file when it is dropped (as
+/// [`super::open`] returns it for a `storage` file), so that a calibration saved in one run is
+/// there in the next.
+pub struct WithStorage {
+    /// The link.
+    pub link: EmulatorLink,
+    /// The EEPROM image file.
+    pub eeprom_file: Option<PathBuf>,
+}
+
+impl Drop for WithStorage {
+    fn drop(&mut self) {
+        if let Some(path) = &self.eeprom_file {
+            let image = self.link.mcu_mut().eeprom();
+            if let Err(e) = std::fs::write(path, image) {
+                // A destructor cannot return the error; losing it silently would lose the save.
+                eprintln!("quadctl: cannot write {}: {e}", path.display());
+            }
+        }
+    }
+}
+
+impl Link for WithStorage {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), super::Error> {
+        self.link.send(bytes)
+    }
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, super::Error> {
+        self.link.recv(buf, timeout)
+    }
+    fn now(&self) -> Duration {
+        self.link.now()
+    }
+    fn baud(&self) -> u32 {
+        self.link.baud()
+    }
+    fn emulator(&mut self) -> Option<&mut EmulatorLink> {
+        Some(&mut self.link)
     }
 }

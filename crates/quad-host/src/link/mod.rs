@@ -10,15 +10,17 @@
 //!   the twelve servo pins against the readbacks.
 //!
 //! A link moves bytes and tells the time; framing, sequence numbers and retries are the
-//! [`crate::client`]'s.
+//! [`crate::client`]'s. [`open`] is the one way to open a link from a [`Target`].
 
 pub mod emulator;
 pub mod serial;
 pub mod sim;
 
-use sim::Rng;
-use std::fmt;
+use quad_device::{Config, ConfigError};
+use quad_protocol::RobotPreset;
+use seeded_rng::SplitMix64;
 use std::io;
+use std::path::PathBuf;
 use std::str::FromStr;
 use std::time::Duration;
 
@@ -37,14 +39,14 @@ pub trait Link {
     ///
     /// # Errors
     /// When the link is down and cannot be reopened.
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError>;
+    fn send(&mut self, bytes: &[u8]) -> Result<(), Error>;
 
     /// Waits at most `timeout` for received bytes and copies them into `buf`; returns 0 when
     /// the timeout passed without any. May return as soon as one byte is there.
     ///
     /// # Errors
     /// When the link is down and cannot be reopened.
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError>;
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, Error>;
 
     /// The link's clock: simulated time for simulated links, monotonic wall time otherwise.
     /// Timeouts and rates are measured on it.
@@ -52,13 +54,18 @@ pub trait Link {
 
     /// The line rate, bit/s.
     fn baud(&self) -> u32;
+
+    /// The emulated firmware behind this link, when it is one: its pin check and MCU.
+    fn emulator(&mut self) -> Option<&mut emulator::EmulatorLink> {
+        None
+    }
 }
 
 impl<L: Link + ?Sized> Link for &mut L {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), Error> {
         (**self).send(bytes)
     }
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, Error> {
         (**self).recv(buf, timeout)
     }
     fn now(&self) -> Duration {
@@ -67,13 +74,130 @@ impl<L: Link + ?Sized> Link for &mut L {
     fn baud(&self) -> u32 {
         (**self).baud()
     }
+    fn emulator(&mut self) -> Option<&mut emulator::EmulatorLink> {
+        (**self).emulator()
+    }
 }
 
-/// Why a link failed.
-#[derive(Debug)]
+impl<L: Link + ?Sized> Link for Box<L> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), Error> {
+        (**self).send(bytes)
+    }
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, Error> {
+        (**self).recv(buf, timeout)
+    }
+    fn now(&self) -> Duration {
+        (**self).now()
+    }
+    fn baud(&self) -> u32 {
+        (**self).baud()
+    }
+    fn emulator(&mut self) -> Option<&mut emulator::EmulatorLink> {
+        (**self).emulator()
+    }
+}
+
+/// Where the device is, and how its line is set up.
+#[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
-pub enum LinkError {
+pub enum Target {
+    /// The `quad-device` controller of a preset robot behind a simulated UART ([`sim`]).
+    Sim {
+        /// The robot the simulated device runs.
+        preset: RobotPreset,
+        /// Line and device timing, faults.
+        config: sim::SimConfig,
+        /// EEPROM image file, read at power-on and written on every change.
+        storage: Option<PathBuf>,
+    },
+    /// The real firmware in simavr ([`emulator`]).
+    Emulator {
+        /// The firmware ELF; `None`: built from `firmware-avr/` for the line rate.
+        elf: Option<PathBuf>,
+        /// Line rate, faults, EEPROM at power-on (overridden by `storage` when it exists).
+        config: emulator::EmulatorConfig,
+        /// EEPROM image file, read at power-on and written back when the link is dropped.
+        storage: Option<PathBuf>,
+    },
+    /// A real device on a serial port ([`serial`]).
+    Serial {
+        /// The port, e.g. `/dev/ttyACM0`.
+        path: String,
+        /// Line rate, bit/s.
+        baud: u32,
+    },
+}
+
+impl Target {
+    /// True when the device runs the host's own maths (the simulated controller), so that its
+    /// angles equal the host's bit for bit.
+    pub fn runs_host_math(&self) -> bool {
+        matches!(self, Target::Sim { .. })
+    }
+}
+
+/// Opens the link to `target`: the one factory of links.
+///
+/// # Errors
+/// [`Error::Open`] for a port, [`Error::Emulator`] when the firmware cannot be built or booted,
+/// [`Error::Storage`] for an unreadable EEPROM image, [`Error::NoSimulatedRobot`] and
+/// [`Error::Device`] for a simulated device that cannot be built.
+pub fn open(target: &Target) -> Result<Box<dyn Link>, Error> {
+    match target {
+        Target::Serial { path, baud } => Ok(Box::new(serial::SerialLink::open(path, *baud)?)),
+        Target::Emulator {
+            elf,
+            config,
+            storage,
+        } => {
+            let mut config = config.clone();
+            if let Some(path) = storage {
+                match std::fs::read(path) {
+                    Ok(bytes) => config.eeprom = Some(bytes),
+                    Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+                    Err(source) => {
+                        return Err(Error::Storage {
+                            path: path.clone(),
+                            source,
+                        })
+                    }
+                }
+            }
+            let link = match elf {
+                Some(elf) => emulator::EmulatorLink::boot(elf, config),
+                None => emulator::EmulatorLink::boot_built(config),
+            }?;
+            Ok(Box::new(emulator::WithStorage {
+                link,
+                eeprom_file: storage.clone(),
+            }))
+        }
+        Target::Sim {
+            preset,
+            config,
+            storage,
+        } => {
+            let device = Config::for_preset(*preset).ok_or(Error::NoSimulatedRobot)?;
+            let storage = match storage {
+                Some(path) => {
+                    sim::SimStorage::with_file(path.clone()).map_err(|source| Error::Storage {
+                        path: path.clone(),
+                        source,
+                    })?
+                }
+                None => sim::SimStorage::erased(),
+            };
+            Ok(Box::new(sim::SimLink::new(*config, device, storage)?))
+        }
+    }
+}
+
+/// Why a link could not be opened or failed, or a `--faults` value could not be read.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
     /// The port could not be opened or reopened.
+    #[error("cannot open {path}: {message}")]
     Open {
         /// The port.
         path: String,
@@ -81,26 +205,50 @@ pub enum LinkError {
         message: String,
     },
     /// Reading or writing failed and reopening did not help.
-    Io(io::Error),
+    #[error("link I/O error: {0}")]
+    Io(#[from] io::Error),
+    /// The emulator could not be started or stopped.
+    #[error(transparent)]
+    Emulator(#[from] emulator::Error),
+    /// The EEPROM image file of a simulated or emulated device could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Storage {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: io::Error,
+    },
+    /// The simulated device was asked for a robot that is not a preset.
+    #[error("the simulated device needs a preset robot (shahriar2023 or fernando2025)")]
+    NoSimulatedRobot,
+    /// The simulated device refused its configuration.
+    #[error("the simulated device: {0}")]
+    Device(#[from] ConfigError),
+    /// A `--faults` entry is not `KEY=VALUE`.
+    #[error("`{0}` is not KEY=VALUE{FAULTS_SYNTAX}")]
+    FaultsSyntax(String),
+    /// A `--faults` value is not a number.
+    #[error("`{0}` is not a number{FAULTS_SYNTAX}")]
+    FaultsNumber(String),
+    /// A `--faults` probability is outside [0, 1].
+    #[error("{key}={value} is not a probability{FAULTS_SYNTAX}")]
+    FaultsProbability {
+        /// The key.
+        key: String,
+        /// The value given.
+        value: f64,
+    },
+    /// A negative or non-finite `stall_ms`.
+    #[error("stall_ms={0} must be >= 0{FAULTS_SYNTAX}")]
+    FaultsStall(f64),
+    /// An unknown `--faults` key.
+    #[error("unknown fault `{0}`{FAULTS_SYNTAX}")]
+    FaultsKey(String),
 }
 
-impl fmt::Display for LinkError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            LinkError::Open { path, message } => write!(f, "cannot open {path}: {message}"),
-            LinkError::Io(e) => write!(f, "link I/O error: {e}"),
-        }
-    }
-}
-
-impl std::error::Error for LinkError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            LinkError::Io(e) => Some(e),
-            LinkError::Open { .. } => None,
-        }
-    }
-}
+/// The syntax of a `--faults` value, appended to its errors.
+const FAULTS_SYNTAX: &str = " (expected KEY=VALUE,... with keys drop, flip, dup, trunc, stall \
+(probabilities in [0, 1]) and stall_ms (>= 0))";
 
 /// Fault injection of the simulated line, the same in both directions. Probabilities are per
 /// byte (`drop`, `flip`) or per frame, i.e. per [`Link::send`] call and per device answer
@@ -148,7 +296,7 @@ impl Faults {
     /// a seed injects the same faults on every link.
     pub(crate) fn plan_frame<'a, T>(
         &self,
-        rng: &mut Rng,
+        rng: &mut SplitMix64,
         frame: &'a [T],
         stats: &mut impl FaultStats,
     ) -> FramePlan<'a, T> {
@@ -178,7 +326,7 @@ impl Faults {
     /// with one random bit flipped with probability `flip`.
     pub(crate) fn pass_byte(
         &self,
-        rng: &mut Rng,
+        rng: &mut SplitMix64,
         b: u8,
         stats: &mut impl FaultStats,
     ) -> Option<u8> {
@@ -226,41 +374,62 @@ pub(crate) struct FramePlan<'a, T> {
     pub copies: u64,
 }
 
-/// A `--faults` value that could not be read.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FaultsError(pub String);
+/// What the simulated and the emulated lines did (fault injection counts, bytes).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct LineStats {
+    /// Bytes the host handed to the line (before faults).
+    pub h2d_bytes: u64,
+    /// Bytes the device handed to the line (before faults).
+    pub d2h_bytes: u64,
+    /// Bytes dropped by fault injection.
+    pub dropped: u64,
+    /// Bytes with a flipped bit.
+    pub flipped: u64,
+    /// Frames sent twice.
+    pub duplicated: u64,
+    /// Frames cut.
+    pub truncated: u64,
+    /// Stalls.
+    pub stalls: u64,
+    /// Bytes lost because the simulated device's receive FIFO was full (always 0 on the
+    /// emulator, whose firmware counts its own overruns).
+    pub rx_overflow: u64,
+}
 
-impl fmt::Display for FaultsError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} (expected KEY=VALUE,... with keys drop, flip, dup, trunc, stall (probabilities in [0, 1]) and stall_ms (>= 0))",
-            self.0
-        )
+impl FaultStats for LineStats {
+    fn count(&mut self, fault: Fault) {
+        match fault {
+            Fault::Stall => self.stalls += 1,
+            Fault::Truncate => self.truncated += 1,
+            Fault::Duplicate => self.duplicated += 1,
+            Fault::Drop => self.dropped += 1,
+            Fault::Flip => self.flipped += 1,
+        }
     }
 }
 
-impl std::error::Error for FaultsError {}
-
 impl FromStr for Faults {
-    type Err = FaultsError;
+    type Err = Error;
 
     /// Parses `drop=0.01,flip=0.001,dup=P,trunc=P,stall=P,stall_ms=MS`; keys may be left out.
-    fn from_str(s: &str) -> Result<Faults, FaultsError> {
+    fn from_str(s: &str) -> Result<Faults, Error> {
         let mut f = Faults::NONE;
         for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
             let (key, value) = part
                 .split_once('=')
-                .ok_or_else(|| FaultsError(format!("`{part}` is not KEY=VALUE")))?;
+                .ok_or_else(|| Error::FaultsSyntax(part.to_owned()))?;
             let v: f64 = value
                 .trim()
                 .parse()
-                .map_err(|_| FaultsError(format!("`{}` is not a number", value.trim())))?;
+                .map_err(|_| Error::FaultsNumber(value.trim().to_owned()))?;
             let probability = |v: f64| {
                 if (0.0..=1.0).contains(&v) {
                     Ok(v)
                 } else {
-                    Err(FaultsError(format!("{key}={v} is not a probability")))
+                    Err(Error::FaultsProbability {
+                        key: key.trim().to_owned(),
+                        value: v,
+                    })
                 }
             };
             match key.trim() {
@@ -270,8 +439,8 @@ impl FromStr for Faults {
                 "trunc" => f.trunc = probability(v)?,
                 "stall" => f.stall = probability(v)?,
                 "stall_ms" if v >= 0.0 && v.is_finite() => f.stall_ms = v,
-                "stall_ms" => return Err(FaultsError(format!("stall_ms={v} must be >= 0"))),
-                other => return Err(FaultsError(format!("unknown fault `{other}`"))),
+                "stall_ms" => return Err(Error::FaultsStall(v)),
+                other => return Err(Error::FaultsKey(other.to_owned())),
             }
         }
         Ok(f)

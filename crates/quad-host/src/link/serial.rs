@@ -7,7 +7,7 @@
 //! Opening the port of an Arduino Mega pulses DTR, which resets the board: its bootloader runs
 //! for about 1.5 s before the firmware listens. The client's handshake retries cover that.
 
-use super::{Link, LinkError};
+use super::{Error, Link};
 use serialport::SerialPort;
 use std::io::{self, Read, Write};
 use std::time::{Duration, Instant};
@@ -31,8 +31,8 @@ impl SerialLink {
     /// Opens `path` at `baud`, 8N1, no flow control.
     ///
     /// # Errors
-    /// [`LinkError::Open`] when the port cannot be opened.
-    pub fn open(path: &str, baud: u32) -> Result<SerialLink, LinkError> {
+    /// [`Error::Open`] when the port cannot be opened.
+    pub fn open(path: &str, baud: u32) -> Result<SerialLink, Error> {
         let mut link = SerialLink {
             path: path.to_owned(),
             baud,
@@ -49,7 +49,7 @@ impl SerialLink {
         self.reopens
     }
 
-    fn open_port(&self) -> Result<Box<dyn SerialPort>, LinkError> {
+    fn open_port(&self) -> Result<Box<dyn SerialPort>, Error> {
         serialport::new(&self.path, self.baud)
             .data_bits(serialport::DataBits::Eight)
             .parity(serialport::Parity::None)
@@ -57,14 +57,14 @@ impl SerialLink {
             .flow_control(serialport::FlowControl::None)
             .timeout(Duration::from_millis(100))
             .open()
-            .map_err(|e| LinkError::Open {
+            .map_err(|e| Error::Open {
                 path: self.path.clone(),
                 message: e.to_string(),
             })
     }
 
     /// The open port, reopening it when it was dropped.
-    fn port(&mut self) -> Result<&mut Box<dyn SerialPort>, LinkError> {
+    fn port(&mut self) -> Result<&mut Box<dyn SerialPort>, Error> {
         if self.port.is_none() {
             let mut last = None;
             for attempt in 0..REOPEN_ATTEMPTS {
@@ -81,7 +81,7 @@ impl SerialLink {
                 }
             }
             if self.port.is_none() {
-                return Err(last.unwrap_or_else(|| LinkError::Open {
+                return Err(last.unwrap_or_else(|| Error::Open {
                     path: self.path.clone(),
                     message: "no attempt made".to_owned(),
                 }));
@@ -89,25 +89,25 @@ impl SerialLink {
         }
         self.port
             .as_mut()
-            .ok_or_else(|| LinkError::Io(io::ErrorKind::NotConnected.into()))
+            .ok_or_else(|| Error::Io(io::ErrorKind::NotConnected.into()))
     }
 }
 
 impl Link for SerialLink {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), Error> {
         // One retry on a fresh port.
         for attempt in 0..2 {
             let port = self.port()?;
             match port.write_all(bytes).and_then(|()| port.flush()) {
                 Ok(()) => return Ok(()),
-                Err(e) if attempt == 1 => return Err(LinkError::Io(e)),
+                Err(e) if attempt == 1 => return Err(Error::Io(e)),
                 Err(_) => self.port = None,
             }
         }
         Ok(())
     }
 
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, Error> {
         if buf.is_empty() {
             return Ok(0);
         }
@@ -116,7 +116,7 @@ impl Link for SerialLink {
         let timeout = timeout.max(Duration::from_millis(1));
         if let Err(e) = port.set_timeout(timeout) {
             self.port = None;
-            return Err(LinkError::Io(io::Error::other(e.to_string())));
+            return Err(Error::Io(io::Error::other(e.to_string())));
         }
         match port.read(buf) {
             Ok(n) => Ok(n),

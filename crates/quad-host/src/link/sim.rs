@@ -29,7 +29,7 @@
 //! random number of bytes) and a duplication (the frame is sent twice); then per byte a drop
 //! (its line time passes, nothing arrives) and a bit flip.
 
-use super::{byte_time, Fault, FaultStats, Faults, Link, LinkError};
+use super::{byte_time, Error, Faults, LineStats, Link};
 use kin_core::DefaultMath;
 use quad_device::{Clock, Config, ConfigError, Device, ServoOutputs, Storage};
 use std::cell::Cell;
@@ -45,8 +45,7 @@ pub const EEPROM_LEN: usize = 4096;
 /// Default receive FIFO of the simulated device, bytes.
 pub const DEFAULT_RX_FIFO_LEN: usize = 64;
 
-/// The seeded generator of fault injection and test data (SplitMix64).
-pub use seeded_rng::SplitMix64 as Rng;
+use seeded_rng::SplitMix64;
 
 /// The simulated servo outputs: what is on the twelve pins.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -194,27 +193,6 @@ impl Default for SimConfig {
     }
 }
 
-/// What the simulated lines did.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct SimStats {
-    /// Bytes put on the host → device line (after duplication and cuts).
-    pub h2d_bytes: u64,
-    /// Bytes put on the device → host line.
-    pub d2h_bytes: u64,
-    /// Bytes dropped by fault injection.
-    pub dropped: u64,
-    /// Bytes with a flipped bit.
-    pub flipped: u64,
-    /// Frames sent twice.
-    pub duplicated: u64,
-    /// Frames cut.
-    pub truncated: u64,
-    /// Stalls.
-    pub stalls: u64,
-    /// Bytes lost because the device's receive FIFO was full.
-    pub rx_overflow: u64,
-}
-
 #[derive(Debug, Default)]
 struct Line {
     /// Bytes on their way, with their arrival time (ns).
@@ -226,9 +204,9 @@ struct Line {
 /// Puts one frame on `line` from `start_ns`, applying the faults.
 fn transmit(
     line: &mut Line,
-    rng: &mut Rng,
+    rng: &mut SplitMix64,
     faults: &Faults,
-    stats: &mut SimStats,
+    stats: &mut LineStats,
     byte_ns: u64,
     mut start_ns: u64,
     frame: &[u8],
@@ -250,24 +228,12 @@ fn transmit(
     t
 }
 
-impl FaultStats for SimStats {
-    fn count(&mut self, fault: Fault) {
-        match fault {
-            Fault::Stall => self.stalls += 1,
-            Fault::Truncate => self.truncated += 1,
-            Fault::Duplicate => self.duplicated += 1,
-            Fault::Drop => self.dropped += 1,
-            Fault::Flip => self.flipped += 1,
-        }
-    }
-}
-
 /// The simulated UART link (see the module docs).
 pub struct SimLink {
     config: SimConfig,
     device_config: Config,
     byte_ns: u64,
-    rng: Rng,
+    rng: SplitMix64,
     now_ns: u64,
     h2d: Line,
     d2h: Line,
@@ -278,7 +244,7 @@ pub struct SimLink {
     clock: Rc<Cell<u64>>,
     device: SimDevice,
     answers: Vec<Vec<u8>>,
-    stats: SimStats,
+    stats: LineStats,
 }
 
 impl SimLink {
@@ -299,7 +265,7 @@ impl SimLink {
             config,
             device_config,
             byte_ns: byte_time(config.baud).as_nanos() as u64,
-            rng: Rng::new(config.seed),
+            rng: SplitMix64::new(config.seed),
             now_ns: 0,
             h2d: Line::default(),
             d2h: Line::default(),
@@ -308,7 +274,7 @@ impl SimLink {
             clock: shared,
             device,
             answers: Vec::new(),
-            stats: SimStats::default(),
+            stats: LineStats::default(),
         })
     }
 
@@ -337,7 +303,7 @@ impl SimLink {
     }
 
     /// What the lines did so far.
-    pub fn stats(&self) -> SimStats {
+    pub fn stats(&self) -> LineStats {
         self.stats
     }
 
@@ -410,7 +376,7 @@ impl SimLink {
 }
 
 impl Link for SimLink {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), Error> {
         self.stats.h2d_bytes += bytes.len() as u64;
         transmit(
             &mut self.h2d,
@@ -424,7 +390,7 @@ impl Link for SimLink {
         Ok(())
     }
 
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, Error> {
         let deadline = self.now_ns + timeout.as_nanos() as u64;
         let mut n = 0;
         loop {

@@ -1,46 +1,16 @@
-//! `quadctl accuracy`: seed 000's hardware accuracy metric (§3.3) between target and measured
-//! joint angles, and the Cartesian foot error through forward kinematics.
+//! Seed 000's hardware accuracy metric (§3.3) between target and measured joint angles, and the
+//! Cartesian foot error through forward kinematics: the operation behind `quadctl accuracy`.
 
-use super::motion::Error;
-use crate::plot;
+use crate::csv::motion::read_samples;
+use crate::{csv, plot, robot_file};
 use kin_core::paper;
-use kin_core::{leg, JointAngles, LegId, Robot};
-use std::io::BufRead;
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
+use kin_core::{leg, Joint, JointAngles, LegId, Robot};
+use serde::Serialize;
+use std::path::PathBuf;
 
-const LONG_ABOUT: &str = "\
-Seed 000's accuracy metric (§3.3) between target angles (what was commanded) and measured angles
-(what the leg did), per joint j over the N paired samples i:
-
-  deviation_j = 100 % · (1/N) · Σ_i |measured_ij − target_ij| / |target_ij|   (mean relative deviation)
-  RSSE        = √(deviation_abduction² + deviation_hip² + deviation_knee²)      (root sum square)
-  accuracy    = 100 % − RSSE
-
-The percentages depend on where each angle's zero is: --angles seed000 first converts both files
-to seed 000's θ1, θ2, θ3 (the paper's setting); --angles canonical (the default) uses the angles
-as they are. A target angle of exactly zero makes its relative deviation undefined and is
-refused, naming the row.
-
-Seed 000 reports 2.59 %, 3.64 % and 20.83 % for its three joints and an RSSE of 21.10 %, i.e.
-78.9 % accuracy. Its own per-joint figures give √(2.59² + 3.64² + 20.83²) = 21.30 %, i.e.
-78.70 %: the 21.10 is an arithmetic slip (a third figure of 20.63 instead of 20.83 would give
-21.11 ≈ 21.1, and 78.9 = 100 − 21.1 follows from it).
-
-With --robot, also the Cartesian foot error: the distance between the feet that forward
-kinematics puts at the target and at the measured angles (mean, RMS and maximum, metres).
-
-Inputs: CSV files with a header, one row per sample, paired by order (same number of rows).
-Joint columns, radians: either one leg, `abduction_rad,hip_rad,knee_rad` (the leg is --leg), or
-the twelve `FL_abduction_rad … RR_knee_rad` of `quadctl motion` (all four legs pooled per joint;
-rows whose status is not ok are skipped in both files). Other columns are ignored; `#` lines
-are comments.
-
-Output: a table; with --json also one JSON object as the last line. --plot draws target and
-measured per joint over the samples (seed 000 Fig. 9-11) for --leg.";
-
-/// `--angles`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+/// Which angles the percentages are taken of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Angles {
     /// The canonical angles as they are in the files.
     Canonical,
@@ -48,140 +18,73 @@ pub enum Angles {
     Seed000,
 }
 
-/// Arguments of `quadctl accuracy`.
-#[derive(Debug, Clone, PartialEq, clap::Args)]
-#[command(
-    about = "Seed 000's accuracy metric: per-joint mean deviation %, RSSE, 100 − RSSE; foot error",
-    long_about = LONG_ABOUT
-)]
-pub struct Args {
-    /// Target (commanded) angles, CSV.
-    #[arg(long, value_name = "A.csv")]
-    pub target: PathBuf,
-    /// Measured angles, CSV.
-    #[arg(long, value_name = "B.csv")]
-    pub measured: PathBuf,
-    /// The leg of single-leg files, and the leg plotted.
-    #[arg(long, default_value = "FL", value_parser = parse_leg)]
-    pub leg: LegId,
-    /// Which angles the percentages are taken of.
-    #[arg(long, value_enum, default_value_t = Angles::Canonical)]
-    pub angles: Angles,
-    /// Robot (preset or TOML file) for the Cartesian foot error.
-    #[arg(long, value_name = "PRESET|FILE.toml")]
-    pub robot: Option<String>,
-    /// Draw target vs measured per joint (.svg or .png).
-    #[arg(long, value_name = "FILE.svg")]
-    pub plot: Option<PathBuf>,
-    /// Also print one JSON object as the last line.
-    #[arg(long)]
-    pub json: bool,
-}
+impl Angles {
+    /// Both, in the command line's order.
+    pub const ALL: [Angles; 2] = [Angles::Canonical, Angles::Seed000];
 
-fn parse_leg(s: &str) -> Result<LegId, String> {
-    LegId::parse(s).ok_or_else(|| format!("`{s}` is not a leg (FL, FR, RL, RR)"))
-}
-
-/// Samples of one file: per row, the legs present with their angles.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Samples {
-    /// The legs in the file (one, or all four).
-    pub legs: Vec<LegId>,
-    /// Per kept row: its line and the angles of `legs`; `None` for a row whose status is not ok.
-    pub rows: Vec<(usize, Option<Vec<JointAngles>>)>,
-}
-
-/// Reads a target or measured file.
-pub fn read_samples(path: &Path, single_leg: LegId) -> Result<Samples, Error> {
-    let input = crate::csv_io::Input::open(path).map_err(|e| Error::Csv {
-        at: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    let name = input.name.clone();
-    let mut lines = input.reader.lines();
-    let mut n = 0usize;
-    let io = |source| Error::Io {
-        context: format!("cannot read `{name}`"),
-        source,
-    };
-    let header = loop {
-        let Some(line) = lines.next() else {
-            return Err(Error::Csv {
-                at: name.clone(),
-                message: "empty file: expected a header".to_owned(),
-            });
-        };
-        n += 1;
-        let line = line.map_err(io)?;
-        let t = line.trim();
-        if !(t.is_empty() || t.starts_with('#')) {
-            break t.to_owned();
+    /// The name on the command line and in the JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Angles::Canonical => "canonical",
+            Angles::Seed000 => "seed000",
         }
-    };
-    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
-    let find = |c: &str| cols.iter().position(|x| x.eq_ignore_ascii_case(c));
-    let joints = ["abduction", "hip", "knee"];
-    let (legs, idx): (Vec<LegId>, Vec<[usize; 3]>) = if find("FL_abduction_rad").is_some() {
-        let mut idx = Vec::new();
-        for l in LegId::ALL {
-            let mut j3 = [0usize; 3];
-            for (k, j) in joints.iter().enumerate() {
-                j3[k] = find(&format!("{l}_{j}_rad")).ok_or_else(|| Error::Csv {
-                    at: format!("{name}:{n}"),
-                    message: format!("header has FL_abduction_rad but no {l}_{j}_rad"),
-                })?;
-            }
-            idx.push(j3);
-        }
-        (LegId::ALL.to_vec(), idx)
-    } else {
-        let mut j3 = [0usize; 3];
-        for (k, j) in joints.iter().enumerate() {
-            j3[k] = find(&format!("{j}_rad")).ok_or_else(|| Error::Csv {
-                at: format!("{name}:{n}"),
-                message: "header needs abduction_rad,hip_rad,knee_rad or the 12 \
-                              FL_abduction_rad … RR_knee_rad columns"
-                    .to_owned(),
-            })?;
-        }
-        (vec![single_leg], vec![j3])
-    };
-    let status = find("status");
-    let mut rows = Vec::new();
-    for line in lines {
-        n += 1;
-        let line = line.map_err(io)?;
-        let t = line.trim();
-        if t.is_empty() || t.starts_with('#') {
-            continue;
-        }
-        let f: Vec<&str> = t.split(',').map(str::trim).collect();
-        if let Some(s) = status {
-            if f.get(s).copied() != Some("ok") {
-                rows.push((n, None));
-                continue;
-            }
-        }
-        let mut angles = Vec::with_capacity(legs.len());
-        for j3 in &idx {
-            let mut v = [0.0f32; 3];
-            for (slot, &i) in v.iter_mut().zip(j3) {
-                let text = f.get(i).copied().unwrap_or("");
-                *slot = text
-                    .parse::<f32>()
-                    .ok()
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| Error::Csv {
-                        at: format!("{name}:{n}"),
-                        message: format!("field {}: `{text}` is not a finite number", i + 1),
-                    })?;
-            }
-            angles.push(JointAngles::from_array(v));
-        }
-        rows.push((n, Some(angles)));
     }
-    Ok(Samples { legs, rows })
+
+    /// The joints' names in the table and the plot.
+    pub fn joint_names(self) -> [&'static str; 3] {
+        match self {
+            Angles::Canonical => ["abduction", "hip", "knee"],
+            Angles::Seed000 => ["θ1 (abduction)", "θ2 (hip)", "θ3 (knee)"],
+        }
+    }
 }
+
+/// Why the metric could not be computed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The robot could not be resolved.
+    #[error(transparent)]
+    Robot(#[from] robot_file::Error),
+    /// A file could not be read.
+    #[error(transparent)]
+    Csv(#[from] csv::Error),
+    /// Drawing failed.
+    #[error(transparent)]
+    Plot(#[from] plot::Error),
+    /// One file has one leg's angles, the other all twelve.
+    #[error("{target} / {measured}: the files do not have the same joint columns (one leg vs twelve angles)")]
+    Columns {
+        /// The target file.
+        target: String,
+        /// The measured file.
+        measured: String,
+    },
+    /// The files do not have as many rows.
+    #[error("{target} / {measured}: {target_rows} target rows but {measured_rows} measured rows (rows are paired by order)")]
+    Rows {
+        /// The target file.
+        target: String,
+        /// The measured file.
+        measured: String,
+        /// Its rows.
+        target_rows: usize,
+        /// Its rows.
+        measured_rows: usize,
+    },
+    /// No pair of ok rows.
+    #[error("no paired samples")]
+    NoPairs,
+    /// A target angle of exactly zero: its relative deviation is undefined.
+    #[error("pair {pair}: target {joint} angle is 0, its relative deviation is undefined")]
+    ZeroTarget {
+        /// 1-based pair.
+        pair: usize,
+        /// The joint.
+        joint: Joint,
+    },
+}
+
 
 /// The metric.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -197,19 +100,21 @@ pub struct Accuracy {
 }
 
 /// Seed 000's metric from paired (target, measured) triples of the same joints.
-pub fn accuracy(pairs: &[([f64; 3], [f64; 3])]) -> Result<Accuracy, String> {
+///
+/// # Errors
+/// [`Error::NoPairs`], [`Error::ZeroTarget`].
+pub fn accuracy(pairs: &[([f64; 3], [f64; 3])]) -> Result<Accuracy, Error> {
     if pairs.is_empty() {
-        return Err("no paired samples".to_owned());
+        return Err(Error::NoPairs);
     }
     let mut sum = [0.0f64; 3];
     for (i, (t, m)) in pairs.iter().enumerate() {
         for j in 0..3 {
             if t[j] == 0.0 {
-                return Err(format!(
-                    "pair {}: target {} angle is 0, its relative deviation is undefined",
-                    i + 1,
-                    ["abduction", "hip", "knee"][j]
-                ));
+                return Err(Error::ZeroTarget {
+                    pair: i + 1,
+                    joint: Joint::ALL[j],
+                });
             }
             sum[j] += ((m[j] - t[j]) / t[j]).abs();
         }
@@ -236,33 +141,80 @@ pub struct FootError {
     pub max_m: f64,
 }
 
-/// `quadctl accuracy`.
-pub fn run(args: &Args) -> ExitCode {
-    super::motion::exit_status(run_inner(args))
+/// What [`run`] is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    /// Target (commanded) angles, CSV.
+    pub target: PathBuf,
+    /// Measured angles, CSV.
+    pub measured: PathBuf,
+    /// The leg of single-leg files, and the leg plotted.
+    pub leg: LegId,
+    /// Which angles the percentages are taken of.
+    pub angles: Angles,
+    /// Robot (preset or TOML file) for the Cartesian foot error.
+    pub robot: Option<String>,
+    /// Draw target vs measured per joint (.svg or .png).
+    pub plot: Option<PathBuf>,
 }
 
-fn run_inner(args: &Args) -> Result<(), Error> {
+/// The metric, the foot error, and `quadctl accuracy --json`'s object (keys in alphabetical
+/// order, as printed since the first release).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Outcome {
+    /// 100 − RSSE, %.
+    pub accuracy_pct: f64,
+    /// Which angles.
+    pub angles: Angles,
+    /// Mean relative deviation per joint, %.
+    pub deviation_pct: Deviation,
+    /// The Cartesian foot error, with a robot.
+    pub foot_error: Option<FootError>,
+    /// Root sum square of the deviations, %.
+    pub rsse_pct: f64,
+    /// Paired joint triples used.
+    pub samples: usize,
+}
+
+/// Mean relative deviation per joint, %.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Deviation {
+    /// Abduction.
+    pub abduction: f64,
+    /// Hip.
+    pub hip: f64,
+    /// Knee.
+    pub knee: f64,
+}
+
+/// Computes the metric (and draws the plot when asked).
+///
+/// # Errors
+/// See [`Error`].
+pub fn run(args: &Request) -> Result<Outcome, Error> {
     let robot: Option<Robot> = match &args.robot {
         None => None,
-        Some(spec) => Some(crate::robot_file::resolve(spec).map_err(Error::Robot)?),
+        Some(spec) => Some(robot_file::resolve(spec)?),
     };
     let target = read_samples(&args.target, args.leg)?;
     let measured = read_samples(&args.measured, args.leg)?;
-    let mismatch = |message: String| Error::Csv {
-        at: format!("{} / {}", args.target.display(), args.measured.display()),
-        message,
-    };
+    let (target_name, measured_name) = (
+        args.target.display().to_string(),
+        args.measured.display().to_string(),
+    );
     if target.legs != measured.legs {
-        return Err(mismatch(
-            "the files do not have the same joint columns (one leg vs twelve angles)".to_owned(),
-        ));
+        return Err(Error::Columns {
+            target: target_name,
+            measured: measured_name,
+        });
     }
     if target.rows.len() != measured.rows.len() {
-        return Err(mismatch(format!(
-            "{} target rows but {} measured rows (rows are paired by order)",
-            target.rows.len(),
-            measured.rows.len()
-        )));
+        return Err(Error::Rows {
+            target: target_name,
+            measured: measured_name,
+            target_rows: target.rows.len(),
+            measured_rows: measured.rows.len(),
+        });
     }
     let convert = |l: LegId, q: JointAngles| -> [f64; 3] {
         match args.angles {
@@ -294,7 +246,7 @@ fn run_inner(args: &Args) -> Result<(), Error> {
             }
         }
     }
-    let acc = accuracy(&pairs).map_err(mismatch)?;
+    let acc = accuracy(&pairs)?;
     let foot = (!dist.is_empty()).then(|| {
         let n = dist.len() as f64;
         FootError {
@@ -303,50 +255,23 @@ fn run_inner(args: &Args) -> Result<(), Error> {
             max_m: dist.iter().copied().fold(0.0, f64::max),
         }
     });
-    let names = match args.angles {
-        Angles::Canonical => ["abduction", "hip", "knee"],
-        Angles::Seed000 => ["θ1 (abduction)", "θ2 (hip)", "θ3 (knee)"],
-    };
-    println!(
-        "accuracy (seed 000 §3.3): {} paired joint triples, angles {}",
-        acc.samples,
-        match args.angles {
-            Angles::Canonical => "canonical",
-            Angles::Seed000 => "seed000 (θ1, θ2, θ3)",
-        }
-    );
-    for (name, d) in names.iter().zip(acc.deviation_pct) {
-        println!("  {name:<16} mean deviation {d:>8.2} %");
-    }
-    println!("  RSSE                            {:>8.2} %", acc.rsse_pct);
-    println!(
-        "  accuracy = 100 − RSSE           {:>8.2} %",
-        acc.accuracy_pct
-    );
-    if let Some(f) = &foot {
-        println!(
-            "  foot error (FK): mean {:.4} m, RMS {:.4} m, max {:.4} m",
-            f.mean_m, f.rms_m, f.max_m
-        );
-    }
     if let Some(p) = &args.plot {
         let title = format!("target vs measured, {}", args.leg);
-        plot::target_vs_measured(p, &title, names, &plotted.0, &plotted.1)?;
+        plot::target_vs_measured(p, &title, args.angles.joint_names(), &plotted.0, &plotted.1)?;
     }
-    if args.json {
-        println!(
-            "{}",
-            serde_json::json!({
-                "samples": acc.samples,
-                "angles": match args.angles { Angles::Canonical => "canonical", Angles::Seed000 => "seed000" },
-                "deviation_pct": { "abduction": acc.deviation_pct[0], "hip": acc.deviation_pct[1], "knee": acc.deviation_pct[2] },
-                "rsse_pct": acc.rsse_pct,
-                "accuracy_pct": acc.accuracy_pct,
-                "foot_error": foot,
-            })
-        );
-    }
-    Ok(())
+    let [abduction, hip, knee] = acc.deviation_pct;
+    Ok(Outcome {
+        accuracy_pct: acc.accuracy_pct,
+        angles: args.angles,
+        deviation_pct: Deviation {
+            abduction,
+            hip,
+            knee,
+        },
+        foot_error: foot,
+        rsse_pct: acc.rsse_pct,
+        samples: acc.samples,
+    })
 }
 
 #[cfg(test)]
@@ -379,7 +304,9 @@ mod tests {
 
     #[test]
     fn a_zero_target_is_refused_by_name() {
-        let e = accuracy(&[([1.0, 0.0, 1.0], [1.0, 0.1, 1.0])]).unwrap_err();
+        let e = accuracy(&[([1.0, 0.0, 1.0], [1.0, 0.1, 1.0])])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("hip"), "{e}");
     }
 }

@@ -1,74 +1,89 @@
-//! `quadctl calibrate`: read, edit (from a TOML file) and save the device's servo calibration.
+//! The device's servo calibration: its TOML file (read and written) and the operation behind
+//! `quadctl calibrate` (read, edit, save).
 
-use super::stream::TargetArgs;
-use super::{EXIT_FATAL, EXIT_OK};
-use crate::client::{Client, ClientError};
-use crate::csv_io::Num;
+use crate::csv::Num;
+use crate::link::{self, Target};
+use crate::client::{self, Client, ClientConfig};
 use quad_protocol::servo::Calibration;
-use quad_protocol::{Request, RobotPreset, ServoId};
+use quad_protocol::{Request as DeviceRequest, ServoId};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::io::{self, Write};
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
-const LONG_ABOUT: &str = "\
-Reads, edits and saves the servo calibration of the device (--sim or --port).
-
-One calibration per servo, named <LEG>_<joint> (FL_abduction, FL_hip, FL_knee, FR_..., RL_...,
-RR_...). The pulse for a joint angle is
-
-  pulse_us = center_us + s * us_per_rad * (angle_rad - zero_rad),  s = -1 if reversed, else +1
-
-valid only within [min_us, max_us] (a target outside is refused, never clamped). Angles in
-RADIANS, pulses in MICROSECONDS.
-
-  get            print the 12 calibrations as TOML (the format `set` reads)
-  set FILE.toml  send the servos listed in FILE (any subset) to the device's RAM; --save also
-                 persists them
-  save           persist the calibration in the device's RAM (EEPROM, two banks with a CRC)
-
-TOML: one inline table per servo, every field required, e.g.
-  FL_knee = { zero_rad = -1.0472, reversed = false, us_per_rad = 636.62, center_us = 1500, min_us = 500, max_us = 2500 }
-
-The device refuses a calibration whose travel excludes the joint's current angle (move the robot
-first). With --sim the simulated device powers on at every run: keep its EEPROM in a file with
---sim-storage FILE to see a save in a later run.";
-
-/// What to do.
-#[derive(Debug, Clone, PartialEq, Eq, clap::Subcommand)]
-pub enum Action {
-    /// Print the device's 12 calibrations as TOML.
-    Get,
-    /// Send the calibrations of FILE.toml to the device's RAM.
-    Set {
-        /// TOML file with one table per servo to change.
-        file: PathBuf,
-        /// Persist them too (as `save`).
-        #[arg(long)]
-        save: bool,
+/// Why a calibration could not be read, sent or saved.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The file could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
     },
-    /// Persist the calibration held in the device's RAM.
-    Save,
+    /// Not valid TOML, or a key is missing, unknown or of the wrong type.
+    #[error("{}: {source}", path.display())]
+    Toml {
+        /// The file.
+        path: PathBuf,
+        /// The TOML error.
+        source: toml::de::Error,
+    },
+    /// A table name that is not a servo.
+    #[error("{}: `{name}` is not a servo (FL_abduction, FL_hip, FL_knee, ..., RR_knee)", path.display())]
+    Servo {
+        /// The file.
+        path: PathBuf,
+        /// The name found.
+        name: String,
+    },
+    /// A calibration the protocol refuses.
+    #[error("{}: {}: {source}", path.display(), servo_name(*servo))]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// The servo.
+        servo: ServoId,
+        /// Why.
+        source: quad_protocol::servo::Error,
+    },
+    /// The link could not be opened.
+    #[error(transparent)]
+    Link(#[from] link::Error),
+    /// A request failed.
+    #[error(transparent)]
+    Client(#[from] client::Error),
+    /// The device refused or failed one servo's calibration.
+    #[error("{}: {source}", servo_name(*servo))]
+    Send {
+        /// The servo.
+        servo: ServoId,
+        /// What the device said.
+        source: client::Error,
+    },
+    /// The device holds another calibration than the one sent.
+    #[error("{}: the device holds another calibration than the one sent ({})", servo_name(*servo), one_line(held))]
+    NotHeld {
+        /// The servo.
+        servo: ServoId,
+        /// What the device holds.
+        held: Calibration,
+    },
 }
 
-/// Arguments of `quadctl calibrate`.
-#[derive(Debug, Clone, PartialEq, clap::Args)]
-#[command(
-    about = "Read, edit (TOML) and save the device's servo calibration (--sim or --port)",
-    long_about = LONG_ABOUT
-)]
-pub struct Args {
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub target: TargetArgs,
-    /// Robot of the simulated device.
-    #[arg(long, value_name = "PRESET", default_value = "fernando2025")]
-    pub robot: String,
-    #[command(subcommand)]
-    #[allow(missing_docs)]
-    pub action: Action,
+/// A calibration on one line, in the file's terms.
+fn one_line(c: &Calibration) -> String {
+    format!(
+        "zero_rad = {}, reversed = {}, us_per_rad = {}, center_us = {}, min_us = {}, max_us = {}",
+        toml_f32(c.zero_rad),
+        c.reversed,
+        toml_f32(c.us_per_rad),
+        c.center_us,
+        c.min_us,
+        c.max_us
+    )
 }
 
 /// One servo in the TOML file.
@@ -137,94 +152,88 @@ pub fn to_toml(table: &[Calibration; 12]) -> String {
 /// Reads a calibration file: the servos it lists, each validated.
 ///
 /// # Errors
-/// A message naming the file and what is wrong.
-pub fn parse_toml(text: &str, path: &Path) -> Result<Vec<(ServoId, Calibration)>, String> {
-    let map: BTreeMap<String, Entry> =
-        toml::from_str(text).map_err(|e| format!("{}: {e}", path.display()))?;
+/// [`Error::Toml`], [`Error::Servo`], [`Error::Invalid`], naming the file.
+pub fn parse_toml(text: &str, path: &Path) -> Result<Vec<(ServoId, Calibration)>, Error> {
+    let map: BTreeMap<String, Entry> = toml::from_str(text).map_err(|source| Error::Toml {
+        path: path.to_owned(),
+        source,
+    })?;
     let mut out = Vec::new();
     for (name, entry) in map {
         let id = ServoId::ALL
             .into_iter()
             .find(|s| servo_name(*s).eq_ignore_ascii_case(&name))
-            .ok_or_else(|| {
-                format!(
-                    "{}: `{name}` is not a servo (FL_abduction, FL_hip, FL_knee, ..., RR_knee)",
-                    path.display()
-                )
+            .ok_or_else(|| Error::Servo {
+                path: path.to_owned(),
+                name: name.clone(),
             })?;
         let c = Calibration::from(entry);
-        c.validate()
-            .map_err(|e| format!("{}: {name}: {e}", path.display()))?;
+        c.validate().map_err(|source| Error::Invalid {
+            path: path.to_owned(),
+            servo: id,
+            source,
+        })?;
         out.push((id, c));
     }
     Ok(out)
 }
 
-/// Runs `quadctl calibrate` and returns its exit status.
-pub fn main(args: &Args) -> ExitCode {
-    let stdout = io::stdout();
-    let mut out = stdout.lock();
-    match run(args, &mut out) {
-        Ok(()) => ExitCode::from(EXIT_OK),
-        Err(message) => {
-            let _ = writeln!(io::stderr(), "quadctl: error: {message}");
-            ExitCode::from(EXIT_FATAL)
-        }
-    }
+/// What to do.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Action {
+    /// Read the 12 calibrations.
+    Get,
+    /// Send the calibrations of a TOML file to the device's RAM, and persist them with `save`.
+    Set {
+        /// The file.
+        file: PathBuf,
+        /// Persist them too.
+        save: bool,
+    },
+    /// Persist the calibration held in the device's RAM.
+    Save,
 }
 
-/// Runs the action, printing the resulting calibration (get, set) or a confirmation (save).
+/// Carries out `action` on the device at `target` (`retries` resends per streamed request) and
+/// returns the calibration it then holds.
 ///
 /// # Errors
-/// A message for the user.
-pub fn run(args: &Args, out: &mut dyn Write) -> Result<(), String> {
-    let preset = RobotPreset::from_name(args.robot.trim()).ok_or_else(|| {
-        format!(
-            "--robot {}: not a preset (shahriar2023, fernando2025)",
-            args.robot
-        )
-    })?;
-    let edits = match &args.action {
+/// See [`Error`].
+pub fn run(target: &Target, retries: u32, action: &Action) -> Result<[Calibration; 12], Error> {
+    let edits = match action {
         Action::Set { file, .. } => {
-            let text = std::fs::read_to_string(file)
-                .map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+            let text = std::fs::read_to_string(file).map_err(|source| Error::Read {
+                path: file.clone(),
+                source,
+            })?;
             Some(parse_toml(&text, file)?)
         }
         _ => None,
     };
-    let (link, config) = args.target.open(preset)?;
-    let mut client = Client::new(link, config);
-    let fail = |e: ClientError| e.to_string();
-    client.hello().map_err(fail)?;
+    let link = link::open(target)?;
+    let mut client = Client::new(link, ClientConfig::for_target(target, retries));
+    client.hello()?;
     for (id, calibration) in edits.iter().flatten() {
         client
-            .ack(Request::SetCalibration {
+            .ack(DeviceRequest::SetCalibration {
                 servo: *id,
                 calibration: *calibration,
             })
-            .map_err(|e| format!("{}: {e}", servo_name(*id)))?;
+            .map_err(|source| Error::Send { servo: *id, source })?;
     }
-    let save = matches!(args.action, Action::Save | Action::Set { save: true, .. });
-    if save {
-        client.ack(Request::SaveCalibration).map_err(fail)?;
+    if matches!(action, Action::Save | Action::Set { save: true, .. }) {
+        client.ack(DeviceRequest::SaveCalibration)?;
     }
-    let table = client.calibrations().map_err(fail)?;
+    let table = client.calibrations()?;
     for (id, want) in edits.iter().flatten() {
         if table[id.index()] != *want {
-            return Err(format!(
-                "{}: the device holds {:?}, not the calibration sent",
-                servo_name(*id),
-                table[id.index()]
-            ));
+            return Err(Error::NotHeld {
+                servo: *id,
+                held: table[id.index()],
+            });
         }
     }
-    let text = match args.action {
-        Action::Save => "# saved\n".to_owned() + &to_toml(&table),
-        _ => to_toml(&table),
-    };
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(|e| e.to_string())
+    Ok(table)
 }
 
 #[cfg(test)]
@@ -258,7 +267,9 @@ mod tests {
         assert!(parse_toml(&format!("FL_knee = {{ {ok}, sign = 1 }}"), p).is_err());
         assert!(parse_toml("FL_knee = { zero_rad = 0.0 }", p).is_err());
         let bad = ok.replace("min_us = 1000", "min_us = 1600");
-        let e = parse_toml(&format!("FL_knee = {{ {bad} }}"), p).unwrap_err();
+        let e = parse_toml(&format!("FL_knee = {{ {bad} }}"), p)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("FL_knee"), "{e}");
     }
 }

@@ -1,87 +1,129 @@
-//! `quadctl check`: the preflight report of a motion CSV or of a motion law
-//! (`kin_core::preflight`).
+//! The preflight report of a motion CSV or of a motion law (`kin_core::preflight`): the
+//! operation behind `quadctl check`.
 
-use super::motion::{self, param_err, Error, Law, LawArgs, MotionCsv};
-use super::pose::Order;
+use super::motion::{self, param_err, Law, Params, Progress};
+use crate::csv::motion::MotionCsv;
+use crate::{csv, robot_file};
 use kin_core::leg::Unreachable;
 use kin_core::motion::{Contact, Frame, Motion};
 use kin_core::preflight::{Checker, Extremum, Report};
 use kin_core::{BodyConfig, Joint, JointAngles, LegId, RotationOrder};
+use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
-const LONG_ABOUT: &str = "\
-Preflight report of a motion: sweeps it and reports, per leg and overall,
-  - reachability: samples the IK refuses, and the first one (time, leg, reason);
-  - minimum workspace margin (m): distance of the foot target to the nearest workspace boundary,
-    min(L1 + L2 − r, r − |L1 − L2|, r_yz − d_lat), r the hip-joint-to-foot distance in the leg
-    plane, r_yz the foot's distance from the abduction axis; negative = out of reach;
-  - minimum joint-limit margin (rad): distance of the tightest joint to its limit;
-  - minimum singularity measure: inverse condition number σmin/σmax of the leg Jacobian
-    (1 = isotropic, 0 = singular), failing below 0.05;
-  - maximum joint speed (rad/s), finite differences between samples, against
-    --max-joint-speed-rad-s.
-
-Source: a CSV written by `quadctl motion` (FILE, `-` for stdin; rows with feet and pose are
-solved again, rows with angles only are checked as they are; the rotation order is read from the
-file's `# quadctl motion … rotation_order=…` line, else --rotation-order, else zyx), or
---motion LAW with the same options as `quadctl motion`.
-
-Output: a table (angles in rad with degrees in brackets); with --json, also one JSON object as
-the last line (SI units). Exit status: 0 all samples pass, 1 some fail, 2 bad input.";
-
-/// Arguments of `quadctl check`.
-#[derive(Debug, Clone, PartialEq, clap::Args)]
-#[command(
-    about = "Preflight report of a motion (file or law): reach, margins, singularity, joint speed",
-    long_about = LONG_ABOUT,
-    allow_negative_numbers = true
-)]
-pub struct Args {
-    /// Motion CSV written by `quadctl motion` (`-` for stdin).
-    #[arg(
-        value_name = "FILE",
-        required_unless_present = "motion",
-        conflicts_with = "motion"
+/// Errors of a check: those of the motion operations, and a status cell that cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Building the law, the robot, reading the CSV.
+    #[error(transparent)]
+    Motion(#[from] motion::Error),
+    /// A row without angles, feet and pose whose status does not name the leg and reason.
+    #[error(
+        "{input}:{line}: status `{status}` without angles, feet and pose: expected \
+         `<leg>:<reason>` (too_far, too_close, inside_offset, non_finite, joint_limit (<joint>))"
     )]
-    pub file: Option<PathBuf>,
-    /// Check this law instead of a file.
-    #[arg(long, value_enum, value_name = "LAW")]
-    pub motion: Option<Law>,
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub law_args: LawArgs,
-    /// With --motion: duration, s [default: one period of the law, or 10 s].
-    #[arg(long, value_name = "T")]
-    pub duration_s: Option<f32>,
-    /// With --motion: sampling rate, Hz [default: 100].
-    #[arg(long, value_name = "F")]
-    pub rate_hz: Option<f32>,
-    /// Joint speed limit, rad/s: one value for all joints or ABDUCTION,HIP,KNEE.
-    #[arg(long, value_name = "RAD_S", default_value = "6")]
-    pub max_joint_speed_rad_s: String,
-    /// Also print the report as one JSON object on the last line.
-    #[arg(long)]
-    pub json: bool,
+    Status {
+        /// Input name.
+        input: String,
+        /// 1-based line.
+        line: usize,
+        /// The status found.
+        status: String,
+    },
 }
 
-fn speed_limits(s: &str) -> Result<[f32; 3], Error> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| {
-            x.trim().parse::<f32>().map_err(|_| Error::Csv {
-                at: "--max-joint-speed-rad-s".to_owned(),
-                message: format!("`{}` is not a number", x.trim()),
-            })
-        })
-        .collect::<Result<_, _>>()?;
-    match v.as_slice() {
-        [a] => Ok([*a; 3]),
-        [a, b, c] => Ok([*a, *b, *c]),
-        _ => Err(Error::Csv {
-            at: "--max-joint-speed-rad-s".to_owned(),
-            message: format!("expected one value or three (abduction,hip,knee), got `{s}`"),
-        }),
+impl From<csv::Error> for Error {
+    fn from(e: csv::Error) -> Self {
+        Error::Motion(e.into())
+    }
+}
+
+impl From<robot_file::Error> for Error {
+    fn from(e: robot_file::Error) -> Self {
+        Error::Motion(e.into())
+    }
+}
+
+/// What to check.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Source {
+    /// A motion CSV (`-`: stdin).
+    File(PathBuf),
+    /// A law, sampled here.
+    Law(Law),
+}
+
+/// What [`run`] is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    /// The motion.
+    pub source: Source,
+    /// The law's parameters, or with a file only its robot and rotation order.
+    pub params: Params,
+    /// With a law: duration, s [default: one period of the law, or 10 s].
+    pub duration_s: Option<f32>,
+    /// With a law: sampling rate, Hz [default: 100].
+    pub rate_hz: Option<f32>,
+    /// Joint speed limit per joint (abduction, hip, knee), rad/s.
+    pub max_joint_speed_rad_s: [f32; 3],
+}
+
+/// The report and what it is of; serialised as `quadctl check --json`'s last line.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Checked {
+    /// The file, or `quadctl motion <law>`.
+    pub source: String,
+    /// The robot as given.
+    pub robot: String,
+    /// Time span, s (of the file when it has two samples or more).
+    pub duration_s: Option<f32>,
+    /// Sampling rate, Hz (of the file: samples over its time span).
+    pub rate_hz: Option<f32>,
+    /// The preflight report.
+    pub report: Report,
+}
+
+/// `quadctl check --json`'s object: keys in alphabetical order, as printed since the first
+/// release.
+#[derive(Debug, Serialize)]
+pub struct Summary<'a> {
+    /// See [`Checked::duration_s`].
+    pub duration_s: Option<f32>,
+    /// Every sample passed.
+    pub ok: bool,
+    /// See [`Checked::rate_hz`].
+    pub rate_hz: Option<f32>,
+    /// See [`Checked::report`].
+    pub report: &'a Report,
+    /// See [`Checked::robot`].
+    pub robot: &'a str,
+    /// See [`Checked::source`].
+    pub source: &'a str,
+}
+
+impl Checked {
+    /// The JSON summary.
+    pub fn summary(&self) -> Summary<'_> {
+        Summary {
+            duration_s: self.duration_s,
+            ok: self.report.ok(),
+            rate_hz: self.rate_hz,
+            report: &self.report,
+            robot: &self.robot,
+            source: &self.source,
+        }
+    }
+}
+
+/// Runs the check. `progress` follows the sampling of a law.
+///
+/// # Errors
+/// See [`Error`].
+pub fn run(args: &Request, progress: &mut dyn FnMut(Progress)) -> Result<Checked, Error> {
+    match &args.source {
+        Source::Law(law) => check_law(args, *law, progress),
+        Source::File(file) => check_file(args, file),
     }
 }
 
@@ -105,101 +147,59 @@ fn unreachable_code(code: &str) -> Option<Unreachable> {
     })
 }
 
-/// What was checked, for the header and the JSON.
-struct Source {
-    label: String,
-    robot: String,
-    duration_s: Option<f32>,
-    rate_hz: Option<f32>,
-}
-
-/// `quadctl check`.
-pub fn run(args: &Args) -> ExitCode {
-    match run_inner(args) {
-        Ok(true) => ExitCode::from(super::EXIT_OK),
-        Ok(false) => ExitCode::from(super::EXIT_MALFORMED),
-        Err(e) => {
-            eprintln!("quadctl: error: {e}");
-            ExitCode::from(super::EXIT_FATAL)
-        }
-    }
-}
-
-fn run_inner(args: &Args) -> Result<bool, Error> {
-    let limits = speed_limits(&args.max_joint_speed_rad_s)?;
-    let (report, source) = match (&args.file, args.motion) {
-        (_, Some(law)) => check_law(args, law, limits)?,
-        (Some(file), None) => check_file(args, file, limits)?,
-        (None, None) => {
-            return Err(Error::NotApplicable {
-                option: "(no FILE and no --motion)",
-                law: "check: give a motion CSV or --motion LAW",
-            })
-        }
-    };
-    print!("{}", table(&report, &source));
-    if args.json {
-        let json = serde_json::json!({
-            "source": source.label,
-            "robot": source.robot,
-            "duration_s": source.duration_s,
-            "rate_hz": source.rate_hz,
-            "ok": report.ok(),
-            "report": report,
-        });
-        println!("{json}");
-    }
-    Ok(report.ok())
-}
-
-fn check_law(args: &Args, law: Law, limits: [f32; 3]) -> Result<(Report, Source), Error> {
-    let m = args.law_args.build(law)?;
+fn check_law(
+    args: &Request,
+    law: Law,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Checked, Error> {
+    let limits = args.max_joint_speed_rad_s;
+    let m = args.params.build(law)?;
     let duration = args
         .duration_s
         .unwrap_or_else(|| m.period_s().unwrap_or(10.0));
     let rate = args.rate_hz.unwrap_or(100.0);
     let sweep = motion::sweep(duration, rate)?;
     let mut c = Checker::new(m.robot(), m.body_config(), limits).map_err(param_err)?;
-    let bar = motion::progress(u64::from(sweep.samples()), "check");
+    progress(Progress::Start(u64::from(sweep.samples())));
     for k in 0..sweep.samples() {
         let t = sweep.time_s(k);
         let frame = m.frame(t).map_err(param_err)?;
         let _ = c.push_frame(t, &frame);
         if k % 4096 == 4095 {
-            bar.inc(4096);
+            progress(Progress::Done(u64::from(k) + 1));
         }
     }
-    bar.finish_and_clear();
-    Ok((
-        c.finish(),
-        Source {
-            label: format!("quadctl motion {}", law.name()),
-            robot: args.law_args.robot.robot.clone(),
-            duration_s: Some(duration),
-            rate_hz: Some(rate),
-        },
-    ))
+    progress(Progress::Finished);
+    Ok(Checked {
+        report: c.finish(),
+        source: format!("quadctl motion {}", law.name()),
+        robot: args.params.robot.clone(),
+        duration_s: Some(duration),
+        rate_hz: Some(rate),
+    })
 }
 
-fn check_file(args: &Args, file: &Path, limits: [f32; 3]) -> Result<(Report, Source), Error> {
-    if let Some(opt) = args.law_args.law_option_given() {
-        return Err(Error::NotApplicable {
+fn check_file(args: &Request, file: &Path) -> Result<Checked, Error> {
+    let limits = args.max_joint_speed_rad_s;
+    if let Some(opt) = args.params.law_option_given() {
+        return Err(motion::Error::NotApplicable {
             option: opt,
             law: "a motion file",
-        });
+        }
+        .into());
     }
     if args.duration_s.is_some() || args.rate_hz.is_some() {
-        return Err(Error::NotApplicable {
+        return Err(motion::Error::NotApplicable {
             option: "--duration-s/--rate-hz",
             law: "a motion file",
-        });
+        }
+        .into());
     }
-    let robot = crate::robot_file::resolve(&args.law_args.robot.robot).map_err(Error::Robot)?;
+    let robot = robot_file::resolve(&args.params.robot)?;
     let mut csv = MotionCsv::open(file)?;
     let order: RotationOrder = args
-        .law_args
+        .params
         .rotation_order
-        .map(Order::into)
         .or(csv.rotation_order)
         .unwrap_or_default();
     let config = BodyConfig {
@@ -236,13 +236,10 @@ fn check_file(args: &Args, file: &Path, limits: [f32; 3]) -> Result<(Report, Sou
                     .split_once(':')
                     .and_then(|(leg, code)| Some((LegId::parse(leg)?, unreachable_code(code)?)));
                 let Some(failure) = parsed else {
-                    return Err(Error::Csv {
-                        at: format!("{}:{}", file.display(), row.line),
-                        message: format!(
-                            "status `{}` without angles, feet and pose: expected `<leg>:<reason>` \
-                             (too_far, too_close, inside_offset, non_finite, joint_limit (<joint>))",
-                            row.status
-                        ),
+                    return Err(Error::Status {
+                        input: file.display().to_string(),
+                        line: row.line,
+                        status: row.status,
                     });
                 };
                 c.push_unreachable(t, &[failure]);
@@ -257,15 +254,13 @@ fn check_file(args: &Args, file: &Path, limits: [f32; 3]) -> Result<(Report, Sou
         ),
         _ => (None, None),
     };
-    Ok((
+    Ok(Checked {
         report,
-        Source {
-            label: file.display().to_string(),
-            robot: args.law_args.robot.robot.clone(),
-            duration_s,
-            rate_hz,
-        },
-    ))
+        source: file.display().to_string(),
+        robot: args.params.robot.clone(),
+        duration_s,
+        rate_hz,
+    })
 }
 
 fn at(e: &Option<Extremum>, unit: &str, deg: bool) -> String {
@@ -282,13 +277,14 @@ fn at(e: &Option<Extremum>, unit: &str, deg: bool) -> String {
 }
 
 /// The human-readable report.
-fn table(r: &Report, s: &Source) -> String {
+pub fn table(checked: &Checked) -> String {
+    let (r, s) = (&checked.report, checked);
     use std::fmt::Write as _;
     let mut out = String::new();
     let _ = writeln!(
         out,
         "preflight: {} (robot {}), {} samples{}",
-        s.label,
+        s.source,
         s.robot,
         r.samples,
         match (s.duration_s, s.rate_hz) {
@@ -370,7 +366,6 @@ fn table(r: &Report, s: &Source) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use kin_core::preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S;
 
     #[test]
     fn status_reasons_parse_or_are_refused() {
@@ -381,14 +376,5 @@ mod tests {
         );
         assert_eq!(unreachable_code("joint_limit"), None);
         assert_eq!(unreachable_code("tired"), None);
-    }
-
-    #[test]
-    fn the_default_speed_limit_is_kin_cores() {
-        let default: f32 = "6".parse().unwrap();
-        assert_eq!(default, DEFAULT_MAX_JOINT_SPEED_RAD_S);
-        assert_eq!(speed_limits("1,2,3").unwrap(), [1.0, 2.0, 3.0]);
-        assert_eq!(speed_limits("4").unwrap(), [4.0; 3]);
-        assert!(speed_limits("1,2").is_err() && speed_limits("x").is_err());
     }
 }

@@ -1,12 +1,10 @@
-//! `quadctl motion`: sample a motion law (seed 001's sways and yaw turn, seed 000's foot path,
-//! trot / walk) into a CSV of joint angles, feet and body pose; optional plot.
-//!
-//! Also the motion CSV format shared with `check` and `plot`: [`header`], [`MotionCsv`].
+//! Motions sampled into the motion CSV ([`crate::csv::motion`]): the laws of both papers (seed
+//! 001's sways and yaw turn, seed 000's foot paths, trot / walk), their parameters and their
+//! validation, and [`run`], the operation behind `quadctl motion`.
 
-use super::pose::Order;
-use super::RobotArgs;
+use crate::csv::motion::{header, push_num, Output};
 use crate::plot::{self, JointSeries};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use crate::{csv, robot_file};
 use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{
     self, Axis, LegPaths, LegPathsParams, Sway, SwayParams, YawTurn, YawTurnParams,
@@ -14,14 +12,12 @@ use kin_core::motion::laws::{
 use kin_core::motion::path::{AnyPath, PathKind, Rectangle, Stride};
 use kin_core::motion::{self, AnyMotion, Motion};
 use kin_core::preflight::Sweep;
-use kin_core::{body, LegId, Pose, ReachPolicy, Robot, RotationOrder, Vec3};
-use std::fmt;
-use std::io::{self, BufRead, IsTerminal, Write};
+use kin_core::{body, ReachPolicy, Robot, RotationOrder, Vec3};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 /// The motion laws.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Law {
     /// Seed 001 eq. 6: roll θ(t) = θ0 + A·sin(2πt/T), feet fixed.
     RollSway,
@@ -40,6 +36,17 @@ pub enum Law {
 }
 
 impl Law {
+    /// Every law, in the order of the command line's help.
+    pub const ALL: [Law; 7] = [
+        Law::RollSway,
+        Law::PitchSway,
+        Law::YawSway,
+        Law::YawTurn,
+        Law::RectPath,
+        Law::Trot,
+        Law::Walk,
+    ];
+
     /// The name on the command line.
     pub fn name(self) -> &'static str {
         match self {
@@ -52,212 +59,83 @@ impl Law {
             Law::Walk => "walk",
         }
     }
-}
 
-/// `--path`: the foot path shape.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum PathArg {
-    /// Lift, stride, lower, return (seed 000 Fig. 8).
-    Rectangle,
-    /// Semicircle of diameter the stride (its height is stride/2).
-    Semicircle,
-    /// Half ellipse.
-    Ellipse,
-    /// Cycloid (zero velocity at lift-off and touch-down).
-    Cycloid,
-    /// Quintic Bézier, C1 with the stance.
-    Bezier,
-}
-
-impl From<PathArg> for PathKind {
-    fn from(p: PathArg) -> PathKind {
-        match p {
-            PathArg::Rectangle => PathKind::Rectangle,
-            PathArg::Semicircle => PathKind::Semicircle,
-            PathArg::Ellipse => PathKind::Ellipse,
-            PathArg::Cycloid => PathKind::Cycloid,
-            PathArg::Bezier => PathKind::Bezier,
-        }
+    /// The law named `name` ([`Law::name`]).
+    pub fn parse(name: &str) -> Option<Law> {
+        Law::ALL.into_iter().find(|l| l.name() == name)
     }
 }
 
-/// The law and its parameters, shared by `motion` and `check --motion`. Every parameter is
-/// optional; the defaults are the papers' (see `quadctl motion --help`).
-#[derive(Debug, Clone, PartialEq, clap::Args)]
-pub struct LawArgs {
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub robot: RobotArgs,
-    /// Stance height H (m): feet straight below the hips, H below them. Default: seed 001's
-    /// initial pose (φ=120°, α=60°, β=0) through forward kinematics (0.9294 m for
-    /// fernando2025); rect-path: 0.2 m (seed 000 Fig. 8).
-    #[arg(long, value_name = "M")]
+/// A law's parameters, every one optional: the defaults are the papers' (see `quadctl motion
+/// --help`). Units in the names; the body pose's rotation order as kin-core's.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Params {
+    /// Robot: a preset name or a TOML robot file ([`robot_file::resolve`]).
+    pub robot: String,
+    /// Stance height H, m.
     pub stance_height_m: Option<f32>,
-    /// Rotation order of the body pose [default: zxy for the sways and yaw-turn (seed 001),
-    /// zyx otherwise].
-    #[arg(long, value_enum)]
-    pub rotation_order: Option<Order>,
-    /// Sways: amplitude A, rad [default: 0.2].
-    #[arg(long, value_name = "RAD")]
+    /// Rotation order of the body pose.
+    pub rotation_order: Option<RotationOrder>,
+    /// Sways: amplitude A, rad.
     pub amplitude_rad: Option<f32>,
-    /// Sways: period T, s [default: 20].
-    #[arg(long, value_name = "S")]
+    /// Sways: period T, s.
     pub period_s: Option<f32>,
-    /// yaw-turn: ω_z, rad/s; positive turns clockwise seen from above [default: 0.085].
-    #[arg(long, value_name = "RAD_S")]
+    /// yaw-turn: ω_z, rad/s.
     pub omega_rad_s: Option<f32>,
-    /// yaw-turn: step period T1, s [default: 6].
-    #[arg(long, value_name = "S")]
+    /// yaw-turn: step period T1, s.
     pub step_period_s: Option<f32>,
-    /// yaw-turn: lift height h_K, m [default: 0.3].
-    #[arg(long, value_name = "M")]
+    /// yaw-turn: lift height h_K, m.
     pub lift_height_m: Option<f32>,
-    /// rect-path: path shape [default: rectangle]; trot/walk: swing shape [default: bezier].
-    #[arg(long, value_enum)]
-    pub path: Option<PathArg>,
-    /// rect-path: stride length, m [default: 0.1].
-    #[arg(long, value_name = "M")]
+    /// rect-path: path shape; trot/walk: swing shape.
+    pub path: Option<PathKind>,
+    /// rect-path: stride length, m.
     pub stride_m: Option<f32>,
-    /// rect-path, trot, walk: swing apex above the ground, m [default: rect-path 0.05,
-    /// gaits 0.15·H].
-    #[arg(long, value_name = "M")]
+    /// rect-path, trot, walk: swing apex above the ground, m.
     pub step_height_m: Option<f32>,
-    /// rect-path, trot, walk: stance fraction of the cycle, in (0, 1) [default: rectangle 1/3
-    /// (one speed round the loop), other paths 0.5; trot 0.5, walk 0.75].
-    #[arg(long, value_name = "D")]
+    /// rect-path, trot, walk: stance fraction of the cycle.
     pub duty_factor: Option<f32>,
-    /// rect-path, trot, walk: cycle time, s [default: rect-path 3, gaits 0.8].
-    #[arg(long, value_name = "S")]
+    /// rect-path, trot, walk: cycle time, s.
     pub cycle_s: Option<f32>,
-    /// trot, walk: forward speed, m/s [default: 0].
-    #[arg(long, value_name = "M_S")]
+    /// trot, walk: forward speed, m/s.
     pub forward_m_s: Option<f32>,
-    /// trot, walk: lateral speed (left positive), m/s [default: 0].
-    #[arg(long, value_name = "M_S")]
+    /// trot, walk: lateral speed (left positive), m/s.
     pub lateral_m_s: Option<f32>,
-    /// trot, walk: yaw rate (counter-clockwise positive), rad/s [default: 0].
-    #[arg(long, value_name = "RAD_S")]
+    /// trot, walk: yaw rate (counter-clockwise positive), rad/s.
     pub yaw_rad_s: Option<f32>,
 }
 
-/// Arguments of `quadctl motion`.
-#[derive(Debug, Clone, PartialEq, clap::Args)]
-#[command(
-    about = "Sample a motion law into CSV: t, 12 joint angles, 4 feet, body pose, status",
-    long_about = LONG_ABOUT,
-    allow_negative_numbers = true
-)]
-pub struct Args {
-    /// The motion law.
-    #[arg(value_enum)]
-    pub law: Law,
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub law_args: LawArgs,
-    /// Duration, s (samples at 0, 1/F, …, up to T).
-    #[arg(long, value_name = "T")]
-    pub duration_s: f32,
-    /// Sampling rate, Hz.
-    #[arg(long, value_name = "F")]
-    pub rate_hz: f32,
-    /// Output CSV file (written to a temporary file and renamed when complete); default stdout.
-    #[arg(long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
-    /// Also draw the joint angles over time (.svg or .png).
-    #[arg(long, value_name = "FILE.svg")]
-    pub plot: Option<PathBuf>,
-}
-
-const LONG_ABOUT: &str = "\
-Sample a motion law at a fixed rate and write one CSV row per sample.
-
-Laws (defaults are the papers' values; seed 001's laws with --robot fernando2025 reproduce its
-Fig. 4-6):
-  roll-sway   seed 001 eq. 6: roll(t) = A·sin(2πt/T), feet fixed on the ground (eq. 7)
-  pitch-sway  seed 001 eq. 8: pitch(t) = A·sin(2πt/T), feet fixed
-  yaw-sway    yaw(t) = A·sin(2πt/T), feet fixed
-              (A = 0.2 rad, T = 20 s, body centre fixed, rotation order zxy)
-  yaw-turn    seed 001 eq. 9-11, corrected (docs/papers.md): yaw(t) = −ω_z·t; the crossed pairs
-              (FL, RR) and (FR, RL) step alternately along the circles of their feet with a
-              half-wave sine lift (ω_z = 0.085 rad/s, T1 = 6 s, h_K = 0.3 m)
-  rect-path   seed 000 §3.2 Fig. 8: each foot runs a closed path under a held body (rectangle:
-              stride 0.1 m, lift 0.05 m at stance height 0.2 m, 3 s per loop)
-  trot, walk  gait driven by --forward-m-s, --lateral-m-s, --yaw-rad-s (stance feet fixed in
-              the world, Bezier swing by default)
-
-Frames and units: world frame = body frame of the nominal pose (x forward, y left, z up, origin
-at the body centre); the ground is z = −H. Metres, radians, seconds.
-
-Output columns: t_s; FL_abduction_rad, FL_hip_rad, FL_knee_rad, then FR, RL, RR likewise (the
-canonical convention, all zero = leg straight down); FL_x_m, FL_y_m, FL_z_m, … RR_z_m (feet in
-the world frame); roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m (body pose, feed to `quadctl
-stream`); status: `ok`, or `<leg>:<reason>` for the first leg that cannot reach (its angle cells
-are then all empty).
-
-Bad parameters (negative durations or periods, zero rates, NaN, a step or lift height beyond
-reach, options that do not apply to the law) are refused before anything is written, naming the
-option; exit status 2. With --output, the file appears only when complete. Exit status 1 when
-some samples are unreachable (the file is complete and says which).";
-
-/// Errors of the motion commands.
-#[derive(Debug)]
+/// Errors of the motion operations (`motion`, `check`, `plot`, `accuracy`).
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// `--robot` could not be resolved.
-    Robot(crate::robot_file::LoadError),
+    /// The robot could not be resolved.
+    #[error(transparent)]
+    Robot(#[from] robot_file::Error),
     /// A law parameter was refused by kin-core (its name mapped to the option).
+    #[error("invalid {option}: {source}")]
     Parameter {
         /// The option.
         option: String,
         /// kin-core's error.
         source: motion::Error,
     },
-    /// An option that the chosen law does not use.
+    /// An option that the chosen law (or source) does not use.
+    #[error("{option} does not apply to {law}")]
     NotApplicable {
         /// The option.
         option: &'static str,
-        /// The law.
+        /// The law or source.
         law: &'static str,
     },
-    /// Reading or writing a file failed.
-    Io {
-        /// What was being done.
-        context: String,
-        /// The I/O error.
-        source: io::Error,
-    },
-    /// A motion CSV could not be read.
-    Csv {
-        /// File and line.
-        at: String,
-        /// What is wrong.
-        message: String,
-    },
+    /// A CSV could not be read or written.
+    #[error(transparent)]
+    Csv(#[from] csv::Error),
     /// Drawing failed.
-    Plot(plot::PlotError),
-}
-
-impl fmt::Display for Error {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Error::Robot(e) => write!(f, "{e}"),
-            Error::Parameter { option, source } => write!(f, "invalid {option}: {source}"),
-            Error::NotApplicable { option, law } => {
-                write!(f, "{option} does not apply to {law}")
-            }
-            Error::Io { context, source } => write!(f, "{context}: {source}"),
-            Error::Csv { at, message } => write!(f, "{at}: {message}"),
-            Error::Plot(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-impl std::error::Error for Error {}
-
-impl From<plot::PlotError> for Error {
-    fn from(e: plot::PlotError) -> Self {
-        Error::Plot(e)
-    }
+    #[error(transparent)]
+    Plot(#[from] plot::Error),
+    /// A time to draw that is not finite.
+    #[error("--at-s: {0} is not a finite time")]
+    NotFiniteTime(f64),
 }
 
 /// The command-line option of a kin-core parameter name.
@@ -287,7 +165,7 @@ pub fn param_err(e: motion::Error) -> Error {
     }
 }
 
-impl LawArgs {
+impl Params {
     /// The first law option given (all but `--robot` and `--rotation-order`), if any.
     pub fn law_option_given(&self) -> Option<&'static str> {
         [
@@ -377,8 +255,8 @@ impl LawArgs {
     /// Builds and validates the motion.
     pub fn build(&self, law: Law) -> Result<AnyMotion, Error> {
         self.check_applicable(law)?;
-        let robot = crate::robot_file::resolve(&self.robot.robot).map_err(Error::Robot)?;
-        let order = |default: RotationOrder| self.rotation_order.map_or(default, Into::into);
+        let robot = robot_file::resolve(&self.robot)?;
+        let order = |default: RotationOrder| self.rotation_order.unwrap_or(default);
         Ok(match law {
             Law::RollSway | Law::PitchSway | Law::YawSway => {
                 let axis = match law {
@@ -415,7 +293,7 @@ impl LawArgs {
                 AnyMotion::YawTurn(YawTurn::new(p).map_err(param_err)?)
             }
             Law::RectPath => {
-                let kind: PathKind = self.path.map_or(PathKind::Rectangle, Into::into);
+                let kind = self.path.unwrap_or(PathKind::Rectangle);
                 let seed = Rectangle::seed000().stride();
                 let default_duty = if kind == PathKind::Rectangle {
                     seed.duty_factor()
@@ -457,7 +335,7 @@ impl LawArgs {
                     p.step_height_m = v;
                 }
                 if let Some(k) = self.path {
-                    p.swing = k.into();
+                    p.swing = k;
                 }
                 p.velocity = Velocity {
                     forward_m_s: self.forward_m_s.unwrap_or(0.0),
@@ -475,119 +353,15 @@ pub fn sweep(duration_s: f32, rate_hz: f32) -> Result<Sweep, Error> {
     Sweep::new(0.0, duration_s, rate_hz).map_err(param_err)
 }
 
-/// The CSV header of a motion.
-pub fn header() -> String {
-    let mut cols = vec!["t_s".to_owned()];
-    for leg in LegId::ALL {
-        for j in ["abduction", "hip", "knee"] {
-            cols.push(format!("{leg}_{j}_rad"));
-        }
-    }
-    for leg in LegId::ALL {
-        for a in ["x", "y", "z"] {
-            cols.push(format!("{leg}_{a}_m"));
-        }
-    }
-    for c in [
-        "roll_rad",
-        "pitch_rad",
-        "yaw_rad",
-        "x_m",
-        "y_m",
-        "z_m",
-        "status",
-    ] {
-        cols.push(c.to_owned());
-    }
-    cols.join(",")
-}
-
-/// A progress bar on stderr when it is a terminal, hidden otherwise.
-pub fn progress(len: u64, what: &str) -> ProgressBar {
-    if !io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} samples ({per_sec}, {eta})")
-    {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message(what.to_owned());
-    bar
-}
-
-/// Pushes `v` as the shortest decimal that reads back to the same f32 (`ryu`; `-0` as `0`).
-fn push_num(line: &mut String, buf: &mut ryu::Buffer, v: f32) {
-    if v == 0.0 {
-        line.push('0');
-    } else {
-        line.push_str(buf.format(v));
-    }
-}
-
-/// Where the rows go: a temporary file renamed on success, or stdout.
-struct Sink {
-    out: Box<dyn Write>,
-    temp: Option<(PathBuf, PathBuf)>,
-}
-
-impl Sink {
-    fn open(output: Option<&Path>) -> Result<Sink, Error> {
-        let Some(path) = output else {
-            return Ok(Sink {
-                out: Box::new(io::BufWriter::with_capacity(1 << 20, io::stdout())),
-                temp: None,
-            });
-        };
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "motion".to_owned());
-        let temp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-        let file = std::fs::File::create(&temp).map_err(|source| Error::Io {
-            context: format!("cannot create `{}`", temp.display()),
-            source,
-        })?;
-        Ok(Sink {
-            out: Box::new(io::BufWriter::with_capacity(1 << 20, file)),
-            temp: Some((temp, path.to_owned())),
-        })
-    }
-
-    /// Flushes and renames into place.
-    fn commit(mut self) -> Result<(), Error> {
-        let flushed = self.out.flush();
-        let temp = self.temp.take();
-        drop(self.out);
-        match (flushed, temp) {
-            (Ok(()), Some((temp, path))) => std::fs::rename(&temp, &path).map_err(|source| {
-                let _ = std::fs::remove_file(&temp);
-                Error::Io {
-                    context: format!("cannot write `{}`", path.display()),
-                    source,
-                }
-            }),
-            (Ok(()), None) => Ok(()),
-            (Err(source), temp) => {
-                if let Some((temp, _)) = temp {
-                    let _ = std::fs::remove_file(temp);
-                }
-                Err(Error::Io {
-                    context: "cannot write the output".to_owned(),
-                    source,
-                })
-            }
-        }
-    }
-
-    /// Removes the temporary file.
-    fn abandon(self) {
-        if let Some((temp, _)) = self.temp {
-            drop(self.out);
-            let _ = std::fs::remove_file(temp);
-        }
-    }
+/// How far a long operation is, for a progress bar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Progress {
+    /// It starts; this many samples to go.
+    Start(u64),
+    /// This many samples done.
+    Done(u64),
+    /// It ended (successfully or not).
+    Finished,
 }
 
 /// Outcome of a written motion.
@@ -603,7 +377,10 @@ pub struct Written {
 
 /// Samples `m` over `sweep` into `out` as CSV, after a `# quadctl motion …` comment line
 /// naming `law`, `robot` and the rotation order; keeps a decimated series for plotting when
-/// `series` is given. `bar` advances per sample.
+/// `series` is given. `progress` is told the samples done, every 4096 and at the end.
+///
+/// # Errors
+/// [`Error::Csv`] when writing fails, [`Error::Parameter`] when the motion refuses a time.
 pub fn write_motion<T: Motion>(
     m: &T,
     sweep: &Sweep,
@@ -611,12 +388,9 @@ pub fn write_motion<T: Motion>(
     robot: &str,
     out: &mut dyn Write,
     mut series: Option<&mut JointSeries>,
-    bar: &ProgressBar,
+    progress: &mut dyn FnMut(u64),
 ) -> Result<Written, Error> {
-    let io_err = |source| Error::Io {
-        context: "cannot write the output".to_owned(),
-        source,
-    };
+    let io_err = |source| Error::Csv(csv::Error::Write { path: None, source });
     writeln!(
         out,
         "# quadctl motion {law} robot={robot} rotation_order={} duration_s={} rate_hz={}",
@@ -686,75 +460,59 @@ pub fn write_motion<T: Motion>(
             }
         }
         if k % 4096 == 4095 {
-            bar.inc(4096);
+            progress(u64::from(k) + 1);
         }
         w.samples += 1;
     }
-    bar.set_position(u64::from(n));
+    progress(u64::from(n));
     Ok(w)
 }
 
-/// The exit status of a command that either succeeds ([`super::EXIT_OK`]) or fails: the error
-/// on stderr and [`super::EXIT_FATAL`].
-pub(super) fn exit_status(result: Result<(), Error>) -> ExitCode {
-    match result {
-        Ok(()) => ExitCode::from(super::EXIT_OK),
-        Err(e) => {
-            eprintln!("quadctl: error: {e}");
-            ExitCode::from(super::EXIT_FATAL)
-        }
-    }
+
+/// What [`run`] is asked to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    /// The law.
+    pub law: Law,
+    /// Its parameters.
+    pub params: Params,
+    /// Duration, s (samples at 0, 1/F, …, up to T).
+    pub duration_s: f32,
+    /// Sampling rate, Hz.
+    pub rate_hz: f32,
+    /// Output CSV file (a temporary file renamed when complete); `None`: stdout.
+    pub output: Option<PathBuf>,
+    /// Joint-angle plot (.svg or .png).
+    pub plot: Option<PathBuf>,
 }
 
-/// `quadctl motion`.
-pub fn run(args: &Args) -> ExitCode {
-    match run_inner(args) {
-        Ok(w) if w.unreachable == 0 => ExitCode::from(super::EXIT_OK),
-        Ok(w) => {
-            if let Some((t, e)) = w.first_unreachable {
-                eprintln!(
-                    "quadctl: {} of {} samples unreachable (first at t = {t} s: {e})",
-                    w.unreachable, w.samples
-                );
-            }
-            ExitCode::from(super::EXIT_MALFORMED)
-        }
-        Err(e) => {
-            eprintln!("quadctl: error: {e}");
-            ExitCode::from(super::EXIT_FATAL)
-        }
-    }
-}
-
-fn run_inner(args: &Args) -> Result<Written, Error> {
-    // Everything is validated before a file is created.
-    let m = args.law_args.build(args.law)?;
+/// Samples a law into a motion CSV (and a plot): everything is validated before a file is
+/// created, and the output file appears only when complete. `progress` follows the sampling.
+///
+/// # Errors
+/// Bad parameters, the robot, writing the CSV, drawing the plot.
+pub fn run(args: &Request, progress: &mut dyn FnMut(Progress)) -> Result<Written, Error> {
+    let m = args.params.build(args.law)?;
     let sw = sweep(args.duration_s, args.rate_hz)?;
     if let Some(p) = &args.plot {
         // Refuse a bad plot name before the long part.
-        if !matches!(
-            p.extension()
-                .and_then(|e| e.to_str())
-                .map(str::to_ascii_lowercase)
-                .as_deref(),
-            Some("svg" | "png")
-        ) {
-            return Err(plot::PlotError::Format(p.display().to_string()).into());
+        if !is_plot_name(p) {
+            return Err(plot::Error::Format(p.display().to_string()).into());
         }
     }
-    let mut sink = Sink::open(args.output.as_deref())?;
-    let bar = progress(u64::from(sw.samples()), args.law.name());
+    let mut sink = Output::open(args.output.as_deref())?;
+    progress(Progress::Start(u64::from(sw.samples())));
     let mut series = args.plot.as_ref().map(|_| JointSeries::default());
     let result = write_motion(
         &m,
         &sw,
         args.law.name(),
-        &args.law_args.robot.robot,
+        &args.params.robot,
         &mut sink.out,
         series.as_mut(),
-        &bar,
+        &mut |done| progress(Progress::Done(done)),
     );
-    bar.finish_and_clear();
+    progress(Progress::Finished);
     let written = match result {
         Ok(w) => w,
         Err(e) => {
@@ -767,215 +525,20 @@ fn run_inner(args: &Args) -> Result<Written, Error> {
         let title = format!(
             "quadctl motion {} — joint angles ({})",
             args.law.name(),
-            args.law_args.robot.robot
+            args.params.robot
         );
         plot::joint_angles(path, &title, series)?;
     }
     Ok(written)
 }
 
-/// One row of a motion CSV.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MotionRow {
-    /// 1-based line number.
-    pub line: usize,
-    /// Time, s.
-    pub t_s: f64,
-    /// The twelve angles, `None` when the row's status is not `ok`.
-    pub angles: Option<[f32; 12]>,
-    /// Feet in the world frame, when the file has them.
-    pub feet: Option<[Vec3; 4]>,
-    /// Body pose, when the file has it.
-    pub pose: Option<Pose>,
-    /// The status cell.
-    pub status: String,
-}
-
-/// Reader of motion CSVs (the format [`header`] describes; extra columns are ignored, the feet
-/// and pose columns are optional).
-pub struct MotionCsv {
-    /// The rotation order named by a `rotation_order=` token in a comment line before the
-    /// header (as `quadctl motion` writes it), if any.
-    pub rotation_order: Option<RotationOrder>,
-    name: String,
-    reader: Box<dyn BufRead>,
-    line: usize,
-    t: usize,
-    angles: [usize; 12],
-    feet: Option<[usize; 12]>,
-    pose: Option<[usize; 6]>,
-    status: usize,
-    buf: String,
-}
-
-impl MotionCsv {
-    /// Opens `path` (`-` for stdin) and reads its header.
-    pub fn open(path: &Path) -> Result<MotionCsv, Error> {
-        let input = crate::csv_io::Input::open(path).map_err(|e| Error::Csv {
-            at: path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        Self::from_input(input)
-    }
-
-    /// Reads the header of `input`.
-    pub fn from_input(input: crate::csv_io::Input) -> Result<MotionCsv, Error> {
-        let crate::csv_io::Input { name, mut reader } = input;
-        let mut buf = String::new();
-        let mut line = 0;
-        let mut rotation_order = None;
-        let header = loop {
-            buf.clear();
-            let n = reader.read_line(&mut buf).map_err(|source| Error::Io {
-                context: format!("cannot read `{name}`"),
-                source,
-            })?;
-            if n == 0 {
-                return Err(Error::Csv {
-                    at: name,
-                    message: "empty file: expected a header starting with t_s".to_owned(),
-                });
-            }
-            line += 1;
-            let t = buf.trim();
-            if let Some(comment) = t.strip_prefix('#') {
-                for token in comment.split_whitespace() {
-                    if let Some(o) = token.strip_prefix("rotation_order=") {
-                        rotation_order = RotationOrder::parse(o);
-                    }
-                }
-            } else if !t.is_empty() {
-                break t.to_owned();
-            }
-        };
-        let cols: Vec<&str> = header.split(',').map(str::trim).collect();
-        let at = |c: &str| cols.iter().position(|x| x.eq_ignore_ascii_case(c));
-        let need = |c: &str| {
-            at(c).ok_or_else(|| Error::Csv {
-                at: format!("{name}:{line}"),
-                message: format!(
-                    "header has no `{c}` column (expected the `quadctl motion` format)"
-                ),
-            })
-        };
-        let t = need("t_s")?;
-        let mut angles = [0usize; 12];
-        for leg in LegId::ALL {
-            for (j, jn) in ["abduction", "hip", "knee"].iter().enumerate() {
-                angles[3 * leg.index() + j] = need(&format!("{leg}_{jn}_rad"))?;
-            }
-        }
-        let status = need("status")?;
-        let mut feet = Some([0usize; 12]);
-        for leg in LegId::ALL {
-            for (a, an) in ["x", "y", "z"].iter().enumerate() {
-                match (at(&format!("{leg}_{an}_m")), feet.as_mut()) {
-                    (Some(i), Some(f)) => f[3 * leg.index() + a] = i,
-                    _ => feet = None,
-                }
-            }
-        }
-        let mut pose = Some([0usize; 6]);
-        for (i, c) in ["roll_rad", "pitch_rad", "yaw_rad", "x_m", "y_m", "z_m"]
-            .iter()
-            .enumerate()
-        {
-            match (at(c), pose.as_mut()) {
-                (Some(k), Some(p)) => p[i] = k,
-                _ => pose = None,
-            }
-        }
-        Ok(MotionCsv {
-            rotation_order,
-            name,
-            reader,
-            line,
-            t,
-            angles,
-            feet,
-            pose,
-            status,
-            buf,
-        })
-    }
-
-    /// The next row, `None` at the end.
-    pub fn next_row(&mut self) -> Result<Option<MotionRow>, Error> {
-        loop {
-            self.buf.clear();
-            let n = self
-                .reader
-                .read_line(&mut self.buf)
-                .map_err(|source| Error::Io {
-                    context: format!("cannot read `{}`", self.name),
-                    source,
-                })?;
-            if n == 0 {
-                return Ok(None);
-            }
-            self.line += 1;
-            let text = self.buf.trim();
-            if text.is_empty() || text.starts_with('#') {
-                continue;
-            }
-            let fields: Vec<&str> = text.split(',').map(str::trim).collect();
-            let at = format!("{}:{}", self.name, self.line);
-            let get = |i: usize| -> Result<&str, Error> {
-                fields.get(i).copied().ok_or_else(|| Error::Csv {
-                    at: at.clone(),
-                    message: format!("expected at least {} fields, found {}", i + 1, fields.len()),
-                })
-            };
-            let num = |i: usize| -> Result<f32, Error> {
-                let s = get(i)?;
-                s.parse::<f32>().map_err(|_| Error::Csv {
-                    at: at.clone(),
-                    message: format!("field {}: `{s}` is not a number", i + 1),
-                })
-            };
-            let status = get(self.status)?.to_owned();
-            let t_s: f64 = get(self.t)?.parse().map_err(|_| Error::Csv {
-                at: at.clone(),
-                message: format!("field {}: t_s is not a number", self.t + 1),
-            })?;
-            let angles = if status == "ok" {
-                let mut a = [0.0f32; 12];
-                for (slot, &i) in a.iter_mut().zip(&self.angles) {
-                    *slot = num(i)?;
-                }
-                Some(a)
-            } else {
-                None
-            };
-            let feet = match self.feet {
-                Some(idx) => {
-                    let mut f = [Vec3::ZERO; 4];
-                    for (l, foot) in f.iter_mut().enumerate() {
-                        *foot =
-                            Vec3::new(num(idx[3 * l])?, num(idx[3 * l + 1])?, num(idx[3 * l + 2])?);
-                    }
-                    Some(f)
-                }
-                None => None,
-            };
-            let pose = match self.pose {
-                Some(idx) => {
-                    let mut v = [0.0f32; 6];
-                    for (slot, &i) in v.iter_mut().zip(&idx) {
-                        *slot = num(i)?;
-                    }
-                    Some(Pose::from_array(v))
-                }
-                None => None,
-            };
-            return Ok(Some(MotionRow {
-                line: self.line,
-                t_s,
-                angles,
-                feet,
-                pose,
-                status,
-            }));
-        }
-    }
+/// True for a `.svg` or `.png` file name (any case).
+fn is_plot_name(p: &Path) -> bool {
+    matches!(
+        p.extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref(),
+        Some("svg" | "png")
+    )
 }

@@ -1,342 +1,145 @@
-//! `quadctl stream`: body poses to the device, simulated (`--sim`) or real (`--port`), every
-//! answer checked against the host's own kin-core; a JSON summary as the last line of stdout.
+//! Body poses from a CSV to the device, every answer checked against the host's own kin-core:
+//! the operation behind `quadctl stream`. Its summary is one JSON object ([`Summary`]).
 
-use super::pose::{self, Order};
-use super::{InputArgs, RobotArgs, EXIT_FATAL, EXIT_MALFORMED, EXIT_OK};
 use crate::client::{
-    AngleCheck, Client, ClientConfig, ClientError, PoseResult, PoseStream, StreamSetup,
-    AVR_ANGLE_TOLERANCE_RAD, DEFAULT_RETRIES,
+    AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, StreamStats,
 };
-use crate::csv_io::{self, AnswerError, Input};
-use crate::link::emulator::{EmulatorConfig, EmulatorLink};
-use crate::link::serial::SerialLink;
-use crate::link::sim::{SimConfig, SimLink, SimStorage, DEFAULT_RX_FIFO_LEN};
-use crate::link::{Faults, Link};
+use crate::csv::{self, AnswerError, FirstColumn, Input, Schema};
+use crate::link::{self, Link, Target};
+use crate::{client, robot_file};
 use kin_core::body::Pose;
-use quad_device::Config;
+use kin_core::RotationOrder;
 use quad_protocol::RobotPreset;
+use serde::Serialize;
 use std::cell::RefCell;
 use std::io::{self, Write};
 use std::path::PathBuf;
-use std::process::ExitCode;
-use std::time::Duration;
 
-/// Exit status when a readback disagreed with the host or a pulse left its travel.
-pub const EXIT_CHECK_FAILED: u8 = 3;
+/// The body-pose columns (`quadctl pose`'s input): rotation in rad, translation in m.
+pub const POSE_COLUMNS: Schema = Schema {
+    columns: &["roll_rad", "pitch_rad", "yaw_rad", "x_m", "y_m", "z_m"],
+    first: FirstColumn::Number,
+};
 
-const LONG_ABOUT: &str = "\
-Streams body poses to the device and checks every answer.
-
-Input: the CSV of `quadctl pose` (roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m: rotation in RADIANS,
-translation in METRES of the body relative to the world frame; feet held at the nominal stance).
-
-Target: --sim runs the device controller in-process behind a simulated UART with the timing of
-a real line at --baud (virtual time: nothing sleeps) and optional --faults; --emulator runs the
-real ATmega2560 firmware (built from firmware-avr/ if needed, or --elf PATH) in simavr
-in-process at 16 MHz, in simulated time, with the same --faults, and checks the pulses on its
-twelve servo pins; --port PATH talks to an Arduino Mega running the firmware.
-
-Each pose is sent as one SetBodyPose request and retried (same sequence number) on a timeout, on
-a nack of an unreadable frame, or when its answer fails the check: the device's 12 angles must
-equal the host's kin-core result (the same bits with --sim; within --angle-tolerance-rad with
---emulator and --port) and its 12 pulses the device calibration's mapping of those angles; an unreachable pose
-must be nacked with the host's own leg and reason. Nacked, lost and mismatching poses are reported
-on stderr as <input>:<line>: ...
-
-Output: the last line of stdout is one JSON object:
-{\"sent\",\"acked\",\"nacked\",\"retries\",\"lost\",\"readback_mismatches\",\"max_angle_err_rad\",
-\"pulses_out_of_range\",\"poses_per_s\", then transient_mismatches (answers a retry corrected),
-timeouts, elapsed_s (link time) and reenabled}; with --emulator also pulses_checked and
-pulse_width_errors: every pulse measured on the 12 servo pins compared with the readback in
-force when it started (the last one sent before it, or the next), an error when it differs by
-more than one 0.5 us timer tick. poses_per_s counts acked + nacked poses per second of link time
-(simulated time with --sim and --emulator).
-
-Exit status: 0 all poses answered or lost, every check passed; 1 malformed input records (the
-others were streamed); 2 nothing or not everything could be streamed (arguments, robot, input,
-link, firmware build, handshake); 3 a readback mismatch, a pulse out of its travel or a pulse
-width error on the pins.";
-
-/// Where the device is: `--sim`, `--emulator` or `--port`, and the line.
-#[derive(Debug, Clone, PartialEq, clap::Args)]
-pub struct TargetArgs {
-    /// Run against the device controller behind a simulated UART.
-    #[arg(long, conflicts_with_all = ["port", "emulator"], required_unless_present_any = ["port", "emulator"])]
-    pub sim: bool,
-    /// Run the real firmware in simavr (an emulated ATmega2560; simulated time).
-    #[arg(long, conflicts_with = "port")]
-    pub emulator: bool,
-    /// Firmware ELF for --emulator; default: built from firmware-avr/ for --baud (115200:
-    /// firmware.elf, 1000000: firmware-1mbaud.elf).
-    #[arg(long, value_name = "PATH", requires = "emulator")]
-    pub elf: Option<PathBuf>,
-    /// Serial port of a real device, e.g. /dev/ttyACM0.
-    #[arg(long, value_name = "PATH")]
-    pub port: Option<String>,
-    /// Line rate, bit/s (8N1).
-    #[arg(long, value_name = "B", default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(300..))]
-    pub baud: u32,
-    /// Line faults of --sim or --emulator: drop=P,flip=P (per byte), dup=P,trunc=P,stall=P (per
-    /// frame), stall_ms=MS.
-    #[arg(
-        long,
-        value_name = "drop=P,flip=P,dup=P,trunc=P",
-        conflicts_with = "port"
-    )]
-    pub faults: Option<Faults>,
-    /// Seed of the simulated faults.
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub seed: u64,
-    /// Modelled device time per answered frame in the simulation, µs (0: wire-limited).
-    #[arg(long, value_name = "US", default_value_t = 0.0, value_parser = parse_us, requires = "sim")]
-    pub sim_compute_us: f64,
-    /// EEPROM image file of the simulated or emulated device (read at power-on; written on
-    /// every change with --sim, at the end of the run with --emulator).
-    #[arg(long, value_name = "FILE", conflicts_with = "port")]
-    pub sim_storage: Option<PathBuf>,
-    /// Resends per request after the first attempt.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_RETRIES)]
+/// What [`run`] is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    /// The robot: a preset name (the device reports its preset and both sides must run the
+    /// same geometry).
+    pub robot: String,
+    /// The device.
+    pub target: Target,
+    /// Resends per pose after the first attempt.
     pub retries: u32,
-}
-
-fn parse_us(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && (0.0..=1e7).contains(&v) => Ok(v),
-        _ => Err(format!("`{s}` is not a time in µs within [0, 1e7]")),
-    }
-}
-
-/// The emulated device and where its EEPROM image is kept between runs.
-pub struct EmulatorTarget {
-    /// The link.
-    pub link: EmulatorLink,
-    /// EEPROM image file, written back when the target is dropped.
-    pub eeprom_file: Option<PathBuf>,
-}
-
-impl Drop for EmulatorTarget {
-    fn drop(&mut self) {
-        if let Some(path) = &self.eeprom_file {
-            let image = self.link.mcu_mut().eeprom();
-            if let Err(e) = std::fs::write(path, image) {
-                eprintln!("quadctl: cannot write {}: {e}", path.display());
-            }
-        }
-    }
-}
-
-/// Any link, opened.
-pub enum AnyLink {
-    /// The simulated UART.
-    Sim(Box<SimLink>),
-    /// The firmware in simavr.
-    Emulator(Box<EmulatorTarget>),
-    /// A serial port.
-    Serial(SerialLink),
-}
-
-impl AnyLink {
-    /// The emulator link, if this is one.
-    pub fn emulator(&mut self) -> Option<&mut EmulatorLink> {
-        match self {
-            AnyLink::Emulator(t) => Some(&mut t.link),
-            _ => None,
-        }
-    }
-
-    /// The angle check that suits the device: the same bits for the simulated controller
-    /// (the host's math), [`AVR_ANGLE_TOLERANCE_RAD`] for the ATmega2560's avr-libc math.
-    pub fn default_check(&self) -> AngleCheck {
-        match self {
-            AnyLink::Sim(_) => AngleCheck::Exact,
-            AnyLink::Emulator(_) | AnyLink::Serial(_) => {
-                AngleCheck::Within(AVR_ANGLE_TOLERANCE_RAD)
-            }
-        }
-    }
-}
-
-impl Link for AnyLink {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), crate::link::LinkError> {
-        match self {
-            AnyLink::Sim(l) => l.send(bytes),
-            AnyLink::Emulator(t) => t.link.send(bytes),
-            AnyLink::Serial(l) => l.send(bytes),
-        }
-    }
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, crate::link::LinkError> {
-        match self {
-            AnyLink::Sim(l) => l.recv(buf, timeout),
-            AnyLink::Emulator(t) => t.link.recv(buf, timeout),
-            AnyLink::Serial(l) => l.recv(buf, timeout),
-        }
-    }
-    fn now(&self) -> Duration {
-        match self {
-            AnyLink::Sim(l) => l.now(),
-            AnyLink::Emulator(t) => t.link.now(),
-            AnyLink::Serial(l) => l.now(),
-        }
-    }
-    fn baud(&self) -> u32 {
-        match self {
-            AnyLink::Sim(l) => l.baud(),
-            AnyLink::Emulator(t) => t.link.baud(),
-            AnyLink::Serial(l) => l.baud(),
-        }
-    }
-}
-
-impl TargetArgs {
-    /// Opens the link and the client configuration that suits it. `preset` is the robot of the
-    /// simulated device.
-    ///
-    /// # Errors
-    /// A message for the user.
-    pub fn open(&self, preset: RobotPreset) -> Result<(AnyLink, ClientConfig), String> {
-        let compute = Duration::from_secs_f64(self.sim_compute_us * 1e-6);
-        if let Some(path) = &self.port {
-            let link = SerialLink::open(path, self.baud).map_err(|e| e.to_string())?;
-            let config = ClientConfig {
-                retries: self.retries,
-                ..ClientConfig::serial()
-            };
-            return Ok((AnyLink::Serial(link), config));
-        }
-        if self.emulator {
-            let eeprom = match &self.sim_storage {
-                Some(path) => match std::fs::read(path) {
-                    Ok(b) => Some(b),
-                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-                    Err(e) => return Err(format!("cannot read {}: {e}", path.display())),
-                },
-                None => None,
-            };
-            let config = EmulatorConfig {
-                baud: self.baud,
-                faults: self.faults.unwrap_or(Faults::NONE),
-                seed: self.seed,
-                eeprom,
-            };
-            let link = match &self.elf {
-                Some(elf) => EmulatorLink::boot(elf, config),
-                None => EmulatorLink::boot_built(config),
-            }
-            .map_err(|e| e.to_string())?;
-            let client = ClientConfig {
-                retries: self.retries,
-                ..ClientConfig::emulator()
-            };
-            let target = EmulatorTarget {
-                link,
-                eeprom_file: self.sim_storage.clone(),
-            };
-            return Ok((AnyLink::Emulator(Box::new(target)), client));
-        }
-        let device = Config::for_preset(preset)
-            .ok_or("the simulated device needs a preset robot (shahriar2023 or fernando2025)")?;
-        let storage = match &self.sim_storage {
-            Some(path) => SimStorage::with_file(path.clone())
-                .map_err(|e| format!("cannot read {}: {e}", path.display()))?,
-            None => SimStorage::erased(),
-        };
-        let sim = SimConfig {
-            baud: self.baud,
-            faults: self.faults.unwrap_or(Faults::NONE),
-            seed: self.seed,
-            compute,
-            rx_fifo_len: DEFAULT_RX_FIFO_LEN,
-        };
-        let link = SimLink::new(sim, device, storage).map_err(|e| e.to_string())?;
-        let config = ClientConfig {
-            retries: self.retries,
-            ..ClientConfig::sim(compute)
-        };
-        Ok((AnyLink::Sim(Box::new(link)), config))
-    }
-}
-
-/// Arguments of `quadctl stream`.
-#[derive(Debug, Clone, PartialEq, clap::Args)]
-#[command(
-    about = "Stream body poses (rad, m) to the device (--sim or --port) and check every readback",
-    long_about = LONG_ABOUT
-)]
-pub struct Args {
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub robot: RobotArgs,
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub target: TargetArgs,
-    /// Stance height H set on the device, metres; default: the device's own.
-    #[arg(long, value_name = "H", value_parser = super::parse_positive_m)]
+    /// Stance height H set on the device, m; `None`: the device's own.
     pub stance_height_m: Option<f32>,
-    /// Rotation order set on the device; default: the device's own.
-    #[arg(long, value_enum)]
-    pub rotation_order: Option<Order>,
-    /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
-    /// exact with --sim, 5e-5 rad with --emulator and --port (the AVR's math differs from the
-    /// host's).
-    #[arg(long, value_name = "RAD")]
+    /// Rotation order set on the device; `None`: the device's own.
+    pub rotation_order: Option<RotationOrder>,
+    /// Compare angles within this bound (rad); `None`: [`AngleCheck::for_target`].
     pub angle_tolerance_rad: Option<f32>,
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub input: InputArgs,
+    /// The poses, CSV (`-`: stdin).
+    pub input: PathBuf,
 }
 
-/// Runs `quadctl stream` and returns its exit status.
-pub fn main(args: &Args) -> ExitCode {
-    let stdout = io::stdout();
-    let mut out = stdout.lock();
-    let stderr = io::stderr();
-    let mut diag = stderr.lock();
-    match run(args, &mut out, &mut diag) {
-        Ok(code) => ExitCode::from(code),
-        Err(message) => {
-            let _ = writeln!(diag, "quadctl: error: {message}");
-            ExitCode::from(EXIT_FATAL)
-        }
+/// Why nothing or not everything could be streamed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The robot is not a preset.
+    #[error(
+        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
+         device reports its preset and both sides must run the same geometry"
+    )]
+    NotAPreset(String),
+    /// The robot could not be resolved.
+    #[error(transparent)]
+    Robot(#[from] robot_file::Error),
+    /// The input could not be read, or the output written.
+    #[error(transparent)]
+    Csv(#[from] csv::Error),
+    /// The link could not be opened.
+    #[error(transparent)]
+    Link(#[from] link::Error),
+    /// The handshake or the link failed.
+    #[error(transparent)]
+    Client(#[from] client::Error),
+    /// A negative or non-finite angle tolerance.
+    #[error("--angle-tolerance-rad {0} must be finite and >= 0")]
+    Tolerance(f32),
+}
+
+/// The pin check of the emulator, in the summary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Pins {
+    /// Pulses measured on the 12 servo pins and compared with the readbacks.
+    pub pulses_checked: u64,
+    /// Pulses off their readback by more than one 0.5 µs timer tick.
+    pub pulse_width_errors: u64,
+}
+
+/// `quadctl stream`'s JSON summary: the stream's statistics, then the pin check with
+/// `--emulator`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Summary {
+    /// The stream.
+    #[serde(flatten)]
+    pub stream: StreamStats,
+    /// The pins, on the emulator.
+    #[serde(flatten)]
+    pub pins: Option<Pins>,
+}
+
+impl Summary {
+    /// True when a readback disagreed with the host, a pulse left its travel or a pulse on
+    /// the pins matched no readback.
+    pub fn check_failed(&self) -> bool {
+        self.stream.readback_mismatches > 0
+            || self.stream.pulses_out_of_range > 0
+            || self.pins.is_some_and(|p| p.pulse_width_errors > 0)
     }
 }
 
-/// Runs the stream, writing the JSON summary to `out` and the per-pose reports to `diag`;
-/// returns the exit status, or a message when nothing or not everything could be streamed.
+/// How a stream ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outcome {
+    /// The summary.
+    pub summary: Summary,
+    /// Malformed input records (reported, not streamed).
+    pub malformed: usize,
+}
+
+/// Streams the poses of `args.input`, reporting malformed records and every pose that was
+/// nacked, lost or mismatched on `diag` as `<input>:<line>: …`.
 ///
 /// # Errors
-/// A message for the user.
-pub fn run(args: &Args, out: &mut dyn Write, diag: &mut dyn Write) -> Result<u8, String> {
-    let preset = RobotPreset::from_name(args.robot.robot.trim()).ok_or_else(|| {
-        format!(
-            "--robot {}: the device link needs a preset robot (shahriar2023, fernando2025): the \
-             device reports its preset and both sides must run the same geometry",
-            args.robot.robot
-        )
-    })?;
-    let robot = args.robot.load(None).map_err(|e| e.to_string())?;
-    let input = Input::open(&args.input.input).map_err(|e| e.to_string())?;
-    let (link, config) = args.target.open(preset)?;
+/// See [`Error`]; a link failure in the middle stops the stream.
+pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
+    let preset = RobotPreset::from_name(args.robot.trim())
+        .ok_or_else(|| Error::NotAPreset(args.robot.clone()))?;
+    let robot = robot_file::resolve(&args.robot)?;
+    let input = Input::open(&args.input)?;
+    let link = link::open(&args.target)?;
     let check = match args.angle_tolerance_rad {
         Some(t) if t.is_finite() && t >= 0.0 => AngleCheck::Within(t),
-        Some(t) => return Err(format!("--angle-tolerance-rad {t} must be finite and >= 0")),
-        None => link.default_check(),
+        Some(t) => return Err(Error::Tolerance(t)),
+        None => AngleCheck::for_target(&args.target),
     };
     let setup = StreamSetup {
         robot,
         preset,
         stance_height_m: args.stance_height_m,
-        order: args.rotation_order.map(Into::into),
+        order: args.rotation_order,
         check,
     };
-    let mut stream =
-        PoseStream::connect(Client::new(link, config), setup).map_err(|e| e.to_string())?;
+    let config = ClientConfig::for_target(&args.target, args.retries);
+    let mut stream = PoseStream::connect(Client::new(link, config), setup)?;
     let name = input.name.clone();
-    let mut failure: Option<ClientError> = None;
+    let mut failure: Option<client::Error> = None;
     // Malformed records (reported by `for_each_row`) and pose reports share `diag`, in order.
     let diag = RefCell::new(diag);
-    let summary = csv_io::for_each_row(
+    let rows = csv::for_each_row(
         input,
-        pose::INPUT,
+        POSE_COLUMNS,
         &mut io::sink(),
         &mut Shared(&diag),
         None,
@@ -368,37 +171,28 @@ pub fn run(args: &Args, out: &mut dyn Write, diag: &mut dyn Write) -> Result<u8,
         },
     );
     if let Some(e) = failure {
-        return Err(e.to_string());
+        return Err(e.into());
     }
-    let summary = summary.map_err(|e| e.to_string())?;
-    let stats = stream.stats();
-    let mut json = serde_json::to_string(&stats).map_err(|e| e.to_string())?;
-    let mut pulse_errors = 0;
+    let rows = rows?;
+    let mut pins = None;
     if let Some(emu) = stream.client_mut().link_mut().emulator() {
         let pulses = emu.pulse_stats();
-        pulse_errors = pulses.errors;
         if let Some(e) = &pulses.first_error {
             writeln!(diag.borrow_mut(), "{name}: PULSE WIDTH ERROR: {e}")
-                .map_err(|e| e.to_string())?;
+                .map_err(|source| csv::Error::Write { path: None, source })?;
         }
-        // Appended after the stream's own fields, which keep their order.
-        json.pop();
-        json.push_str(&format!(
-            ",\"pulses_checked\":{},\"pulse_width_errors\":{}}}",
-            pulses.checked, pulses.errors
-        ));
+        pins = Some(Pins {
+            pulses_checked: pulses.checked,
+            pulse_width_errors: pulses.errors,
+        });
     }
-    writeln!(out, "{json}").map_err(|e| e.to_string())?;
-    out.flush().map_err(|e| e.to_string())?;
-    Ok(
-        if stats.readback_mismatches > 0 || stats.pulses_out_of_range > 0 || pulse_errors > 0 {
-            EXIT_CHECK_FAILED
-        } else if summary.malformed > 0 {
-            EXIT_MALFORMED
-        } else {
-            EXIT_OK
+    Ok(Outcome {
+        summary: Summary {
+            stream: stream.stats(),
+            pins,
         },
-    )
+        malformed: rows.malformed,
+    })
 }
 
 /// A `Write` through a shared `RefCell`.
@@ -410,5 +204,32 @@ impl Write for Shared<'_, '_> {
     }
     fn flush(&mut self) -> io::Result<()> {
         self.0.borrow_mut().flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pins_follow_the_stream_in_the_json_and_only_with_the_emulator() {
+        let mut summary = Summary {
+            stream: StreamStats {
+                sent: 2,
+                ..StreamStats::default()
+            },
+            pins: None,
+        };
+        let json = serde_json::to_string(&summary).unwrap();
+        assert!(json.starts_with("{\"sent\":2,") && !json.contains("pulses"), "{json}");
+        summary.pins = Some(Pins {
+            pulses_checked: 7,
+            pulse_width_errors: 0,
+        });
+        let json = serde_json::to_string(&summary).unwrap();
+        assert!(
+            json.ends_with(",\"pulses_checked\":7,\"pulse_width_errors\":0}"),
+            "{json}"
+        );
     }
 }
