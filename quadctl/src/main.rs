@@ -1,7 +1,9 @@
 //! `quadctl`: command-line front end of the quadruped kinematics. See `quadctl --help`.
 
+mod args;
+mod cmd;
+
 use clap::{Parser, Subcommand};
-use host_tools::cmd;
 use std::process::ExitCode;
 
 const ABOUT: &str = "Kinematics of a 12-DoF quadruped: leg IK/FK and body poses, as CSV batches.
@@ -34,13 +36,13 @@ enum Command {
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Ik(args) => {
-            cmd::run_batch(&args.input.input, |i, o, d| cmd::ik::run(&args, i, o, d))
+            args::run_batch(&args.input.input, |i, o, d| cmd::ik::run(&args, i, o, d))
         }
         Command::Fk(args) => {
-            cmd::run_batch(&args.input.input, |i, o, d| cmd::fk::run(&args, i, o, d))
+            args::run_batch(&args.input.input, |i, o, d| cmd::fk::run(&args, i, o, d))
         }
         Command::Pose(args) => {
-            cmd::run_batch(&args.input.input, |i, o, d| cmd::pose::run(&args, i, o, d))
+            args::run_batch(&args.input.input, |i, o, d| cmd::pose::run(&args, i, o, d))
         }
         Command::Motion(args) => cmd::motion::run(&args),
         Command::Check(args) => cmd::check::run(&args),

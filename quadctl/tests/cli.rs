@@ -433,7 +433,7 @@ fn bad_robot_files_are_refused_with_a_clear_message() {
 fn example_robot_files_equal_the_presets() {
     for name in Robot::PRESETS {
         let path = repo_root().join(format!("examples/robots/{name}.toml"));
-        let robot = host_tools::robot_file::load_file(&path).expect("example robot file");
+        let robot = quad_host::robot_file::load_file(&path).expect("example robot file");
         assert_eq!(Some(robot), Robot::preset(name), "{name}");
         let input = "FL,0.1,0.2,-0.3\nRR,-0.2,0.4,-1.1\n";
         let from_file = quadctl(&["fk", "--robot", path.to_str().expect("utf-8")], input);

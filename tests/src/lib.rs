@@ -2,7 +2,7 @@
 //!
 //! - [`avr_bench`]: the firmware's IK cycle benchmark (`cargo xtask avr-bench`).
 //!
-//! Building the firmware and running it in simavr is `host_tools::emu` (one implementation
+//! Building the firmware and running it in simavr is `quad_host::emu` (one implementation
 //! for these tests and `quadctl`).
 
 pub mod avr_bench;

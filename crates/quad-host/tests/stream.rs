@@ -3,11 +3,11 @@
 
 mod stream_common;
 
-use host_tools::client::{Expected, PoseResult};
-use host_tools::link::sim::{SimConfig, SimLink};
-use host_tools::link::{byte_time, Link};
 use kin_core::body::Pose;
 use kin_core::LegId;
+use quad_host::client::{Expected, PoseResult};
+use quad_host::link::sim::{SimConfig, SimLink};
+use quad_host::link::{byte_time, Link};
 use quad_protocol::{LinkLossAction, LinkTimeout, NackReason, ReachFault, Request};
 use std::time::Duration;
 use stream_common::*;
@@ -18,7 +18,7 @@ const MIN_WIRE_EFFICIENCY: f64 = 0.90;
 #[test]
 fn poses_are_acked_with_the_hosts_angles_and_the_outputs_follow() {
     let mut stream = connect(SimConfig::default(), Robo::Fernando);
-    let mut rng = host_tools::link::sim::Rng::new(11);
+    let mut rng = seeded_rng::SplitMix64::new(11);
     for _ in 0..50 {
         let pose = reachable_pose(&stream, &mut rng);
         let Expected::Angles(want) = stream.expected(&pose) else {
@@ -92,7 +92,7 @@ fn throughput(baud: u32, compute: Duration) -> (f64, f64, u64, u64) {
         ..SimConfig::default()
     };
     let mut stream = connect(cfg, Robo::Fernando);
-    let mut rng = host_tools::link::sim::Rng::new(5);
+    let mut rng = seeded_rng::SplitMix64::new(5);
     let poses: Vec<Pose> = (0..400)
         .map(|_| reachable_pose(&stream, &mut rng))
         .collect();
@@ -196,7 +196,7 @@ fn the_sim_is_deterministic_for_a_seed() {
             ..SimConfig::default()
         };
         let mut stream = connect(cfg, Robo::Fernando);
-        let mut rng = host_tools::link::sim::Rng::new(9);
+        let mut rng = seeded_rng::SplitMix64::new(9);
         for _ in 0..100 {
             let p = reachable_pose(&stream, &mut rng);
             stream.send(&p).unwrap();
@@ -216,7 +216,7 @@ fn a_sim_link_with_no_device_answer_times_out_in_virtual_time() {
     let mut link = SimLink::new(
         SimConfig::default(),
         quad_device::Config::fernando2025(),
-        host_tools::link::sim::SimStorage::erased(),
+        quad_host::link::sim::SimStorage::erased(),
     )
     .unwrap();
     let t0 = std::time::Instant::now();
@@ -266,14 +266,10 @@ impl Tamper {
 }
 
 impl Link for Tamper {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), host_tools::link::LinkError> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), quad_host::link::Error> {
         self.inner.send(bytes)
     }
-    fn recv(
-        &mut self,
-        buf: &mut [u8],
-        timeout: Duration,
-    ) -> Result<usize, host_tools::link::LinkError> {
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, quad_host::link::Error> {
         if self.out.is_empty() {
             let mut raw = [0u8; 256];
             let n = self.inner.recv(&mut raw, timeout)?;
@@ -307,13 +303,13 @@ impl Link for Tamper {
 }
 
 /// A stream through a [`Tamper`] link, armed after the session set-up.
-fn tampered(acks: u32, nacks: u32) -> host_tools::client::PoseStream<Tamper> {
-    use host_tools::client::{AngleCheck, Client, ClientConfig, PoseStream, StreamSetup};
+fn tampered(acks: u32, nacks: u32) -> quad_host::client::PoseStream<Tamper> {
+    use quad_host::client::{AngleCheck, Client, ClientConfig, PoseStream, StreamSetup};
     let config = quad_device::Config::fernando2025();
     let inner = SimLink::new(
         SimConfig::default(),
         config,
-        host_tools::link::sim::SimStorage::erased(),
+        quad_host::link::sim::SimStorage::erased(),
     )
     .unwrap();
     let link = Tamper {
@@ -359,7 +355,7 @@ fn a_wrong_readback_is_retried_and_counted_when_it_persists() {
     // Always wrong: a mismatch after every retry, exit status material.
     let mut s = tampered(u32::MAX, 0);
     match s.send(&pose).unwrap() {
-        PoseResult::Mismatch(what) => assert!(what.contains("FR.hip"), "{what}"),
+        PoseResult::Mismatch(what) => assert!(what.to_string().contains("FR.hip"), "{what}"),
         other => panic!("{other:?}"),
     }
     let st = s.stats();
@@ -371,7 +367,7 @@ fn a_wrong_readback_is_retried_and_counted_when_it_persists() {
         ..Pose::default()
     };
     match s.send(&up).unwrap() {
-        PoseResult::Mismatch(what) => assert!(what.contains("too_close"), "{what}"),
+        PoseResult::Mismatch(what) => assert!(what.to_string().contains("too_close"), "{what}"),
         other => panic!("{other:?}"),
     }
     assert_eq!(s.stats().readback_mismatches, 1);

@@ -7,8 +7,9 @@
 
 mod stream_common;
 
-use host_tools::client::PoseResult;
-use host_tools::link::sim::{Rng, SimConfig};
+use quad_host::client::PoseResult;
+use quad_host::link::sim::SimConfig;
+use seeded_rng::SplitMix64 as Rng;
 use std::time::Duration;
 use stream_common::*;
 
@@ -23,7 +24,7 @@ const POSES_EVERY_FAULT: usize = 2_000;
 /// probability ≈ 0.03.
 const MAX_LOST_SHARE: f64 = 0.06;
 
-fn run(faults: &str, seed: u64, baud: u32, poses: usize) -> host_tools::client::StreamStats {
+fn run(faults: &str, seed: u64, baud: u32, poses: usize) -> quad_host::client::StreamStats {
     let cfg = SimConfig {
         baud,
         faults: faults.parse().unwrap(),

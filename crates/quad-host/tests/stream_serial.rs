@@ -5,14 +5,14 @@
 
 #![cfg(unix)]
 
-use host_tools::client::{
-    AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
-};
-use host_tools::link::serial::SerialLink;
-use host_tools::link::sim::{SimOutputs, SimStorage};
-use host_tools::link::Link;
 use kin_core::body::Pose;
 use quad_device::{Clock, Config, Device};
+use quad_host::client::{
+    AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
+};
+use quad_host::link::serial::SerialLink;
+use quad_host::link::sim::{SimOutputs, SimStorage};
+use quad_host::link::Link;
 use quad_protocol::{NackReason, RobotPreset};
 use serialport::{SerialPort, TTYPort};
 use std::io::{Read, Write};

@@ -1,18 +1,9 @@
 //! `quadctl fk`: leg forward kinematics, one set of joint angles per record.
 
-use super::{Error, InputArgs, RobotArgs, BATCH_RULES};
-use crate::csv_io::{self, FirstColumn, Input, Num, Schema, Summary};
-use kin_core::{leg, JointAngles};
+use crate::args::{Error, InputArgs, RobotArgs, BATCH_RULES};
+use quad_host::csv::{Input, Summary};
+use quad_host::ops::batch;
 use std::io::Write;
-
-/// Input columns.
-pub const INPUT: Schema = Schema {
-    columns: &["leg", "abduction_rad", "hip_rad", "knee_rad"],
-    first: FirstColumn::Leg,
-};
-
-/// Output header.
-pub const OUTPUT_HEADER: &str = "leg,x_m,y_m,z_m";
 
 const LONG_ABOUT: &str = "\
 Leg forward kinematics: joint angles -> foot position in the hip frame.
@@ -54,13 +45,5 @@ pub fn run(
     diag: &mut dyn Write,
 ) -> Result<Summary, Error> {
     let robot = args.robot.load(None)?;
-    let summary =
-        csv_io::for_each_row(input, INPUT, out, diag, Some(OUTPUT_HEADER), |row, out| {
-            let leg = row.leg(0)?;
-            let q = JointAngles::new(row.finite(1)?, row.finite(2)?, row.finite(3)?);
-            let foot = leg::forward(&robot.leg, leg, q);
-            writeln!(out, "{leg},{},{},{}", Num(foot.x), Num(foot.y), Num(foot.z))?;
-            Ok(())
-        })?;
-    Ok(summary)
+    Ok(batch::fk(&robot, input, out, diag)?)
 }

@@ -1,21 +1,10 @@
 //! `quadctl ik`: leg inverse kinematics, one foot target per record.
 
-use super::{Error, InputArgs, Knee, RobotArgs, BATCH_RULES};
-use crate::csv_io::{self, FirstColumn, Input, Num, Schema, Summary};
-use kin_core::{leg, ReachPolicy, Vec3};
+use crate::args::{self, Error, InputArgs, RobotArgs, BATCH_RULES};
+use kin_core::{KneeBend, ReachPolicy};
+use quad_host::csv::{Input, Summary};
+use quad_host::ops::batch;
 use std::io::Write;
-
-/// Input columns.
-pub const INPUT: Schema = Schema {
-    columns: &["leg", "x_m", "y_m", "z_m"],
-    first: FirstColumn::Leg,
-};
-
-/// Output header under `--policy reject`.
-pub const OUTPUT_HEADER: &str = "leg,abduction_rad,hip_rad,knee_rad,status";
-
-/// Output header under `--policy clamp`.
-pub const OUTPUT_HEADER_CLAMP: &str = "leg,abduction_rad,hip_rad,knee_rad,status,clamp_distance_m";
 
 const LONG_ABOUT: &str = "\
 Leg inverse kinematics: foot positions in the hip frame -> joint angles.
@@ -36,15 +25,6 @@ angles clamped to the joint limits): the row then has angles, status `clamped:<r
 last column clamp_distance_m, the distance in metres between the requested foot and the foot the
 angles reach (0 for `ok` rows; empty for non_finite rows, which are still rejected).";
 
-/// What the IK does with an unreachable target.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Policy {
-    /// Report the reason in `status`, leave the angles empty.
-    Reject,
-    /// Move the target to the nearest reachable point and report the distance moved.
-    Clamp,
-}
-
 /// Arguments of `quadctl ik`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 #[command(
@@ -57,11 +37,13 @@ pub struct Args {
     #[allow(missing_docs)]
     pub robot: RobotArgs,
     /// Knee solution; default: the robot's own (backward for the presets).
-    #[arg(long, value_enum)]
-    pub knee: Option<Knee>,
-    /// What to do with unreachable targets.
-    #[arg(long, value_enum, default_value_t = Policy::Reject)]
-    pub policy: Policy,
+    #[arg(long, value_parser = args::knee())]
+    pub knee: Option<KneeBend>,
+    /// What to do with unreachable targets: reject (report the reason in `status`, leave the
+    /// angles empty) or clamp (move the target to the nearest reachable point and report the
+    /// distance moved).
+    #[arg(long, value_parser = args::policy(), default_value = "reject")]
+    pub policy: ReachPolicy,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub input: InputArgs,
@@ -76,36 +58,5 @@ pub fn run(
     diag: &mut dyn Write,
 ) -> Result<Summary, Error> {
     let robot = args.robot.load(args.knee)?;
-    let (policy, header) = match args.policy {
-        Policy::Reject => (ReachPolicy::Reject, OUTPUT_HEADER),
-        Policy::Clamp => (ReachPolicy::Clamp, OUTPUT_HEADER_CLAMP),
-    };
-    let clamp = policy == ReachPolicy::Clamp;
-    let summary = csv_io::for_each_row(input, INPUT, out, diag, Some(header), |row, out| {
-        let leg = row.leg(0)?;
-        let foot_in_hip = Vec3::new(row.number(1)?, row.number(2)?, row.number(3)?);
-        match leg::inverse(&robot, leg, foot_in_hip, policy) {
-            Ok(solution) => {
-                let q = solution.angles;
-                write!(
-                    out,
-                    "{leg},{},{},{},",
-                    Num(q.abduction_rad),
-                    Num(q.hip_rad),
-                    Num(q.knee_rad)
-                )?;
-                match solution.clamped {
-                    None if clamp => writeln!(out, "ok,0")?,
-                    None => writeln!(out, "ok")?,
-                    Some(c) => writeln!(out, "clamped:{},{}", c.kind.code(), Num(c.distance_m))?,
-                }
-            }
-            Err(e) => {
-                let tail = if clamp { "," } else { "" };
-                writeln!(out, "{leg},,,,{}{tail}", e.kind.code())?;
-            }
-        }
-        Ok(())
-    })?;
-    Ok(summary)
+    Ok(batch::ik(&robot, args.policy, input, out, diag)?)
 }

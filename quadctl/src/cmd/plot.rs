@@ -1,10 +1,9 @@
 //! `quadctl plot`: figures of a motion CSV — joint angles over time (seed 001 Fig. 4–6) or the
 //! robot in top, side and front views at chosen instants (seed 000 Fig. 6–7).
 
-use super::motion::{Error, MotionCsv};
-use super::pose::Order;
-use crate::plot::{self, Decimator, Snapshot};
-use kin_core::{BodyConfig, JointAngles, RotationOrder, Vec3};
+use crate::args;
+use kin_core::RotationOrder;
+use quad_host::ops::plot::{self, Request};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -50,8 +49,8 @@ pub struct Args {
     #[arg(long, value_name = "PRESET|FILE.toml")]
     pub robot: Option<String>,
     /// Rotation order of the poses in the file (overrides the file's own).
-    #[arg(long, value_enum)]
-    pub rotation_order: Option<Order>,
+    #[arg(long, value_parser = args::rotation_order())]
+    pub rotation_order: Option<RotationOrder>,
     /// Figure title [default: the file name].
     #[arg(long)]
     pub title: Option<String>,
@@ -59,77 +58,12 @@ pub struct Args {
 
 /// `quadctl plot`.
 pub fn run(args: &Args) -> ExitCode {
-    super::motion::exit_status(run_inner(args))
-}
-
-fn run_inner(args: &Args) -> Result<(), Error> {
-    let title = args
-        .title
-        .clone()
-        .unwrap_or_else(|| args.file.display().to_string());
-    if args.at_s.is_empty() {
-        if args.robot.is_some() {
-            return Err(Error::NotApplicable {
-                option: "--robot",
-                law: "the joint-angle plot (use it with --at-s)",
-            });
-        }
-        let mut csv = MotionCsv::open(&args.file)?;
-        let mut d = Decimator::new();
-        while let Some(row) = csv.next_row()? {
-            d.push(row.t_s, row.angles);
-        }
-        return Ok(plot::joint_angles(&args.output, &title, &d.finish())?);
-    }
-    if let Some(t) = args.at_s.iter().find(|t| !t.is_finite()) {
-        return Err(Error::Csv {
-            at: "--at-s".to_owned(),
-            message: format!("{t} is not a finite time"),
-        });
-    }
-    let robot_spec = args.robot.as_ref().ok_or(Error::NotApplicable {
-        option: "--at-s without --robot",
-        law: "the robot views (they need the robot's geometry)",
-    })?;
-    let robot = crate::robot_file::resolve(robot_spec).map_err(Error::Robot)?;
-    let mut csv = MotionCsv::open(&args.file)?;
-    let order: RotationOrder = args
-        .rotation_order
-        .map(Order::into)
-        .or(csv.rotation_order)
-        .unwrap_or_default();
-    let config = BodyConfig {
-        order,
-        pivot_m: Vec3::ZERO,
-    };
-    // Nearest reachable sample to each requested time.
-    let mut best: Vec<Option<(f64, Snapshot)>> = vec![None; args.at_s.len()];
-    while let Some(row) = csv.next_row()? {
-        let (Some(a), Some(pose)) = (row.angles, row.pose) else {
-            continue;
-        };
-        for (slot, &want) in best.iter_mut().zip(&args.at_s) {
-            let d = (row.t_s - want).abs();
-            if slot.as_ref().is_none_or(|(bd, _)| d < *bd) {
-                *slot = Some((
-                    d,
-                    Snapshot {
-                        t_s: row.t_s,
-                        pose,
-                        angles: core::array::from_fn(|l| {
-                            JointAngles::new(a[3 * l], a[3 * l + 1], a[3 * l + 2])
-                        }),
-                    },
-                ));
-            }
-        }
-    }
-    let snaps: Vec<Snapshot> = best.into_iter().flatten().map(|(_, s)| s).collect();
-    Ok(plot::robot_views(
-        &args.output,
-        &title,
-        &robot,
-        &config,
-        &snaps,
-    )?)
+    args::exit_status(plot::run(&Request {
+        file: args.file.clone(),
+        output: args.output.clone(),
+        at_s: args.at_s.clone(),
+        robot: args.robot.clone(),
+        rotation_order: args.rotation_order,
+        title: args.title.clone(),
+    }))
 }

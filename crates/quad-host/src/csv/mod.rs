@@ -293,7 +293,10 @@ impl fmt::Display for Error {
             Error::Create { path, source } => {
                 write!(f, "cannot create `{}`: {source}", path.display())
             }
-            Error::Write { path: Some(p), source } => {
+            Error::Write {
+                path: Some(p),
+                source,
+            } => {
                 write!(f, "cannot write `{}`: {source}", p.display())
             }
             Error::Write { path: None, source } => write!(f, "cannot write the output: {source}"),

@@ -429,4 +429,3 @@ pub fn read_samples(path: &Path, single_leg: LegId) -> Result<Samples, Error> {
     }
     Ok(Samples { legs, rows })
 }
-

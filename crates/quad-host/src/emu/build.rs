@@ -5,8 +5,8 @@
 //! Needs the Debian packages and toolchain components that `scripts/install-deps.sh` installs;
 //! without them the build fails and [`firmware_elf`] returns its output as the error.
 
-use std::path::{Path, PathBuf};
 use std::io;
+use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus};
 use std::sync::{Arc, OnceLock};
 

@@ -301,8 +301,8 @@ impl EmulatorLink {
     /// # Errors
     /// See [`Error`].
     pub fn boot_built(config: EmulatorConfig) -> Result<EmulatorLink, Error> {
-        let bin = build::firmware_for_baud(config.baud)
-            .ok_or(Error::NoFirmwareForBaud(config.baud))?;
+        let bin =
+            build::firmware_for_baud(config.baud).ok_or(Error::NoFirmwareForBaud(config.baud))?;
         let elf = build::firmware_elf(bin).map_err(Error::Build)?;
         EmulatorLink::boot(&elf, config)
     }

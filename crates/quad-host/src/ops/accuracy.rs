@@ -85,7 +85,6 @@ pub enum Error {
     },
 }
 
-
 /// The metric.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Accuracy {

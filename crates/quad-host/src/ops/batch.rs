@@ -94,13 +94,20 @@ pub fn fk(
     out: &mut dyn Write,
     diag: &mut dyn Write,
 ) -> Result<Summary, csv::Error> {
-    csv::for_each_row(input, FK_INPUT, out, diag, Some(FK_OUTPUT_HEADER), |row, out| {
-        let leg = row.leg(0)?;
-        let q = JointAngles::new(row.finite(1)?, row.finite(2)?, row.finite(3)?);
-        let foot = leg::forward(&robot.leg, leg, q);
-        writeln!(out, "{leg},{},{},{}", Num(foot.x), Num(foot.y), Num(foot.z))?;
-        Ok(())
-    })
+    csv::for_each_row(
+        input,
+        FK_INPUT,
+        out,
+        diag,
+        Some(FK_OUTPUT_HEADER),
+        |row, out| {
+            let leg = row.leg(0)?;
+            let q = JointAngles::new(row.finite(1)?, row.finite(2)?, row.finite(3)?);
+            let foot = leg::forward(&robot.leg, leg, q);
+            writeln!(out, "{leg},{},{},{}", Num(foot.x), Num(foot.y), Num(foot.z))?;
+            Ok(())
+        },
+    )
 }
 
 /// How `pose` prints.

@@ -1,9 +1,9 @@
 //! The device's servo calibration: its TOML file (read and written) and the operation behind
 //! `quadctl calibrate` (read, edit, save).
 
+use crate::client::{self, Client, ClientConfig};
 use crate::csv::Num;
 use crate::link::{self, Target};
-use crate::client::{self, Client, ClientConfig};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{Request as DeviceRequest, ServoId};
 use serde::Deserialize;

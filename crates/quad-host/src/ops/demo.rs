@@ -207,7 +207,11 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
     let poses = poses(args.poses_per_sweep)?;
     let wall = Instant::now();
     let target = if let Some(port) = &args.port {
-        writeln!(log, "quadctl demo: Arduino Mega on {port}, {} baud", args.baud)?;
+        writeln!(
+            log,
+            "quadctl demo: Arduino Mega on {port}, {} baud",
+            args.baud
+        )?;
         Target::Serial {
             path: port.clone(),
             baud: args.baud,

@@ -468,7 +468,6 @@ pub fn write_motion<T: Motion>(
     Ok(w)
 }
 
-
 /// What [`run`] is asked to write.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Request {

@@ -221,7 +221,10 @@ mod tests {
             pins: None,
         };
         let json = serde_json::to_string(&summary).unwrap();
-        assert!(json.starts_with("{\"sent\":2,") && !json.contains("pulses"), "{json}");
+        assert!(
+            json.starts_with("{\"sent\":2,") && !json.contains("pulses"),
+            "{json}"
+        );
         summary.pins = Some(Pins {
             pulses_checked: 7,
             pulse_width_errors: 0,

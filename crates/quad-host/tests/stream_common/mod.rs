@@ -3,11 +3,12 @@
 
 #![allow(dead_code)]
 
-use host_tools::client::{AngleCheck, Client, ClientConfig, Expected, PoseStream, StreamSetup};
-use host_tools::link::sim::{Rng, SimConfig, SimLink, SimStorage};
 use kin_core::body::Pose;
 use quad_device::Config;
+use quad_host::client::{AngleCheck, Client, ClientConfig, Expected, PoseStream, StreamSetup};
+use quad_host::link::sim::{SimConfig, SimLink, SimStorage};
 use quad_protocol::RobotPreset;
+use seeded_rng::SplitMix64 as Rng;
 
 /// The two presets.
 #[derive(Debug, Clone, Copy)]
@@ -39,7 +40,7 @@ pub fn connect(cfg: SimConfig, robot: Robo) -> PoseStream<SimLink> {
 
 /// A random pose the host's kin-core solves and the device's calibration maps: rotations within
 /// ±0.25 rad, translations within ±6 cm (z ±8 cm), redrawn until reachable.
-pub fn reachable_pose<L: host_tools::link::Link>(stream: &PoseStream<L>, rng: &mut Rng) -> Pose {
+pub fn reachable_pose<L: quad_host::link::Link>(stream: &PoseStream<L>, rng: &mut Rng) -> Pose {
     loop {
         let r = |rng: &mut Rng, a: f64| rng.range(-a, a) as f32;
         let pose = Pose {
