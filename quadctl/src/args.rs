@@ -336,11 +336,11 @@ pub enum ArgError {
     /// Not three comma-separated numbers.
     NotThree(usize),
     /// Not a time in µs within [0, 1e7].
-    NotMicroseconds(String),
+    OutOfMicrosecondRange(String),
     /// Not a leg name.
-    NotALeg(String),
+    UnknownLeg(String),
     /// Not one speed or three.
-    NotOneOrThree(String),
+    SpeedCount(String),
 }
 
 impl fmt::Display for ArgError {
@@ -352,11 +352,11 @@ impl fmt::Display for ArgError {
             ArgError::NotThree(n) => {
                 write!(f, "expected three comma-separated numbers X,Y,Z, found {n}")
             }
-            ArgError::NotMicroseconds(s) => {
+            ArgError::OutOfMicrosecondRange(s) => {
                 write!(f, "`{s}` is not a time in µs within [0, 1e7]")
             }
-            ArgError::NotALeg(s) => write!(f, "`{s}` is not a leg (FL, FR, RL, RR)"),
-            ArgError::NotOneOrThree(s) => write!(
+            ArgError::UnknownLeg(s) => write!(f, "`{s}` is not a leg (FL, FR, RL, RR)"),
+            ArgError::SpeedCount(s) => write!(
                 f,
                 "expected one value or three (abduction,hip,knee), got `{s}`"
             ),
@@ -405,13 +405,13 @@ pub fn parse_vec3_m(s: &str) -> Result<Vec3, ArgError> {
 pub fn parse_us(s: &str) -> Result<f64, ArgError> {
     match s.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && (0.0..=1e7).contains(&v) => Ok(v),
-        _ => Err(ArgError::NotMicroseconds(s.to_owned())),
+        _ => Err(ArgError::OutOfMicrosecondRange(s.to_owned())),
     }
 }
 
 /// Value parser: a leg name (any case).
 pub fn parse_leg(s: &str) -> Result<LegId, ArgError> {
-    LegId::parse(s).ok_or_else(|| ArgError::NotALeg(s.to_owned()))
+    LegId::parse(s).ok_or_else(|| ArgError::UnknownLeg(s.to_owned()))
 }
 
 /// Value parser of `--max-joint-speed-rad-s`: one speed for all joints or ABDUCTION,HIP,KNEE,
@@ -428,7 +428,7 @@ pub fn parse_speed_limits(s: &str) -> Result<[f32; 3], ArgError> {
     match v.as_slice() {
         [a] => Ok([*a; 3]),
         [a, b, c] => Ok([*a, *b, *c]),
-        _ => Err(ArgError::NotOneOrThree(s.to_owned())),
+        _ => Err(ArgError::SpeedCount(s.to_owned())),
     }
 }
 

@@ -3,7 +3,7 @@
 use crate::args::{self, Error, InputArgs, RobotArgs, BATCH_RULES};
 use kin_core::{BodyConfig, KneeBend, RotationOrder, Vec3};
 use quad_host::csv::{Input, Summary};
-use quad_host::ops::batch::{self, PoseFormat};
+use quad_host::ops::batch::{self, PoseFormat, PoseSetup};
 use std::io::Write;
 
 const LONG_ABOUT: &str = "\
@@ -107,14 +107,12 @@ pub fn run(
         Format::Csv => PoseFormat::Csv,
         Format::Table => PoseFormat::Table,
     };
-    Ok(batch::pose(
-        &robot,
-        &args.robot.robot,
-        &config,
-        args.stance_height_m,
+    let setup = PoseSetup {
+        robot: &robot,
+        robot_name: &args.robot.robot,
+        config,
+        stance_height_m: args.stance_height_m,
         format,
-        input,
-        out,
-        diag,
-    )?)
+    };
+    Ok(batch::pose(&setup, input, out, diag)?)
 }

@@ -119,21 +119,40 @@ pub enum PoseFormat {
     Table,
 }
 
+/// What `pose` solves with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseSetup<'a> {
+    /// The robot.
+    pub robot: &'a Robot,
+    /// The robot as given (preset or file), for the table.
+    pub robot_name: &'a str,
+    /// Rotation order and pivot.
+    pub config: BodyConfig,
+    /// Stance height H, m: the feet's depth below the hips in the nominal pose.
+    pub stance_height_m: f32,
+    /// How to print.
+    pub format: PoseFormat,
+}
+
 /// Full-body IK of every record of `input` (body pose → the 12 joint angles, feet at the
-/// nominal stance of `stance_height_m`). `robot_name` is the robot as given, for the table.
+/// nominal stance).
 ///
 /// # Errors
 /// As [`ik`].
 pub fn pose(
-    robot: &Robot,
-    robot_name: &str,
-    config: &BodyConfig,
-    stance_height_m: f32,
-    format: PoseFormat,
+    setup: &PoseSetup<'_>,
     input: Input,
     out: &mut dyn Write,
     diag: &mut dyn Write,
 ) -> Result<Summary, csv::Error> {
+    let PoseSetup {
+        robot,
+        robot_name,
+        config,
+        stance_height_m,
+        format,
+    } = *setup;
+    let config = &config;
     let header = match format {
         PoseFormat::Csv => POSE_OUTPUT_HEADER.to_owned(),
         PoseFormat::Table => table_preamble(robot_name, robot, stance_height_m, config),
