@@ -18,8 +18,7 @@ use kin_core::rotation;
 use kin_core::{leg, BodyConfig, JointAngles, LegId, Robot, Vec3};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// Font files tried in order when `$QUADCTL_FONT` is not set.
@@ -39,33 +38,33 @@ pub const FONT_CANDIDATES: &[&str] = &[
 pub const MAX_POINTS: usize = 4000;
 
 /// Why a figure could not be drawn.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
     /// The file extension is neither `.svg` nor `.png`.
+    #[error("plot file `{0}` must end in .svg or .png")]
     Format(String),
-    /// No usable font was found.
-    Font(String),
-    /// Drawing or writing the file failed.
+    /// The font file given by `QUADCTL_FONT` cannot be read.
+    #[error("cannot read the font QUADCTL_FONT=`{}`", .0.display())]
+    FontUnreadable(PathBuf),
+    /// A font file that is not a usable TrueType font.
+    #[error("`{}` is not a usable TrueType font", .0.display())]
+    NotAFont(PathBuf),
+    /// No font was found.
+    #[error(
+        "plots need a TrueType font and none was found (tried {}); install one (Debian: \
+         apt-get install fonts-dejavu-core) or set QUADCTL_FONT=/path/to/font.ttf",
+        FONT_CANDIDATES.join(", ")
+    )]
+    NoFont,
+    /// Drawing or writing the file failed: the drawing backend's message (its error types
+    /// are generic over the backend, so the message is what can be kept).
+    #[error("cannot draw the plot: {0}")]
     Draw(String),
     /// Nothing to draw.
+    #[error("nothing to plot: {0}")]
     Empty(&'static str),
 }
-
-impl fmt::Display for Error {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Error::Format(p) => {
-                write!(f, "plot file `{p}` must end in .svg or .png")
-            }
-            Error::Font(m) => write!(f, "{m}"),
-            Error::Draw(m) => write!(f, "cannot draw the plot: {m}"),
-            Error::Empty(what) => write!(f, "nothing to plot: {what}"),
-        }
-    }
-}
-
-impl std::error::Error for Error {}
 
 fn draw_err<E: std::fmt::Display>(e: E) -> Error {
     Error::Draw(e.to_string())
@@ -73,7 +72,7 @@ fn draw_err<E: std::fmt::Display>(e: E) -> Error {
 
 /// Registers the font once per process.
 fn ensure_font() -> Result<(), Error> {
-    static FONT: OnceLock<Result<(), String>> = OnceLock::new();
+    static FONT: OnceLock<Result<(), Error>> = OnceLock::new();
     FONT.get_or_init(|| {
         let from_env = std::env::var_os("QUADCTL_FONT");
         let candidates: Vec<std::path::PathBuf> = match &from_env {
@@ -84,23 +83,15 @@ fn ensure_font() -> Result<(), Error> {
             if let Ok(bytes) = std::fs::read(path) {
                 let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
                 return plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
-                    .map_err(|_| format!("`{}` is not a usable TrueType font", path.display()));
+                    .map_err(|_| Error::NotAFont(path.clone()));
             }
         }
         Err(match from_env {
-            Some(p) => format!(
-                "cannot read the font QUADCTL_FONT=`{}`",
-                Path::new(&p).display()
-            ),
-            None => format!(
-                "plots need a TrueType font and none was found (tried {}); install one (Debian: \
-                 apt-get install fonts-dejavu-core) or set QUADCTL_FONT=/path/to/font.ttf",
-                FONT_CANDIDATES.join(", ")
-            ),
+            Some(p) => Error::FontUnreadable(p.into()),
+            None => Error::NoFont,
         })
     })
     .clone()
-    .map_err(Error::Font)
 }
 
 enum Kind {

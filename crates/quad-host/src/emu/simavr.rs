@@ -31,10 +31,9 @@ use super::{CYCLES_PER_US, F_CPU_HZ, SERVO_PINS};
 use simavr_ffi as ffi;
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, c_void, CString};
-use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::ptr::NonNull;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 extern "C" {
     fn free(ptr: *mut c_void);
@@ -102,14 +101,28 @@ unsafe extern "C" fn quiet_logger(
 }
 
 /// Why the simulator could not run.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, thiserror::Error)]
 #[non_exhaustive]
 pub enum EmuError {
-    /// The firmware file is missing or not an AVR ELF.
-    Firmware(String),
+    /// The firmware file could not be read (shared: the error is cloned with the value).
+    #[error("firmware: cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: Arc<std::io::Error>,
+    },
+    /// The firmware file is not an AVR ELF.
+    #[error("firmware: {} is not an AVR ELF file", .0.display())]
+    NotAvrElf(PathBuf),
+    /// The path cannot be passed to simavr.
+    #[error("firmware: path contains a NUL byte")]
+    NulInPath,
     /// simavr could not create or initialise the MCU.
-    Init(String),
+    #[error("simavr: {0}")]
+    Init(&'static str),
     /// The CPU stopped (crash, or sleep with interrupts off) at this cycle.
+    #[error("the AVR stopped ({state}) at cycle {cycle}, pc {pc:#x}")]
     Stopped {
         /// simavr's state.
         state: &'static str,
@@ -119,20 +132,6 @@ pub enum EmuError {
         pc: u32,
     },
 }
-
-impl fmt::Display for EmuError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            EmuError::Firmware(m) => write!(f, "firmware: {m}"),
-            EmuError::Init(m) => write!(f, "simavr: {m}"),
-            EmuError::Stopped { state, cycle, pc } => {
-                write!(f, "the AVR stopped ({state}) at cycle {cycle}, pc {pc:#x}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for EmuError {}
 
 /// One high pulse seen on a servo pin.
 ///
@@ -242,17 +241,16 @@ impl Mega2560 {
     /// # Errors
     /// When the file is not an AVR ELF or simavr cannot create the MCU.
     pub fn new(elf: &Path) -> Result<Mega2560, EmuError> {
-        let head = std::fs::read(elf)
-            .map_err(|e| EmuError::Firmware(format!("cannot read {}: {e}", elf.display())))?;
+        let head = std::fs::read(elf).map_err(|e| EmuError::Read {
+            path: elf.to_owned(),
+            source: Arc::new(e),
+        })?;
         // simavr exits the process on a file it cannot load: check first (ELF, machine AVR).
         if head.len() < 20 || &head[..4] != b"\x7fELF" || head[18] != 0x53 {
-            return Err(EmuError::Firmware(format!(
-                "{} is not an AVR ELF file",
-                elf.display()
-            )));
+            return Err(EmuError::NotAvrElf(elf.to_owned()));
         }
-        let path = CString::new(elf.as_os_str().as_encoded_bytes())
-            .map_err(|_| EmuError::Firmware("path contains a NUL byte".into()))?;
+        let path =
+            CString::new(elf.as_os_str().as_encoded_bytes()).map_err(|_| EmuError::NulInPath)?;
         let mcu = CString::new("atmega2560").expect("no NUL");
         let _guard = CREATE.lock().unwrap_or_else(|e| e.into_inner());
         // SAFETY (this block): the calls follow simavr's documented set-up sequence
@@ -261,10 +259,10 @@ impl Mega2560 {
         unsafe {
             ffi::avr_global_logger_set(Some(quiet_logger));
             let avr = NonNull::new(ffi::avr_make_mcu_by_name(mcu.as_ptr()))
-                .ok_or_else(|| EmuError::Init("unknown MCU atmega2560".into()))?;
+                .ok_or(EmuError::Init("unknown MCU atmega2560"))?;
             if ffi::avr_init(avr.as_ptr()) != 0 {
                 free(avr.as_ptr().cast());
-                return Err(EmuError::Init("avr_init failed".into()));
+                return Err(EmuError::Init("avr_init failed"));
             }
             (*avr.as_ptr()).frequency = F_CPU_HZ;
             let mut fw: Box<ffi::elf_firmware_t> = Box::new(std::mem::zeroed());
@@ -304,7 +302,7 @@ impl Mega2560 {
             ) else {
                 ffi::avr_terminate(avr.as_ptr());
                 free(avr.as_ptr().cast());
-                return Err(EmuError::Init("USART0 has no IRQs".into()));
+                return Err(EmuError::Init("USART0 has no IRQs"));
             };
             let hooks = NonNull::from(Box::leak(Box::new(Hooks {
                 avr: avr.as_ptr(),
