@@ -30,15 +30,6 @@ joint_limit, non_finite (a nan or inf in the pose is reported as FL:non_finite).
 Output (--table): a human-readable table per pose, angles in DEGREES (pose angles too), for
 reading, not for parsing.";
 
-/// `--format`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Format {
-    /// CSV in radians, for programs.
-    Csv,
-    /// A table per pose in degrees, for people.
-    Table,
-}
-
 /// Arguments of `quadctl pose`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
@@ -68,9 +59,10 @@ pub struct Args {
     /// Knee solution; default: the robot's own (backward for the presets).
     #[arg(long, value_parser = args::knee())]
     pub knee: Option<KneeBend>,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = Format::Csv)]
-    pub format: Format,
+    /// Output format: csv (radians, for programs) or table (a table per pose in degrees, for
+    /// people).
+    #[arg(long, value_parser = args::choice(&PoseFormat::ALL, PoseFormat::name), default_value = "csv")]
+    pub format: PoseFormat,
     /// Same as `--format table`: a human-readable table in degrees.
     #[arg(long, conflicts_with = "format")]
     pub table: bool,
@@ -81,9 +73,9 @@ pub struct Args {
 
 impl Args {
     /// The output format, `--table` included.
-    pub fn output_format(&self) -> Format {
+    pub fn output_format(&self) -> PoseFormat {
         if self.table {
-            Format::Table
+            PoseFormat::Table
         } else {
             self.format
         }
@@ -103,10 +95,7 @@ pub fn run(
         order: args.rotation_order,
         pivot_m: args.pivot_m,
     };
-    let format = match args.output_format() {
-        Format::Csv => PoseFormat::Csv,
-        Format::Table => PoseFormat::Table,
-    };
+    let format = args.output_format();
     let setup = PoseSetup {
         robot: &robot,
         robot_name: &args.robot.robot,

@@ -115,8 +115,21 @@ pub fn fk(
 pub enum PoseFormat {
     /// CSV in radians, for programs.
     Csv,
-    /// A table per pose in degrees, for people; the robot's name for the preamble.
+    /// A table per pose in degrees, for people.
     Table,
+}
+
+impl PoseFormat {
+    /// Both, in the command line's order.
+    pub const ALL: [PoseFormat; 2] = [PoseFormat::Csv, PoseFormat::Table];
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            PoseFormat::Csv => "csv",
+            PoseFormat::Table => "table",
+        }
+    }
 }
 
 /// What `pose` solves with.
