@@ -122,8 +122,9 @@ fn workload(poses: &[Pose]) -> Vec<Request> {
     out
 }
 
-/// Boots the firmware `elf_path` in simavr, sends [`workload`] (plus the feet and joints the
-/// device reports, and its own calibration back) and measures.
+/// Boots the firmware `elf_path` in simavr, sends every request type (the body poses `poses`,
+/// the joints the device reports back, the stance feet, a calibration written back) and
+/// measures.
 ///
 /// # Panics
 /// When the ELF cannot be read or booted, or a request gets no answer.
@@ -151,13 +152,7 @@ pub fn measure(elf_path: &Path, poses: &[Pose]) -> Figures {
             }
             let servo = ServoId::ALL[11];
             let calibration = client.calibration(servo).unwrap_or_else(|e| panic!("{e}"));
-            answer(
-                &mut client,
-                Request::SetCalibration {
-                    servo,
-                    calibration,
-                },
-            );
+            answer(&mut client, Request::SetCalibration { servo, calibration });
         }
         if let DeviceToHost::Ack { readback, .. } = answer(&mut client, request) {
             if readback.angles_rad.iter().any(|a| *a != 0.0) {

@@ -326,7 +326,11 @@ mod tests {
         assert_eq!(n[0], "deps");
         let pos = |name| n.iter().position(|s| *s == name).unwrap();
         assert!(pos("firmware") < pos("test"));
-        assert_eq!(pos("budget"), pos("firmware") + 1, "the budget follows the firmware build");
+        assert_eq!(
+            pos("budget"),
+            pos("firmware") + 1,
+            "the budget follows the firmware build"
+        );
     }
 
     #[test]
