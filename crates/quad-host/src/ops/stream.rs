@@ -222,7 +222,7 @@ mod tests {
         };
         let json = serde_json::to_string(&summary).unwrap();
         assert!(
-            json.starts_with("{\"sent\":2,") && !json.contains("pulses"),
+            json.starts_with("{\"sent\":2,") && !json.contains("pulses_checked"),
             "{json}"
         );
         summary.pins = Some(Pins {
