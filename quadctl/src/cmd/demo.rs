@@ -71,6 +71,9 @@ pub fn main(args: &Args) -> ExitCode {
             return args::fail("quadctl demo", &e);
         }
     };
+    for (i, what) in &run.mismatches {
+        eprintln!("  pose {i}: READBACK MISMATCH: {what}");
+    }
     let mut target = describe_info(&run.info);
     if let Some(mcu) = run.mcu {
         target.push_str(&format!(

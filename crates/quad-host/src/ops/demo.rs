@@ -4,7 +4,7 @@
 //! readbacks. The operation behind `quadctl demo`.
 
 use crate::client::{
-    self, AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup,
+    self, AngleCheck, Client, ClientConfig, Mismatch, PoseResult, PoseStream, StreamSetup,
     AVR_ANGLE_TOLERANCE_RAD, DEFAULT_RETRIES,
 };
 use crate::emu::{build, elf};
@@ -124,8 +124,8 @@ pub fn poses(n: usize) -> Result<Vec<kin_core::Pose>, Error> {
     Ok(out)
 }
 
-/// Streams `poses` and checks them (see the module docs); mismatches are reported on stderr
-/// as they come.
+/// Streams `poses` and checks them (see the module docs); `progress` sees every pose's index
+/// and result as it comes.
 ///
 /// # Errors
 /// Link failures and handshake errors.
@@ -133,7 +133,7 @@ pub fn stream<L: Link>(
     link: L,
     config: ClientConfig,
     poses: &[kin_core::Pose],
-    mut progress: impl FnMut(&PoseStream<L>, usize),
+    mut progress: impl FnMut(&PoseStream<L>, usize, &PoseResult),
 ) -> Result<(PoseStream<L>, Summary), client::Error> {
     let setup = StreamSetup {
         robot: Robot::shahriar2023(),
@@ -151,10 +151,7 @@ pub fn stream<L: Link>(
         let dt = stream.client().link().now().saturating_sub(t0);
         latency_sum += dt;
         latency_max = latency_max.max(dt);
-        if let PoseResult::Mismatch(what) = &result {
-            eprintln!("  pose {i}: READBACK MISMATCH: {what}");
-        }
-        progress(&stream, i + 1);
+        progress(&stream, i, &result);
     }
     let s = stream.stats();
     let summary = Summary {
@@ -193,6 +190,8 @@ pub struct Demo {
     pub mcu: Option<Mcu>,
     /// Wall time of the run.
     pub wall: Duration,
+    /// The poses whose readback disagreed with the host: index and what disagreed.
+    pub mismatches: Vec<(usize, Mismatch)>,
 }
 
 /// Runs the demo, writing what it sets up (the firmware build, the target) to `log` as it
@@ -250,7 +249,12 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
     };
     let link = link::open(&target)?;
     let config = ClientConfig::for_target(&target, DEFAULT_RETRIES);
-    let (mut stream, mut summary) = stream(link, config, &poses, |_, _| {})?;
+    let mut mismatches = Vec::new();
+    let (mut stream, mut summary) = stream(link, config, &poses, |_, i, result| {
+        if let PoseResult::Mismatch(what) = result {
+            mismatches.push((i, *what));
+        }
+    })?;
     let info = *stream.info();
     let mcu = stream.client_mut().link_mut().emulator().map(|link| {
         let pulses = link.pulse_stats();
@@ -267,6 +271,7 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
         info,
         mcu,
         wall: wall.elapsed(),
+        mismatches,
     })
 }
 
