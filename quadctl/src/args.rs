@@ -2,7 +2,7 @@
 //! (`--robot`, `--input`, the device target, a law's parameters), the value parsers, the
 //! batch driver and the one place where errors become exit codes.
 
-use clap::builder::{PossibleValuesParser, TypedValueParser};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use kin_core::motion::path::PathKind;
 use kin_core::{KneeBend, LegId, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_host::client::DEFAULT_RETRIES;
@@ -12,6 +12,7 @@ use quad_host::link::sim::{SimConfig, DEFAULT_RX_FIFO_LEN};
 use quad_host::link::{Faults, Target};
 use quad_host::names;
 use quad_host::ops::accuracy::Angles;
+use quad_host::ops::batch::PoseFormat;
 use quad_host::ops::motion::{Law, Params};
 use quad_host::robot_file;
 use quad_protocol::RobotPreset;
@@ -261,12 +262,18 @@ impl LawArgs {
 }
 
 /// A value parser for one of a fixed set of named values: the names are the library's or
-/// kin-core's own (no mirror enums here), listed as the possible values in `--help`.
+/// kin-core's own (no mirror enums here), listed with `help` as the possible values in
+/// `--help`.
 pub fn choice<T: Copy + Send + Sync + 'static>(
     all: &'static [T],
     name: fn(T) -> &'static str,
+    help: fn(T) -> String,
 ) -> impl TypedValueParser<Value = T> {
-    PossibleValuesParser::new(all.iter().map(|&v| name(v))).map(move |s| {
+    PossibleValuesParser::new(
+        all.iter()
+            .map(|&v| PossibleValue::new(name(v)).help(help(v))),
+    )
+    .map(move |s| {
         all.iter()
             .copied()
             .find(|&v| name(v) == s)
@@ -274,35 +281,89 @@ pub fn choice<T: Copy + Send + Sync + 'static>(
     })
 }
 
-/// `--rotation-order`: kin-core's six orders by name, the product read left to right (`zyx`
-/// is Rz(yaw)·Ry(pitch)·Rx(roll), `zxy` seed 001's Rz(yaw)·Rx(roll)·Ry(pitch)).
+/// `--rotation-order`: kin-core's six orders by name, each described by its product read
+/// left to right.
 pub fn rotation_order() -> impl TypedValueParser<Value = RotationOrder> {
-    choice(&RotationOrder::ALL, RotationOrder::name)
+    fn help(o: RotationOrder) -> String {
+        let factor = |axis: u8| ["Rx(roll)", "Ry(pitch)", "Rz(yaw)"][usize::from(axis)];
+        let product = o.axes().map(factor).join("·");
+        match o {
+            RotationOrder::Zxy => format!("{product} (seed 001)"),
+            RotationOrder::Zyx => format!("{product} (the default)"),
+            _ => product,
+        }
+    }
+    choice(&RotationOrder::ALL, RotationOrder::name, help)
 }
 
-/// `--knee`: backward (knee <= 0, the knee joint behind the hip-foot line) or forward.
+/// `--knee`.
 pub fn knee() -> impl TypedValueParser<Value = KneeBend> {
-    choice(&names::KNEE_BEND_VALUES, names::knee_bend_name)
+    fn help(k: KneeBend) -> String {
+        match k {
+            KneeBend::Backward => "knee <= 0 (the knee joint behind the hip-foot line)",
+            KneeBend::Forward => "knee >= 0 (the knee joint in front of the hip-foot line)",
+        }
+        .to_owned()
+    }
+    choice(&names::KNEE_BEND_VALUES, names::knee_bend_name, help)
 }
 
-/// `--policy`: reject (report the reason, no angles) or clamp (nearest reachable point).
+/// `--policy`.
 pub fn policy() -> impl TypedValueParser<Value = ReachPolicy> {
-    choice(&names::REACH_POLICY_VALUES, names::reach_policy_name)
+    fn help(p: ReachPolicy) -> String {
+        match p {
+            ReachPolicy::Reject => "Report the reason in `status`, leave the angles empty",
+            ReachPolicy::Clamp => {
+                "Move the target to the nearest reachable point and report the distance moved"
+            }
+        }
+        .to_owned()
+    }
+    choice(&names::REACH_POLICY_VALUES, names::reach_policy_name, help)
 }
 
 /// `--path`: kin-core's foot path shapes by name.
 pub fn path_kind() -> impl TypedValueParser<Value = PathKind> {
-    choice(&PathKind::ALL, PathKind::name)
+    fn help(k: PathKind) -> String {
+        match k {
+            PathKind::Rectangle => "Lift, stride, lower, return (seed 000 Fig. 8)",
+            PathKind::Semicircle => "Semicircle of diameter the stride (its height is stride/2)",
+            PathKind::Ellipse => "Half ellipse",
+            PathKind::Cycloid => "Cycloid (zero velocity at lift-off and touch-down)",
+            PathKind::Bezier => "Quintic Bézier, C1 with the stance",
+        }
+        .to_owned()
+    }
+    choice(&PathKind::ALL, PathKind::name, help)
 }
 
 /// A motion law by name.
 pub fn law() -> impl TypedValueParser<Value = Law> {
-    choice(&Law::ALL, Law::name)
+    choice(&Law::ALL, Law::name, |l| l.summary().to_owned())
 }
 
-/// `--angles`: canonical or seed000.
+/// `--angles`.
 pub fn angles() -> impl TypedValueParser<Value = Angles> {
-    choice(&Angles::ALL, Angles::name)
+    fn help(a: Angles) -> String {
+        match a {
+            Angles::Canonical => "The canonical angles as they are in the files",
+            Angles::Seed000 => "Seed 000's θ1, θ2, θ3 (kin_core::paper::to_seed000)",
+        }
+        .to_owned()
+    }
+    choice(&Angles::ALL, Angles::name, help)
+}
+
+/// `--format` of `pose`.
+pub fn pose_format() -> impl TypedValueParser<Value = PoseFormat> {
+    fn help(f: PoseFormat) -> String {
+        match f {
+            PoseFormat::Csv => "CSV in radians, for programs",
+            PoseFormat::Table => "A table per pose in degrees, for people",
+        }
+        .to_owned()
+    }
+    choice(&PoseFormat::ALL, PoseFormat::name, help)
 }
 
 /// Errors that stop a batch command.

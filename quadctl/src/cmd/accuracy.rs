@@ -53,8 +53,7 @@ pub struct Args {
     /// The leg of single-leg files, and the leg plotted.
     #[arg(long, default_value = "FL", value_parser = args::parse_leg)]
     pub leg: LegId,
-    /// Which angles the percentages are taken of: canonical (as in the files) or seed000
-    /// (seed 000's θ1, θ2, θ3).
+    /// Which angles the percentages are taken of.
     #[arg(long, value_parser = args::angles(), default_value = "canonical")]
     pub angles: Angles,
     /// Robot (preset or TOML file) for the Cartesian foot error.
@@ -111,7 +110,9 @@ pub fn run(args: &Args) -> ExitCode {
         );
     }
     if args.json {
-        match serde_json::to_string(&acc) {
+        // Through a `serde_json::Value`, as since the first release: keys sorted at every
+        // level.
+        match serde_json::to_value(acc).and_then(|v| serde_json::to_string(&v)) {
             Ok(json) => println!("{json}"),
             Err(e) => return args::fail("quadctl", &e),
         }

@@ -83,7 +83,11 @@ pub fn run(args: &Args) -> ExitCode {
         Ok(checked) => {
             print!("{}", check::table(&checked));
             if args.json {
-                match serde_json::to_string(&checked.summary()) {
+                // Through a `serde_json::Value`, as since the first release: keys sorted at every
+                // level and f32 figures widened to f64.
+                match serde_json::to_value(checked.summary())
+                    .and_then(|v| serde_json::to_string(&v))
+                {
                     Ok(json) => println!("{json}"),
                     Err(e) => return args::fail("quadctl", &e),
                 }

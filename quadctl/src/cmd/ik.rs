@@ -39,9 +39,7 @@ pub struct Args {
     /// Knee solution; default: the robot's own (backward for the presets).
     #[arg(long, value_parser = args::knee())]
     pub knee: Option<KneeBend>,
-    /// What to do with unreachable targets: reject (report the reason in `status`, leave the
-    /// angles empty) or clamp (move the target to the nearest reachable point and report the
-    /// distance moved).
+    /// What to do with unreachable targets.
     #[arg(long, value_parser = args::policy(), default_value = "reject")]
     pub policy: ReachPolicy,
     #[command(flatten)]

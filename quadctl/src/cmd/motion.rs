@@ -16,7 +16,7 @@ use std::process::ExitCode;
     allow_negative_numbers = true
 )]
 pub struct Args {
-    /// The motion law: roll-sway, pitch-sway, yaw-sway, yaw-turn, rect-path, trot, walk.
+    /// The motion law.
     #[arg(value_parser = args::law())]
     pub law: Law,
     #[command(flatten)]

@@ -59,9 +59,8 @@ pub struct Args {
     /// Knee solution; default: the robot's own (backward for the presets).
     #[arg(long, value_parser = args::knee())]
     pub knee: Option<KneeBend>,
-    /// Output format: csv (radians, for programs) or table (a table per pose in degrees, for
-    /// people).
-    #[arg(long, value_parser = args::choice(&PoseFormat::ALL, PoseFormat::name), default_value = "csv")]
+    /// Output format.
+    #[arg(long, value_parser = args::pose_format(), default_value = "csv")]
     pub format: PoseFormat,
     /// Same as `--format table`: a human-readable table in degrees.
     #[arg(long, conflicts_with = "format")]

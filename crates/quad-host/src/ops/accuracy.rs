@@ -72,6 +72,22 @@ pub enum Error {
         /// Its rows.
         measured_rows: usize,
     },
+    /// The metric is undefined on these files.
+    #[error("{target} / {measured}: {source}")]
+    Metric {
+        /// The target file.
+        target: String,
+        /// The measured file.
+        measured: String,
+        /// Why.
+        source: MetricError,
+    },
+}
+
+/// Why the metric is undefined on a set of pairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MetricError {
     /// No pair of ok rows.
     #[error("no paired samples")]
     NoPairs,
@@ -101,16 +117,16 @@ pub struct Accuracy {
 /// Seed 000's metric from paired (target, measured) triples of the same joints.
 ///
 /// # Errors
-/// [`Error::NoPairs`], [`Error::ZeroTarget`].
-pub fn accuracy(pairs: &[([f64; 3], [f64; 3])]) -> Result<Accuracy, Error> {
+/// [`MetricError::NoPairs`], [`MetricError::ZeroTarget`].
+pub fn accuracy(pairs: &[([f64; 3], [f64; 3])]) -> Result<Accuracy, MetricError> {
     if pairs.is_empty() {
-        return Err(Error::NoPairs);
+        return Err(MetricError::NoPairs);
     }
     let mut sum = [0.0f64; 3];
     for (i, (t, m)) in pairs.iter().enumerate() {
         for j in 0..3 {
             if t[j] == 0.0 {
-                return Err(Error::ZeroTarget {
+                return Err(MetricError::ZeroTarget {
                     pair: i + 1,
                     joint: Joint::ALL[j],
                 });
@@ -245,7 +261,11 @@ pub fn run(args: &Request) -> Result<Outcome, Error> {
             }
         }
     }
-    let acc = accuracy(&pairs)?;
+    let acc = accuracy(&pairs).map_err(|source| Error::Metric {
+        target: target_name.clone(),
+        measured: measured_name.clone(),
+        source,
+    })?;
     let foot = (!dist.is_empty()).then(|| {
         let n = dist.len() as f64;
         FootError {

@@ -60,6 +60,29 @@ impl Law {
         }
     }
 
+    /// One line on the law, with the equation it implements.
+    pub fn summary(self) -> &'static str {
+        match self {
+            Law::RollSway => "Seed 001 eq. 6: roll θ(t) = θ0 + A·sin(2πt/T), feet fixed",
+            Law::PitchSway => "Seed 001 eq. 8: pitch γ(t) = γ0 + A·sin(2πt/T), feet fixed",
+            Law::YawSway => {
+                "Yaw ψ(t) = ψ0 + A·sin(2πt/T), feet fixed (seed 000's twisting posture)"
+            }
+            Law::YawTurn => {
+                "Seed 001 eq. 9–11 (corrected): ψ(t) = ψ0 − ω_z·t, crossed pairs stepping on \
+                 circles"
+            }
+            Law::RectPath => {
+                "Seed 000 §3.2: every foot follows a closed path (default its rectangle) under a \
+                 held body"
+            }
+            Law::Trot => {
+                "Trot: diagonal pairs in antiphase, duty 0.5, driven by a velocity command"
+            }
+            Law::Walk => "Walk: one leg at a time (RL, FL, RR, FR), duty 0.75",
+        }
+    }
+
     /// The law named `name` ([`Law::name`]).
     pub fn parse(name: &str) -> Option<Law> {
         Law::ALL.into_iter().find(|l| l.name() == name)
