@@ -2,6 +2,7 @@
 
 mod args;
 mod cmd;
+mod progress;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -243,6 +243,14 @@ pub enum Error {
     },
 }
 
+/// The host's mapping of a pulse, for messages.
+fn host_pulse(half_us: &Option<u16>) -> String {
+    match half_us {
+        Some(p) => format!("{p} half-µs"),
+        None => "beyond the servo's travel".to_owned(),
+    }
+}
+
 /// Short name of an answer, for messages.
 pub fn answer_name(a: &DeviceToHost) -> &'static str {
     match a {
@@ -268,7 +276,10 @@ pub enum Mismatch {
         host_rad: f32,
     },
     /// A readback pulse differs from the calibration's mapping of the device's angle.
-    #[error("{servo}: device pulse {device_half_us} half-µs, host mapping {host_half_us:?}")]
+    #[error(
+        "{servo}: device pulse {device_half_us} half-µs, host mapping {}",
+        host_pulse(host_half_us)
+    )]
     Pulse {
         /// The joint.
         servo: ServoId,

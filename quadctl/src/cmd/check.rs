@@ -1,8 +1,8 @@
 //! `quadctl check`: the preflight report of a motion CSV or of a motion law
 //! (`kin_core::preflight`).
 
-use super::motion::Bar;
 use crate::args::{self, LawArgs, EXIT_MALFORMED, EXIT_OK};
+use crate::progress::Bar;
 use quad_host::ops::check::{self, Request, Source};
 use quad_host::ops::motion::Law;
 use std::path::PathBuf;

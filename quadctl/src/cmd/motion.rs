@@ -2,9 +2,8 @@
 //! trot / walk) into a CSV of joint angles, feet and body pose; optional plot.
 
 use crate::args::{self, LawArgs, EXIT_MALFORMED, EXIT_OK};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use quad_host::ops::motion::{self, Law, Progress, Request};
-use std::io::{self, IsTerminal};
+use crate::progress::Bar;
+use quad_host::ops::motion::{self, Law, Request};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -66,46 +65,6 @@ Bad parameters (negative durations or periods, zero rates, NaN, a step or lift h
 reach, options that do not apply to the law) are refused before anything is written, naming the
 option; exit status 2. With --output, the file appears only when complete. Exit status 1 when
 some samples are unreachable (the file is complete and says which).";
-
-/// A progress bar on stderr when it is a terminal, hidden otherwise, driven by the library's
-/// [`Progress`] reports.
-pub struct Bar {
-    bar: ProgressBar,
-    what: String,
-}
-
-impl Bar {
-    /// A bar labelled `what`, not yet shown.
-    pub fn new(what: &str) -> Bar {
-        Bar {
-            bar: ProgressBar::hidden(),
-            what: what.to_owned(),
-        }
-    }
-
-    /// Follows one report.
-    pub fn update(&mut self, p: Progress) {
-        match p {
-            Progress::Start(len) => self.bar = progress(len, &self.what),
-            Progress::Done(n) => self.bar.set_position(n),
-            Progress::Finished => self.bar.finish_and_clear(),
-        }
-    }
-}
-
-fn progress(len: u64, what: &str) -> ProgressBar {
-    if !io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} samples ({per_sec}, {eta})")
-    {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message(what.to_owned());
-    bar
-}
 
 /// `quadctl motion`.
 pub fn run(args: &Args) -> ExitCode {
