@@ -15,7 +15,7 @@
 //! Numbers are written with Rust's shortest round-trip formatting of `f32` (`{}`), so parsing a
 //! printed value as `f32` gives back the same value; `-0` is printed as `0`.
 //!
-//! The motion CSV (`quadctl motion`'s output, read by `check`, `plot` and `stream`-side tools)
+//! The motion CSV (`quadctl motion`'s output, read by `check`, `plot` and `accuracy`)
 //! has its own reader and writer in [`motion`].
 
 pub mod motion;
