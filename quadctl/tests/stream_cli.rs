@@ -47,10 +47,11 @@ fn stream_sim_on_the_example_poses() {
     assert_eq!(s["pulses_out_of_range"], 0);
     assert_eq!(s["max_angle_err_rad"], 0.0);
     assert!(s["poses_per_s"].as_f64().unwrap() > 90.0);
-    // The unreachable pose (line 19) is reported, with the host's agreement.
+    // The unreachable pose (line 21, the body 15 cm higher) is reported, with the host's
+    // agreement.
     assert!(
         run.stderr
-            .contains("examples/poses.csv:19: nacked: unreachable: FL too_far"),
+            .contains("examples/poses.csv:21: nacked: unreachable: FL too_far"),
         "{}",
         run.stderr
     );
