@@ -205,7 +205,7 @@ fn write_leg(x: &mut String, model: &Model, leg: LegId) {
 }
 
 /// The model's name: the preset's name when the geometry is a preset's, else `robot`.
-pub(crate) fn robot_name(model: &Model) -> &'static str {
+pub fn robot_name(model: &Model) -> &'static str {
     kin_core::Robot::PRESETS
         .into_iter()
         .find(|n| kin_core::Robot::preset(n).as_ref() == Some(model.robot()))

@@ -85,8 +85,38 @@ impl ServoModel {
         mass_kg: 0.48,
     };
 
+    /// A 35 kgf·cm-class digital hobby servo (DS3235 class): 3.4 N·m stall at 7.4 V,
+    /// 0.13 s/60°, deadband 3 µs, 65 g. Class values, not one datasheet; the other parameters
+    /// as [`ServoModel::MG996R`].
+    pub const DS3235: ServoModel = ServoModel {
+        name: "ds3235",
+        stall_torque_nm: 3.4,
+        no_load_speed_rad_s: (PI / 3.0) / 0.13,
+        full_duty_error_rad: 0.1,
+        deadband_rad: 3.0 / DATASHEET_US_PER_RAD,
+        derivative_s: 0.0,
+        armature_kg_m2: 2.0e-3,
+        friction_loss_nm: 0.01,
+        mass_kg: 0.065,
+    };
+
+    /// A quasi-direct-drive actuator of the Unitree A1 class: 33.5 N·m peak torque, 21 rad/s,
+    /// 0.605 kg. Assumed as [`ServoModel::QDD17`]: full duty at 0.1 rad, derivative time
+    /// 0.02 s, friction 0.05 N·m, deadband 1 mrad; reflected inertia 4·10⁻³ kg·m² (9:1 gearing).
+    pub const QDD33: ServoModel = ServoModel {
+        name: "qdd33",
+        stall_torque_nm: 33.5,
+        no_load_speed_rad_s: 21.0,
+        full_duty_error_rad: 0.1,
+        deadband_rad: 1.0e-3,
+        derivative_s: 0.02,
+        armature_kg_m2: 4.0e-3,
+        friction_loss_nm: 0.05,
+        mass_kg: 0.605,
+    };
+
     /// Names of the presets accepted by [`ServoModel::preset`].
-    pub const PRESETS: [&'static str; 2] = ["mg996r", "qdd17"];
+    pub const PRESETS: [&'static str; 4] = ["mg996r", "ds3235", "qdd17", "qdd33"];
 
     /// A preset by name.
     ///
@@ -95,7 +125,9 @@ impl ServoModel {
     pub fn preset(name: &str) -> Result<ServoModel, UnknownServo> {
         match name {
             "mg996r" => Ok(ServoModel::MG996R),
+            "ds3235" => Ok(ServoModel::DS3235),
             "qdd17" => Ok(ServoModel::QDD17),
+            "qdd33" => Ok(ServoModel::QDD33),
             _ => Err(UnknownServo {
                 name: name.to_owned(),
             }),
