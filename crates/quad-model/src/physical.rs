@@ -43,9 +43,10 @@ pub struct Physical {
 }
 
 impl Physical {
-    /// Seed 000's robot (0.6 × 0.28 m body, 0.28 / 0.277 m legs) built with MG996R-class
-    /// servos: 1.8 kg body (frame 0.9, 2S LiPo 0.35, electronics and wiring 0.33, four
-    /// abduction servos 0.22), 3D-printed or aluminium links; 2.8 kg in all.
+    /// Seed 000's robot (0.6 × 0.28 m body, 0.28 / 0.277 m legs) with 35 kgf·cm-class hobby
+    /// servos ([`ServoModel::DS3235`]; the twin shows MG996R-class servos cannot hold its
+    /// stance): 1.8 kg body (frame 0.9, 2S LiPo 0.35, electronics and wiring 0.33, four
+    /// abduction servos 0.22), 3D-printed or aluminium links; 2.84 kg in all.
     pub const fn shahriar2023() -> Physical {
         Physical {
             body_mass_kg: 1.8,
@@ -57,14 +58,15 @@ impl Physical {
             foot_radius_m: 0.015,
             foot_friction: 0.8,
             link_radius_m: 0.012,
-            servo: ServoModel::MG996R,
+            servo: ServoModel::DS3235,
         }
     }
 
     /// Seed 001's robot (1.0 × 0.5 m body, 0.15 / 0.45 / 0.45 m legs), which no hobby servo
-    /// can hold: Mini Cheetah-class actuators (seed 001 cites that robot), a 12 kg body
-    /// (aluminium-profile frame 6, 24 V battery 2.5, electronics 1.5, four abduction actuators
-    /// 1.9), aluminium-tube links; 21.5 kg in all.
+    /// can hold: Unitree A1-class actuators ([`ServoModel::QDD33`]; the Mini Cheetah class
+    /// seed 001 cites, [`ServoModel::QDD17`], holds the stance but not a trot on two legs), a
+    /// 12 kg body (aluminium-profile frame 6, 24 V battery 2.5, electronics 1.5, four
+    /// abduction actuators 2), aluminium-tube links; 22 kg in all.
     pub const fn fernando2025() -> Physical {
         Physical {
             body_mass_kg: 12.0,
@@ -76,7 +78,7 @@ impl Physical {
             foot_radius_m: 0.03,
             foot_friction: 0.8,
             link_radius_m: 0.025,
-            servo: ServoModel::QDD17,
+            servo: ServoModel::QDD33,
         }
     }
 
@@ -342,9 +344,9 @@ mod tests {
     #[test]
     fn presets_validate_and_weigh_what_the_docs_say() {
         let s = Model::preset("shahriar2023").unwrap();
-        assert!((s.physical().total_mass_kg() - 2.8).abs() < 1e-4);
+        assert!((s.physical().total_mass_kg() - 2.84).abs() < 1e-4);
         let f = Model::preset("fernando2025").unwrap();
-        assert!((f.physical().total_mass_kg() - 21.52).abs() < 1e-3);
+        assert!((f.physical().total_mass_kg() - 22.02).abs() < 1e-3);
     }
 
     #[test]

@@ -26,7 +26,10 @@ fn main() -> ExitCode {
     let config = match RobotPreset::from_name(robot).and_then(Config::for_preset) {
         Some(c) => c,
         None => {
-            eprintln!("unknown robot `{robot}` (known: {})", Physical::PRESETS.join(", "));
+            eprintln!(
+                "unknown robot `{robot}` (known: {})",
+                Physical::PRESETS.join(", ")
+            );
             return ExitCode::from(2);
         }
     };

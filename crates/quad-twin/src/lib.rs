@@ -224,7 +224,8 @@ pub fn run(
 ) -> Result<Run, Error> {
     let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
     let plan = Plan::new(kind, config).map_err(Error::Motion)?;
-    let device = device::SimDevice::start(*config).map_err(|error| Error::Device { frame: 0, error })?;
+    let device =
+        device::SimDevice::start(*config).map_err(|error| Error::Device { frame: 0, error })?;
     let mut source = source::HostDriven::new(plan, device);
     let tmp = tempfile::tempdir().map_err(Error::Io)?;
     let out_dir = options.out_dir.as_deref();

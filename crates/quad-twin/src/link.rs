@@ -133,14 +133,18 @@ impl Twin {
     /// [`crate::Error::Venv`] when the environment is missing, [`crate::Error::Io`] when the
     /// process cannot start.
     pub fn spawn(root: &Path) -> Result<Twin, crate::Error> {
-        let mut cmd = quad_model::venv::python_module(root, "runner").map_err(crate::Error::Venv)?;
+        let mut cmd =
+            quad_model::venv::python_module(root, "runner").map_err(crate::Error::Venv)?;
         let mut child = cmd
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
             .map_err(crate::Error::Io)?;
-        let stdin = child.stdin.take().ok_or(crate::Error::Protocol("no stdin"))?;
+        let stdin = child
+            .stdin
+            .take()
+            .ok_or(crate::Error::Protocol("no stdin"))?;
         let stdout = child
             .stdout
             .take()

@@ -28,6 +28,11 @@ pub const TROT_SPEED_HEIGHTS_PER_S: f32 = 0.25;
 pub const TROT_DURATION_S: f32 = 10.0;
 /// Yaw-turn duration, in step periods.
 pub const YAW_TURN_PERIODS: f32 = 2.0;
+/// Step period of the fast yaw turn, s: the gait's default cycle, so that each diagonal pair
+/// is in the air for 0.4 s instead of seed 001's 3 s.
+pub const FAST_YAW_TURN_PERIOD_S: f32 = 0.8;
+/// Step height of the fast yaw turn as a fraction of the stance height (the gait's default).
+pub const FAST_YAW_TURN_LIFT_FRACTION: f32 = 0.15;
 
 /// A motion of the twin's catalogue.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -46,13 +51,16 @@ pub enum MotionKind {
     SweepYaw,
     /// Seed 001's crossed-pair yaw turn (eq. 9–11: ω = 0.085 rad/s, T1 = 6 s), two periods.
     YawTurn,
+    /// Seed 001's yaw turn at the same turn rate with a step period of
+    /// [`FAST_YAW_TURN_PERIOD_S`] (dynamic, trot-like) over the same 12 s.
+    YawTurnFast,
     /// A trot forward at [`TROT_SPEED_HEIGHTS_PER_S`], [`TROT_DURATION_S`].
     Trot,
 }
 
 impl MotionKind {
     /// Every motion.
-    pub const ALL: [MotionKind; 8] = [
+    pub const ALL: [MotionKind; 9] = [
         MotionKind::Stand,
         MotionKind::Roll,
         MotionKind::Pitch,
@@ -60,6 +68,7 @@ impl MotionKind {
         MotionKind::SweepPitch,
         MotionKind::SweepYaw,
         MotionKind::YawTurn,
+        MotionKind::YawTurnFast,
         MotionKind::Trot,
     ];
 
@@ -73,6 +82,7 @@ impl MotionKind {
             MotionKind::SweepPitch => "sweep-pitch",
             MotionKind::SweepYaw => "sweep-yaw",
             MotionKind::YawTurn => "yaw-turn",
+            MotionKind::YawTurnFast => "yaw-turn-fast",
             MotionKind::Trot => "trot",
         }
     }
@@ -163,6 +173,21 @@ impl Plan {
                     YAW_TURN_PERIODS * p.step_period_s,
                 )
             }
+            MotionKind::YawTurnFast => {
+                let base = YawTurnParams::seed001();
+                let p = YawTurnParams {
+                    robot,
+                    order,
+                    stance_feet: robot.stance_feet(h),
+                    lift_height_m: FAST_YAW_TURN_LIFT_FRACTION * h,
+                    step_period_s: FAST_YAW_TURN_PERIOD_S,
+                    ..base
+                };
+                (
+                    Script::Law(AnyMotion::YawTurn(YawTurn::new(p)?)),
+                    YAW_TURN_PERIODS * base.step_period_s,
+                )
+            }
             MotionKind::Trot => {
                 let mut p = GaitParams::new(Pattern::Trot, robot, h);
                 p.order = order;
@@ -170,10 +195,7 @@ impl Plan {
                     forward_m_s: TROT_SPEED_HEIGHTS_PER_S * h,
                     ..Velocity::default()
                 };
-                (
-                    Script::Law(AnyMotion::Gait(Gait::new(p)?)),
-                    TROT_DURATION_S,
-                )
+                (Script::Law(AnyMotion::Gait(Gait::new(p)?)), TROT_DURATION_S)
             }
         };
         Ok(Plan {
