@@ -13,19 +13,15 @@ const FK_TOLERANCE_M: f64 = 1e-6;
 /// Random joint-angle samples per preset.
 const SAMPLES: usize = 200;
 
-fn run_check_fk(model_path: &std::path::Path, angles: &[[f32; 12]]) -> serde_json::Value {
+fn run_check(module: &str, request: &serde_json::Value) -> serde_json::Value {
     let mut cmd =
-        venv::python_module(&venv::workspace_root(), "check_fk").unwrap_or_else(|e| panic!("{e}"));
+        venv::python_module(&venv::workspace_root(), module).unwrap_or_else(|e| panic!("{e}"));
     let mut child = cmd
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("start the twin's Python");
-    let request = serde_json::json!({
-        "model": model_path,
-        "angles_rad": angles.iter().map(|a| a.map(f64::from).to_vec()).collect::<Vec<_>>(),
-    });
     child
         .stdin
         .take()
@@ -35,7 +31,7 @@ fn run_check_fk(model_path: &std::path::Path, angles: &[[f32; 12]]) -> serde_jso
     let out = child.wait_with_output().unwrap();
     assert!(
         out.status.success(),
-        "check_fk failed: {}",
+        "{module} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).expect("JSON answer")
@@ -61,7 +57,11 @@ fn every_preset_loads_and_its_feet_agree_with_kin_core() {
                 })
             })
             .collect();
-        let answer = run_check_fk(&path, &angles);
+        let request = serde_json::json!({
+            "model": path,
+            "angles_rad": angles.iter().map(|a| a.map(f64::from).to_vec()).collect::<Vec<_>>(),
+        });
+        let answer = run_check("check_fk", &request);
         assert_eq!(answer["nq"], 19, "{name}: free joint (7) + 12 hinges");
         assert_eq!(answer["nu"], 12, "{name}: one actuator per joint");
         assert_eq!(answer["servo_name"], model.physical().servo.name);
@@ -92,6 +92,49 @@ fn every_preset_loads_and_its_feet_agree_with_kin_core() {
         );
         eprintln!(
             "{name}: worst MuJoCo vs kin-core foot distance {worst:.3e} m over {SAMPLES} samples"
+        );
+    }
+}
+
+/// The servo law in MuJoCo: a knee servo stepping its unloaded tibia tops out at its no-load
+/// speed (the back-EMF term is the speed limit), never exceeds its stall torque from rest, and
+/// settles within its deadband plus the friction it cannot overcome.
+#[test]
+fn a_servo_step_is_speed_limited_and_torque_limited() {
+    let dir = tempfile::tempdir().unwrap();
+    for servo in quad_model::ServoModel::PRESETS {
+        let model = Model::new(
+            Robot::shahriar2023(),
+            quad_model::Physical::shahriar2023()
+                .with_servo(servo)
+                .unwrap(),
+        )
+        .unwrap();
+        let path = dir.path().join(format!("{servo}.xml"));
+        mjcf::write(&model, &path).unwrap();
+        let request = serde_json::json!({
+            "model": path, "joint": "FL_knee", "from_rad": -2.0, "to_rad": -0.3, "duration_s": 1.5,
+        });
+        let a = run_check("check_servo", &request);
+        let get = |k: &str| a[k].as_f64().unwrap();
+        let (speed, top) = (get("max_speed_rad_s"), get("no_load_speed_rad_s"));
+        eprintln!("{servo}: knee step top speed {speed:.3} rad/s (no-load {top:.3}), {a}");
+        assert!(
+            speed <= top * 1.02 && speed >= 0.8 * top,
+            "{servo}: top speed {speed} rad/s against the no-load {top} rad/s"
+        );
+        assert!(
+            get("max_torque_nm") <= get("stall_torque_nm") * 1.001,
+            "{servo}: {a}"
+        );
+        // Settled: inside the deadband, or where the gear friction holds the link (the duty
+        // at the residual error drives less than the friction).
+        let friction_error = f64::from(model.physical().servo.friction_loss_nm)
+            / get("stall_torque_nm")
+            * get("full_duty_error_rad");
+        assert!(
+            get("final_error_rad").abs() <= get("deadband_rad").max(friction_error) + 1e-4,
+            "{servo}: {a}"
         );
     }
 }
