@@ -72,6 +72,11 @@ required); knee_bend = \"backward\" | \"forward\" (optional, default backward); 
 [limits] table with abduction_rad, hip_rad, knee_rad = [min, max] (radians; a joint left out is
 limited only to the full turn [-pi, pi]). Unknown keys are refused.";
 
+/// The text after a batch command's `--help`: its examples, then [`BATCH_RULES`].
+pub fn batch_help(examples: &str) -> String {
+    format!("{examples}\n\n{BATCH_RULES}")
+}
+
 /// `--robot`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 pub struct RobotArgs {

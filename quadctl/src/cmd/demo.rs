@@ -33,11 +33,19 @@ the readback in force within one 0.5 us timer tick. Times are simulated time on 
 Exit status: 0 every check passed; 2 the firmware could not be built or the link failed; 3 a
 check failed.";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl demo
+  quadctl demo --poses-per-sweep 20 --baud 1000000
+  quadctl demo --port /dev/ttyACM0";
+
 /// Arguments of `quadctl demo`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Demo: body-pose sweeps on the firmware in an emulated Mega (or --port), all checked",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// Drive a real Arduino Mega on this serial port instead of the emulator.

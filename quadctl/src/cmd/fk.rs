@@ -1,6 +1,6 @@
 //! `quadctl fk`: leg forward kinematics, one set of joint angles per record.
 
-use crate::args::{Error, InputArgs, RobotArgs, BATCH_RULES};
+use crate::args::{self, Error, InputArgs, RobotArgs};
 use quad_host::csv::{Input, Summary};
 use quad_host::ops::batch;
 use std::io::Write;
@@ -20,12 +20,19 @@ leg's hip (abduction-axis) mount, axes parallel to the body frame (x forward, y 
 
 with s = +1 for the left legs (FL, RL) and −1 for the right legs (FR, RR).";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl fk --robot shahriar2023 --input examples/angles.csv
+  quadctl fk --robot examples/robots/fernando2025.toml --input examples/angles.csv";
+
 /// Arguments of `quadctl fk`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 #[command(
     about = "Leg FK: joint angles (rad) -> foot in hip frame (m), CSV",
     long_about = LONG_ABOUT,
-    after_long_help = BATCH_RULES
+    after_help = EXAMPLES,
+    after_long_help = args::batch_help(EXAMPLES)
 )]
 pub struct Args {
     #[command(flatten)]

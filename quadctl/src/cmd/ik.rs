@@ -1,6 +1,6 @@
 //! `quadctl ik`: leg inverse kinematics, one foot target per record.
 
-use crate::args::{self, Error, InputArgs, RobotArgs, BATCH_RULES};
+use crate::args::{self, Error, InputArgs, RobotArgs};
 use kin_core::{KneeBend, ReachPolicy};
 use quad_host::csv::{Input, Summary};
 use quad_host::ops::batch;
@@ -25,12 +25,19 @@ angles clamped to the joint limits): the row then has angles, status `clamped:<r
 last column clamp_distance_m, the distance in metres between the requested foot and the foot the
 angles reach (0 for `ok` rows; empty for non_finite rows, which are still rejected).";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl ik --robot shahriar2023 --input examples/feet.csv
+  quadctl ik --robot fernando2025 --policy clamp --knee forward --input examples/feet.csv";
+
 /// Arguments of `quadctl ik`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 #[command(
     about = "Leg IK: foot in hip frame (m) -> joint angles (rad), CSV",
     long_about = LONG_ABOUT,
-    after_long_help = BATCH_RULES
+    after_help = EXAMPLES,
+    after_long_help = args::batch_help(EXAMPLES)
 )]
 pub struct Args {
     #[command(flatten)]
