@@ -50,22 +50,32 @@ pub fn exit_status<E: std::error::Error>(result: Result<(), E>) -> ExitCode {
 
 /// Help text shared by the batch commands: input rules and exit codes.
 pub const BATCH_RULES: &str = "\
-Input: CSV, one record per line, fields separated by commas (no quoting), spaces around fields
-ignored. Blank lines and lines starting with `#` are skipped. The header row is optional: the
-first record is taken as a header when its first field is not a value of the first column; it
-must then name exactly the expected columns, or nothing is processed. Leg names are FL, FR, RL,
-RR (any case).
+Input: CSV in UTF-8 (a byte-order mark at the start is ignored), one record per line, fields
+separated by commas (no quoting; a line using `;` or tabs is refused with that hint), spaces
+around fields ignored. Blank lines and lines starting with `#` are skipped. The header row is
+optional: the first record is taken as a header when its first field is not a value of the
+first column; it must then name exactly the expected columns, optionally followed by the columns
+another batch command writes (status, clamp_distance_m, line: so `ik | fk` and `fk | ik` pipe),
+or nothing is processed. Leg names are FL, FR, RL, RR (any case). An input without any record
+is an error.
 
 Output: CSV on stdout with a header row. Numbers are printed with the shortest decimal that reads
-back to the same f32.
+back to the same f32. The last column, line, is the input line of the record, so that output
+rows can be matched to input rows although malformed records get no row; when the input carries
+a line column (piped from another batch command), its value is kept, naming the line of the
+first input. A piped record that was not answered (status other than ok or clamped:...) is
+passed on with its status and empty cells.
 
-Malformed records (wrong number of fields, a field that is not a number or not a leg name) are
-reported on stderr as `<input>:<line>: <what is wrong>` and get NO output row; the other records
-are still answered, in input order.
+Numbers that are nan, inf or beyond the f32 range (e.g. 1e300) are answered with the status
+non_finite and empty cells, the same way by ik, fk and pose.
+
+Malformed records (wrong number of fields, a field that is not a number or not a leg name, a
+line that is not UTF-8) are reported on stderr as `<input>:<line>: <what is wrong>` and get NO
+output row; the other records are still answered, in input order.
 
 Exit status: 0 every record answered (unreachable targets are answers, see `status`); 1 at least
 one malformed record; 2 nothing processed or processing stopped (bad arguments, robot file or
-input not readable or invalid, foreign header, output error).
+input not readable or invalid, foreign header, no record, output error).
 
 Robot files (TOML): d_lat_m, d_ax_m, femur_m, tibia_m, body_length_m, body_width_m (metres,
 required); knee_bend = \"backward\" | \"forward\" (optional, default backward); optional

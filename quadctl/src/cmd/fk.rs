@@ -10,10 +10,12 @@ Leg forward kinematics: joint angles -> foot position in the hip frame.
 
 Input columns: leg,abduction_rad,hip_rad,knee_rad — joint angles in RADIANS in the canonical
 convention (all zero: leg straight down; abduction about x, hip and knee about the abducted y
-axis, knee relative to the femur). Angles must be finite (nan or inf make the record
-malformed). Joint limits are NOT checked: any finite angles give the foot they put it at.
+axis, knee relative to the femur). Joint limits are NOT checked: any finite angles give the
+foot they put it at.
 
-Output columns: leg,x_m,y_m,z_m — the foot in the HIP FRAME of that leg, metres: origin at the
+Output columns: leg,x_m,y_m,z_m,status,line — status is `ok`, or `non_finite` with the three
+position cells left empty when an angle is nan, inf or beyond the f32 range (e.g. 1e300), as
+`ik` and `pose` answer such numbers; line is the record's input line (see below). The foot in the HIP FRAME of that leg, metres: origin at the
 leg's hip (abduction-axis) mount, axes parallel to the body frame (x forward, y left, z up):
 
   foot = Rx(abduction)·([0, s·d_lat, −d_ax] + Ry(hip)·[0,0,−femur] + Ry(hip+knee)·[0,0,−tibia])

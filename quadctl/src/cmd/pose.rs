@@ -22,10 +22,11 @@ Rz(yaw)·Rx(roll)·Ry(pitch) (seed 001). With --pivot-m c (body frame, metres) t
 about c: foot_in_hip = Rᵀ·(foot_in_world − t − c) + c − hip_in_body.
 
 Output (CSV): FL_abduction_rad,FL_hip_rad,FL_knee_rad, then FR, RL, RR likewise (RADIANS, the
-canonical convention: all zero is the leg straight down), then status: `ok`, or `<leg>:<reason>`
+canonical convention: all zero is the leg straight down), then status and line (the record's input line, see below): status is `ok`, or `<leg>:<reason>`
 for the first leg (in the order FL, FR, RL, RR) that cannot reach, e.g. `FR:too_far`, with all
 twelve angle cells empty (all or nothing). Reasons: too_far, too_close, inside_offset,
-joint_limit, non_finite (a nan or inf in the pose is reported as FL:non_finite).
+joint_limit, non_finite (a nan, inf or 1e300 in the pose is reported as FL:non_finite, as `ik`
+and `fk` answer such numbers).
 
 Output (--table): a human-readable table per pose, angles in DEGREES (pose angles too), for
 reading, not for parsing.";
