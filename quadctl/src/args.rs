@@ -70,8 +70,8 @@ Numbers that are nan, inf or beyond the f32 range (e.g. 1e300) are answered with
 non_finite and empty cells, the same way by ik, fk and pose.
 
 Malformed records (wrong number of fields, a field that is not a number or not a leg name, a
-line that is not UTF-8) are reported on stderr as `<input>:<line>: <what is wrong>` and get NO
-output row; the other records are still answered, in input order.
+line that is not UTF-8) are reported on stderr as `<input>:<line>: <what is wrong>` and
+get NO output row; the other records are still answered, in input order.
 
 Exit status: 0 every record answered (unreachable targets are answers, see `status`); 1 at least
 one malformed record; 2 nothing processed or processing stopped (bad arguments, robot file or
@@ -115,22 +115,24 @@ pub struct InputArgs {
     pub input: PathBuf,
 }
 
-/// Where the device is: `--sim`, `--emulator` or `--port`, and the line (`stream`,
+/// Where the device is: `--sim`, `--emulator` or `--port` (exactly one: the group `target`,
+/// so that a missing one is reported with the three choices), and the line (`stream`,
 /// `calibrate`).
 #[derive(Debug, Clone, PartialEq, clap::Args)]
+#[command(group = clap::ArgGroup::new("target").required(true).multiple(false))]
 pub struct TargetArgs {
     /// Run against the device controller behind a simulated UART.
-    #[arg(long, conflicts_with_all = ["port", "emulator"], required_unless_present_any = ["port", "emulator"])]
+    #[arg(long, group = "target")]
     pub sim: bool,
     /// Run the real firmware in simavr (an emulated ATmega2560; simulated time).
-    #[arg(long, conflicts_with = "port")]
+    #[arg(long, group = "target")]
     pub emulator: bool,
     /// Firmware ELF for --emulator; default: built from firmware-avr/ for --baud (115200:
     /// firmware.elf, 1000000: firmware-1mbaud.elf).
     #[arg(long, value_name = "PATH", requires = "emulator")]
     pub elf: Option<PathBuf>,
     /// Serial port of a real device, e.g. /dev/ttyACM0.
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, value_name = "PATH", group = "target")]
     pub port: Option<String>,
     /// Line rate, bit/s (8N1).
     #[arg(long, value_name = "B", default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(300..))]

@@ -107,13 +107,13 @@ pub fn main(args: &Args) -> ExitCode {
 
 fn describe_info(info: &quad_protocol::DeviceInfo) -> String {
     format!(
-        "  device: protocol {}.{}, firmware {}.{}.{}, robot {:?}",
+        "  device: protocol {}.{}, firmware {}.{}.{}, robot {}",
         info.version >> 8,
         info.version & 0xFF,
         info.firmware.major,
         info.firmware.minor,
         info.firmware.patch,
-        info.robot
+        quad_host::names::robot_preset_name(info.robot)
     )
 }
 

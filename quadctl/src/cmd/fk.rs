@@ -26,7 +26,8 @@ with s = +1 for the left legs (FL, RL) and −1 for the right legs (FR, RR).";
 pub const EXAMPLES: &str = "\
 Examples (from the repository root):
   quadctl fk --robot shahriar2023 --input examples/angles.csv
-  quadctl fk --robot examples/robots/fernando2025.toml --input examples/angles.csv";
+  quadctl fk --robot examples/robots/fernando2025.toml --input examples/angles.csv
+  quadctl fk --robot shahriar2023 --input examples/angles.csv | quadctl ik --robot shahriar2023";
 
 /// Arguments of `quadctl fk`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]

@@ -30,7 +30,8 @@ angles reach (0 for `ok` rows; empty for non_finite rows, which are still reject
 pub const EXAMPLES: &str = "\
 Examples (from the repository root):
   quadctl ik --robot shahriar2023 --input examples/feet.csv
-  quadctl ik --robot fernando2025 --policy clamp --knee forward --input examples/feet.csv";
+  quadctl ik --robot fernando2025 --policy clamp --knee forward --input examples/feet.csv
+  quadctl ik --robot shahriar2023 --input examples/feet.csv | quadctl fk --robot shahriar2023";
 
 /// Arguments of `quadctl ik`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]

@@ -43,7 +43,8 @@ Examples (from the repository root):
     about = "Body IK: body pose (rad, m) -> 12 joint angles (rad) at the nominal stance, CSV",
     long_about = LONG_ABOUT,
     after_help = EXAMPLES,
-    after_long_help = args::batch_help(EXAMPLES)
+    after_long_help = args::batch_help(EXAMPLES),
+    allow_negative_numbers = true
 )]
 pub struct Args {
     #[command(flatten)]

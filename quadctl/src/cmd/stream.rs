@@ -57,7 +57,8 @@ Examples (from the repository root):
 #[command(
     about = "Stream body poses (rad, m) to the device (--sim or --port) and check every readback",
     long_about = LONG_ABOUT,
-    after_help = EXAMPLES
+    after_help = EXAMPLES,
+    allow_negative_numbers = true
 )]
 pub struct Args {
     #[command(flatten)]

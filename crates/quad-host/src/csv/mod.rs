@@ -398,10 +398,9 @@ impl fmt::Display for Error {
                 }
                 write!(f, " (nothing was processed)")
             }
-            Error::NoRecords { input, expected } => write!(
-                f,
-                "{input}: no records (expected lines of {expected}): nothing to answer"
-            ),
+            Error::NoRecords { input, expected } => {
+                write!(f, "{input}: no records (expected {expected})")
+            }
             Error::Read { input, source } => write!(f, "cannot read `{input}`: {source}"),
             Error::Empty { input, expected } => {
                 write!(f, "{input}: empty file: expected a header {expected}")
@@ -719,7 +718,7 @@ pub fn for_each_row(
     if summary.answered == 0 && summary.malformed == 0 {
         return Err(Error::NoRecords {
             input: name,
-            expected: format!("`{}`", schema.header()),
+            expected: format!("lines of `{}`", schema.header()),
         });
     }
     Ok(summary)
