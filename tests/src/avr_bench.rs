@@ -13,12 +13,12 @@
 //!   forward kinematics (written from the chain formula in kin-core's crate docs), started
 //!   from the host's f32 solution, to a residual below [`REFERENCE_RESIDUAL_M`].
 
-use host_tools::client::{Client, ClientConfig};
-use host_tools::emu::{build, elf, Mega2560, MARKER_PIN};
-use host_tools::link::emulator::{EmulatorConfig, EmulatorLink};
 use kin_core::math::Libm;
 use kin_core::{body, BodyConfig, LegId, Pose, ReachPolicy, Robot, Vec3};
 use nalgebra::{Matrix3, Rotation3, Vector3};
+use quad_host::client::{Client, ClientConfig};
+use quad_host::emu::{build, elf, Mega2560, MARKER_PIN};
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::{DeviceToHost, PoseConfig, Request};
 use seeded_rng::SplitMix64;
 use serde::Serialize;
@@ -413,9 +413,9 @@ pub fn measure_backend(
     }
 }
 
-pub use host_tools::emu::elf::ElfSizes;
+pub use quad_host::emu::elf::ElfSizes;
 
-/// Flash and static SRAM of an ELF (`host_tools::emu::elf`).
+/// Flash and static SRAM of an ELF (`quad_host::emu::elf`).
 pub fn elf_sizes(path: &Path) -> ElfSizes {
     elf::sizes(path).unwrap_or_else(|e| panic!("{e}"))
 }
