@@ -51,6 +51,15 @@ pub type BoardDevice = Device<Servos, Clock, Eeprom, AvrFast>;
 
 /// Brings the board up and runs the device forever at `baud`.
 pub fn run(baud: Baud) -> ! {
+    run_with_receive_hold(baud, 0)
+}
+
+/// [`run`], but each pass of the main loop takes the received bytes with interrupts off and
+/// keeps them off for `hold_cycles` more cycles — **a defect on purpose**, for the
+/// `firmware-1mbaud-cli-hold` binary only: the emulator tests show that a receive path which
+/// blocks interrupts for longer than the chip's two-byte buffer covers loses bytes, and that
+/// the emulator counts them. [`run`] passes 0 (no interrupts-off stretch at all).
+pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
     crate::stack::paint();
     let Some(dp) = crate::pac::Peripherals::take() else {
         panic!()
@@ -73,7 +82,7 @@ pub fn run(baud: Baud) -> ! {
     device.boot();
     loop {
         watchdog.feed();
-        serve(&mut device, &mut usart);
+        serve(&mut device, &mut usart, hold_cycles);
     }
 }
 
@@ -97,9 +106,17 @@ fn new_device(servos: Servos, clock: Clock, eeprom: Eeprom) -> BoardDevice {
 /// access to a local would need a frame pointer beyond the AVR's 63-byte displacement (about
 /// 8 instructions per access) — it doubled the firmware's flash.
 #[inline(never)]
-fn serve(device: &mut BoardDevice, usart: &mut Usart0) {
+fn serve(device: &mut BoardDevice, usart: &mut Usart0, hold_cycles: u32) {
     let mut chunk = [0u8; CHUNK];
-    let n = usart.read_into(&mut chunk);
+    let n = if hold_cycles == 0 {
+        usart.read_into(&mut chunk)
+    } else {
+        avr_device::interrupt::free(|_| {
+            let n = usart.read_into(&mut chunk);
+            avr_device::asm::delay_cycles(hold_cycles);
+            n
+        })
+    };
     if n > 0 {
         device.receive(&chunk[..n], |frame| usart.send(frame));
     }

@@ -3,9 +3,12 @@
 //! ## Timing
 //! Time is the emulated MCU's cycle counter (16 MHz); nothing sleeps, and simavr runs slower
 //! than real time, so every rate measured on this link is in **simulated** time.
-//! - **Host → device**: [`Link::send`] puts a frame on the line at the current cycle; simavr's
-//!   USART model delivers its bytes at the line rate the firmware configured (checked against
-//!   [`EmulatorConfig::baud`] at boot), one per byte time of [`SIMAVR_BITS_PER_BYTE`] bits.
+//! - **Host → device**: [`Link::send`] puts a frame on the line at the current cycle; its bytes
+//!   reach the firmware at the line rate it configured (checked against
+//!   [`EmulatorConfig::baud`] at boot), one per byte time of [`SIMAVR_BITS_PER_BYTE`] bits,
+//!   through a receiver as strict as the chip's: two bytes of buffer plus the shift register,
+//!   a byte the firmware does not read in time is lost and counted (data overrun, see
+//!   [`crate::emu::Mega2560`]; [`EmulatorLink::rx_overruns`], `LineStats::rx_overflow`).
 //! - **Device → host**: a byte the firmware writes to UDR0 arrives one byte time later (simavr
 //!   paces the transmitter at the same byte time).
 //!   [`Link::recv`] runs the MCU until a byte has arrived (or the timeout passed) and returns
@@ -382,9 +385,18 @@ impl EmulatorLink {
         &self.config
     }
 
-    /// What the line did so far.
+    /// What the line did so far; `rx_overflow` counts the bytes the chip's receive buffer
+    /// lost (data overruns, see [`crate::emu::Mega2560::rx_overruns`]).
     pub fn line_stats(&self) -> LineStats {
-        self.stats
+        LineStats {
+            rx_overflow: self.mcu.rx_overruns(),
+            ..self.stats
+        }
+    }
+
+    /// Bytes the chip's receive buffer lost because the firmware did not read them in time.
+    pub fn rx_overruns(&self) -> u64 {
+        self.mcu.rx_overruns()
     }
 
     /// The pin check so far, with every pulse judged that can be (pulses that started after
