@@ -8,7 +8,7 @@
 //!   `Ack` with the [`Readback`], `Calibration`, or `Nack` with a typed [`NackReason`]).
 //! - [`frame`]: `COBS(postcard(message) ‖ CRC-16) ‖ 0x00` — [`encode_frame`] and the
 //!   bounded [`Accumulator`] for split, concatenated, oversize and garbled input.
-//! - [`crc`]: CRC-16/GENIBUS (CCITT-FALSE with a final XOR), bitwise, no table.
+//! - [`crc`]: CRC-16/GENIBUS (CCITT-FALSE with a final XOR), a byte at a time, no table.
 //! - [`range`]: the admissible range of every request field, one check for host and device.
 //! - [`servo`]: per-joint [`servo::Calibration`] and the angle ↔ pulse mapping.
 //! - [`wire`]: the explicit wire index of every enum variant, and the tables of the kin-core

@@ -13,9 +13,9 @@
 //!   paces the transmitter at the same byte time).
 //!   [`Link::recv`] runs the MCU until a byte has arrived (or the timeout passed) and returns
 //!   the bytes up to the end of that frame.
-//! - The firmware's own timing (IK, answer encoding, polled transmission, EEPROM writes of
-//!   3.4 ms per byte, its 1 kHz clock and link-loss failsafe) is emulated instruction by
-//!   instruction.
+//! - The firmware's own timing (IK, answer encoding, interrupt-driven transmission, EEPROM
+//!   writes of 3.4 ms per byte, its 1 kHz clock and link-loss failsafe) is emulated instruction
+//!   by instruction.
 //!
 //! ## Faults
 //! [`Faults`] apply to both directions, drawn from one seeded generator: per frame a stall, a
@@ -26,9 +26,11 @@
 //! ## Pin check
 //! Every pulse on the twelve servo pins (Timer1/3/4/5 incl. port L) is measured and compared
 //! with the readbacks the firmware sent (decoded from its UART output before any line fault):
-//! the device writes the compare registers before it answers, and the hardware takes them over
-//! at the start of a period, so a pulse that starts at cycle `t` must be as wide as the pulses
-//! of the last readback sent before `t` or of the next one, within one timer tick (0.5 µs). A
+//! the device writes the compare registers between pulses — before it answers, or, when the
+//! request came during the pulses, after them and before the period ends — and the hardware
+//! takes them over at the start of a period, so a pulse that starts at cycle `t` must be as wide
+//! as the pulses of the last readback sent before `t` or of the next one, within one timer tick
+//! (0.5 µs). A
 //! pulse while both say the outputs are off, or at power-on before any answer, is an error
 //! too. See [`PulseStats`].
 
