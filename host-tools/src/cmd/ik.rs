@@ -84,7 +84,7 @@ pub fn run(
     let summary = csv_io::for_each_row(input, INPUT, out, diag, Some(header), |row, out| {
         let leg = row.leg(0)?;
         let foot_in_hip = Vec3::new(row.number(1)?, row.number(2)?, row.number(3)?);
-        match leg::inverse(&robot, leg, foot_in_hip, policy) {
+        match leg::Solver::new(&robot).inverse(leg, foot_in_hip, policy) {
             Ok(solution) => {
                 let q = solution.angles;
                 write!(

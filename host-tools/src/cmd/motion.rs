@@ -637,8 +637,7 @@ pub fn write_motion<T: Motion>(
         let t64 = f64::from(k) / rate;
         let t = sweep.time_s(k);
         let frame = m.frame(t).map_err(param_err)?;
-        let sol = body::inverse(
-            m.robot(),
+        let sol = body::Solver::new(m.robot()).inverse(
             &frame.pose,
             &config,
             &frame.feet_in_world,

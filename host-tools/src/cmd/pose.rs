@@ -156,8 +156,7 @@ pub fn run(
             *slot = row.number(i)?;
         }
         let pose = Pose::from_array(v);
-        let result = body::inverse_at_stance(
-            &robot,
+        let result = body::Solver::new(&robot).inverse_at_stance(
             &pose,
             &config,
             args.stance_height_m,
