@@ -548,6 +548,7 @@ pub fn wrap_two_pi(angle_rad: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use seeded_rng::SplitMix64;
     extern crate std;
     use std::vec;
 
@@ -682,11 +683,9 @@ mod tests {
             "worst atan2_fixed error {worst}"
         );
         // No panic (debug overflow checks) and a finite result on any bit pattern but NaN.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = SplitMix64::new(0x2545_f491_4f6c_dd1du64);
         for _ in 0..100_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
+            let state = rng.next_u64();
             let (y, x) = (
                 f32::from_bits(state as u32),
                 f32::from_bits((state >> 32) as u32),
@@ -756,11 +755,9 @@ mod tests {
         let mut vals = vec![
             0.0f32, -0.0, 1.0, -1.0, 1e-30, -1e-30, 3e30, -3e30, 0.5, -2.5,
         ];
-        let mut state = 0x1234_5678_9abc_def0u64;
+        let mut rng = SplitMix64::new(0x1234_5678_9abc_def0u64);
         for _ in 0..200 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
+            let state = rng.next_u64();
             vals.push((state >> 40) as f32 / (1u64 << 23) as f32 - 1.0);
         }
         let bits = |a: [f32; 3]| a.map(f32::to_bits);
@@ -807,11 +804,9 @@ mod tests {
     /// The byte-wise 16 × 16-bit product is the product.
     #[test]
     fn byte_wise_product_is_the_product() {
-        let mut state = 0x0123_4567_89ab_cdefu64;
+        let mut rng = SplitMix64::new(0x0123_4567_89ab_cdefu64);
         for _ in 0..200_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
+            let state = rng.next_u64();
             let (a, b) = (state as u16, (state >> 16) as u16);
             assert_eq!(poly::mul_16x16(a, b), a as u32 * b as u32);
         }
@@ -850,11 +845,9 @@ mod tests {
             f32::from_bits(0x7fff_ffff),
             f32::from_bits(0xffff_ffff),
         ];
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = SplitMix64::new(0x9e37_79b9_7f4a_7c15u64);
         for _ in 0..300 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
+            let state = rng.next_u64();
             vals.push(f32::from_bits((state >> 32) as u32));
         }
         for &a in &vals {
