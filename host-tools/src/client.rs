@@ -35,7 +35,7 @@
 
 use crate::link::{byte_time, Link, LinkError};
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, ReachPolicy, Robot, RotationOrder, Vec3};
+use kin_core::{BodyConfig, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     encode_frame, frame, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,

@@ -15,15 +15,15 @@
 //! | paper step | equation (seed 000) | here |
 //! |---|---|---|
 //! | distance of the foot from the abduction axis, `A = √(y² + z²)` | 4.1 | [`Solver::inverse`]'s `r_sq` (`A²`), checked `A² ≥ La²` ([`Unreachable::InsideOffset`]) |
-//! | α1, the direction of `A` (erratum 6a: measured from +y, one `atan2`) | 4.2–4.5 | [`abduction_yx`] |
-//! | α2, α3 of the right triangle with legs `La`, `ℓ = √(A² − La²)` | 4.6–4.7 | [`depth`]: `w = −ℓ` |
-//! | θ1 = α1 + (90° − α2) per quadrant (erratum 6c: wrapped on both sides) | 4.8–4.11 | [`abduction_yx`]: `atan2(sd·z − w·y, sd·y + w·z)` |
-//! | `R = √(x² + z²)` in the tilted leg plane (its z is `w`, plus `d_ax`) | 4.12 | [`leg_plane`]: `R² = u² + v²`, checked against `(L1 ± L2)²` ([`Unreachable::TooFar`], [`Unreachable::TooClose`]) |
-//! | R1, the direction of `R` (erratum 6b: by the sign of x, one `atan2`) | 4.13–4.14 | [`hip_yx`]: `angle(−v, −u)` |
-//! | R2 by the law of cosines (erratum 1: `Lc²`) | 4.15 | [`hip_yx`]: `angle(L1 + L2·cos k, L2·sin k)` |
-//! | R3 by the law of cosines | 4.16 | [`knee_yx`]: `cos k = (R² − L1² − L2²)/(2·L1·L2)` |
-//! | θ2 = R1 − R2 | 4.17–4.20 | [`hip_yx`]: one `atan2` of the difference angle |
-//! | θ3 = π − R3 | 4.21 | [`knee_yx`]: `atan2(sin k, cos k)`, `sin k` by the knee bend |
+//! | α1, the direction of `A` (erratum 6a: measured from +y, one `atan2`) | 4.2–4.5 | `abduction_yx` |
+//! | α2, α3 of the right triangle with legs `La`, `ℓ = √(A² − La²)` | 4.6–4.7 | `depth`: `w = −ℓ` |
+//! | θ1 = α1 + (90° − α2) per quadrant (erratum 6c: wrapped on both sides) | 4.8–4.11 | `abduction_yx`: `atan2(sd·z − w·y, sd·y + w·z)` |
+//! | `R = √(x² + z²)` in the tilted leg plane (its z is `w`, plus `d_ax`) | 4.12 | `Consts::leg_plane`: `R² = u² + v²`, checked against `(L1 ± L2)²` ([`Unreachable::TooFar`], [`Unreachable::TooClose`]) |
+//! | R1, the direction of `R` (erratum 6b: by the sign of x, one `atan2`) | 4.13–4.14 | `hip_yx`: `angle(−v, −u)` |
+//! | R2 by the law of cosines (erratum 1: `Lc²`) | 4.15 | `hip_yx`: `angle(L1 + L2·cos k, L2·sin k)` |
+//! | R3 by the law of cosines | 4.16 | `Consts::knee_yx`: `cos k = (R² − L1² − L2²)/(2·L1·L2)` |
+//! | θ2 = R1 − R2 | 4.17–4.20 | `hip_yx`: one `atan2` of the difference angle |
+//! | θ3 = π − R3 | 4.21 | `Consts::knee_yx`: `atan2(sin k, cos k)`, `sin k` by the knee bend |
 //! | `math_error_handler`, `angle_range_limiter` | Algorithm 1 | [`ReachPolicy`], [`JointLimits`] |
 //!
 //! The paper's angles θ1, θ2, θ3 relate to the crate's abduction, hip and knee as

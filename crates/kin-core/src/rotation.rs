@@ -125,7 +125,7 @@ fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32)
 /// Body rotation matrix for `roll`, `pitch`, `yaw` (rad) in `order`, on backend `M`
 /// (`rotation::matrix::<kin_core::DefaultMath>(…)` on a host): three `sin_cos`, then the
 /// closed form of the order — written out entry by entry for the papers' orders ([`zyx`],
-/// [`zxy`]), from the general Tait–Bryan table ([`closed_form`]) for the other four.
+/// [`zxy`]), from the general Tait–Bryan closed form for the other four.
 ///
 /// ```
 /// use kin_core::{rotation::{self, RotationOrder}, DefaultMath, Mat3};

@@ -4,7 +4,7 @@ mod common;
 
 use common::*;
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, Joint, LegId, ReachPolicy, Vec3};
+use kin_core::{BodyConfig, Joint, LegId, ReachPolicy, Vec3};
 use quad_device::config::DEFAULT_CENTER_US;
 use quad_device::{Config, Device};
 use quad_protocol::servo::{self, Calibration};
