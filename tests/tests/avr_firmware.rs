@@ -16,7 +16,7 @@ use host_tools::link::sim::Rng;
 use host_tools::link::{Faults, Link};
 use integration_tests::avr_bench::{self, STACK_PAINT, STANCE_HEIGHT_M};
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, ReachPolicy, RotationOrder};
+use kin_core::{BodyConfig, ReachPolicy, RotationOrder};
 use quad_protocol::{
     encode_frame, Accumulator, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction,
     LinkTimeout, NackReason, Request, RobotPreset, MAX_DECODED_LEN, MAX_FRAME_LEN,
