@@ -245,9 +245,13 @@ impl Usart0 {
     /// Queues `bytes` for the transmit interrupt and returns; waits (interrupts on) only while
     /// the transmit ring is full.
     pub fn send(&mut self, bytes: &[u8]) {
-        for &b in bytes {
+        for (i, &b) in bytes.iter().enumerate() {
             while !TX.push(b) {
                 // Full: make sure the transmitter is draining it.
+                self.start_transmitter();
+            }
+            if i == 0 {
+                // The first byte leaves while the others are queued.
                 self.start_transmitter();
             }
         }
