@@ -56,6 +56,7 @@ pub fn ik(
     } else {
         IK_OUTPUT_HEADER
     };
+    let solver = leg::Solver::new(robot);
     csv::for_each_row(input, IK_INPUT, out, diag, Some(header), |row, out| {
         let leg = row.leg(0)?;
         let line = row.source_line()?;
@@ -65,7 +66,7 @@ pub fn ik(
             return Ok(());
         }
         let foot_in_hip = Vec3::new(row.number(1)?, row.number(2)?, row.number(3)?);
-        match leg::inverse(robot, leg, foot_in_hip, policy) {
+        match solver.inverse(leg, foot_in_hip, policy) {
             Ok(solution) => {
                 let q = solution.angles;
                 write!(
@@ -198,6 +199,7 @@ pub fn pose(
         PoseFormat::Csv => POSE_OUTPUT_HEADER.to_owned(),
         PoseFormat::Table => table_preamble(robot_name, robot, stance_height_m, config),
     };
+    let solver = body::Solver::new(robot);
     csv::for_each_row(input, POSE_INPUT, out, diag, Some(&header), |row, out| {
         let line = row.source_line()?;
         if let Some(status) = row.unanswered_status() {
@@ -212,8 +214,7 @@ pub fn pose(
             *slot = row.number(i)?;
         }
         let pose = Pose::from_array(v);
-        let result =
-            body::inverse_at_stance(robot, &pose, config, stance_height_m, ReachPolicy::Reject);
+        let result = solver.inverse_at_stance(&pose, config, stance_height_m, ReachPolicy::Reject);
         match format {
             PoseFormat::Csv => write_csv(out, &result, line)?,
             PoseFormat::Table => write_table(out, line, &pose, &result)?,
