@@ -192,6 +192,21 @@ fn a_plot_into_a_missing_directory_is_refused_before_any_output() {
     let run = quadctl(&["plot", s(&motion), "--output", s(&plot)], "");
     assert_refused(&run, 2, "directory");
     assert!(run.stderr.contains(s(&plot)), "{}", run.stderr);
+    let run = quadctl(
+        &[
+            "accuracy",
+            "--target",
+            "examples/accuracy-target.csv",
+            "--measured",
+            "examples/accuracy-measured.csv",
+            "--plot",
+            s(&plot),
+        ],
+        "",
+    );
+    assert_refused(&run, 2, "directory");
+    assert!(run.stderr.contains(s(&plot)), "{}", run.stderr);
+    assert_eq!(run.stdout, "", "no table before the error");
 }
 
 #[test]
