@@ -469,6 +469,19 @@ impl<M: Math> Solver<M> {
         foot_in_hip: Vec3,
         policy: ReachPolicy,
     ) -> Result<LegSolution, IkError> {
+        self.inverse_inline(leg, foot_in_hip, policy)
+    }
+
+    /// [`Solver::inverse`], always inlined into its two wrappers: the public one, which the
+    /// compiler may then inline into the caller (a host's loop keeps the solve, its `atan2`
+    /// kernels included, in one piece), and [`Solver::inverse_out_of_line`].
+    #[inline(always)]
+    fn inverse_inline(
+        &self,
+        leg: LegId,
+        foot_in_hip: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<LegSolution, IkError> {
         let err = |kind| IkError { leg, kind };
         if !(finite(foot_in_hip.x) && finite(foot_in_hip.y) && finite(foot_in_hip.z)) {
             return Err(err(Unreachable::NonFinite));
@@ -535,7 +548,7 @@ impl<M: Math> Solver<M> {
         foot_in_hip: Vec3,
         policy: ReachPolicy,
     ) -> Result<LegSolution, IkError> {
-        self.inverse(leg, foot_in_hip, policy)
+        self.inverse_inline(leg, foot_in_hip, policy)
     }
 
     /// Solves the abduction and planar problem exactly for a point known to be reachable
