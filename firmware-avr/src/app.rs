@@ -32,8 +32,8 @@ use quad_device::{Config, Device};
 /// What the device runs: seed 000's robot with the controller's defaults.
 pub const DEVICE_CONFIG: Config = Config::shahriar2023();
 
-/// Watchdog timeout: far above the longest main-loop iteration (one body-pose solve, about
-/// 7 ms, plus sending its answer, 8 ms at 115,200 baud).
+/// Watchdog timeout: far above the longest main-loop iteration (one body-pose solve plus
+/// sending its answer at the line rate; the solve's cycles are in `BENCHMARKS.md`).
 pub const WATCHDOG_TIMEOUT: Timeout = Timeout::Ms250;
 
 /// Received bytes handed to the controller per call.
