@@ -492,10 +492,7 @@ impl<M: Math> Solver<M> {
         // Clamp: the Reject path, the hot one, stays free of it.)
         let target = match policy {
             ReachPolicy::Clamp => {
-                let m = libm::fmaxf(
-                    libm::fabsf(foot_in_hip.x),
-                    libm::fmaxf(libm::fabsf(foot_in_hip.y), libm::fabsf(foot_in_hip.z)),
-                );
+                let m = max_abs(foot_in_hip);
                 if m > FAR_M {
                     foot_in_hip * (FAR_M / m)
                 } else {
@@ -701,15 +698,22 @@ impl<M: Math> Solver<M> {
 /// shrunk towards the hip to this distance.
 const FAR_M: f32 = 1.0e6;
 
+/// The largest absolute coordinate of `v` (its maximum norm): what decides whether squaring
+/// `v`'s coordinates could overflow.
+#[inline(always)]
+fn max_abs(v: Vec3) -> f32 {
+    libm::fmaxf(
+        libm::fabsf(v.x),
+        libm::fmaxf(libm::fabsf(v.y), libm::fabsf(v.z)),
+    )
+}
+
 /// `|a − b|` without overflowing the squares of far targets, with the backend's square root
 /// (a firmware then links one square root, its backend's).
 #[inline]
 fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     let d = a - b;
-    let m = libm::fmaxf(
-        libm::fabsf(d.x),
-        libm::fmaxf(libm::fabsf(d.y), libm::fabsf(d.z)),
-    );
+    let m = max_abs(d);
     if m > FAR_M {
         m * M::sqrt((d * (1.0 / m)).norm_squared())
     } else {
