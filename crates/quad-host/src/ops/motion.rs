@@ -12,7 +12,7 @@ use kin_core::motion::laws::{
 use kin_core::motion::path::{AnyPath, PathKind, Rectangle, Stride};
 use kin_core::motion::{self, AnyMotion, Motion};
 use kin_core::preflight::{Sweep, MAX_SWEEP_SAMPLES};
-use kin_core::{body, ReachPolicy, Robot, RotationOrder, Vec3};
+use kin_core::{body, DefaultMath, ReachPolicy, Robot, RotationOrder, Vec3};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -482,7 +482,7 @@ pub fn write_motion<T: Motion>(
     for k in 0..n {
         let t64 = f64::from(k) / rate;
         let t = sweep.time_s(k);
-        let frame = m.frame(t).map_err(param_err)?;
+        let frame = m.frame::<DefaultMath>(t).map_err(param_err)?;
         let sol = solver.inverse(
             &frame.pose,
             &config,
