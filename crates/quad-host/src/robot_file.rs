@@ -277,6 +277,14 @@ pub enum Error {
         /// quad-model's reason, naming the key.
         source: quad_model::Error,
     },
+    /// A URDF file is not a robot with this project's leg chain (or cannot be read).
+    #[error("URDF `{}`: {source}", path.display())]
+    Urdf {
+        /// The file.
+        path: PathBuf,
+        /// What differs.
+        source: quad_model::urdf::ReadError,
+    },
 }
 
 /// The `line N: ` part of a message.
@@ -344,7 +352,9 @@ pub fn parse_description(text: &str) -> Result<Description, Error> {
 }
 
 /// Resolves a `--robot` argument with its physical properties: a preset name (its physical
-/// preset) or else a TOML file path (see [`parse_description`]).
+/// preset), a URDF file (`.urdf`, legs with this project's chain, [`quad_model::urdf`]; the
+/// physical preset of [`default_physical`]) or else a TOML file path (see
+/// [`parse_description`]).
 pub fn resolve_description(spec: &str) -> Result<Description, Error> {
     if let Some(robot) = Robot::preset(spec) {
         return Ok(Description {
@@ -353,6 +363,19 @@ pub fn resolve_description(spec: &str) -> Result<Description, Error> {
         });
     }
     let path = Path::new(spec);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        let robot = quad_model::urdf::read_file(path).map_err(|source| Error::Urdf {
+            path: path.to_owned(),
+            source,
+        })?;
+        return Ok(Description {
+            robot,
+            physical: default_physical(&robot),
+        });
+    }
     let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
         path: path.to_owned(),
         source,

@@ -14,7 +14,9 @@
 //!   host sending `SetFeet` every frame to the in-process device;
 //!   [`emulated::Emulated`]: the firmware ELF in simavr, its pin pulses measured).
 //! - [`link`]: the JSON-lines protocol and the twin process.
+//! - [`command`]: `quadctl sim` and `quadctl export` (robot argument to a run or a file).
 
+pub mod command;
 pub mod device;
 pub mod emulated;
 pub mod link;
@@ -382,32 +384,22 @@ pub fn run(
     Ok(run)
 }
 
-/// The device configuration of `robot`: its preset's when it is a preset's geometry, else the
-/// preset `base`'s settings on this geometry (reported as a custom robot); `stance_height_m`
-/// overrides the stance.
-pub fn config_for(
-    robot: &kin_core::Robot,
-    base: quad_protocol::RobotPreset,
-    stance_height_m: Option<f32>,
-) -> Option<Config> {
-    let preset = [
-        quad_protocol::RobotPreset::Shahriar2023,
-        quad_protocol::RobotPreset::Fernando2025,
-    ]
-    .into_iter()
-    .find(|p| Config::for_preset(*p).is_some_and(|c| c.robot == *robot));
-    let mut config = match preset {
-        Some(p) => Config::for_preset(p)?,
-        None => Config {
+/// The device configuration of `robot`: its preset's when it is a preset's geometry, else
+/// seed 000's robot's device settings on this geometry (reported as a custom robot);
+/// `stance_height_m` overrides the stance.
+pub fn config_for(robot: &kin_core::Robot, stance_height_m: Option<f32>) -> Config {
+    let mut config = [Config::shahriar2023(), Config::fernando2025()]
+        .into_iter()
+        .find(|c| c.robot == *robot)
+        .unwrap_or(Config {
             preset: quad_protocol::RobotPreset::Custom,
             robot: *robot,
-            ..Config::for_preset(base)?
-        },
-    };
+            ..Config::shahriar2023()
+        });
     if let Some(h) = stance_height_m {
         config.pose_config.stance_height_m = h;
     }
-    Some(config)
+    config
 }
 
 /// The loop on any frame source.
