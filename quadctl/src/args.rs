@@ -6,6 +6,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use kin_core::motion::path::PathKind;
 use kin_core::{KneeBend, LegId, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_host::client::DEFAULT_RETRIES;
+use quad_host::csv::play::ColumnKind;
 use quad_host::csv::{self, Input, Summary};
 use quad_host::link::emulator::EmulatorConfig;
 use quad_host::link::sim::{SimConfig, DEFAULT_RX_FIFO_LEN};
@@ -335,6 +336,20 @@ pub fn path_kind() -> impl TypedValueParser<Value = PathKind> {
         .to_owned()
     }
     choice(&PathKind::ALL, PathKind::name, help)
+}
+
+/// `--send` of `play`: a kind of setpoint columns.
+pub fn column_kind() -> impl TypedValueParser<Value = ColumnKind> {
+    fn help(k: ColumnKind) -> String {
+        match k {
+            ColumnKind::Joints => "The joint-angle columns, as SetJoints",
+            ColumnKind::Feet => "The foot columns, as SetFeet",
+            ColumnKind::Pose => "The body-pose columns, as SetBodyPose",
+            _ => "",
+        }
+        .to_owned()
+    }
+    choice(&ColumnKind::ALL, ColumnKind::name, help)
 }
 
 /// A motion law by name.

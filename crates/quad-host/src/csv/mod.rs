@@ -19,6 +19,7 @@
 //! has its own reader and writer in [`motion`].
 
 pub mod motion;
+pub mod play;
 
 use kin_core::LegId;
 use std::fmt;

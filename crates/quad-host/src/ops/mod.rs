@@ -7,5 +7,6 @@ pub mod calibrate;
 pub mod check;
 pub mod demo;
 pub mod motion;
+pub mod play;
 pub mod plot;
 pub mod stream;
