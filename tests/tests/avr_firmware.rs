@@ -9,7 +9,7 @@
 
 use integration_tests::avr_bench::{self, STACK_PAINT, STANCE_HEIGHT_M};
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, ReachPolicy, RotationOrder};
+use kin_core::{BodyConfig, ReachPolicy, RotationOrder};
 use quad_host::client::{
     AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
 };
@@ -77,15 +77,15 @@ fn connect(link: EmulatorLink) -> PoseStream<EmulatorLink> {
 /// The twelve pulse widths the host expects for `pose`: its own kin-core IK mapped through the
 /// device's calibration, in timer ticks.
 fn host_pulses(stream: &PoseStream<EmulatorLink>, pose: &Pose) -> [u16; 12] {
-    let angles = body::inverse_at_stance_with::<DefaultMath>(
-        &avr_bench::robot(),
-        pose,
-        &BodyConfig::default(),
-        STANCE_HEIGHT_M,
-        ReachPolicy::Reject,
-    )
-    .expect("the host solves the pose")
-    .flat();
+    let angles = body::Solver::new(&avr_bench::robot())
+        .inverse_at_stance(
+            pose,
+            &BodyConfig::default(),
+            STANCE_HEIGHT_M,
+            ReachPolicy::Reject,
+        )
+        .expect("the host solves the pose")
+        .flat();
     std::array::from_fn(|i| {
         stream.calibration()[i]
             .pulse_half_us(angles[i])
@@ -496,14 +496,14 @@ fn soak_poses(n: usize) -> Vec<Pose> {
             y_m: rng.range(-0.02, 0.02) as f32,
             z_m: rng.range(-0.02, 0.02) as f32,
         };
-        if body::inverse_at_stance_with::<DefaultMath>(
-            &robot,
-            &pose,
-            &BodyConfig::default(),
-            STANCE_HEIGHT_M,
-            ReachPolicy::Reject,
-        )
-        .is_ok()
+        if body::Solver::new(&robot)
+            .inverse_at_stance(
+                &pose,
+                &BodyConfig::default(),
+                STANCE_HEIGHT_M,
+                ReachPolicy::Reject,
+            )
+            .is_ok()
         {
             out.push(pose);
         }

@@ -21,7 +21,7 @@
 //! port, USB latency).
 //!
 //! ## Readback check ([`PoseStream`])
-//! For every body pose the host runs kin-core itself (`inverse_at_stance_with::<DefaultMath>`,
+//! For every body pose the host runs kin-core itself (`body::Solver::inverse_at_stance` on `DefaultMath`,
 //! the device's robot, stance height, rotation order and reject policy) and maps the angles
 //! through the device's calibration (read at connection):
 //! - a pose the host solves must be acked, with the twelve angles equal to the host's
@@ -35,7 +35,7 @@
 
 use crate::link::{self, byte_time, Link};
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, ReachPolicy, Robot, RotationOrder, Vec3};
+use kin_core::{BodyConfig, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     encode_frame, frame, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,
@@ -829,8 +829,7 @@ impl<L: Link> PoseStream<L> {
             order: self.pose_config.order,
             pivot_m: Vec3::ZERO,
         };
-        match body::inverse_at_stance_with::<DefaultMath>(
-            &self.setup.robot,
+        match body::Solver::new(&self.setup.robot).inverse_at_stance(
             pose,
             &config,
             self.pose_config.stance_height_m,

@@ -289,14 +289,14 @@ mod tests {
         assert!((max(|q| q.yaw_rad).to_degrees() - 21.0).abs() < 0.5);
         let robot = Robot::shahriar2023();
         for q in &p {
-            kin_core::body::inverse_at_stance(
-                &robot,
-                q,
-                &kin_core::BodyConfig::default(),
-                SEED000_SWEEP_STANCE_HEIGHT_M,
-                kin_core::ReachPolicy::Reject,
-            )
-            .expect("every demo pose is reachable");
+            kin_core::body::Solver::new(&robot)
+                .inverse_at_stance(
+                    q,
+                    &kin_core::BodyConfig::default(),
+                    SEED000_SWEEP_STANCE_HEIGHT_M,
+                    kin_core::ReachPolicy::Reject,
+                )
+                .expect("every demo pose is reachable");
         }
     }
 }
