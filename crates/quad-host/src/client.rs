@@ -841,23 +841,16 @@ impl<L: Link> PoseStream<L> {
     }
 
     /// What the host's kin-core, joint limits and calibration make of `setpoint`: the device's
-    /// own steps (IK about the body centre in the pose configuration's order for a pose or
-    /// feet; the joint limits for joint angles; then the calibration of all twelve joints).
+    /// own steps (the body IK about the body centre in the pose configuration's order for a
+    /// pose, the legs' IK of each foot less its hip mount for feet, the joint limits for joint
+    /// angles; then the calibration of all twelve joints).
     pub fn expected_for(&self, setpoint: &Setpoint) -> Expected {
         let angles = match setpoint {
             Setpoint::Pose(pose) => return self.expected(pose),
             Setpoint::Feet(feet) => {
-                let config = BodyConfig {
-                    order: self.pose_config.order,
-                    pivot_m: Vec3::ZERO,
-                };
-                match body::inverse_with::<DefaultMath>(
-                    &self.setup.robot,
-                    &Pose::default(),
-                    &config,
-                    feet,
-                    ReachPolicy::Reject,
-                ) {
+                match body::Solver::new(&self.setup.robot)
+                    .inverse_feet_in_body(feet, ReachPolicy::Reject)
+                {
                     Err(e) => return Expected::Nack(e.into()),
                     Ok(solution) => solution.flat(),
                 }

@@ -26,7 +26,7 @@ use crate::link::{self, Link, Target};
 use crate::ops::stream::Pins;
 use crate::{client, csv, robot_file};
 use kin_core::body;
-use kin_core::{BodyConfig, DefaultMath, LegId, Robot, RotationOrder, Vec3};
+use kin_core::{BodyConfig, LegId, Robot, RotationOrder, Vec3};
 use quad_protocol::RobotPreset;
 use serde::Serialize;
 use std::io::Write;
@@ -187,8 +187,7 @@ pub fn setpoint(
                         order,
                         pivot_m: Vec3::ZERO,
                     };
-                    let in_hips =
-                        body::feet_in_hips_with::<DefaultMath>(robot, &pose, &config, &feet);
+                    let in_hips = body::Solver::new(robot).feet_in_hips(&pose, &config, &feet);
                     let mut in_body = [Vec3::ZERO; 4];
                     for (i, leg) in LegId::ALL.into_iter().enumerate() {
                         in_body[i] = robot.hip_in_body(leg) + in_hips[i];
