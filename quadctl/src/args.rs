@@ -191,8 +191,9 @@ pub struct LawArgs {
     /// fernando2025); rect-path: 0.2 m (seed 000 Fig. 8).
     #[arg(long, value_name = "M")]
     pub stance_height_m: Option<f32>,
-    /// Rotation order of the body pose [default: zxy for the sways and yaw-turn (seed 001),
-    /// zyx otherwise].
+    /// Rotation order of the body pose [default: a preset's device order (fernando2025 zxy,
+    /// shahriar2023 zyx, as the firmware runs it); a robot file: zxy for the sways and
+    /// yaw-turn (seed 001), zyx otherwise].
     #[arg(long, value_parser = rotation_order())]
     pub rotation_order: Option<RotationOrder>,
     /// Sways: amplitude A, rad [default: 0.2].

@@ -223,3 +223,34 @@ fn play_on_the_emulator_checks_the_pins() {
     assert_eq!(json["pulse_width_errors"], 0);
     assert!(json["pulses_checked"].as_u64().unwrap() > 12 * 40);
 }
+
+#[test]
+fn motion_uses_the_devices_rotation_order_for_a_preset() {
+    for (law, robot, order) in [
+        ("roll-sway", "shahriar2023", "zyx"),
+        ("roll-sway", "fernando2025", "zxy"),
+        ("trot", "fernando2025", "zxy"),
+        ("trot", "shahriar2023", "zyx"),
+    ] {
+        let csv = motion_csv(&[
+            law,
+            "--robot",
+            robot,
+            "--stance-height-m",
+            if robot == "fernando2025" {
+                "0.9294"
+            } else {
+                "0.4"
+            },
+            "--duration-s",
+            "0.1",
+            "--rate-hz",
+            "10",
+        ]);
+        let first = csv.lines().next().expect("a comment line");
+        assert!(
+            first.contains(&format!("rotation_order={order}")),
+            "{law} {robot}: {first}"
+        );
+    }
+}
