@@ -234,7 +234,11 @@ pub enum Error {
         device: u16,
     },
     /// The device runs another robot than the host was asked for.
-    #[error("the device runs robot {device:?}, the host was given {host:?}")]
+    #[error(
+        "the device runs robot {}, the host was given {}",
+        crate::names::robot_preset_name(*device),
+        crate::names::robot_preset_name(*host)
+    )]
     Robot {
         /// The device's robot.
         device: RobotPreset,
@@ -258,6 +262,7 @@ pub fn answer_name(a: &DeviceToHost) -> &'static str {
         DeviceToHost::HelloAck { .. } => "HelloAck",
         DeviceToHost::Ack { .. } => "Ack",
         DeviceToHost::Calibration { .. } => "Calibration",
+        DeviceToHost::Configured { .. } => "Configured",
     }
 }
 
@@ -537,14 +542,19 @@ impl<L: Link> Client<L> {
         }
     }
 
-    /// A request answered by an `Ack`; returns its readback.
+    /// A request answered by an `Ack`, or a configuration request answered by a `Configured`
+    /// that echoes exactly the setting sent; returns its readback.
     ///
     /// # Errors
-    /// As [`Client::request`], or [`Error::Unexpected`].
+    /// As [`Client::request`], or [`Error::Unexpected`] (an echo that differs included).
     pub fn ack(&mut self, request: Request) -> Result<Readback, Error> {
         let name = request_name(&request);
+        let sent = quad_protocol::Setting::of_request(&request);
         match self.request(request)? {
             DeviceToHost::Ack { readback, .. } => Ok(readback),
+            DeviceToHost::Configured {
+                setting, readback, ..
+            } if Some(setting) == sent => Ok(readback),
             other => Err(Error::Unexpected {
                 request: name,
                 answer: Box::new(other),
@@ -823,8 +833,12 @@ impl<L: Link> PoseStream<L> {
         &mut self.client
     }
 
-    /// What the host's kin-core and calibration make of `pose`.
+    /// What the host's kin-core and calibration make of `pose`, after the range check the
+    /// device runs too (`quad_protocol::range`).
     pub fn expected(&self, pose: &Pose) -> Expected {
+        if let Err(reason) = quad_protocol::range::check_pose(pose, &self.setup.robot) {
+            return Expected::Nack(reason);
+        }
         let config = BodyConfig {
             order: self.pose_config.order,
             pivot_m: Vec3::ZERO,

@@ -29,6 +29,7 @@ use kin_core::{JointLimits, KneeBend, LegGeometry, Robot};
 use serde::{Deserialize, Deserializer};
 use std::io;
 use std::path::{Path, PathBuf};
+use toml::Spanned;
 
 /// `knee_bend = "backward" | "forward"`, through [`names::knee_bend`].
 fn knee_bend<'de, D: Deserializer<'de>>(d: D) -> Result<KneeBend, D::Error> {
@@ -38,35 +39,67 @@ fn knee_bend<'de, D: Deserializer<'de>>(d: D) -> Result<KneeBend, D::Error> {
 }
 
 /// The `[limits]` table: `[min, max]` per joint, rad.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LimitsTable {
-    abduction_rad: Option<[f32; 2]>,
-    hip_rad: Option<[f32; 2]>,
-    knee_rad: Option<[f32; 2]>,
+    abduction_rad: Option<Spanned<[f32; 2]>>,
+    hip_rad: Option<Spanned<[f32; 2]>>,
+    knee_rad: Option<Spanned<[f32; 2]>>,
 }
 
-/// The whole file.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+/// The whole file; every value with its place in the text, for messages.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RobotFile {
-    d_lat_m: f32,
-    d_ax_m: f32,
-    femur_m: f32,
-    tibia_m: f32,
-    body_length_m: f32,
-    body_width_m: f32,
+    d_lat_m: Spanned<f32>,
+    d_ax_m: Spanned<f32>,
+    femur_m: Spanned<f32>,
+    tibia_m: Spanned<f32>,
+    body_length_m: Spanned<f32>,
+    body_width_m: Spanned<f32>,
     #[serde(default, deserialize_with = "knee_bend")]
     knee_bend: KneeBend,
     #[serde(default)]
     limits: LimitsTable,
 }
 
+/// The longest link or body dimension a robot file may give, m. Any longer is taken for a value
+/// in the wrong unit (millimetres for metres), not a robot.
+pub const MAX_DIMENSION_M: f32 = 10.0;
+
 impl RobotFile {
+    /// The lengths by key.
+    fn lengths(&self) -> [(&'static str, &Spanned<f32>); 6] {
+        [
+            ("d_lat_m", &self.d_lat_m),
+            ("d_ax_m", &self.d_ax_m),
+            ("femur_m", &self.femur_m),
+            ("tibia_m", &self.tibia_m),
+            ("body_length_m", &self.body_length_m),
+            ("body_width_m", &self.body_width_m),
+        ]
+    }
+
+    /// The byte offset of the value kin-core names when it refuses one (a length's key or a
+    /// joint's name).
+    fn span_of(&self, key: &str) -> Option<usize> {
+        if let Some((_, v)) = self.lengths().into_iter().find(|(k, _)| *k == key) {
+            return Some(v.span().start);
+        }
+        let limit = match key {
+            "abduction" => &self.limits.abduction_rad,
+            "hip" => &self.limits.hip_rad,
+            "knee" => &self.limits.knee_rad,
+            _ => return None,
+        };
+        limit.as_ref().map(|l| l.span().start)
+    }
+
     fn into_robot(self) -> Robot {
         let full = JointLimits::FULL_TURN;
-        let pick =
-            |entry: Option<[f32; 2]>, j: usize| entry.unwrap_or([full.min_rad[j], full.max_rad[j]]);
+        let pick = |entry: Option<Spanned<[f32; 2]>>, j: usize| {
+            entry.map_or([full.min_rad[j], full.max_rad[j]], Spanned::into_inner)
+        };
         let entries = [
             pick(self.limits.abduction_rad, 0),
             pick(self.limits.hip_rad, 1),
@@ -74,13 +107,13 @@ impl RobotFile {
         ];
         Robot {
             leg: LegGeometry {
-                d_lat_m: self.d_lat_m,
-                d_ax_m: self.d_ax_m,
-                femur_m: self.femur_m,
-                tibia_m: self.tibia_m,
+                d_lat_m: *self.d_lat_m.get_ref(),
+                d_ax_m: *self.d_ax_m.get_ref(),
+                femur_m: *self.femur_m.get_ref(),
+                tibia_m: *self.tibia_m.get_ref(),
             },
-            body_length_m: self.body_length_m,
-            body_width_m: self.body_width_m,
+            body_length_m: *self.body_length_m.get_ref(),
+            body_width_m: *self.body_width_m.get_ref(),
             limits: JointLimits {
                 min_rad: entries.map(|e| e[0]),
                 max_rad: entries.map(|e| e[1]),
@@ -88,6 +121,15 @@ impl RobotFile {
             knee_bend: self.knee_bend,
         }
     }
+}
+
+/// 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// Why a robot file or a `--robot` argument was refused.
@@ -107,40 +149,66 @@ pub enum Error {
         source: io::Error,
     },
     /// Not valid TOML, or a key is missing, unknown or of the wrong type.
-    #[error("{}{}", file(path), source.to_string().trim_end())]
+    #[error("{}{}", place(path, *line), source.message().trim_end())]
     Toml {
         /// The file, when the text came from one.
         path: Option<PathBuf>,
-        /// The TOML error (it names the key and the line).
-        source: toml::de::Error,
+        /// 1-based line of the error, when it has one (a missing key has none).
+        line: Option<usize>,
+        /// The TOML error (its message names the key); boxed, it is large.
+        source: Box<toml::de::Error>,
     },
     /// The values were read but [`Robot::validate`] refused them.
-    #[error("{}{source}", file(path))]
+    #[error("{}{source}", place(path, *line))]
     Invalid {
         /// The file, when the text came from one.
         path: Option<PathBuf>,
+        /// 1-based line of the refused value.
+        line: Option<usize>,
         /// kin-core's reason, naming the key.
         source: RobotError,
     },
+    /// A length beyond [`MAX_DIMENSION_M`]: a value in another unit than metres.
+    #[error(
+        "{}`{key}` = {value_m} m is implausible (more than {MAX_DIMENSION_M} m): values are in \
+         metres, e.g. 0.28 for 280 mm",
+        place(path, Some(*line))
+    )]
+    Implausible {
+        /// The file, when the text came from one.
+        path: Option<PathBuf>,
+        /// 1-based line of the value.
+        line: usize,
+        /// The key.
+        key: &'static str,
+        /// The value given.
+        value_m: f32,
+    },
 }
 
-/// The `robot file `PATH`: ` prefix of a message, when there is a file.
-fn file(path: &Option<PathBuf>) -> String {
-    path.as_ref()
-        .map(|p| format!("robot file `{}`: ", p.display()))
-        .unwrap_or_default()
+/// The `robot file `PATH`:LINE: ` prefix of a message (parts left out when unknown).
+fn place(path: &Option<PathBuf>, line: Option<usize>) -> String {
+    match (path, line) {
+        (Some(p), Some(l)) => format!("robot file `{}`:{l}: ", p.display()),
+        (Some(p), None) => format!("robot file `{}`: ", p.display()),
+        (None, Some(l)) => format!("line {l}: "),
+        (None, None) => String::new(),
+    }
 }
 
 impl Error {
     fn in_file(self, file: &Path) -> Error {
+        let path = Some(file.to_owned());
         match self {
-            Error::Toml { source, .. } => Error::Toml {
-                path: Some(file.to_owned()),
-                source,
-            },
-            Error::Invalid { source, .. } => Error::Invalid {
-                path: Some(file.to_owned()),
-                source,
+            Error::Toml { line, source, .. } => Error::Toml { path, line, source },
+            Error::Invalid { line, source, .. } => Error::Invalid { path, line, source },
+            Error::Implausible {
+                line, key, value_m, ..
+            } => Error::Implausible {
+                path,
+                line,
+                key,
+                value_m,
             },
             other => other,
         }
@@ -148,13 +216,50 @@ impl Error {
 }
 
 /// Parses and validates the text of a robot file (see the module docs for the keys).
+///
+/// # Errors
+/// [`Error::Toml`], [`Error::Invalid`] or [`Error::Implausible`], with the line of the value at
+/// fault when there is one.
 pub fn parse(text: &str) -> Result<Robot, Error> {
-    let file: RobotFile =
-        toml::from_str(text).map_err(|source| Error::Toml { path: None, source })?;
+    let file: RobotFile = toml::from_str(text).map_err(|source| {
+        // A missing key is reported on an empty span at the start (or on the whole document):
+        // it has no line of its own, and line 1 would point at whatever is there.
+        let line = source
+            .span()
+            .filter(|s| s.start > 0 || (s.end > 0 && s.end < text.trim_end().len()))
+            .map(|s| line_of(text, s.start));
+        Error::Toml {
+            path: None,
+            line,
+            source: Box::new(source),
+        }
+    })?;
+    if let Some((key, v)) = file
+        .lengths()
+        .into_iter()
+        .find(|(_, v)| v.get_ref().abs() > MAX_DIMENSION_M)
+    {
+        return Err(Error::Implausible {
+            path: None,
+            line: line_of(text, v.span().start),
+            key,
+            value_m: *v.get_ref(),
+        });
+    }
+    let spans = file.clone();
     let robot = file.into_robot();
-    robot
-        .validate()
-        .map_err(|source| Error::Invalid { path: None, source })?;
+    robot.validate().map_err(|source| {
+        let key = match &source {
+            RobotError::BadLength(name) => Some(*name),
+            RobotError::BadLimit(joint) => Some(joint.name()),
+            _ => None,
+        };
+        Error::Invalid {
+            path: None,
+            line: key.and_then(|k| spans.span_of(k)).map(|o| line_of(text, o)),
+            source,
+        }
+    })?;
     Ok(robot)
 }
 
@@ -164,7 +269,9 @@ pub fn load_file(path: &Path) -> Result<Robot, Error> {
         path: path.to_owned(),
         source,
     })?;
-    parse(&text).map_err(|e| e.in_file(path))
+    // Editors on Windows may start the file with a byte-order mark; TOML does not allow one.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    parse(text).map_err(|e| e.in_file(path))
 }
 
 /// Resolves a `--robot` argument: a preset name ([`Robot::PRESETS`]) or else a TOML file path.
@@ -213,6 +320,7 @@ mod tests {
             err,
             Error::Invalid {
                 source: RobotError::BadLength("femur_m"),
+                line: Some(3),
                 ..
             }
         ));

@@ -12,7 +12,7 @@ use crate::link::emulator::EmulatorConfig;
 use crate::link::{self, Link, Target};
 use kin_core::motion::laws::{Axis, Sway, SwayParams};
 use kin_core::motion::Motion;
-use kin_core::Robot;
+use kin_core::{DefaultMath, Robot};
 use quad_protocol::{DeviceInfo, RobotPreset};
 use std::io::{self, Write};
 use std::path::PathBuf;
@@ -85,6 +85,8 @@ pub struct Summary {
     pub pulse_width_errors: Option<u64>,
     /// The first pulse error, described.
     pub first_pulse_error: Option<String>,
+    /// Bytes the chip's receive buffer lost (emulator only).
+    pub rx_overruns: Option<u64>,
     /// Answered poses per second of link time.
     pub poses_per_s: f64,
     /// Mean command → readback time, link time.
@@ -104,6 +106,7 @@ impl Summary {
             && self.mismatches == 0
             && self.pulse_width_errors.unwrap_or(0) == 0
             && self.pulses_checked != Some(0)
+            && self.rx_overruns.unwrap_or(0) == 0
     }
 }
 
@@ -121,7 +124,7 @@ pub fn poses(n: usize) -> Result<Vec<kin_core::Pose>, Error> {
         let period = sway.params().period_s;
         for k in 0..n {
             let t = period * k as f32 / n as f32;
-            out.push(sway.frame(t)?.pose);
+            out.push(sway.frame::<DefaultMath>(t)?.pose);
         }
     }
     Ok(out)
@@ -181,6 +184,8 @@ pub struct Mcu {
     pub resets: u32,
     /// Deepest stack, bytes.
     pub stack_peak_bytes: u16,
+    /// The longest stretch with interrupts off while bytes were arriving, cycles.
+    pub interrupts_off_receiving_cycles: u64,
 }
 
 /// What the demo did.
@@ -265,9 +270,11 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
         summary.pulses_checked = Some(pulses.checked);
         summary.pulse_width_errors = Some(pulses.errors);
         summary.first_pulse_error = pulses.first_error;
+        summary.rx_overruns = Some(link.rx_overruns());
         Mcu {
             resets: link.mcu().resets().count,
             stack_peak_bytes: link.mcu().stack_peak_bytes(),
+            interrupts_off_receiving_cycles: link.mcu().interrupts_off().longest_receiving_cycles,
         }
     });
     Ok(Demo {

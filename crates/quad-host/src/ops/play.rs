@@ -141,7 +141,9 @@ impl Summary {
     pub fn check_failed(&self) -> bool {
         self.stream.readback_mismatches > 0
             || self.stream.pulses_out_of_range > 0
-            || self.pins.is_some_and(|p| p.pulse_width_errors > 0)
+            || self
+                .pins
+                .is_some_and(|p| p.pulse_width_errors > 0 || p.rx_overruns > 0)
     }
 }
 
@@ -236,7 +238,17 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Summary, Error> {
             writeln!(diag, "{}: PULSE WIDTH ERROR: {e}", file.name)
                 .map_err(|source| csv::Error::Write { path: None, source })?;
         }
+        let rx_overruns = emu.rx_overruns();
+        if rx_overruns > 0 {
+            writeln!(
+                diag,
+                "{}: RECEIVE OVERRUN: {rx_overruns} bytes lost by the chip's receive buffer",
+                file.name
+            )
+            .map_err(|source| csv::Error::Write { path: None, source })?;
+        }
         pins = Some(Pins {
+            rx_overruns,
             pulses_checked: pulses.checked,
             pulse_width_errors: pulses.errors,
         });
