@@ -32,6 +32,7 @@ enum Command {
     Stream(cmd::stream::Args),
     Calibrate(cmd::calibrate::Args),
     Demo(cmd::demo::Args),
+    Play(cmd::play::Args),
     Sim(cmd::sim::Args),
     Export(cmd::export::Args),
 }
@@ -54,6 +55,7 @@ fn main() -> ExitCode {
         Command::Stream(args) => cmd::stream::main(&args),
         Command::Calibrate(args) => cmd::calibrate::main(&args),
         Command::Demo(args) => cmd::demo::main(&args),
+        Command::Play(args) => cmd::play::main(&args),
         Command::Sim(args) => cmd::sim::run(&args),
         Command::Export(args) => cmd::export::run(&args),
     }
