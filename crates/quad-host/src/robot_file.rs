@@ -62,12 +62,12 @@ fn knee_bend<'de, D: Deserializer<'de>>(d: D) -> Result<KneeBend, D::Error> {
 }
 
 /// The `[limits]` table: `[min, max]` per joint, rad.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LimitsTable {
-    abduction_rad: Option<[f32; 2]>,
-    hip_rad: Option<[f32; 2]>,
-    knee_rad: Option<[f32; 2]>,
+    abduction_rad: Option<Spanned<[f32; 2]>>,
+    hip_rad: Option<Spanned<[f32; 2]>>,
+    knee_rad: Option<Spanned<[f32; 2]>>,
 }
 
 /// The `[physical]` table: every key optional (see the module docs), kept with its place in
@@ -86,11 +86,6 @@ struct PhysicalTable {
     foot_radius_m: Option<Spanned<f32>>,
     foot_friction: Option<Spanned<f32>>,
     link_radius_m: Option<Spanned<f32>>,
-}
-
-/// Line (from 1) of byte offset `at` in `text`.
-fn line_of(text: &str, at: usize) -> usize {
-    text.get(..at).map_or(0, |s| s.matches('\n').count()) + 1
 }
 
 impl PhysicalTable {
@@ -188,16 +183,16 @@ pub fn default_physical(robot: &Robot) -> Physical {
         .unwrap_or(Physical::shahriar2023())
 }
 
-/// The whole file.
+/// The whole file; every value with its place in the text, for messages.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RobotFile {
-    d_lat_m: f32,
-    d_ax_m: f32,
-    femur_m: f32,
-    tibia_m: f32,
-    body_length_m: f32,
-    body_width_m: f32,
+    d_lat_m: Spanned<f32>,
+    d_ax_m: Spanned<f32>,
+    femur_m: Spanned<f32>,
+    tibia_m: Spanned<f32>,
+    body_length_m: Spanned<f32>,
+    body_width_m: Spanned<f32>,
     #[serde(default, deserialize_with = "knee_bend")]
     knee_bend: KneeBend,
     #[serde(default)]
@@ -206,11 +201,43 @@ struct RobotFile {
     physical: PhysicalTable,
 }
 
+/// The longest link or body dimension a robot file may give, m. Any longer is taken for a value
+/// in the wrong unit (millimetres for metres), not a robot.
+pub const MAX_DIMENSION_M: f32 = 10.0;
+
 impl RobotFile {
-    fn to_robot(&self) -> Robot {
+    /// The lengths by key.
+    fn lengths(&self) -> [(&'static str, &Spanned<f32>); 6] {
+        [
+            ("d_lat_m", &self.d_lat_m),
+            ("d_ax_m", &self.d_ax_m),
+            ("femur_m", &self.femur_m),
+            ("tibia_m", &self.tibia_m),
+            ("body_length_m", &self.body_length_m),
+            ("body_width_m", &self.body_width_m),
+        ]
+    }
+
+    /// The byte offset of the value kin-core names when it refuses one (a length's key or a
+    /// joint's name).
+    fn span_of(&self, key: &str) -> Option<usize> {
+        if let Some((_, v)) = self.lengths().into_iter().find(|(k, _)| *k == key) {
+            return Some(v.span().start);
+        }
+        let limit = match key {
+            "abduction" => &self.limits.abduction_rad,
+            "hip" => &self.limits.hip_rad,
+            "knee" => &self.limits.knee_rad,
+            _ => return None,
+        };
+        limit.as_ref().map(|l| l.span().start)
+    }
+
+    fn into_robot(self) -> Robot {
         let full = JointLimits::FULL_TURN;
-        let pick =
-            |entry: Option<[f32; 2]>, j: usize| entry.unwrap_or([full.min_rad[j], full.max_rad[j]]);
+        let pick = |entry: Option<Spanned<[f32; 2]>>, j: usize| {
+            entry.map_or([full.min_rad[j], full.max_rad[j]], Spanned::into_inner)
+        };
         let entries = [
             pick(self.limits.abduction_rad, 0),
             pick(self.limits.hip_rad, 1),
@@ -218,13 +245,13 @@ impl RobotFile {
         ];
         Robot {
             leg: LegGeometry {
-                d_lat_m: self.d_lat_m,
-                d_ax_m: self.d_ax_m,
-                femur_m: self.femur_m,
-                tibia_m: self.tibia_m,
+                d_lat_m: *self.d_lat_m.get_ref(),
+                d_ax_m: *self.d_ax_m.get_ref(),
+                femur_m: *self.femur_m.get_ref(),
+                tibia_m: *self.tibia_m.get_ref(),
             },
-            body_length_m: self.body_length_m,
-            body_width_m: self.body_width_m,
+            body_length_m: *self.body_length_m.get_ref(),
+            body_width_m: *self.body_width_m.get_ref(),
             limits: JointLimits {
                 min_rad: entries.map(|e| e[0]),
                 max_rad: entries.map(|e| e[1]),
@@ -232,6 +259,15 @@ impl RobotFile {
             knee_bend: self.knee_bend,
         }
     }
+}
+
+/// 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// Why a robot file or a `--robot` argument was refused.
@@ -251,24 +287,44 @@ pub enum Error {
         source: io::Error,
     },
     /// Not valid TOML, or a key is missing, unknown or of the wrong type.
-    #[error("{}{}", file(path), source.to_string().trim_end())]
+    #[error("{}{}", place(path, *line), source.message().trim_end())]
     Toml {
         /// The file, when the text came from one.
         path: Option<PathBuf>,
-        /// The TOML error (it names the key and the line).
-        source: toml::de::Error,
+        /// 1-based line of the error, when it has one (a missing key has none).
+        line: Option<usize>,
+        /// The TOML error (its message names the key); boxed, it is large.
+        source: Box<toml::de::Error>,
     },
     /// The values were read but [`Robot::validate`] refused them.
-    #[error("{}{source}", file(path))]
+    #[error("{}{source}", place(path, *line))]
     Invalid {
         /// The file, when the text came from one.
         path: Option<PathBuf>,
+        /// 1-based line of the refused value.
+        line: Option<usize>,
         /// kin-core's reason, naming the key.
         source: RobotError,
     },
+    /// A length beyond [`MAX_DIMENSION_M`]: a value in another unit than metres.
+    #[error(
+        "{}`{key}` = {value_m} m is implausible (more than {MAX_DIMENSION_M} m): values are in \
+         metres, e.g. 0.28 for 280 mm",
+        place(path, Some(*line))
+    )]
+    Implausible {
+        /// The file, when the text came from one.
+        path: Option<PathBuf>,
+        /// 1-based line of the value.
+        line: usize,
+        /// The key.
+        key: &'static str,
+        /// The value given.
+        value_m: f32,
+    },
     /// A `[physical]` value was refused: not finite and > 0, an unknown servo or physical preset
     /// (the message lists the known ones), a knee servo beyond the femur.
-    #[error("{}{}[physical] {source}", file(path), at_line(*line))]
+    #[error("{}[physical] {source}", place(path, *line))]
     Physical {
         /// The file, when the text came from one.
         path: Option<PathBuf>,
@@ -287,52 +343,87 @@ pub enum Error {
     },
 }
 
-/// The `line N: ` part of a message.
-fn at_line(line: Option<usize>) -> String {
-    line.map(|l| format!("line {l}: ")).unwrap_or_default()
-}
-
-/// The `robot file `PATH`: ` prefix of a message, when there is a file.
-fn file(path: &Option<PathBuf>) -> String {
-    path.as_ref()
-        .map(|p| format!("robot file `{}`: ", p.display()))
-        .unwrap_or_default()
+/// The `robot file `PATH`:LINE: ` prefix of a message (parts left out when unknown).
+fn place(path: &Option<PathBuf>, line: Option<usize>) -> String {
+    match (path, line) {
+        (Some(p), Some(l)) => format!("robot file `{}`:{l}: ", p.display()),
+        (Some(p), None) => format!("robot file `{}`: ", p.display()),
+        (None, Some(l)) => format!("line {l}: "),
+        (None, None) => String::new(),
+    }
 }
 
 impl Error {
     fn in_file(self, file: &Path) -> Error {
+        let path = Some(file.to_owned());
         match self {
-            Error::Toml { source, .. } => Error::Toml {
-                path: Some(file.to_owned()),
-                source,
-            },
-            Error::Invalid { source, .. } => Error::Invalid {
-                path: Some(file.to_owned()),
-                source,
-            },
-            Error::Physical { line, source, .. } => Error::Physical {
-                path: Some(file.to_owned()),
+            Error::Toml { line, source, .. } => Error::Toml { path, line, source },
+            Error::Invalid { line, source, .. } => Error::Invalid { path, line, source },
+            Error::Implausible {
+                line, key, value_m, ..
+            } => Error::Implausible {
+                path,
                 line,
-                source,
+                key,
+                value_m,
             },
+            Error::Physical { line, source, .. } => Error::Physical { path, line, source },
             other => other,
         }
     }
 }
 
 /// Parses and validates the text of a robot file (see the module docs for the keys).
+///
+/// # Errors
+/// [`Error::Toml`], [`Error::Invalid`] or [`Error::Implausible`], with the line of the value at
+/// fault when there is one.
 pub fn parse(text: &str) -> Result<Robot, Error> {
     parse_file(text).map(|(_, robot)| robot)
 }
 
+/// The file with the places of its values, and its validated robot.
 fn parse_file(text: &str) -> Result<(RobotFile, Robot), Error> {
-    let file: RobotFile =
-        toml::from_str(text).map_err(|source| Error::Toml { path: None, source })?;
-    let robot = file.to_robot();
-    robot
-        .validate()
-        .map_err(|source| Error::Invalid { path: None, source })?;
-    Ok((file, robot))
+    let file: RobotFile = toml::from_str(text).map_err(|source| {
+        // A missing key is reported on an empty span at the start (or on the whole document):
+        // it has no line of its own, and line 1 would point at whatever is there.
+        let line = source
+            .span()
+            .filter(|s| s.start > 0 || (s.end > 0 && s.end < text.trim_end().len()))
+            .map(|s| line_of(text, s.start));
+        Error::Toml {
+            path: None,
+            line,
+            source: Box::new(source),
+        }
+    })?;
+    if let Some((key, v)) = file
+        .lengths()
+        .into_iter()
+        .find(|(_, v)| v.get_ref().abs() > MAX_DIMENSION_M)
+    {
+        return Err(Error::Implausible {
+            path: None,
+            line: line_of(text, v.span().start),
+            key,
+            value_m: *v.get_ref(),
+        });
+    }
+    let spans = file.clone();
+    let robot = file.into_robot();
+    robot.validate().map_err(|source| {
+        let key = match &source {
+            RobotError::BadLength(name) => Some(*name),
+            RobotError::BadLimit(joint) => Some(joint.name()),
+            _ => None,
+        };
+        Error::Invalid {
+            path: None,
+            line: key.and_then(|k| spans.span_of(k)).map(|o| line_of(text, o)),
+            source,
+        }
+    })?;
+    Ok((spans, robot))
 }
 
 /// A robot with its physical properties, for the physics twin.
@@ -380,7 +471,8 @@ pub fn resolve_description(spec: &str) -> Result<Description, Error> {
         path: path.to_owned(),
         source,
     })?;
-    parse_description(&text).map_err(|e| e.in_file(path))
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    parse_description(text).map_err(|e| e.in_file(path))
 }
 
 /// Reads and validates a robot file.
@@ -389,7 +481,9 @@ pub fn load_file(path: &Path) -> Result<Robot, Error> {
         path: path.to_owned(),
         source,
     })?;
-    parse(&text).map_err(|e| e.in_file(path))
+    // Editors on Windows may start the file with a byte-order mark; TOML does not allow one.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    parse(text).map_err(|e| e.in_file(path))
 }
 
 /// Resolves a `--robot` argument: a preset name ([`Robot::PRESETS`]) or else a TOML file path.
@@ -438,6 +532,7 @@ mod tests {
             err,
             Error::Invalid {
                 source: RobotError::BadLength("femur_m"),
+                line: Some(3),
                 ..
             }
         ));

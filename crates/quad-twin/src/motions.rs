@@ -257,7 +257,7 @@ impl Plan {
                 (pose, self.robot.stance_feet(stance_m), [Contact::Stance; 4])
             }
             Script::Law(m) => {
-                let f = m.frame(t_s)?;
+                let f = m.frame::<kin_core::DefaultMath>(t_s)?;
                 (f.pose, f.feet_in_world, f.contact)
             }
         };
