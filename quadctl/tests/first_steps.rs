@@ -1,4 +1,5 @@
-//! docs/first-steps.md is true: every `quadctl` command in its shell blocks runs against the
+//! docs/first-steps.md is true: every `quadctl` command in its shell blocks (`cargo run --release
+//! -p quadctl -- ARGS`) runs against the
 //! emulated firmware (`--port /dev/ttyACM0` replaced by `--emulator`, `> FILE` written by the
 //! test), in order, in a scratch directory, and exits 0.
 
@@ -26,7 +27,10 @@ fn every_command_of_first_steps_runs_on_the_emulator() {
             in_block = line == "```sh";
             continue;
         }
-        let Some(args) = line.strip_prefix("quadctl ").filter(|_| in_block) else {
+        let Some(args) = line
+            .strip_prefix("cargo run --release -p quadctl -- ")
+            .filter(|_| in_block)
+        else {
             continue;
         };
         let (args, output) = match args.split_once(" > ") {
