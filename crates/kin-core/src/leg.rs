@@ -669,14 +669,18 @@ impl<M: Math> Solver<M> {
         // dependency chains sit next to each other in the instruction stream; the abductions
         // above start as soon as their depths are known. (The same `atan2` calls as
         // `Math::atan2_3` makes: bit for bit the leg-by-leg results.)
-        let mut planar = [(0.0f32, 0.0f32, 0.0f32, 0.0f32); 4];
+        // The knee's and the hip's `atan2` arguments as `([knee_y, hip_y], [knee_x, hip_x])`:
+        // pairs of the two joints, which the compiler keeps in registers and evaluates
+        // side by side; as one 4-tuple per leg they went through the stack with loads and
+        // stores of different widths (store-forwarding stalls; see `BENCHMARKS.md`).
+        let mut planar = [([0.0f32; 2], [0.0f32; 2]); 4];
         for (i, p) in feet_in_hip.iter().enumerate() {
             let (knee_y, knee_x) = self.c.knee_yx::<M>(g, self.knee_bend, dist2[i], false);
             let (hip_y, hip_x) = hip_yx(p.x, v[i], dist2[i], self.c.diff_sq, knee_y);
-            planar[i] = (knee_y, knee_x, hip_y, hip_x);
+            planar[i] = ([knee_y, hip_y], [knee_x, hip_x]);
         }
         let mut out = [JointAngles::default(); 4];
-        for (i, (knee_y, knee_x, hip_y, hip_x)) in planar.iter().enumerate() {
+        for (i, ([knee_y, hip_y], [knee_x, hip_x])) in planar.iter().enumerate() {
             let knee = M::atan2(*knee_y, *knee_x);
             let hip = M::atan2(*hip_y, *hip_x);
             out[i] = JointAngles::new(abduction[i], hip, knee);
