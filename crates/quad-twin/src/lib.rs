@@ -31,7 +31,7 @@ use source::FrameSource;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-pub use motions::{MotionKind, Plan};
+pub use motions::{MotionKind, Plan, TrotShape};
 
 /// Why a twin run failed.
 #[derive(Debug)]
@@ -338,8 +338,22 @@ pub fn run(
     kind: MotionKind,
     options: &RunOptions,
 ) -> Result<Run, Error> {
-    let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
     let plan = Plan::new(kind, config).map_err(Error::Motion)?;
+    run_plan(config, physical, &plan, options)
+}
+
+/// [`run`] with a plan built by the caller (e.g. [`Plan::trot`] with another shape).
+///
+/// # Errors
+/// [`Error`].
+pub fn run_plan(
+    config: &quad_device::Config,
+    physical: &Physical,
+    plan: &Plan,
+    options: &RunOptions,
+) -> Result<Run, Error> {
+    let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
+    let plan = *plan;
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {
             let device = device::SimDevice::start(*config)
