@@ -57,15 +57,16 @@ pub struct TrotShape {
 }
 
 impl TrotShape {
-    /// The gait phase the twin's trot starts at, cycles: the middle of the first span with
-    /// all four feet down (duty factor above ½), so that the first pair lifts only after the
-    /// body is moving on four feet; 0 (a pair lifts at once) when there is no such span.
+    /// The gait phase the twin's trot starts at, cycles: the start of the first span with all
+    /// four feet down (the first pair has just touched down), so that the body has the whole
+    /// span to pick up the gait's speed before a pair lifts; 0 (a pair lifts at once) when
+    /// there is no such span (duty factor ½ or less).
     pub fn four_feet_start(&self) -> f32 {
         // Pairs at phase offsets 0 and ½ (kin-core's trot): the first pair is in stance from
         // 1 − d, the second until ½.
         let d = self.duty_factor;
         if d > 0.5 {
-            0.5 * ((1.0 - d) + 0.5)
+            1.0 - d
         } else {
             0.0
         }
