@@ -15,6 +15,10 @@ const AMPLITUDE_BAND: (f64, f64) = (0.8, 1.25);
 const YAW_RATIO_MIN: f64 = 0.8;
 /// The trot must cover this fraction of its commanded distance.
 const TRAVEL_RATIO_MIN: f64 = 0.5;
+/// Each stance foot of the trot must sweep at least this fraction of its commanded stride
+/// under the body (kin-core's trot, duty 0.5, sweeps 0.2–0.3 on seed 000's robot: its
+/// two-leg stances sag).
+const STANCE_SWEEP_MIN: f64 = 0.6;
 /// The stepping motions may have a servo at full duty for at most this share of the physics
 /// steps.
 const STEPPING_SATURATED_MAX: f64 = 0.05;
@@ -110,6 +114,11 @@ fn the_trot_covers_half_its_distance_on_both_presets() {
         assert_steps(name, &s);
         let travel = s.travel.expect("a travelling motion");
         assert!(travel.ratio >= TRAVEL_RATIO_MIN, "{name}: {travel:?}");
+        let stepping = s.stepping.as_ref().expect("a stepping motion");
+        for leg in &stepping.legs {
+            let sweep = leg.stance_sweep_ratio.expect("whole stances in 10 s");
+            assert!(sweep >= STANCE_SWEEP_MIN, "{name}: {stepping:?}");
+        }
     }
 }
 
