@@ -124,14 +124,14 @@ impl Math for Fast {
 /// (the ATmega2560 firmware: `SoftFloat<AvrLibm>`, avr-libc's hand-written `sqrt`; the host
 /// tests: `SoftFloat<Libm>`, the default, which rounds the same):
 ///
-/// - [`poly::atan2_fixed`]: one float division, the polynomial in 16-bit fixed point on the
-///   integer multiplier (error ≤ 3.5e-5 rad);
+/// - [`poly::atan2_fixed`]: one float division, then in 16-bit fixed point on the
+///   integer multiplier, atan from a table of quadratic cells (error ≤ 2e-6 rad);
 /// - [`poly::sin_cos_deg5`]: short polynomials, no range reduction within ±π/4 (error ≤ 7e-7);
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
 /// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false).
 ///
-/// Against [`DefaultMath`] the angles of a leg or body solve differ by at most about 4e-5 rad
+/// Against [`DefaultMath`] the angles of a leg or body solve differ by at most about 4e-6 rad
 /// (the fixed-point arctangent's error plus rounding; `tests/avr_kernels.rs`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SoftFloat<S: Math = Libm>(PhantomData<S>);
@@ -180,7 +180,7 @@ const PI: f32 = core::f32::consts::PI;
 /// |---|---|---|
 /// | [`atan2_deg15`](poly::atan2_deg15) | 3e-7 rad | hosts: branch-free, Estrin |
 /// | [`atan2_deg9`](poly::atan2_deg9) | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
-/// | [`atan2_fixed`](poly::atan2_fixed) | 3.5e-5 rad (0.002°) | CPUs with software floats and an integer multiplier (the ATmega2560): 1 float division, the polynomial in 16-bit fixed point |
+/// | [`atan2_fixed`](poly::atan2_fixed) | 2e-6 rad (0.0001°) | CPUs with software floats and an integer multiplier (the ATmega2560): 1 float division, a table of 32 quadratic cells in 16-bit fixed point |
 /// | [`sin_cos_deg9`](poly::sin_cos_deg9) | 2e-7 | hosts: branch-free |
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
 pub mod poly {
@@ -306,11 +306,62 @@ pub mod poly {
         f32::from_bits(r.to_bits() | (yb & SIGN))
     }
 
-    /// Magnitudes of [`ATAN_DEG9`]'s coefficients in the fixed-point formats of
-    /// [`atan2_fixed`]'s Horner levels: Q16, Q16, Q17, Q18, Q20 (each level in the bits its
-    /// magnitude allows in 16 bits). The signs alternate (+ − + − +), and so do those of the
-    /// levels for t ∈ [0, 1], so that the evaluation runs on magnitudes.
-    const ATAN_DEG9_Q: [u16; 5] = [65527, 21647, 23614, 22323, 21858];
+    /// [`atan2_fixed`]'s arctangent on `t ∈ [0, 1]` in 32 cells of width 1/32 (and cell 32,
+    /// `t = 1` alone): in cell `k`, `atan(k/32 + d) ≈ a + b·d − c·d²` for `d ∈ [0, 1/32)`, the
+    /// quadratic through the cell's three Chebyshev nodes, rounded to `a` in Q29 (`a₀ = 0`:
+    /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
+    /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
+    /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the 264 bytes of
+    /// tables are what it costs.
+    const ATAN_CELL_A_Q29: [u32; 33] = [
+        0,
+        16_771_589,
+        33_510_678,
+        50_184_805,
+        66_762_427,
+        83_213_099,
+        99_507_789,
+        115_619_162,
+        131_521_807,
+        147_192_431,
+        162_609_989,
+        177_755_778,
+        192_613_475,
+        207_169_131,
+        221_411_131,
+        235_330_121,
+        248_918_896,
+        262_172_285,
+        275_086_996,
+        287_661_475,
+        299_895_737,
+        311_791_212,
+        323_350_581,
+        334_577_621,
+        345_477_059,
+        356_054_431,
+        366_315_948,
+        376_268_384,
+        385_918_958,
+        395_275_239,
+        404_345_057,
+        413_136_426,
+        421_657_471,
+    ];
+
+    /// `b` of [`ATAN_CELL_A_Q29`]'s cells, Q15.
+    const ATAN_CELL_B_Q15: [u16; 33] = [
+        32_774, 32_742, 32_646, 32_488, 32_269, 31_992, 31_660, 31_276, 30_844, 30_369, 29_856,
+        29_308, 28_730, 28_128, 27_505, 26_866, 26_215, 25_556, 24_892, 24_227, 23_563, 22_903,
+        22_250, 21_605, 20_970, 20_347, 19_737, 19_140, 18_557, 17_990, 17_438, 16_902, 16_383,
+    ];
+
+    /// `c` of [`ATAN_CELL_A_Q29`]'s cells, Q16.
+    const ATAN_CELL_C_Q16: [u16; 33] = [
+        1023, 3058, 5057, 6998, 8861, 10_625, 12_276, 13_800, 15_187, 16_430, 17_524, 18_470,
+        19_268, 19_922, 20_438, 20_824, 21_086, 21_236, 21_282, 21_235, 21_105, 20_901, 20_633,
+        20_311, 19_942, 19_535, 19_097, 18_633, 18_151, 17_655, 17_150, 16_640, 16_128,
+    ];
 
     /// `a·b` of two 16-bit numbers from its four 8 × 8-bit partial products: on the
     /// ATmega2560 four hardware multiplications inline, where `a as u32 * b as u32` would call
@@ -324,16 +375,15 @@ pub mod poly {
     }
 
     /// Four-quadrant arctangent for CPUs without hardware floating point: one float division
-    /// `t = min(|x|,|y|) / max(|x|,|y|)`, then [`ATAN_DEG9`] evaluated in 16-bit fixed point
-    /// (six 16 × 16-bit products), the octant added in fixed point, and one integer-to-float
-    /// conversion: on the ATmega2560 far fewer cycles than [`atan2_deg9`] in software floats
-    /// (see `BENCHMARKS.md`). Absolute error ≤ 3.5e-5 rad (0.002°): the degree-9 fit's 1.1e-5 plus
-    /// the 16-bit quantization of `t²` and of the Horner levels (tests). `atan2(±0, ±0)` as libm
-    /// (±0 or ±π); exact on the axes.
+    /// `t = min(|x|,|y|) / max(|x|,|y|)`, then atan(t) from a table of 32 quadratic cells
+    /// ([`ATAN_CELL_A_Q29`]) in 16-bit fixed point (three 16 × 16-bit products), the octant
+    /// added in fixed point, and one integer-to-float conversion: on the ATmega2560 far fewer
+    /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
+    /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
+    /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes.
     ///
-    /// Formats: `t` in Q24 (`T`, from the float's mantissa) and Q16, `s = t²` in Q16, the
-    /// Horner levels in Q20…Q16 (as magnitudes, the signs being known), the result in Q29
-    /// (π < 2²).
+    /// Formats: `t` in Q24 (`T`, from the float's mantissa), the cell offset `d` in Q21, the
+    /// result in Q29 (π < 2²).
     ///
     /// Never inlined: on the AVR its `mul` instructions stay in this function's own small stack
     /// frame, clear of an LLVM AVR miscompilation in frames beyond 63 bytes (see the
@@ -368,18 +418,16 @@ pub mod poly {
             } else {
                 0
             };
-            let t16 = ((big_t + 128) >> 8).min(65_535) as u16;
-            let s = ((mul_16x16(t16, t16) + (1 << 15)) >> 16) as u16; // t² in Q16
-            let c = &ATAN_DEG9_Q;
-            // Levels |c3 + s·c4| (Q18), c2 − s·|…| (Q17), |c1 + s·…| (Q16), q = c0 − s·|…|
-            // (Q16): each stays positive and below 2¹⁶ for s ∈ [0, 1].
-            let l3 = c[3] - ((mul_16x16(c[4], s) + (1 << 17)) >> 18) as u16;
-            let l2 = c[2] - ((mul_16x16(l3, s) + (1 << 16)) >> 17) as u16;
-            let l1 = c[1] - ((mul_16x16(l2, s) + (1 << 16)) >> 17) as u16;
-            let q = c[0] - ((mul_16x16(l1, s) + (1 << 15)) >> 16) as u16;
-            // p = T·q (Q40) in Q29, from the 8 high and 16 low bits of T.
-            let (t_hi, t_lo) = ((big_t >> 16) as u16, big_t as u16);
-            (mul_16x16(t_hi, q) << 5) + ((mul_16x16(t_lo, q) + (1 << 10)) >> 11)
+            // Cell k = ⌊32·t⌋ (t = 1: cell 32; T above 2²⁴ comes only from NaN arguments) and
+            // the offset d = t − k/32 in Q21 (16 bits).
+            let big_t = big_t.min(1 << 24);
+            let k = (big_t >> 19) as usize;
+            let d = ((big_t & 0x7_ffff) >> 3) as u16;
+            // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
+            let lin = (mul_16x16(d, ATAN_CELL_B_Q15[k]) + (1 << 6)) >> 7;
+            let d_sq = (mul_16x16(d, d) >> 16) as u16;
+            let quad = (mul_16x16(d_sq, ATAN_CELL_C_Q16[k]) + (1 << 12)) >> 13;
+            ATAN_CELL_A_Q29[k] + lin - quad
         };
         let r = match (swap, xb & SIGN != 0) {
             (false, false) => p,
@@ -686,6 +734,34 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// [`poly::atan2_fixed`]'s cells: the tight bound of its documentation, on the circle,
+    /// densely over `t` in every cell, and at the cells' edges.
+    #[test]
+    fn atan2_fixed_cells_are_within_2e_6() {
+        const TOL_RAD: f64 = 2.0e-6;
+        let mut worst = worst_atan2_error(poly::atan2_fixed);
+        for i in 0..=400_000 {
+            let t = i as f32 / 400_000.0;
+            for (y, x) in [(t, 1.0f32), (1.0, t), (-t, -1.0), (-1.0, -t)] {
+                let d = (poly::atan2_fixed(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+                worst = worst.max(d);
+            }
+        }
+        for k in 0..=32u32 {
+            let edge = k as f32 / 32.0;
+            for t in [
+                f32::from_bits(edge.to_bits().saturating_sub(1)),
+                edge,
+                f32::from_bits(edge.to_bits() + 1).min(1.0),
+            ] {
+                let d = (poly::atan2_fixed(t, 1.0) as f64 - (t as f64).atan()).abs();
+                worst = worst.max(d);
+            }
+        }
+        std::eprintln!("atan2_fixed: worst error {worst:e} rad");
+        assert!(worst < TOL_RAD, "worst atan2_fixed error {worst}");
     }
 
     #[test]
