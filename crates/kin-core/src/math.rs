@@ -14,12 +14,13 @@
 //!   The reference the others are tested against.
 //! - [`SoftFloat`]: the choices for CPUs without floating-point hardware (the ATmega2560
 //!   firmware's backend is `SoftFloat` over avr-libc's square root): the kernels
-//!   [`poly::atan2_fixed`] and [`poly::sin_cos_deg5`], which cost far fewer software-float
-//!   operations, comparisons of the bit patterns instead of software-float comparisons, and
+//!   [`poly::atan2_fixed`] and [`poly::sin_cos_fixed`] (tables of quadratic cells in fixed
+//!   point), which cost far fewer software-float operations, comparisons of the bit patterns instead of software-float comparisons, and
 //!   the four legs of a body solved one after the other.
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
-//! minimax fit); they are constants, not tables.
+//! minimax fit), and so do the fixed-point kernels' cell tables (quadratics through Chebyshev
+//! nodes).
 
 use core::marker::PhantomData;
 
@@ -126,7 +127,8 @@ impl Math for Fast {
 ///
 /// - [`poly::atan2_fixed`]: one float division, then in 16-bit fixed point on the
 ///   integer multiplier, atan from a table of quadratic cells (error ≤ 2e-6 rad);
-/// - [`poly::sin_cos_deg5`]: short polynomials, no range reduction within ±π/4 (error ≤ 7e-7);
+/// - [`poly::sin_cos_fixed`]: no range reduction within ±π/4, then a table of quadratic cells
+///   in 16-bit fixed point (error ≤ 1e-6);
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
 /// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false).
@@ -151,7 +153,7 @@ impl<S: Math> Math for SoftFloat<S> {
 
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
-        poly::sin_cos_deg5(x)
+        poly::sin_cos_fixed(x)
     }
 
     #[inline(always)]
@@ -183,6 +185,7 @@ const PI: f32 = core::f32::consts::PI;
 /// | [`atan2_fixed`](poly::atan2_fixed) | 2e-6 rad (0.0001°) | CPUs with software floats and an integer multiplier (the ATmega2560): 1 float division, a table of 32 quadratic cells in 16-bit fixed point |
 /// | [`sin_cos_deg9`](poly::sin_cos_deg9) | 2e-7 | hosts: branch-free |
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
+/// | [`sin_cos_fixed`](poly::sin_cos_fixed) | 1e-6 | CPUs with software floats and an integer multiplier (the ATmega2560): no range reduction for \|x\| ≤ π/4, a table of 26 quadratic cells in 16-bit fixed point, two integer-to-float conversions |
 pub mod poly {
     use super::{FRAC_PI_2, PI};
 
@@ -363,6 +366,99 @@ pub mod poly {
         20_311, 19_942, 19_535, 19_097, 18_633, 18_151, 17_655, 17_150, 16_640, 16_128,
     ];
 
+    /// [`sin_cos_fixed`]'s sine on `r ∈ [0, 0.8125]` (π/4 and the rounding of a range
+    /// reduction) in 26 cells of width 1/32: in cell `k`, `sin(k/32 + d) ≈ a + b·d − c·d²` for
+    /// `d ∈ [0, 1/32)`, the quadratic through the cell's three Chebyshev nodes
+    /// (`scripts/fit_polynomials.py`), `a` in Q29 (`a₀ = 0`), `b` in Q15, `c` in Q16.
+    const SIN_CELL_A_Q29: [u32; 26] = [
+        0,
+        16_774_400,
+        33_532_506,
+        50_257_868,
+        66_934_153,
+        83_545_079,
+        100_074_424,
+        116_506_049,
+        132_823_907,
+        149_012_065,
+        165_054_715,
+        180_936_192,
+        196_640_988,
+        212_153_767,
+        227_459_382,
+        242_542_886,
+        257_389_552,
+        271_984_881,
+        286_314_621,
+        300_364_780,
+        314_121_638,
+        327_571_761,
+        340_702_017,
+        353_499_582,
+        365_951_961,
+        378_046_994,
+    ];
+
+    /// `b` of [`SIN_CELL_A_Q29`]'s cells, Q15.
+    const SIN_CELL_B_Q15: [u16; 26] = [
+        32_771, 32_755, 32_707, 32_627, 32_515, 32_372, 32_197, 31_990, 31_752, 31_483, 31_184,
+        30_854, 30_494, 30_104, 29_684, 29_236, 28_759, 28_254, 27_722, 27_162, 26_576, 25_964,
+        25_327, 24_664, 23_978, 23_268,
+    ];
+
+    /// `c` of [`SIN_CELL_A_Q29`]'s cells, Q16.
+    const SIN_CELL_C_Q16: [u16; 26] = [
+        512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477, 13_417,
+        14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958, 22_707,
+        23_435,
+    ];
+
+    /// [`sin_cos_fixed`]'s cosine in the cells of [`SIN_CELL_A_Q29`]:
+    /// `cos(k/32 + d) ≈ a − b·d − c·d²`, `a` in Q29 (`a₀ = 1`: `cos 0` exact), `b` and `c` in
+    /// Q16.
+    const COS_CELL_A_Q29: [u32; 26] = [
+        536_870_912,
+        536_608_793,
+        535_822_684,
+        534_513_352,
+        532_682_078,
+        530_330_649,
+        527_461_361,
+        524_077_015,
+        520_180_918,
+        515_776_872,
+        510_869_179,
+        505_462_631,
+        499_562_508,
+        493_174_570,
+        486_305_055,
+        478_960_672,
+        471_148_592,
+        462_876_443,
+        454_152_304,
+        444_984_692,
+        435_382_560,
+        425_355_285,
+        414_912_657,
+        404_064_875,
+        392_822_529,
+        381_196_599,
+    ];
+
+    /// `b` of [`COS_CELL_A_Q29`]'s cells, Q16.
+    const COS_CELL_B_Q16: [u16; 26] = [
+        0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089, 24_006,
+        25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593, 43_156,
+        44_676, 46_153,
+    ];
+
+    /// `c` of [`COS_CELL_A_Q29`]'s cells, Q16.
+    const COS_CELL_C_Q16: [u16; 26] = [
+        32_764, 32_732, 32_668, 32_572, 32_444, 32_285, 32_094, 31_872, 31_618, 31_334, 31_019,
+        30_674, 30_299, 29_895, 29_461, 28_998, 28_507, 27_988, 27_442, 26_870, 26_270, 25_646,
+        24_996, 24_322, 23_624, 22_903,
+    ];
+
     /// `a·b` of two 16-bit numbers from its four 8 × 8-bit partial products: on the
     /// ATmega2560 four hardware multiplications inline, where `a as u32 * b as u32` would call
     /// a 32 × 32-bit routine. Only [`atan2_fixed`] uses it, the kernel of CPUs without
@@ -477,6 +573,66 @@ pub mod poly {
             (sin, cos)
         } else {
             quadrant(k, sin, cos)
+        }
+    }
+
+    /// `(sin x, cos x)` for CPUs without hardware floating point: arguments within ±π/4 (body
+    /// rotations) skip the range reduction (an integer comparison finds them); then `|r|` in
+    /// Q24 from the float's mantissa, sine and cosine from a table of 26 quadratic cells
+    /// ([`SIN_CELL_A_Q29`], [`COS_CELL_A_Q29`]) in 16-bit fixed point (five 16 × 16-bit
+    /// products for both), two integer-to-float conversions: on the ATmega2560 far fewer
+    /// cycles than [`sin_cos_deg5`]'s twelve software-float operations (see
+    /// `BENCHMARKS.md`). Absolute error ≤ 1e-6 (tests; the cells' 8.4e-7 in this arithmetic).
+    /// `sin_cos_fixed(0) = (0, 1)`; odd in the sine, even in the cosine.
+    ///
+    /// Never inlined, for [`atan2_fixed`]'s reason (its `mul` instructions in a small frame).
+    #[inline(never)]
+    pub fn sin_cos_fixed(x: f32) -> (f32, f32) {
+        const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
+                                                 // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
+                                                 // range reduction of huge arguments, for which any bounded value will do.
+        const CELLS_END_Q24: u32 = (26 << 19) - 1;
+        let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
+        let (k, r) = if reduced { reduce(x) } else { (0.0, x) };
+        let rb = r.to_bits();
+        // |r| = m·2^(e − 150) with the 24-bit mantissa m: R = |r|·2²⁴ = m >> (126 − e),
+        // truncated (2⁻²⁴ is far below the cells' error); 0 for |r| < 2⁻²⁴ and subnormals.
+        let e = (rb >> 23) & 0xff;
+        let m = (rb & 0x007f_ffff) | 0x0080_0000;
+        let big_r = if e > 126 {
+            CELLS_END_Q24
+        } else if 126 - e > 24 {
+            0
+        } else {
+            (m >> (126 - e)).min(CELLS_END_Q24)
+        };
+        // Cell k = ⌊32·|r|⌋, offset d in Q21 (16 bits), d² in Q26.
+        let cell = (big_r >> 19) as usize;
+        let d = ((big_r & 0x7_ffff) >> 3) as u16;
+        let d_sq = (mul_16x16(d, d) >> 16) as u16;
+        // b·d: Q36 (sine) or Q37 (cosine) → Q29; c·d²: Q42 → Q29.
+        let sin_q = SIN_CELL_A_Q29[cell] + ((mul_16x16(d, SIN_CELL_B_Q15[cell]) + (1 << 6)) >> 7)
+            - ((mul_16x16(d_sq, SIN_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
+        let cos_q = COS_CELL_A_Q29[cell]
+            - ((mul_16x16(d, COS_CELL_B_Q16[cell]) + (1 << 7)) >> 8)
+            - ((mul_16x16(d_sq, COS_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
+        let sin = f32::from_bits(q29_bits(sin_q) | (rb & SIGN));
+        let cos = f32::from_bits(q29_bits(cos_q));
+        if reduced {
+            quadrant(k, sin, cos)
+        } else {
+            (sin, cos)
+        }
+    }
+
+    /// The bits of the float `v·2⁻²⁹` (`v < 2³¹`, positive): one integer-to-float conversion,
+    /// then the exponent lowered by 29 (`v = 0` stays +0).
+    #[inline(always)]
+    fn q29_bits(v: u32) -> u32 {
+        if v == 0 {
+            0
+        } else {
+            (v as f32).to_bits() - (29 << 23)
         }
     }
 
@@ -862,6 +1018,53 @@ mod tests {
             assert!((c as f64 - (x as f64).cos()).abs() < 7.0e-7, "cos {x}");
         }
         assert_eq!(poly::sin_cos_deg5(0.0), (0.0, 1.0));
+    }
+
+    #[test]
+    fn sin_cos_fixed_matches_f64() {
+        const TOL: f64 = 1.0e-6;
+        let mut worst = 0.0f64;
+        for i in -400_000..=400_000 {
+            let x = i as f32 * 0.000_025; // ±10 rad, across the ±π/4 switch and every cell
+            let (s, c) = poly::sin_cos_fixed(x);
+            worst = worst
+                .max((s as f64 - (x as f64).sin()).abs())
+                .max((c as f64 - (x as f64).cos()).abs());
+            assert_eq!(
+                poly::sin_cos_fixed(-x),
+                (-s, c),
+                "odd sine, even cosine at {x}"
+            );
+        }
+        let q = core::f32::consts::FRAC_PI_4;
+        for x in [
+            f32::from_bits(q.to_bits() - 1),
+            q,
+            f32::from_bits(q.to_bits() + 1),
+            1e-30,
+            f32::MIN_POSITIVE,
+            1e-7,
+        ] {
+            let (s, c) = poly::sin_cos_fixed(x);
+            worst = worst
+                .max((s as f64 - (x as f64).sin()).abs())
+                .max((c as f64 - (x as f64).cos()).abs());
+        }
+        std::eprintln!("sin_cos_fixed: worst error {worst:e}");
+        assert!(worst < TOL, "worst sin/cos error {worst}");
+        assert_eq!(poly::sin_cos_fixed(0.0), (0.0, 1.0));
+        // Bounded on any finite argument (huge ones are not reduced exactly).
+        let mut rng = SplitMix64::new(0x5eed_5eed_0000_0001u64);
+        for _ in 0..100_000 {
+            let x = f32::from_bits(rng.next_u64() as u32);
+            if x.is_finite() {
+                let (s, c) = poly::sin_cos_fixed(x);
+                assert!(
+                    s.abs() <= 1.0 && c.abs() <= 1.0,
+                    "sin_cos_fixed({x:e}) = ({s}, {c})"
+                );
+            }
+        }
     }
 
     /// The byte-wise 16 × 16-bit product is the product.
