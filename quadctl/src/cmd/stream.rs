@@ -75,7 +75,7 @@ pub struct Args {
     #[arg(long, value_parser = args::rotation_order())]
     pub rotation_order: Option<RotationOrder>,
     /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
-    /// exact with --sim, 5e-5 rad with --emulator and --port (the AVR's math differs from the
+    /// exact with --sim, 2e-5 rad with --emulator and --port (the AVR's math differs from the
     /// host's).
     #[arg(long, value_name = "RAD")]
     pub angle_tolerance_rad: Option<f32>,
