@@ -478,7 +478,7 @@ pub mod poly {
     /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
     /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes.
     ///
-    /// Formats: `t` in Q24 (`T`, from the float's mantissa), the cell offset `d` in Q21, the
+    /// Formats: `t` in Q24 (`T`, from the float's mantissa, truncated), the cell offset `d` in Q21, the
     /// result in Q29 (π < 2²).
     ///
     /// Never inlined: on the AVR its `mul` instructions stay in this function's own small stack
@@ -493,30 +493,28 @@ pub mod poly {
         let (ay, ax) = (yb & ABS, xb & ABS);
         let swap = ay > ax;
         let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+        // The octant in one byte (swap, x < 0, y < 0), the only state kept across the
+        // division's call: fewer registers to save.
+        let octant = swap as u8 | ((xb >> 30) as u8 & 2) | ((yb >> 29) as u8 & 4);
         // p = atan(t) in Q29, t ∈ [0, 1].
         let p: u32 = if den == 0 {
             0
         } else {
             let t = (f32::from_bits(num) / f32::from_bits(den)).to_bits();
-            // t = m·2^(e − 23) with the 24-bit mantissa m, so T = round(t·2²⁴) = m >> (−e − 1).
-            // (Exponents above −1 come only from t = 1 and from NaN arguments, for which any
-            // bounded value will do.)
+            // t = m·2^(e − 23) with the 24-bit mantissa m, so T = t·2²⁴ = m >> (−e − 1),
+            // truncated (2⁻²⁴ is far below the cells' error); 0 for t < 2⁻²⁴ (t = 0 and
+            // subnormals included). t ≥ 1 is t = 1 (or a NaN argument, for which any bounded
+            // value will do).
             let m = (t & 0x007f_ffff) | 0x0080_0000;
             let shift = 126i32 - (t >> 23) as i32; // −e − 1
-            let big_t: u32 = if t == 0 {
-                0
-            } else if shift < 0 {
-                m << 1
-            } else if shift == 0 {
-                m
+            let big_t: u32 = if t >= 0x3f80_0000 {
+                1 << 24
             } else if shift < 25 {
-                (m + (1 << (shift - 1))) >> shift
+                m >> shift
             } else {
                 0
             };
-            // Cell k = ⌊32·t⌋ (t = 1: cell 32; T above 2²⁴ comes only from NaN arguments) and
-            // the offset d = t − k/32 in Q21 (16 bits).
-            let big_t = big_t.min(1 << 24);
+            // Cell k = ⌊32·t⌋ (t = 1: cell 32) and the offset d = t − k/32 in Q21 (16 bits).
             let k = (big_t >> 19) as usize;
             let d = ((big_t & 0x7_ffff) >> 3) as u16;
             // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
@@ -525,11 +523,11 @@ pub mod poly {
             let quad = (mul_16x16(d_sq, ATAN_CELL_C_Q16[k]) + (1 << 12)) >> 13;
             ATAN_CELL_A_Q29[k] + lin - quad
         };
-        let r = match (swap, xb & SIGN != 0) {
-            (false, false) => p,
-            (false, true) => PI_Q29 - p,
-            (true, false) => FRAC_PI_2_Q29 - p,
-            (true, true) => FRAC_PI_2_Q29 + p,
+        let r = match octant & 3 {
+            0 => p,
+            2 => PI_Q29 - p,
+            1 => FRAC_PI_2_Q29 - p,
+            _ => FRAC_PI_2_Q29 + p,
         };
         // r ≥ 0; r·2⁻²⁹ by the exponent (r = 0 stays 0), then the sign of y.
         let r = if r == 0 {
@@ -537,7 +535,7 @@ pub mod poly {
         } else {
             (r as f32).to_bits() - (29 << 23)
         };
-        f32::from_bits(r | (yb & SIGN))
+        f32::from_bits(r | ((octant as u32 & 4) << 29))
     }
 
     /// `(sin x, cos x)` with degree-9/8 polynomials after a Cody–Waite reduction to
