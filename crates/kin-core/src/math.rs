@@ -472,7 +472,7 @@ pub mod poly {
 
     /// Four-quadrant arctangent for CPUs without hardware floating point: one float division
     /// `t = min(|x|,|y|) / max(|x|,|y|)`, then atan(t) from a table of 32 quadratic cells
-    /// ([`ATAN_CELL_A_Q29`]) in 16-bit fixed point (three 16 × 16-bit products), the octant
+    /// (`ATAN_CELL_A_Q29`) in 16-bit fixed point (three 16 × 16-bit products), the octant
     /// added in fixed point, and one integer-to-float conversion: on the ATmega2560 far fewer
     /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
     /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
@@ -577,7 +577,7 @@ pub mod poly {
     /// `(sin x, cos x)` for CPUs without hardware floating point: arguments within ±π/4 (body
     /// rotations) skip the range reduction (an integer comparison finds them); then `|r|` in
     /// Q24 from the float's mantissa, sine and cosine from a table of 26 quadratic cells
-    /// ([`SIN_CELL_A_Q29`], [`COS_CELL_A_Q29`]) in 16-bit fixed point (five 16 × 16-bit
+    /// (`SIN_CELL_A_Q29`, `COS_CELL_A_Q29`) in 16-bit fixed point (five 16 × 16-bit
     /// products for both), two integer-to-float conversions: on the ATmega2560 far fewer
     /// cycles than [`sin_cos_deg5`]'s twelve software-float operations (see
     /// `BENCHMARKS.md`). Absolute error ≤ 1e-6 (tests; the cells' 8.4e-7 in this arithmetic).
