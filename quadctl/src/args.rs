@@ -280,10 +280,10 @@ pub struct LawArgs {
     #[arg(long, value_name = "M")]
     pub step_height_m: Option<f32>,
     /// rect-path, trot, walk: stance fraction of the cycle, in (0, 1) [default: rectangle 1/3
-    /// (one speed round the loop), other paths 0.5; trot 0.5, walk 0.75].
+    /// (one speed round the loop), other paths 0.5; trot and walk 0.75].
     #[arg(long, value_name = "D")]
     pub duty_factor: Option<f32>,
-    /// rect-path, trot, walk: cycle time, s [default: rect-path 3, gaits 0.8].
+    /// rect-path, trot, walk: cycle time, s [default: rect-path 3, gaits 1.0].
     #[arg(long, value_name = "S")]
     pub cycle_s: Option<f32>,
     /// trot, walk: forward speed, m/s [default: 0].

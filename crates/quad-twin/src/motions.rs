@@ -24,14 +24,14 @@ pub const STAND_HOLD_S: f32 = 2.0;
 pub const SEED001_STANCE_HEIGHT_M: f32 = 0.9294;
 /// Trot speed as stance heights per second (0.1 m/s for seed 000's robot).
 pub const TROT_SPEED_HEIGHTS_PER_S: f32 = 0.25;
-/// Gait cycle of the twin's trot, s (kin-core's default is 0.8 s).
-pub const TROT_CYCLE_S: f32 = 1.0;
-/// Stance fraction of the twin's trot (kin-core's trot has 0.5): each diagonal pair hands the
-/// body over to the other while all four feet are down, so no stance leg carries half the
-/// body alone for its whole stance. With hobby-class servos, whose position error grows with
-/// the load, a 0.5 duty factor lets the two loaded knees sag through the stance and eat the
-/// stride; docs/twin.md has the measurements.
-pub const TROT_DUTY_FACTOR: f32 = 0.75;
+/// Gait cycle of the twin's trot, s: kin-core's default.
+pub const TROT_CYCLE_S: f32 = GaitParams::DEFAULT_CYCLE_S;
+/// Stance fraction of the twin's trot: kin-core's trot's. Each diagonal pair hands the body
+/// over to the other while all four feet are down, so no stance leg carries half the body
+/// alone for its whole stance. With hobby-class servos, whose position error grows with the
+/// load, a 0.5 duty factor lets the two loaded knees sag through the stance and eat the
+/// stride; docs/twin.md has the measurements (they set kin-core's default).
+pub const TROT_DUTY_FACTOR: f32 = Pattern::Trot.duty_factor();
 /// Duration of the trot, s.
 pub const TROT_DURATION_S: f32 = 10.0;
 /// Yaw-turn duration, in step periods.
@@ -69,16 +69,6 @@ impl TrotShape {
             1.0 - d
         } else {
             0.0
-        }
-    }
-
-    /// kin-core's own trot: [`GaitParams::DEFAULT_CYCLE_S`], [`Pattern::Trot`]'s duty factor
-    /// (0.5), [`GaitParams::DEFAULT_STEP_HEIGHT_FRACTION`], at [`TROT_SPEED_HEIGHTS_PER_S`].
-    pub fn kin_core() -> TrotShape {
-        TrotShape {
-            cycle_s: GaitParams::DEFAULT_CYCLE_S,
-            duty_factor: Pattern::Trot.duty_factor(),
-            ..TrotShape::default()
         }
     }
 }

@@ -45,7 +45,11 @@ pub struct Velocity {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Pattern {
-    /// Diagonal pairs in antiphase: FL + RR at 0, FR + RL at ½; duty 0.5.
+    /// Diagonal pairs in antiphase: FL + RR at 0, FR + RL at ½; duty 0.75, so the pairs hand
+    /// the body over with all four feet down. At duty ½ each stance pair carries half the body
+    /// alone for its whole stance; on position servos whose error grows with the load the two
+    /// loaded knees sag through the stance and eat the stride (docs/twin.md: a quarter of the
+    /// commanded distance on seed 000's robot, a roll-over on seed 001's).
     Trot,
     /// Lateral-sequence walk RL → FL → RR → FR, a quarter cycle apart; duty 0.75 (always three
     /// feet down).
@@ -64,7 +68,7 @@ impl Pattern {
     /// Stance fraction of the cycle.
     pub const fn duty_factor(self) -> f32 {
         match self {
-            Pattern::Trot => 0.5,
+            Pattern::Trot => 0.75,
             Pattern::Walk => 0.75,
         }
     }
@@ -103,8 +107,10 @@ pub struct GaitParams {
 }
 
 impl GaitParams {
-    /// Default cycle, s.
-    pub const DEFAULT_CYCLE_S: f32 = 0.8;
+    /// Default cycle, s (with the trot's duty factor, the shape the physics twin found to keep
+    /// both presets' joints under their servos' stall torque with the most distance:
+    /// docs/twin.md).
+    pub const DEFAULT_CYCLE_S: f32 = 1.0;
     /// Default step height as a fraction of the stance height.
     pub const DEFAULT_STEP_HEIGHT_FRACTION: f32 = 0.15;
 

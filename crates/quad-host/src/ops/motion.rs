@@ -29,7 +29,7 @@ pub enum Law {
     YawTurn,
     /// Seed 000 §3.2: every foot follows a closed path (default its rectangle) under a held body.
     RectPath,
-    /// Trot: diagonal pairs in antiphase, duty 0.5, driven by a velocity command.
+    /// Trot: diagonal pairs in antiphase, duty 0.75, driven by a velocity command.
     Trot,
     /// Walk: one leg at a time (RL, FL, RR, FR), duty 0.75.
     Walk,
@@ -77,7 +77,7 @@ impl Law {
                  held body"
             }
             Law::Trot => {
-                "Trot: diagonal pairs in antiphase, duty 0.5, driven by a velocity command"
+                "Trot: diagonal pairs in antiphase, duty 0.75, driven by a velocity command"
             }
             Law::Walk => "Walk: one leg at a time (RL, FL, RR, FR), duty 0.75",
         }
