@@ -72,6 +72,102 @@ pub trait Math {
     fn within(x: f32, lo: f32, hi: f32) -> bool {
         (x >= lo) & (x <= hi)
     }
+    /// Reads a 16-bit entry of a table of the fixed-point kernels ([`poly::atan2_fixed`],
+    /// [`poly::sin_cos_fixed`]; see [`TableEntry`]). The only per-target part of those
+    /// kernels: the default is a plain load, right wherever the tables are ordinary read-only
+    /// data; where this crate links them into program memory (the AVR's flash, see
+    /// [`TABLES_IN_PROGRAM_MEMORY`]) a backend must read them there, and the default does not
+    /// compile for it.
+    #[inline(always)]
+    fn read_table_u16(entry: TableEntry<u16>) -> u16 {
+        entry.read_data_memory::<Self>()
+    }
+    /// Reads a 32-bit entry of a table of the fixed-point kernels, as
+    /// [`Math::read_table_u16`].
+    #[inline(always)]
+    fn read_table_u32(entry: TableEntry<u32>) -> u32 {
+        entry.read_data_memory::<Self>()
+    }
+}
+
+/// Whether this target links the fixed-point kernels' tables ([`poly::atan2_fixed`],
+/// [`poly::sin_cos_fixed`]) into program memory: on the AVR, avr-gcc's startup code copies all
+/// ordinary read-only data into SRAM, the scarcest memory of the ATmega2560, so there the
+/// tables go to flash (`.progmem.data`, which the linker script keeps in the first 64 KB, as
+/// `lpm` needs) and must be read with `lpm` by the backend ([`Math::read_table_u16`]). The
+/// tables' declaration (`flash_tables!`) is the other place that names the target; elsewhere
+/// they are ordinary read-only data.
+pub const TABLES_IN_PROGRAM_MEMORY: bool = cfg!(target_arch = "avr");
+
+/// The address of one entry of a fixed-point kernel's table, for [`Math::read_table_u16`] and
+/// [`Math::read_table_u32`]; made only by this crate, from an index checked against the
+/// table's length. The tables are reachable through nothing else, and the entry's one plain
+/// load ([`Math`]'s default read) does not compile where the tables are in program memory: no
+/// Rust code loads them there, which would read SRAM at a flash address.
+#[derive(Debug, Clone, Copy)]
+pub struct TableEntry<T: 'static>(&'static T);
+
+impl<T: Copy + 'static> TableEntry<T> {
+    /// The entry's address: in program memory when [`TABLES_IN_PROGRAM_MEMORY`], else in data
+    /// memory. Valid for the whole program (the tables are immutable statics).
+    #[inline(always)]
+    pub fn addr(self) -> *const T {
+        self.0
+    }
+
+    /// The plain load of [`Math`]'s default table reads, for the backend `M`: refused when
+    /// `M` is compiled for a target whose tables are in program memory (a post-monomorphization
+    /// error names the fix), so that a backend that forgets the flash read does not build.
+    #[inline(always)]
+    fn read_data_memory<M: ?Sized>(self) -> T {
+        let () = ReadsDataMemory::<M>::CHECK;
+        *self.0
+    }
+}
+
+/// The compile-time check of [`TableEntry::read_data_memory`], per backend `M` (generic so
+/// that it is evaluated only for a backend that uses the plain load).
+struct ReadsDataMemory<M: ?Sized>(PhantomData<M>);
+
+impl<M: ?Sized> ReadsDataMemory<M> {
+    const CHECK: () = assert!(
+        !TABLES_IN_PROGRAM_MEMORY,
+        "this target keeps the fixed-point kernels' tables in program memory: the Math backend \
+         must read them there (override Math::read_table_u16 and Math::read_table_u32)"
+    );
+}
+
+/// A constant table of a fixed-point kernel, readable only through [`Table::entry`] and a
+/// backend's [`Math::read_table_u16`] / [`Math::read_table_u32`] (the array is private, so no
+/// code can index it with a plain load).
+struct Table<T: 'static, const N: usize>([T; N]);
+
+impl<T: Copy + 'static, const N: usize> Table<T, N> {
+    /// Entry `i` (panics when `i ≥ N`, as indexing does).
+    #[inline(always)]
+    fn entry(&'static self, i: usize) -> TableEntry<T> {
+        // Indexing checks the bounds and takes the address, without a load.
+        TableEntry(&self.0[i])
+    }
+}
+
+/// Declares the kernels' tables as [`Table`] statics, in program memory on the AVR
+/// ([`TABLES_IN_PROGRAM_MEMORY`]; `.progmem.data` is the section avr-gcc's linker script keeps
+/// in flash and its startup code does not copy to SRAM).
+macro_rules! flash_tables {
+    ($($(#[$doc:meta])* static $name:ident: [$t:ty; $n:expr] = $value:expr;)+) => {
+        $(
+            $(#[$doc])*
+            // `unsafe_code` flags a static's `link_section` because plain loads of data placed
+            // in another memory would be wrong: [`Table`] admits only the backend's reads.
+            #[cfg_attr(
+                target_arch = "avr",
+                allow(unsafe_code),
+                link_section = ".progmem.data"
+            )]
+            static $name: Table<$t, $n> = Table($value);
+        )+
+    };
 }
 
 /// The backend used by the convenience functions of this crate.
@@ -148,12 +244,12 @@ impl<S: Math> Math for SoftFloat<S> {
 
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed(y, x)
+        poly::atan2_fixed::<S>(y, x)
     }
 
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
-        poly::sin_cos_fixed(x)
+        poly::sin_cos_fixed::<S>(x)
     }
 
     #[inline(always)]
@@ -169,6 +265,16 @@ impl<S: Math> Math for SoftFloat<S> {
     #[inline(always)]
     fn within(x: f32, lo: f32, hi: f32) -> bool {
         bits::within(x, bits::interval(lo, hi))
+    }
+
+    #[inline(always)]
+    fn read_table_u16(entry: TableEntry<u16>) -> u16 {
+        S::read_table_u16(entry)
+    }
+
+    #[inline(always)]
+    fn read_table_u32(entry: TableEntry<u32>) -> u32 {
+        S::read_table_u32(entry)
     }
 }
 
@@ -187,7 +293,7 @@ const PI: f32 = core::f32::consts::PI;
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
 /// | [`sin_cos_fixed`](poly::sin_cos_fixed) | 1e-6 | CPUs with software floats and an integer multiplier (the ATmega2560): no range reduction for \|x\| ≤ π/4, a table of 26 quadratic cells in 16-bit fixed point, two integer-to-float conversions |
 pub mod poly {
-    use super::{FRAC_PI_2, PI};
+    use super::{Math, Table, FRAC_PI_2, PI};
 
     const SIGN: u32 = 0x8000_0000;
     const ABS: u32 = 0x7fff_ffff;
@@ -309,155 +415,157 @@ pub mod poly {
         f32::from_bits(r.to_bits() | (yb & SIGN))
     }
 
-    /// [`atan2_fixed`]'s arctangent on `t ∈ [0, 1]` in 32 cells of width 1/32 (and cell 32,
-    /// `t = 1` alone): in cell `k`, `atan(k/32 + d) ≈ a + b·d − c·d²` for `d ∈ [0, 1/32)`, the
-    /// quadratic through the cell's three Chebyshev nodes, rounded to `a` in Q29 (`a₀ = 0`:
-    /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
-    /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
-    /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the 264 bytes of
-    /// tables are what it costs.
-    const ATAN_CELL_A_Q29: [u32; 33] = [
-        0,
-        16_771_589,
-        33_510_678,
-        50_184_805,
-        66_762_427,
-        83_213_099,
-        99_507_789,
-        115_619_162,
-        131_521_807,
-        147_192_431,
-        162_609_989,
-        177_755_778,
-        192_613_475,
-        207_169_131,
-        221_411_131,
-        235_330_121,
-        248_918_896,
-        262_172_285,
-        275_086_996,
-        287_661_475,
-        299_895_737,
-        311_791_212,
-        323_350_581,
-        334_577_621,
-        345_477_059,
-        356_054_431,
-        366_315_948,
-        376_268_384,
-        385_918_958,
-        395_275_239,
-        404_345_057,
-        413_136_426,
-        421_657_471,
-    ];
+    flash_tables! {
+        /// [`atan2_fixed`]'s arctangent on `t ∈ [0, 1]` in 32 cells of width 1/32 (and cell 32,
+        /// `t = 1` alone): in cell `k`, `atan(k/32 + d) ≈ a + b·d − c·d²` for `d ∈ [0, 1/32)`, the
+        /// quadratic through the cell's three Chebyshev nodes, rounded to `a` in Q29 (`a₀ = 0`:
+        /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
+        /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
+        /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the tables are
+        /// what it costs (in flash on the AVR, see [`TABLES_IN_PROGRAM_MEMORY`](super::TABLES_IN_PROGRAM_MEMORY)).
+        static ATAN_CELL_A_Q29: [u32; 33] = [
+            0,
+            16_771_589,
+            33_510_678,
+            50_184_805,
+            66_762_427,
+            83_213_099,
+            99_507_789,
+            115_619_162,
+            131_521_807,
+            147_192_431,
+            162_609_989,
+            177_755_778,
+            192_613_475,
+            207_169_131,
+            221_411_131,
+            235_330_121,
+            248_918_896,
+            262_172_285,
+            275_086_996,
+            287_661_475,
+            299_895_737,
+            311_791_212,
+            323_350_581,
+            334_577_621,
+            345_477_059,
+            356_054_431,
+            366_315_948,
+            376_268_384,
+            385_918_958,
+            395_275_239,
+            404_345_057,
+            413_136_426,
+            421_657_471,
+        ];
 
-    /// `b` of [`ATAN_CELL_A_Q29`]'s cells, Q15.
-    const ATAN_CELL_B_Q15: [u16; 33] = [
-        32_774, 32_742, 32_646, 32_488, 32_269, 31_992, 31_660, 31_276, 30_844, 30_369, 29_856,
-        29_308, 28_730, 28_128, 27_505, 26_866, 26_215, 25_556, 24_892, 24_227, 23_563, 22_903,
-        22_250, 21_605, 20_970, 20_347, 19_737, 19_140, 18_557, 17_990, 17_438, 16_902, 16_383,
-    ];
+        /// `b` of [`ATAN_CELL_A_Q29`]'s cells, Q15.
+        static ATAN_CELL_B_Q15: [u16; 33] = [
+            32_774, 32_742, 32_646, 32_488, 32_269, 31_992, 31_660, 31_276, 30_844, 30_369, 29_856,
+            29_308, 28_730, 28_128, 27_505, 26_866, 26_215, 25_556, 24_892, 24_227, 23_563, 22_903,
+            22_250, 21_605, 20_970, 20_347, 19_737, 19_140, 18_557, 17_990, 17_438, 16_902, 16_383,
+        ];
 
-    /// `c` of [`ATAN_CELL_A_Q29`]'s cells, Q16.
-    const ATAN_CELL_C_Q16: [u16; 33] = [
-        1023, 3058, 5057, 6998, 8861, 10_625, 12_276, 13_800, 15_187, 16_430, 17_524, 18_470,
-        19_268, 19_922, 20_438, 20_824, 21_086, 21_236, 21_282, 21_235, 21_105, 20_901, 20_633,
-        20_311, 19_942, 19_535, 19_097, 18_633, 18_151, 17_655, 17_150, 16_640, 16_128,
-    ];
+        /// `c` of [`ATAN_CELL_A_Q29`]'s cells, Q16.
+        static ATAN_CELL_C_Q16: [u16; 33] = [
+            1023, 3058, 5057, 6998, 8861, 10_625, 12_276, 13_800, 15_187, 16_430, 17_524, 18_470,
+            19_268, 19_922, 20_438, 20_824, 21_086, 21_236, 21_282, 21_235, 21_105, 20_901, 20_633,
+            20_311, 19_942, 19_535, 19_097, 18_633, 18_151, 17_655, 17_150, 16_640, 16_128,
+        ];
 
-    /// [`sin_cos_fixed`]'s sine on `r ∈ [0, 0.8125]` (π/4 and the rounding of a range
-    /// reduction) in 26 cells of width 1/32: in cell `k`, `sin(k/32 + d) ≈ a + b·d − c·d²` for
-    /// `d ∈ [0, 1/32)`, the quadratic through the cell's three Chebyshev nodes
-    /// (`scripts/fit_polynomials.py`), `a` in Q29 (`a₀ = 0`), `b` in Q15, `c` in Q16.
-    const SIN_CELL_A_Q29: [u32; 26] = [
-        0,
-        16_774_400,
-        33_532_506,
-        50_257_868,
-        66_934_153,
-        83_545_079,
-        100_074_424,
-        116_506_049,
-        132_823_907,
-        149_012_065,
-        165_054_715,
-        180_936_192,
-        196_640_988,
-        212_153_767,
-        227_459_382,
-        242_542_886,
-        257_389_552,
-        271_984_881,
-        286_314_621,
-        300_364_780,
-        314_121_638,
-        327_571_761,
-        340_702_017,
-        353_499_582,
-        365_951_961,
-        378_046_994,
-    ];
+        /// [`sin_cos_fixed`]'s sine on `r ∈ [0, 0.8125]` (π/4 and the rounding of a range
+        /// reduction) in 26 cells of width 1/32: in cell `k`, `sin(k/32 + d) ≈ a + b·d − c·d²` for
+        /// `d ∈ [0, 1/32)`, the quadratic through the cell's three Chebyshev nodes
+        /// (`scripts/fit_polynomials.py`), `a` in Q29 (`a₀ = 0`), `b` in Q15, `c` in Q16.
+        static SIN_CELL_A_Q29: [u32; 26] = [
+            0,
+            16_774_400,
+            33_532_506,
+            50_257_868,
+            66_934_153,
+            83_545_079,
+            100_074_424,
+            116_506_049,
+            132_823_907,
+            149_012_065,
+            165_054_715,
+            180_936_192,
+            196_640_988,
+            212_153_767,
+            227_459_382,
+            242_542_886,
+            257_389_552,
+            271_984_881,
+            286_314_621,
+            300_364_780,
+            314_121_638,
+            327_571_761,
+            340_702_017,
+            353_499_582,
+            365_951_961,
+            378_046_994,
+        ];
 
-    /// `b` of [`SIN_CELL_A_Q29`]'s cells, Q15.
-    const SIN_CELL_B_Q15: [u16; 26] = [
-        32_771, 32_755, 32_707, 32_627, 32_515, 32_372, 32_197, 31_990, 31_752, 31_483, 31_184,
-        30_854, 30_494, 30_104, 29_684, 29_236, 28_759, 28_254, 27_722, 27_162, 26_576, 25_964,
-        25_327, 24_664, 23_978, 23_268,
-    ];
+        /// `b` of [`SIN_CELL_A_Q29`]'s cells, Q15.
+        static SIN_CELL_B_Q15: [u16; 26] = [
+            32_771, 32_755, 32_707, 32_627, 32_515, 32_372, 32_197, 31_990, 31_752, 31_483, 31_184,
+            30_854, 30_494, 30_104, 29_684, 29_236, 28_759, 28_254, 27_722, 27_162, 26_576, 25_964,
+            25_327, 24_664, 23_978, 23_268,
+        ];
 
-    /// `c` of [`SIN_CELL_A_Q29`]'s cells, Q16.
-    const SIN_CELL_C_Q16: [u16; 26] = [
-        512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477, 13_417,
-        14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958, 22_707,
-        23_435,
-    ];
+        /// `c` of [`SIN_CELL_A_Q29`]'s cells, Q16.
+        static SIN_CELL_C_Q16: [u16; 26] = [
+            512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477, 13_417,
+            14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958, 22_707,
+            23_435,
+        ];
 
-    /// [`sin_cos_fixed`]'s cosine in the cells of [`SIN_CELL_A_Q29`]:
-    /// `cos(k/32 + d) ≈ a − b·d − c·d²`, `a` in Q29 (`a₀ = 1`: `cos 0` exact), `b` and `c` in
-    /// Q16.
-    const COS_CELL_A_Q29: [u32; 26] = [
-        536_870_912,
-        536_608_793,
-        535_822_684,
-        534_513_352,
-        532_682_078,
-        530_330_649,
-        527_461_361,
-        524_077_015,
-        520_180_918,
-        515_776_872,
-        510_869_179,
-        505_462_631,
-        499_562_508,
-        493_174_570,
-        486_305_055,
-        478_960_672,
-        471_148_592,
-        462_876_443,
-        454_152_304,
-        444_984_692,
-        435_382_560,
-        425_355_285,
-        414_912_657,
-        404_064_875,
-        392_822_529,
-        381_196_599,
-    ];
+        /// [`sin_cos_fixed`]'s cosine in the cells of [`SIN_CELL_A_Q29`]:
+        /// `cos(k/32 + d) ≈ a − b·d − c·d²`, `a` in Q29 (`a₀ = 1`: `cos 0` exact), `b` and `c` in
+        /// Q16.
+        static COS_CELL_A_Q29: [u32; 26] = [
+            536_870_912,
+            536_608_793,
+            535_822_684,
+            534_513_352,
+            532_682_078,
+            530_330_649,
+            527_461_361,
+            524_077_015,
+            520_180_918,
+            515_776_872,
+            510_869_179,
+            505_462_631,
+            499_562_508,
+            493_174_570,
+            486_305_055,
+            478_960_672,
+            471_148_592,
+            462_876_443,
+            454_152_304,
+            444_984_692,
+            435_382_560,
+            425_355_285,
+            414_912_657,
+            404_064_875,
+            392_822_529,
+            381_196_599,
+        ];
 
-    /// `b` of [`COS_CELL_A_Q29`]'s cells, Q16.
-    const COS_CELL_B_Q16: [u16; 26] = [
-        0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089, 24_006,
-        25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593, 43_156,
-        44_676, 46_153,
-    ];
+        /// `b` of [`COS_CELL_A_Q29`]'s cells, Q16.
+        static COS_CELL_B_Q16: [u16; 26] = [
+            0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089, 24_006,
+            25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593, 43_156,
+            44_676, 46_153,
+        ];
 
-    /// `c` of [`COS_CELL_A_Q29`]'s cells, Q16.
-    const COS_CELL_C_Q16: [u16; 26] = [
-        32_764, 32_732, 32_668, 32_572, 32_444, 32_285, 32_094, 31_872, 31_618, 31_334, 31_019,
-        30_674, 30_299, 29_895, 29_461, 28_998, 28_507, 27_988, 27_442, 26_870, 26_270, 25_646,
-        24_996, 24_322, 23_624, 22_903,
-    ];
+        /// `c` of [`COS_CELL_A_Q29`]'s cells, Q16.
+        static COS_CELL_C_Q16: [u16; 26] = [
+            32_764, 32_732, 32_668, 32_572, 32_444, 32_285, 32_094, 31_872, 31_618, 31_334, 31_019,
+            30_674, 30_299, 29_895, 29_461, 28_998, 28_507, 27_988, 27_442, 26_870, 26_270, 25_646,
+            24_996, 24_322, 23_624, 22_903,
+        ];
+    }
 
     /// `a·b` of two 16-bit numbers from its four 8 × 8-bit partial products: on the
     /// ATmega2560 four hardware multiplications inline, where `a as u32 * b as u32` would call
@@ -476,7 +584,9 @@ pub mod poly {
     /// added in fixed point, and one integer-to-float conversion: on the ATmega2560 far fewer
     /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
     /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
-    /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes.
+    /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes. The backend `M` reads the
+    /// tables ([`Math::read_table_u16`], [`Math::read_table_u32`]: in flash on the AVR), the
+    /// kernel's only per-target part; [`SoftFloat`](super::SoftFloat) passes its own.
     ///
     /// Formats: `t` in Q24 (`T`, from the float's mantissa, truncated), the cell offset `d` in Q21, the
     /// result in Q29 (π < 2²).
@@ -486,7 +596,7 @@ pub mod poly {
     /// firmware's emulator test `no_mul_result_is_clobbered_by_a_frame_pointer_adjustment`);
     /// hosts do not use this kernel in their backends, so the call costs them nothing.
     #[inline(never)]
-    pub fn atan2_fixed(y: f32, x: f32) -> f32 {
+    pub fn atan2_fixed<M: Math>(y: f32, x: f32) -> f32 {
         const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
         const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
         let (yb, xb) = (y.to_bits(), x.to_bits());
@@ -518,10 +628,11 @@ pub mod poly {
             let k = (big_t >> 19) as usize;
             let d = ((big_t & 0x7_ffff) >> 3) as u16;
             // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
-            let lin = (mul_16x16(d, ATAN_CELL_B_Q15[k]) + (1 << 6)) >> 7;
+            let lin = (mul_16x16(d, M::read_table_u16(ATAN_CELL_B_Q15.entry(k))) + (1 << 6)) >> 7;
             let d_sq = (mul_16x16(d, d) >> 16) as u16;
-            let quad = (mul_16x16(d_sq, ATAN_CELL_C_Q16[k]) + (1 << 12)) >> 13;
-            ATAN_CELL_A_Q29[k] + lin - quad
+            let quad =
+                (mul_16x16(d_sq, M::read_table_u16(ATAN_CELL_C_Q16.entry(k))) + (1 << 12)) >> 13;
+            M::read_table_u32(ATAN_CELL_A_Q29.entry(k)) + lin - quad
         };
         let r = match octant & 3 {
             0 => p,
@@ -581,11 +692,12 @@ pub mod poly {
     /// products for both), two integer-to-float conversions: on the ATmega2560 far fewer
     /// cycles than [`sin_cos_deg5`]'s twelve software-float operations (see
     /// `BENCHMARKS.md`). Absolute error ≤ 1e-6 (tests; the cells' 8.4e-7 in this arithmetic).
-    /// `sin_cos_fixed(0) = (0, 1)`; odd in the sine, even in the cosine.
+    /// `sin_cos_fixed(0) = (0, 1)`; odd in the sine, even in the cosine. The backend `M` reads
+    /// the tables, as for [`atan2_fixed`].
     ///
     /// Never inlined, for [`atan2_fixed`]'s reason (its `mul` instructions in a small frame).
     #[inline(never)]
-    pub fn sin_cos_fixed(x: f32) -> (f32, f32) {
+    pub fn sin_cos_fixed<M: Math>(x: f32) -> (f32, f32) {
         const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
                                                  // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
                                                  // range reduction of huge arguments, for which any bounded value will do.
@@ -609,11 +721,14 @@ pub mod poly {
         let d = ((big_r & 0x7_ffff) >> 3) as u16;
         let d_sq = (mul_16x16(d, d) >> 16) as u16;
         // b·d: Q36 (sine) or Q37 (cosine) → Q29; c·d²: Q42 → Q29.
-        let sin_q = SIN_CELL_A_Q29[cell] + ((mul_16x16(d, SIN_CELL_B_Q15[cell]) + (1 << 6)) >> 7)
-            - ((mul_16x16(d_sq, SIN_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
-        let cos_q = COS_CELL_A_Q29[cell]
-            - ((mul_16x16(d, COS_CELL_B_Q16[cell]) + (1 << 7)) >> 8)
-            - ((mul_16x16(d_sq, COS_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
+        let read_u16 = |table: &'static Table<u16, 26>| M::read_table_u16(table.entry(cell));
+        let read_u32 = |table: &'static Table<u32, 26>| M::read_table_u32(table.entry(cell));
+        let sin_q = read_u32(&SIN_CELL_A_Q29)
+            + ((mul_16x16(d, read_u16(&SIN_CELL_B_Q15)) + (1 << 6)) >> 7)
+            - ((mul_16x16(d_sq, read_u16(&SIN_CELL_C_Q16)) + (1 << 12)) >> 13);
+        let cos_q = read_u32(&COS_CELL_A_Q29)
+            - ((mul_16x16(d, read_u16(&COS_CELL_B_Q16)) + (1 << 7)) >> 8)
+            - ((mul_16x16(d_sq, read_u16(&COS_CELL_C_Q16)) + (1 << 12)) >> 13);
         let sin = f32::from_bits(q29_bits(sin_q) | (rb & SIGN));
         let cos = f32::from_bits(q29_bits(cos_q));
         if reduced {
@@ -848,7 +963,7 @@ mod tests {
 
     #[test]
     fn atan2_fixed_matches_f64_everywhere() {
-        let worst = worst_atan2_error(poly::atan2_fixed);
+        let worst = worst_atan2_error(poly::atan2_fixed::<SoftFloat>);
         assert!(
             worst < ATAN2_FIXED_TOL_RAD,
             "worst atan2_fixed error {worst}"
@@ -856,14 +971,15 @@ mod tests {
         let mut worst = 0.0f64;
         let mut t = 1.0e-12f32;
         while t < 1.0 {
-            let d = (poly::atan2_fixed(t, 1.0) as f64 - (t as f64).atan()).abs();
+            let d = (poly::atan2_fixed::<SoftFloat>(t, 1.0) as f64 - (t as f64).atan()).abs();
             worst = worst.max(d);
             t *= 1.001;
         }
         for i in 0..=200_000 {
             let t = i as f32 / 200_000.0;
             for (y, x) in [(t, 1.0f32), (1.0, t), (-t, -1.0), (-1.0, t * 3.0)] {
-                let d = (poly::atan2_fixed(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+                let d = (poly::atan2_fixed::<SoftFloat>(y, x) as f64 - (y as f64).atan2(x as f64))
+                    .abs();
                 worst = worst.max(d);
             }
         }
@@ -879,7 +995,7 @@ mod tests {
                 f32::from_bits(state as u32),
                 f32::from_bits((state >> 32) as u32),
             );
-            let r = poly::atan2_fixed(y, x);
+            let r = poly::atan2_fixed::<SoftFloat>(y, x);
             if !(y.is_nan() || x.is_nan() || (y.is_infinite() && x.is_infinite())) {
                 let want = (y as f64).atan2(x as f64);
                 assert!(
@@ -895,11 +1011,12 @@ mod tests {
     #[test]
     fn atan2_fixed_cells_are_within_2e_6() {
         const TOL_RAD: f64 = 2.0e-6;
-        let mut worst = worst_atan2_error(poly::atan2_fixed);
+        let mut worst = worst_atan2_error(poly::atan2_fixed::<SoftFloat>);
         for i in 0..=400_000 {
             let t = i as f32 / 400_000.0;
             for (y, x) in [(t, 1.0f32), (1.0, t), (-t, -1.0), (-1.0, -t)] {
-                let d = (poly::atan2_fixed(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+                let d = (poly::atan2_fixed::<SoftFloat>(y, x) as f64 - (y as f64).atan2(x as f64))
+                    .abs();
                 worst = worst.max(d);
             }
         }
@@ -910,7 +1027,7 @@ mod tests {
                 edge,
                 f32::from_bits(edge.to_bits() + 1).min(1.0),
             ] {
-                let d = (poly::atan2_fixed(t, 1.0) as f64 - (t as f64).atan()).abs();
+                let d = (poly::atan2_fixed::<SoftFloat>(t, 1.0) as f64 - (t as f64).atan()).abs();
                 worst = worst.max(d);
             }
         }
@@ -943,7 +1060,11 @@ mod tests {
             for (name, got, tol) in [
                 ("deg15", poly::atan2_deg15(y, x), 3.0e-7),
                 ("deg9", poly::atan2_deg9(y, x), ATAN2_DEG9_TOL_RAD as f32),
-                ("fixed", poly::atan2_fixed(y, x), ATAN2_FIXED_TOL_RAD as f32),
+                (
+                    "fixed",
+                    poly::atan2_fixed::<SoftFloat>(y, x),
+                    ATAN2_FIXED_TOL_RAD as f32,
+                ),
             ] {
                 assert!(
                     (got - want).abs() < tol,
@@ -960,9 +1081,9 @@ mod tests {
         assert_eq!(poly::atan2_deg9(0.0, -1.0), PI);
         assert_eq!(poly::atan2_deg9(1.0, 0.0), FRAC_PI_2);
         assert_eq!(poly::atan2_deg9(-1.0, 0.0), -FRAC_PI_2);
-        assert_eq!(poly::atan2_fixed(0.0, -1.0), PI);
-        assert_eq!(poly::atan2_fixed(1.0, 0.0), FRAC_PI_2);
-        assert_eq!(poly::atan2_fixed(-1.0, 0.0), -FRAC_PI_2);
+        assert_eq!(poly::atan2_fixed::<SoftFloat>(0.0, -1.0), PI);
+        assert_eq!(poly::atan2_fixed::<SoftFloat>(1.0, 0.0), FRAC_PI_2);
+        assert_eq!(poly::atan2_fixed::<SoftFloat>(-1.0, 0.0), -FRAC_PI_2);
     }
 
     /// `atan2_3` returns exactly three `atan2` calls, including
@@ -1024,12 +1145,12 @@ mod tests {
         let mut worst = 0.0f64;
         for i in -400_000..=400_000 {
             let x = i as f32 * 0.000_025; // ±10 rad, across the ±π/4 switch and every cell
-            let (s, c) = poly::sin_cos_fixed(x);
+            let (s, c) = poly::sin_cos_fixed::<SoftFloat>(x);
             worst = worst
                 .max((s as f64 - (x as f64).sin()).abs())
                 .max((c as f64 - (x as f64).cos()).abs());
             assert_eq!(
-                poly::sin_cos_fixed(-x),
+                poly::sin_cos_fixed::<SoftFloat>(-x),
                 (-s, c),
                 "odd sine, even cosine at {x}"
             );
@@ -1043,20 +1164,20 @@ mod tests {
             f32::MIN_POSITIVE,
             1e-7,
         ] {
-            let (s, c) = poly::sin_cos_fixed(x);
+            let (s, c) = poly::sin_cos_fixed::<SoftFloat>(x);
             worst = worst
                 .max((s as f64 - (x as f64).sin()).abs())
                 .max((c as f64 - (x as f64).cos()).abs());
         }
         std::eprintln!("sin_cos_fixed: worst error {worst:e}");
         assert!(worst < TOL, "worst sin/cos error {worst}");
-        assert_eq!(poly::sin_cos_fixed(0.0), (0.0, 1.0));
+        assert_eq!(poly::sin_cos_fixed::<SoftFloat>(0.0), (0.0, 1.0));
         // Bounded on any finite argument (huge ones are not reduced exactly).
         let mut rng = SplitMix64::new(0x5eed_5eed_0000_0001u64);
         for _ in 0..100_000 {
             let x = f32::from_bits(rng.next_u64() as u32);
             if x.is_finite() {
-                let (s, c) = poly::sin_cos_fixed(x);
+                let (s, c) = poly::sin_cos_fixed::<SoftFloat>(x);
                 assert!(
                     s.abs() <= 1.0 && c.abs() <= 1.0,
                     "sin_cos_fixed({x:e}) = ({s}, {c})"

@@ -21,8 +21,11 @@
 
 #![no_std]
 #![cfg(target_arch = "avr")]
+// `asm!` on the AVR (the `lpm` of `read_table_u16` / `read_table_u32`).
+#![feature(asm_experimental_arch)]
 
-use kin_core::math::SoftFloat;
+use core::arch::asm;
+use kin_core::math::{SoftFloat, TableEntry};
 use kin_core::Math;
 
 /// Links avr-libc's `libm.a` (and `libc.a`, for its `memcpy`/`memset`) ahead of
@@ -69,6 +72,55 @@ impl Math for AvrLibm {
     fn sin_cos(x: f32) -> (f32, f32) {
         // SAFETY: pure functions of their argument.
         unsafe { (sin(x), cos(x)) }
+    }
+
+    // kin-core links its fixed-point kernels' tables into flash on the AVR
+    // (`kin_core::math::TABLES_IN_PROGRAM_MEMORY`), so that avr-gcc's startup does not copy
+    // them into SRAM; `lpm` reads them there. Written here rather than with the `avr-progmem`
+    // crate: its reads go byte by byte through a buffer in memory (a store and a load per
+    // byte, and stack space in the kernels, which keep small frames for the reason given on
+    // `poly::atan2_fixed`), where these are two or four `lpm Rd, Z+` straight into the result's
+    // registers; and it has had no release for the toolchains since 2023.
+
+    #[inline(always)]
+    fn read_table_u16(entry: TableEntry<u16>) -> u16 {
+        let (b0, b1): (u8, u8);
+        // SAFETY: `entry` is the address of a `u16` of a kin-core table in `.progmem.data`,
+        // which the avr6 linker script places at the start of flash, below 64 KB (`lpm`'s
+        // reach; a table beyond it would fail to link, its address truncated). `lpm` only
+        // reads flash; Z is declared clobbered.
+        unsafe {
+            asm!(
+                "lpm {b0}, Z+",
+                "lpm {b1}, Z",
+                b0 = out(reg) b0,
+                b1 = out(reg) b1,
+                inout("Z") entry.addr() => _,
+                options(pure, readonly, nostack, preserves_flags),
+            );
+        }
+        u16::from_le_bytes([b0, b1])
+    }
+
+    #[inline(always)]
+    fn read_table_u32(entry: TableEntry<u32>) -> u32 {
+        let (b0, b1, b2, b3): (u8, u8, u8, u8);
+        // SAFETY: as in `read_table_u16`, for the four bytes of a `u32`.
+        unsafe {
+            asm!(
+                "lpm {b0}, Z+",
+                "lpm {b1}, Z+",
+                "lpm {b2}, Z+",
+                "lpm {b3}, Z",
+                b0 = out(reg) b0,
+                b1 = out(reg) b1,
+                b2 = out(reg) b2,
+                b3 = out(reg) b3,
+                inout("Z") entry.addr() => _,
+                options(pure, readonly, nostack, preserves_flags),
+            );
+        }
+        u32::from_le_bytes([b0, b1, b2, b3])
     }
 }
 
