@@ -16,7 +16,9 @@
 //!   firmware's backend is `SoftFloat` over avr-libc's square root): the kernels
 //!   [`poly::atan2_fixed`] and [`poly::sin_cos_fixed`] (tables of quadratic cells in fixed
 //!   point), which cost far fewer software-float operations, comparisons of the bit patterns instead of software-float comparisons, and
-//!   the four legs of a body solved one after the other.
+//!   the four legs of a body solved one after the other. The kernels' tables are the one thing
+//!   a backend reads per target ([`Math::read_table_u16`]): on the AVR they stay in flash, out
+//!   of the scarce SRAM, and the backend reads them with `lpm`.
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
 //! minimax fit), and so do the fixed-point kernels' cell tables (quadratics through Chebyshev
@@ -227,7 +229,10 @@ impl Math for Fast {
 ///   in 16-bit fixed point (error ≤ 1e-6);
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
-/// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false).
+/// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false);
+/// - the kernels' tables read by `S` ([`Math::read_table_u16`], [`Math::read_table_u32`]): a
+///   plain load for `Libm`; from flash for the firmware's `AvrLibm`, on the AVR, where the
+///   tables are linked into flash ([`TABLES_IN_PROGRAM_MEMORY`]).
 ///
 /// Against [`DefaultMath`] the angles of a leg or body solve differ by at most about 4e-6 rad
 /// (the fixed-point arctangent's error plus rounding; `tests/avr_kernels.rs`).

@@ -126,7 +126,8 @@ impl Math for AvrLibm {
 
 /// The firmware's backend: kin-core's [`SoftFloat`] (the kernels, comparisons and leg staging
 /// for CPUs without floating-point hardware; the host tests run the same choices) over
-/// avr-libc's `sqrt`, with all float arithmetic on avr-libc's primitives. The fastest mix
+/// avr-libc's `sqrt` and [`AvrLibm`]'s reads of the kernels' tables from flash, with all float
+/// arithmetic on avr-libc's primitives. The fastest mix
 /// measured in simavr (see `BENCHMARKS.md`).
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by
