@@ -427,7 +427,7 @@ pub mod poly {
         /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
         /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
         /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the tables are
-        /// what it costs (in flash on the AVR, see [`TABLES_IN_PROGRAM_MEMORY`](super::TABLES_IN_PROGRAM_MEMORY)).
+        /// what it costs (in flash on the AVR: [`super::TABLES_IN_PROGRAM_MEMORY`]).
         static ATAN_CELL_A_Q29: [u32; 33] = [
             0,
             16_771_589,
@@ -520,9 +520,9 @@ pub mod poly {
 
         /// `c` of [`SIN_CELL_A_Q29`]'s cells, Q16.
         static SIN_CELL_C_Q16: [u16; 26] = [
-            512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477, 13_417,
-            14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958, 22_707,
-            23_435,
+            512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477,
+            13_417, 14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958,
+            22_707, 23_435,
         ];
 
         /// [`sin_cos_fixed`]'s cosine in the cells of [`SIN_CELL_A_Q29`]:
@@ -559,9 +559,9 @@ pub mod poly {
 
         /// `b` of [`COS_CELL_A_Q29`]'s cells, Q16.
         static COS_CELL_B_Q16: [u16; 26] = [
-            0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089, 24_006,
-            25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593, 43_156,
-            44_676, 46_153,
+            0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089,
+            24_006, 25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593,
+            43_156, 44_676, 46_153,
         ];
 
         /// `c` of [`COS_CELL_A_Q29`]'s cells, Q16.
@@ -704,8 +704,9 @@ pub mod poly {
     #[inline(never)]
     pub fn sin_cos_fixed<M: Math>(x: f32) -> (f32, f32) {
         const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
-                                                 // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
-                                                 // range reduction of huge arguments, for which any bounded value will do.
+
+        // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
+        // range reduction of huge arguments, for which any bounded value will do.
         const CELLS_END_Q24: u32 = (26 << 19) - 1;
         let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
         let (k, r) = if reduced { reduce(x) } else { (0.0, x) };
