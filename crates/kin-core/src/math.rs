@@ -17,7 +17,7 @@
 //!   [`poly::atan2_fixed`] and [`poly::sin_cos_fixed`] (tables of quadratic cells in fixed
 //!   point), which cost far fewer software-float operations, comparisons of the bit patterns instead of software-float comparisons, and
 //!   the four legs of a body solved one after the other. The kernels' tables are the one thing
-//!   a backend reads per target ([`Math::read_table_u16`]): on the AVR they stay in flash, out
+//!   a backend reads per target ([`Math::read_table_cell`]): on the AVR they stay in flash, out
 //!   of the scarce SRAM, and the backend reads them with `lpm`.
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
@@ -74,20 +74,14 @@ pub trait Math {
     fn within(x: f32, lo: f32, hi: f32) -> bool {
         (x >= lo) & (x <= hi)
     }
-    /// Reads a 16-bit entry of a table of the fixed-point kernels ([`poly::atan2_fixed`],
-    /// [`poly::sin_cos_fixed`]; see [`TableEntry`]). The only per-target part of those
-    /// kernels: the default is a plain load, right wherever the tables are ordinary read-only
-    /// data; where this crate links them into program memory (the AVR's flash, see
-    /// [`TABLES_IN_PROGRAM_MEMORY`]) a backend must read them there, and the default does not
-    /// compile for it.
+    /// Reads one cell of a fixed-point kernel's table ([`poly::atan2_fixed`],
+    /// [`poly::sin_cos_fixed`]): `N` consecutive 16-bit words, see [`TableEntry`]. The only
+    /// per-target part of those kernels: the default is a plain load, right wherever the tables
+    /// are ordinary read-only data; where this crate links them into program memory (the AVR's
+    /// flash, see [`TABLES_IN_PROGRAM_MEMORY`]) a backend must read them there, and the default
+    /// does not compile for it.
     #[inline(always)]
-    fn read_table_u16(entry: TableEntry<u16>) -> u16 {
-        entry.read_data_memory::<Self>()
-    }
-    /// Reads a 32-bit entry of a table of the fixed-point kernels, as
-    /// [`Math::read_table_u16`].
-    #[inline(always)]
-    fn read_table_u32(entry: TableEntry<u32>) -> u32 {
+    fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
         entry.read_data_memory::<Self>()
     }
 }
@@ -96,13 +90,13 @@ pub trait Math {
 /// [`poly::sin_cos_fixed`]) into program memory: on the AVR, avr-gcc's startup code copies all
 /// ordinary read-only data into SRAM, the scarcest memory of the ATmega2560, so there the
 /// tables go to flash (`.progmem.data`, which the linker script keeps in the first 64 KB, as
-/// `lpm` needs) and must be read with `lpm` by the backend ([`Math::read_table_u16`]). The
+/// `lpm` needs) and must be read with `lpm` by the backend ([`Math::read_table_cell`]). The
 /// tables' declaration (`flash_tables!`) is the other place that names the target; elsewhere
 /// they are ordinary read-only data.
 pub const TABLES_IN_PROGRAM_MEMORY: bool = cfg!(target_arch = "avr");
 
-/// The address of one entry of a fixed-point kernel's table, for [`Math::read_table_u16`] and
-/// [`Math::read_table_u32`]; made only by this crate, from an index checked against the
+/// The address of one entry of a fixed-point kernel's table (a cell), for
+/// [`Math::read_table_cell`]; made only by this crate, from an index checked against the
 /// table's length. The tables are reachable through nothing else, and the entry's one plain
 /// load ([`Math`]'s default read) does not compile where the tables are in program memory: no
 /// Rust code loads them there, which would read SRAM at a flash address.
@@ -135,13 +129,13 @@ impl<M: ?Sized> ReadsDataMemory<M> {
     const CHECK: () = assert!(
         !TABLES_IN_PROGRAM_MEMORY,
         "this target keeps the fixed-point kernels' tables in program memory: the Math backend \
-         must read them there (override Math::read_table_u16 and Math::read_table_u32)"
+         must read them there (override Math::read_table_cell)"
     );
 }
 
 /// A constant table of a fixed-point kernel, readable only through [`Table::entry`] and a
-/// backend's [`Math::read_table_u16`] / [`Math::read_table_u32`] (the array is private, so no
-/// code can index it with a plain load).
+/// backend's [`Math::read_table_cell`] (the array is private, so no code can index it with a
+/// plain load).
 struct Table<T: 'static, const N: usize>([T; N]);
 
 impl<T: Copy + 'static, const N: usize> Table<T, N> {
@@ -230,7 +224,7 @@ impl Math for Fast {
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
 /// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false);
-/// - the kernels' tables read by `S` ([`Math::read_table_u16`], [`Math::read_table_u32`]): a
+/// - the kernels' tables read by `S` ([`Math::read_table_cell`]): a
 ///   plain load for `Libm`; from flash for the firmware's `AvrLibm`, on the AVR, where the
 ///   tables are linked into flash ([`TABLES_IN_PROGRAM_MEMORY`]).
 ///
@@ -273,13 +267,8 @@ impl<S: Math> Math for SoftFloat<S> {
     }
 
     #[inline(always)]
-    fn read_table_u16(entry: TableEntry<u16>) -> u16 {
-        S::read_table_u16(entry)
-    }
-
-    #[inline(always)]
-    fn read_table_u32(entry: TableEntry<u32>) -> u32 {
-        S::read_table_u32(entry)
+    fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
+        S::read_table_cell(entry)
     }
 }
 
@@ -420,156 +409,205 @@ pub mod poly {
         f32::from_bits(r.to_bits() | (yb & SIGN))
     }
 
+    /// [`atan2_fixed`]'s arctangent on `t ∈ [0, 1]` in 32 cells of width 1/32 (and cell 32,
+    /// `t = 1` alone): in cell `k`, `atan(k/32 + d) ≈ a + b·d − c·d²` for `d ∈ [0, 1/32)`, the
+    /// quadratic through the cell's three Chebyshev nodes, rounded to `a` in Q29 (`a₀ = 0`:
+    /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
+    /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
+    /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the tables are
+    /// what it costs (in flash on the AVR: [`ATAN_CELLS`]).
+    const ATAN_CELL_A_Q29: [u32; 33] = [
+        0,
+        16_771_589,
+        33_510_678,
+        50_184_805,
+        66_762_427,
+        83_213_099,
+        99_507_789,
+        115_619_162,
+        131_521_807,
+        147_192_431,
+        162_609_989,
+        177_755_778,
+        192_613_475,
+        207_169_131,
+        221_411_131,
+        235_330_121,
+        248_918_896,
+        262_172_285,
+        275_086_996,
+        287_661_475,
+        299_895_737,
+        311_791_212,
+        323_350_581,
+        334_577_621,
+        345_477_059,
+        356_054_431,
+        366_315_948,
+        376_268_384,
+        385_918_958,
+        395_275_239,
+        404_345_057,
+        413_136_426,
+        421_657_471,
+    ];
+
+    /// `b` of [`ATAN_CELL_A_Q29`]'s cells, Q15.
+    const ATAN_CELL_B_Q15: [u16; 33] = [
+        32_774, 32_742, 32_646, 32_488, 32_269, 31_992, 31_660, 31_276, 30_844, 30_369, 29_856,
+        29_308, 28_730, 28_128, 27_505, 26_866, 26_215, 25_556, 24_892, 24_227, 23_563, 22_903,
+        22_250, 21_605, 20_970, 20_347, 19_737, 19_140, 18_557, 17_990, 17_438, 16_902, 16_383,
+    ];
+
+    /// `c` of [`ATAN_CELL_A_Q29`]'s cells, Q16.
+    const ATAN_CELL_C_Q16: [u16; 33] = [
+        1023, 3058, 5057, 6998, 8861, 10_625, 12_276, 13_800, 15_187, 16_430, 17_524, 18_470,
+        19_268, 19_922, 20_438, 20_824, 21_086, 21_236, 21_282, 21_235, 21_105, 20_901, 20_633,
+        20_311, 19_942, 19_535, 19_097, 18_633, 18_151, 17_655, 17_150, 16_640, 16_128,
+    ];
+
+    /// [`sin_cos_fixed`]'s sine on `r ∈ [0, 0.8125]` (π/4 and the rounding of a range
+    /// reduction) in 26 cells of width 1/32: in cell `k`, `sin(k/32 + d) ≈ a + b·d − c·d²` for
+    /// `d ∈ [0, 1/32)`, the quadratic through the cell's three Chebyshev nodes
+    /// (`scripts/fit_polynomials.py`), `a` in Q29 (`a₀ = 0`), `b` in Q15, `c` in Q16.
+    const SIN_CELL_A_Q29: [u32; 26] = [
+        0,
+        16_774_400,
+        33_532_506,
+        50_257_868,
+        66_934_153,
+        83_545_079,
+        100_074_424,
+        116_506_049,
+        132_823_907,
+        149_012_065,
+        165_054_715,
+        180_936_192,
+        196_640_988,
+        212_153_767,
+        227_459_382,
+        242_542_886,
+        257_389_552,
+        271_984_881,
+        286_314_621,
+        300_364_780,
+        314_121_638,
+        327_571_761,
+        340_702_017,
+        353_499_582,
+        365_951_961,
+        378_046_994,
+    ];
+
+    /// `b` of [`SIN_CELL_A_Q29`]'s cells, Q15.
+    const SIN_CELL_B_Q15: [u16; 26] = [
+        32_771, 32_755, 32_707, 32_627, 32_515, 32_372, 32_197, 31_990, 31_752, 31_483, 31_184,
+        30_854, 30_494, 30_104, 29_684, 29_236, 28_759, 28_254, 27_722, 27_162, 26_576, 25_964,
+        25_327, 24_664, 23_978, 23_268,
+    ];
+
+    /// `c` of [`SIN_CELL_A_Q29`]'s cells, Q16.
+    const SIN_CELL_C_Q16: [u16; 26] = [
+        512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477, 13_417,
+        14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958, 22_707,
+        23_435,
+    ];
+
+    /// [`sin_cos_fixed`]'s cosine in the cells of [`SIN_CELL_A_Q29`]:
+    /// `cos(k/32 + d) ≈ a − b·d − c·d²`, `a` in Q29 (`a₀ = 1`: `cos 0` exact), `b` and `c` in
+    /// Q16.
+    const COS_CELL_A_Q29: [u32; 26] = [
+        536_870_912,
+        536_608_793,
+        535_822_684,
+        534_513_352,
+        532_682_078,
+        530_330_649,
+        527_461_361,
+        524_077_015,
+        520_180_918,
+        515_776_872,
+        510_869_179,
+        505_462_631,
+        499_562_508,
+        493_174_570,
+        486_305_055,
+        478_960_672,
+        471_148_592,
+        462_876_443,
+        454_152_304,
+        444_984_692,
+        435_382_560,
+        425_355_285,
+        414_912_657,
+        404_064_875,
+        392_822_529,
+        381_196_599,
+    ];
+
+    /// `b` of [`COS_CELL_A_Q29`]'s cells, Q16.
+    const COS_CELL_B_Q16: [u16; 26] = [
+        0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089, 24_006,
+        25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593, 43_156,
+        44_676, 46_153,
+    ];
+
+    /// `c` of [`COS_CELL_A_Q29`]'s cells, Q16.
+    const COS_CELL_C_Q16: [u16; 26] = [
+        32_764, 32_732, 32_668, 32_572, 32_444, 32_285, 32_094, 31_872, 31_618, 31_334, 31_019,
+        30_674, 30_299, 29_895, 29_461, 28_998, 28_507, 27_988, 27_442, 26_870, 26_270, 25_646,
+        24_996, 24_322, 23_624, 22_903,
+    ];
+
     flash_tables! {
-        /// [`atan2_fixed`]'s arctangent on `t ∈ [0, 1]` in 32 cells of width 1/32 (and cell 32,
-        /// `t = 1` alone): in cell `k`, `atan(k/32 + d) ≈ a + b·d − c·d²` for `d ∈ [0, 1/32)`, the
-        /// quadratic through the cell's three Chebyshev nodes, rounded to `a` in Q29 (`a₀ = 0`:
-        /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
-        /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
-        /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the tables are
-        /// what it costs (in flash on the AVR: [`super::TABLES_IN_PROGRAM_MEMORY`]).
-        static ATAN_CELL_A_Q29: [u32; 33] = [
-            0,
-            16_771_589,
-            33_510_678,
-            50_184_805,
-            66_762_427,
-            83_213_099,
-            99_507_789,
-            115_619_162,
-            131_521_807,
-            147_192_431,
-            162_609_989,
-            177_755_778,
-            192_613_475,
-            207_169_131,
-            221_411_131,
-            235_330_121,
-            248_918_896,
-            262_172_285,
-            275_086_996,
-            287_661_475,
-            299_895_737,
-            311_791_212,
-            323_350_581,
-            334_577_621,
-            345_477_059,
-            356_054_431,
-            366_315_948,
-            376_268_384,
-            385_918_958,
-            395_275_239,
-            404_345_057,
-            413_136_426,
-            421_657_471,
-        ];
+        /// [`atan2_fixed`]'s cells as the kernel reads them, one row per cell `k`:
+        /// `[a_lo, a_hi, b, c]` of [`ATAN_CELL_A_Q29`], [`ATAN_CELL_B_Q15`], [`ATAN_CELL_C_Q16`]
+        /// (`a` in two 16-bit halves), so that one read fetches a cell's consecutive bytes.
+        static ATAN_CELLS: [[u16; 4]; 33] =
+            cells(&ATAN_CELL_A_Q29, &ATAN_CELL_B_Q15, &ATAN_CELL_C_Q16);
 
-        /// `b` of [`ATAN_CELL_A_Q29`]'s cells, Q15.
-        static ATAN_CELL_B_Q15: [u16; 33] = [
-            32_774, 32_742, 32_646, 32_488, 32_269, 31_992, 31_660, 31_276, 30_844, 30_369, 29_856,
-            29_308, 28_730, 28_128, 27_505, 26_866, 26_215, 25_556, 24_892, 24_227, 23_563, 22_903,
-            22_250, 21_605, 20_970, 20_347, 19_737, 19_140, 18_557, 17_990, 17_438, 16_902, 16_383,
-        ];
+        /// [`sin_cos_fixed`]'s cells as the kernel reads them: per cell the sine's row
+        /// (`[a_lo, a_hi, b, c]` of [`SIN_CELL_A_Q29`], …), then the cosine's.
+        static SIN_COS_CELLS: [[u16; 8]; 26] = concat_cells(
+            cells(&SIN_CELL_A_Q29, &SIN_CELL_B_Q15, &SIN_CELL_C_Q16),
+            cells(&COS_CELL_A_Q29, &COS_CELL_B_Q16, &COS_CELL_C_Q16),
+        );
+    }
 
-        /// `c` of [`ATAN_CELL_A_Q29`]'s cells, Q16.
-        static ATAN_CELL_C_Q16: [u16; 33] = [
-            1023, 3058, 5057, 6998, 8861, 10_625, 12_276, 13_800, 15_187, 16_430, 17_524, 18_470,
-            19_268, 19_922, 20_438, 20_824, 21_086, 21_236, 21_282, 21_235, 21_105, 20_901, 20_633,
-            20_311, 19_942, 19_535, 19_097, 18_633, 18_151, 17_655, 17_150, 16_640, 16_128,
-        ];
+    /// Rows `[a_lo, a_hi, b, c]` of the cells `(a[k], b[k], c[k])`, at compile time.
+    const fn cells<const N: usize>(a: &[u32; N], b: &[u16; N], c: &[u16; N]) -> [[u16; 4]; N] {
+        let mut rows = [[0; 4]; N];
+        let mut k = 0;
+        while k < N {
+            rows[k] = [a[k] as u16, (a[k] >> 16) as u16, b[k], c[k]];
+            k += 1;
+        }
+        rows
+    }
 
-        /// [`sin_cos_fixed`]'s sine on `r ∈ [0, 0.8125]` (π/4 and the rounding of a range
-        /// reduction) in 26 cells of width 1/32: in cell `k`, `sin(k/32 + d) ≈ a + b·d − c·d²` for
-        /// `d ∈ [0, 1/32)`, the quadratic through the cell's three Chebyshev nodes
-        /// (`scripts/fit_polynomials.py`), `a` in Q29 (`a₀ = 0`), `b` in Q15, `c` in Q16.
-        static SIN_CELL_A_Q29: [u32; 26] = [
-            0,
-            16_774_400,
-            33_532_506,
-            50_257_868,
-            66_934_153,
-            83_545_079,
-            100_074_424,
-            116_506_049,
-            132_823_907,
-            149_012_065,
-            165_054_715,
-            180_936_192,
-            196_640_988,
-            212_153_767,
-            227_459_382,
-            242_542_886,
-            257_389_552,
-            271_984_881,
-            286_314_621,
-            300_364_780,
-            314_121_638,
-            327_571_761,
-            340_702_017,
-            353_499_582,
-            365_951_961,
-            378_046_994,
-        ];
+    /// Rows `first[k]` followed by `second[k]`, at compile time.
+    const fn concat_cells<const N: usize>(
+        first: [[u16; 4]; N],
+        second: [[u16; 4]; N],
+    ) -> [[u16; 8]; N] {
+        let mut rows = [[0; 8]; N];
+        let mut k = 0;
+        while k < N {
+            let mut i = 0;
+            while i < 4 {
+                rows[k][i] = first[k][i];
+                rows[k][4 + i] = second[k][i];
+                i += 1;
+            }
+            k += 1;
+        }
+        rows
+    }
 
-        /// `b` of [`SIN_CELL_A_Q29`]'s cells, Q15.
-        static SIN_CELL_B_Q15: [u16; 26] = [
-            32_771, 32_755, 32_707, 32_627, 32_515, 32_372, 32_197, 31_990, 31_752, 31_483, 31_184,
-            30_854, 30_494, 30_104, 29_684, 29_236, 28_759, 28_254, 27_722, 27_162, 26_576, 25_964,
-            25_327, 24_664, 23_978, 23_268,
-        ];
-
-        /// `c` of [`SIN_CELL_A_Q29`]'s cells, Q16.
-        static SIN_CELL_C_Q16: [u16; 26] = [
-            512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477,
-            13_417, 14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958,
-            22_707, 23_435,
-        ];
-
-        /// [`sin_cos_fixed`]'s cosine in the cells of [`SIN_CELL_A_Q29`]:
-        /// `cos(k/32 + d) ≈ a − b·d − c·d²`, `a` in Q29 (`a₀ = 1`: `cos 0` exact), `b` and `c` in
-        /// Q16.
-        static COS_CELL_A_Q29: [u32; 26] = [
-            536_870_912,
-            536_608_793,
-            535_822_684,
-            534_513_352,
-            532_682_078,
-            530_330_649,
-            527_461_361,
-            524_077_015,
-            520_180_918,
-            515_776_872,
-            510_869_179,
-            505_462_631,
-            499_562_508,
-            493_174_570,
-            486_305_055,
-            478_960_672,
-            471_148_592,
-            462_876_443,
-            454_152_304,
-            444_984_692,
-            435_382_560,
-            425_355_285,
-            414_912_657,
-            404_064_875,
-            392_822_529,
-            381_196_599,
-        ];
-
-        /// `b` of [`COS_CELL_A_Q29`]'s cells, Q16.
-        static COS_CELL_B_Q16: [u16; 26] = [
-            0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089,
-            24_006, 25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593,
-            43_156, 44_676, 46_153,
-        ];
-
-        /// `c` of [`COS_CELL_A_Q29`]'s cells, Q16.
-        static COS_CELL_C_Q16: [u16; 26] = [
-            32_764, 32_732, 32_668, 32_572, 32_444, 32_285, 32_094, 31_872, 31_618, 31_334, 31_019,
-            30_674, 30_299, 29_895, 29_461, 28_998, 28_507, 27_988, 27_442, 26_870, 26_270, 25_646,
-            24_996, 24_322, 23_624, 22_903,
-        ];
+    /// `a_lo + a_hi·2¹⁶` of a row of [`cells`].
+    #[inline(always)]
+    fn join(lo: u16, hi: u16) -> u32 {
+        lo as u32 | (hi as u32) << 16
     }
 
     /// `a·b` of two 16-bit numbers from its four 8 × 8-bit partial products: on the
@@ -590,7 +628,7 @@ pub mod poly {
     /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
     /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
     /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes. The backend `M` reads the
-    /// tables ([`Math::read_table_u16`], [`Math::read_table_u32`]: in flash on the AVR), the
+    /// tables ([`Math::read_table_cell`]: in flash on the AVR), the
     /// kernel's only per-target part; [`SoftFloat`](super::SoftFloat) passes its own.
     ///
     /// Formats: `t` in Q24 (`T`, from the float's mantissa, truncated), the cell offset `d` in Q21, the
@@ -633,11 +671,11 @@ pub mod poly {
             let k = (big_t >> 19) as usize;
             let d = ((big_t & 0x7_ffff) >> 3) as u16;
             // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
-            let lin = (mul_16x16(d, M::read_table_u16(ATAN_CELL_B_Q15.entry(k))) + (1 << 6)) >> 7;
+            let [a_lo, a_hi, b, c] = M::read_table_cell(ATAN_CELLS.entry(k));
+            let lin = (mul_16x16(d, b) + (1 << 6)) >> 7;
             let d_sq = (mul_16x16(d, d) >> 16) as u16;
-            let quad =
-                (mul_16x16(d_sq, M::read_table_u16(ATAN_CELL_C_Q16.entry(k))) + (1 << 12)) >> 13;
-            M::read_table_u32(ATAN_CELL_A_Q29.entry(k)) + lin - quad
+            let quad = (mul_16x16(d_sq, c) + (1 << 12)) >> 13;
+            join(a_lo, a_hi) + lin - quad
         };
         let r = match octant & 3 {
             0 => p,
@@ -727,14 +765,13 @@ pub mod poly {
         let d = ((big_r & 0x7_ffff) >> 3) as u16;
         let d_sq = (mul_16x16(d, d) >> 16) as u16;
         // b·d: Q36 (sine) or Q37 (cosine) → Q29; c·d²: Q42 → Q29.
-        let read_u16 = |table: &'static Table<u16, 26>| M::read_table_u16(table.entry(cell));
-        let read_u32 = |table: &'static Table<u32, 26>| M::read_table_u32(table.entry(cell));
-        let sin_q = read_u32(&SIN_CELL_A_Q29)
-            + ((mul_16x16(d, read_u16(&SIN_CELL_B_Q15)) + (1 << 6)) >> 7)
-            - ((mul_16x16(d_sq, read_u16(&SIN_CELL_C_Q16)) + (1 << 12)) >> 13);
-        let cos_q = read_u32(&COS_CELL_A_Q29)
-            - ((mul_16x16(d, read_u16(&COS_CELL_B_Q16)) + (1 << 7)) >> 8)
-            - ((mul_16x16(d_sq, read_u16(&COS_CELL_C_Q16)) + (1 << 12)) >> 13);
+        let [sa_lo, sa_hi, sb, sc, ca_lo, ca_hi, cb, cc] =
+            M::read_table_cell(SIN_COS_CELLS.entry(cell));
+        let sin_q = join(sa_lo, sa_hi) + ((mul_16x16(d, sb) + (1 << 6)) >> 7)
+            - ((mul_16x16(d_sq, sc) + (1 << 12)) >> 13);
+        let cos_q = join(ca_lo, ca_hi)
+            - ((mul_16x16(d, cb) + (1 << 7)) >> 8)
+            - ((mul_16x16(d_sq, cc) + (1 << 12)) >> 13);
         let sin = f32::from_bits(q29_bits(sin_q) | (rb & SIGN));
         let cos = f32::from_bits(q29_bits(cos_q));
         if reduced {
