@@ -100,8 +100,17 @@ pub const TABLES_IN_PROGRAM_MEMORY: bool = cfg!(target_arch = "avr");
 /// table's length. The tables are reachable through nothing else, and the entry's one plain
 /// load ([`Math`]'s default read) does not compile where the tables are in program memory: no
 /// Rust code loads them there, which would read SRAM at a flash address.
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct TableEntry<T: 'static>(&'static T);
+
+/// The address only: formatting the entry must not load it (see [`TableEntry`]).
+impl<T: 'static> core::fmt::Debug for TableEntry<T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_tuple("TableEntry")
+            .field(&(self.0 as *const T))
+            .finish()
+    }
+}
 
 impl<T: Copy + 'static> TableEntry<T> {
     /// The entry's address: in program memory when [`TABLES_IN_PROGRAM_MEMORY`], else in data
@@ -151,7 +160,7 @@ impl<T: Copy + 'static, const N: usize> Table<T, N> {
 /// ([`TABLES_IN_PROGRAM_MEMORY`]; `.progmem.data` is the section avr-gcc's linker script keeps
 /// in flash and its startup code does not copy to SRAM).
 macro_rules! flash_tables {
-    ($($(#[$doc:meta])* static $name:ident: [$t:ty; $n:expr] = $value:expr;)+) => {
+    ($($(#[$doc:meta])* $vis:vis static $name:ident: [$t:ty; $n:expr] = $value:expr;)+) => {
         $(
             $(#[$doc])*
             // `unsafe_code` flags a static's `link_section` because plain loads of data placed
@@ -161,7 +170,7 @@ macro_rules! flash_tables {
                 allow(unsafe_code),
                 link_section = ".progmem.data"
             )]
-            static $name: Table<$t, $n> = Table($value);
+            $vis static $name: Table<$t, $n> = Table($value);
         )+
     };
 }
@@ -563,7 +572,7 @@ pub mod poly {
         /// [`atan2_fixed`]'s cells as the kernel reads them, one row per cell `k`:
         /// `[a_lo, a_hi, b, c]` of [`ATAN_CELL_A_Q29`], [`ATAN_CELL_B_Q15`], [`ATAN_CELL_C_Q16`]
         /// (`a` in two 16-bit halves), so that one read fetches a cell's consecutive bytes.
-        static ATAN_CELLS: [[u16; 4]; 33] =
+        pub(super) static ATAN_CELLS: [[u16; 4]; 33] =
             cells(&ATAN_CELL_A_Q29, &ATAN_CELL_B_Q15, &ATAN_CELL_C_Q16);
 
         /// [`sin_cos_fixed`]'s cells as the kernel reads them: per cell the sine's row
@@ -1295,6 +1304,21 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The default table read is a plain load of the entry, and an entry's `Debug` shows its
+    /// address, not its value.
+    #[test]
+    fn table_entries_read_and_print_without_a_second_path() {
+        use std::format;
+        let entry = poly::ATAN_CELLS.entry(32);
+        assert_eq!(
+            Libm::read_table_cell(entry),
+            SoftFloat::<Libm>::read_table_cell(entry)
+        );
+        assert_eq!(Libm::read_table_cell(entry)[2], 16_383);
+        let shown = format!("{entry:?}");
+        assert!(shown.starts_with("TableEntry(0x"), "{shown}");
     }
 
     #[test]
