@@ -16,7 +16,9 @@
 //!   firmware's backend is `SoftFloat` over avr-libc's square root): the kernels
 //!   [`poly::atan2_fixed`] and [`poly::sin_cos_fixed`] (tables of quadratic cells in fixed
 //!   point), which cost far fewer software-float operations, comparisons of the bit patterns instead of software-float comparisons, and
-//!   the four legs of a body solved one after the other.
+//!   the four legs of a body solved one after the other. The kernels' tables are the one thing
+//!   a backend reads per target ([`Math::read_table_cell`]): on the AVR they stay in flash, out
+//!   of the scarce SRAM, and the backend reads them with `lpm`.
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
 //! minimax fit), and so do the fixed-point kernels' cell tables (quadratics through Chebyshev
@@ -72,6 +74,105 @@ pub trait Math {
     fn within(x: f32, lo: f32, hi: f32) -> bool {
         (x >= lo) & (x <= hi)
     }
+    /// Reads one cell of a fixed-point kernel's table ([`poly::atan2_fixed`],
+    /// [`poly::sin_cos_fixed`]): `N` consecutive 16-bit words, see [`TableEntry`]. The only
+    /// per-target part of those kernels: the default is a plain load, right wherever the tables
+    /// are ordinary read-only data; where this crate links them into program memory (the AVR's
+    /// flash, see [`TABLES_IN_PROGRAM_MEMORY`]) a backend must read them there, and the default
+    /// does not compile for it.
+    #[inline(always)]
+    fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
+        entry.read_data_memory::<Self>()
+    }
+}
+
+/// Whether this target links the fixed-point kernels' tables ([`poly::atan2_fixed`],
+/// [`poly::sin_cos_fixed`]) into program memory: on the AVR, avr-gcc's startup code copies all
+/// ordinary read-only data into SRAM, the scarcest memory of the ATmega2560, so there the
+/// tables go to flash (`.progmem.data`, which the linker script keeps in the first 64 KB, as
+/// `lpm` needs) and must be read with `lpm` by the backend ([`Math::read_table_cell`]). The
+/// tables' declaration (`flash_tables!`) is the other place that names the target; elsewhere
+/// they are ordinary read-only data.
+pub const TABLES_IN_PROGRAM_MEMORY: bool = cfg!(target_arch = "avr");
+
+/// The address of one entry of a fixed-point kernel's table (a cell), for
+/// [`Math::read_table_cell`]; made only by this crate, from an index checked against the
+/// table's length. The tables are reachable through nothing else, and the entry's one plain
+/// load ([`Math`]'s default read) does not compile where the tables are in program memory: no
+/// Rust code loads them there, which would read SRAM at a flash address.
+#[derive(Clone, Copy)]
+pub struct TableEntry<T: 'static>(&'static T);
+
+/// The address only: formatting the entry must not load it (see [`TableEntry`]).
+impl<T: 'static> core::fmt::Debug for TableEntry<T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_tuple("TableEntry")
+            .field(&(self.0 as *const T))
+            .finish()
+    }
+}
+
+impl<T: Copy + 'static> TableEntry<T> {
+    /// The entry's address: in program memory when [`TABLES_IN_PROGRAM_MEMORY`], else in data
+    /// memory. Valid for the whole program (the tables are immutable statics).
+    #[inline(always)]
+    pub fn addr(self) -> *const T {
+        self.0
+    }
+
+    /// The plain load of [`Math`]'s default table reads, for the backend `M`: refused when
+    /// `M` is compiled for a target whose tables are in program memory (a post-monomorphization
+    /// error names the fix), so that a backend that forgets the flash read does not build.
+    #[inline(always)]
+    fn read_data_memory<M: ?Sized>(self) -> T {
+        let () = ReadsDataMemory::<M>::CHECK;
+        *self.0
+    }
+}
+
+/// The compile-time check of [`TableEntry::read_data_memory`], per backend `M` (generic so
+/// that it is evaluated only for a backend that uses the plain load).
+struct ReadsDataMemory<M: ?Sized>(PhantomData<M>);
+
+impl<M: ?Sized> ReadsDataMemory<M> {
+    const CHECK: () = assert!(
+        !TABLES_IN_PROGRAM_MEMORY,
+        "this target keeps the fixed-point kernels' tables in program memory: the Math backend \
+         must read them there (override Math::read_table_cell)"
+    );
+}
+
+/// A constant table of a fixed-point kernel, readable only through [`Table::entry`] and a
+/// backend's [`Math::read_table_cell`] (the array is private, so no code can index it with a
+/// plain load).
+struct Table<T: 'static, const N: usize>([T; N]);
+
+impl<T: Copy + 'static, const N: usize> Table<T, N> {
+    /// Entry `i` (panics when `i ≥ N`, as indexing does).
+    #[inline(always)]
+    fn entry(&'static self, i: usize) -> TableEntry<T> {
+        // Indexing checks the bounds and takes the address, without a load.
+        TableEntry(&self.0[i])
+    }
+}
+
+/// Declares the kernels' tables as [`Table`] statics, in program memory on the AVR
+/// ([`TABLES_IN_PROGRAM_MEMORY`]; `.progmem.data` is the section avr-gcc's linker script keeps
+/// in flash and its startup code does not copy to SRAM).
+macro_rules! flash_tables {
+    ($($(#[$doc:meta])* $vis:vis static $name:ident: [$t:ty; $n:expr] = $value:expr;)+) => {
+        $(
+            $(#[$doc])*
+            // `unsafe_code` flags a static's `link_section` because plain loads of data placed
+            // in another memory would be wrong: [`Table`] admits only the backend's reads.
+            #[cfg_attr(
+                target_arch = "avr",
+                allow(unsafe_code),
+                link_section = ".progmem.data"
+            )]
+            $vis static $name: Table<$t, $n> = Table($value);
+        )+
+    };
 }
 
 /// The backend used by the convenience functions of this crate.
@@ -131,7 +232,10 @@ impl Math for Fast {
 ///   in 16-bit fixed point (error ≤ 1e-6);
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
-/// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false).
+/// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false);
+/// - the kernels' tables read by `S` ([`Math::read_table_cell`]): a
+///   plain load for `Libm`; from flash for the firmware's `AvrLibm`, on the AVR, where the
+///   tables are linked into flash ([`TABLES_IN_PROGRAM_MEMORY`]).
 ///
 /// Against [`DefaultMath`] the angles of a leg or body solve differ by at most about 4e-6 rad
 /// (the fixed-point arctangent's error plus rounding; `tests/avr_kernels.rs`).
@@ -148,12 +252,12 @@ impl<S: Math> Math for SoftFloat<S> {
 
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed(y, x)
+        poly::atan2_fixed::<S>(y, x)
     }
 
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
-        poly::sin_cos_fixed(x)
+        poly::sin_cos_fixed::<S>(x)
     }
 
     #[inline(always)]
@@ -169,6 +273,11 @@ impl<S: Math> Math for SoftFloat<S> {
     #[inline(always)]
     fn within(x: f32, lo: f32, hi: f32) -> bool {
         bits::within(x, bits::interval(lo, hi))
+    }
+
+    #[inline(always)]
+    fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
+        S::read_table_cell(entry)
     }
 }
 
@@ -187,7 +296,7 @@ const PI: f32 = core::f32::consts::PI;
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
 /// | [`sin_cos_fixed`](poly::sin_cos_fixed) | 1e-6 | CPUs with software floats and an integer multiplier (the ATmega2560): no range reduction for \|x\| ≤ π/4, a table of 26 quadratic cells in 16-bit fixed point, two integer-to-float conversions |
 pub mod poly {
-    use super::{FRAC_PI_2, PI};
+    use super::{Math, Table, FRAC_PI_2, PI};
 
     const SIGN: u32 = 0x8000_0000;
     const ABS: u32 = 0x7fff_ffff;
@@ -314,8 +423,8 @@ pub mod poly {
     /// quadratic through the cell's three Chebyshev nodes, rounded to `a` in Q29 (`a₀ = 0`:
     /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
     /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
-    /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the 264 bytes of
-    /// tables are what it costs.
+    /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the tables are
+    /// what it costs (in flash on the AVR: [`ATAN_CELLS`]).
     const ATAN_CELL_A_Q29: [u32; 33] = [
         0,
         16_771_589,
@@ -459,6 +568,57 @@ pub mod poly {
         24_996, 24_322, 23_624, 22_903,
     ];
 
+    flash_tables! {
+        /// [`atan2_fixed`]'s cells as the kernel reads them, one row per cell `k`:
+        /// `[a_lo, a_hi, b, c]` of [`ATAN_CELL_A_Q29`], [`ATAN_CELL_B_Q15`], [`ATAN_CELL_C_Q16`]
+        /// (`a` in two 16-bit halves), so that one read fetches a cell's consecutive bytes.
+        pub(super) static ATAN_CELLS: [[u16; 4]; 33] =
+            cells(&ATAN_CELL_A_Q29, &ATAN_CELL_B_Q15, &ATAN_CELL_C_Q16);
+
+        /// [`sin_cos_fixed`]'s cells as the kernel reads them: per cell the sine's row
+        /// (`[a_lo, a_hi, b, c]` of [`SIN_CELL_A_Q29`], …), then the cosine's.
+        static SIN_COS_CELLS: [[u16; 8]; 26] = concat_cells(
+            cells(&SIN_CELL_A_Q29, &SIN_CELL_B_Q15, &SIN_CELL_C_Q16),
+            cells(&COS_CELL_A_Q29, &COS_CELL_B_Q16, &COS_CELL_C_Q16),
+        );
+    }
+
+    /// Rows `[a_lo, a_hi, b, c]` of the cells `(a[k], b[k], c[k])`, at compile time.
+    const fn cells<const N: usize>(a: &[u32; N], b: &[u16; N], c: &[u16; N]) -> [[u16; 4]; N] {
+        let mut rows = [[0; 4]; N];
+        let mut k = 0;
+        while k < N {
+            rows[k] = [a[k] as u16, (a[k] >> 16) as u16, b[k], c[k]];
+            k += 1;
+        }
+        rows
+    }
+
+    /// Rows `first[k]` followed by `second[k]`, at compile time.
+    const fn concat_cells<const N: usize>(
+        first: [[u16; 4]; N],
+        second: [[u16; 4]; N],
+    ) -> [[u16; 8]; N] {
+        let mut rows = [[0; 8]; N];
+        let mut k = 0;
+        while k < N {
+            let mut i = 0;
+            while i < 4 {
+                rows[k][i] = first[k][i];
+                rows[k][4 + i] = second[k][i];
+                i += 1;
+            }
+            k += 1;
+        }
+        rows
+    }
+
+    /// `a_lo + a_hi·2¹⁶` of a row of [`cells`].
+    #[inline(always)]
+    fn join(lo: u16, hi: u16) -> u32 {
+        lo as u32 | (hi as u32) << 16
+    }
+
     /// `a·b` of two 16-bit numbers from its four 8 × 8-bit partial products: on the
     /// ATmega2560 four hardware multiplications inline, where `a as u32 * b as u32` would call
     /// a 32 × 32-bit routine. Only [`atan2_fixed`] uses it, the kernel of CPUs without
@@ -476,7 +636,9 @@ pub mod poly {
     /// added in fixed point, and one integer-to-float conversion: on the ATmega2560 far fewer
     /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
     /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
-    /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes.
+    /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes. The backend `M` reads the
+    /// tables ([`Math::read_table_cell`]: in flash on the AVR), the
+    /// kernel's only per-target part; [`SoftFloat`](super::SoftFloat) passes its own.
     ///
     /// Formats: `t` in Q24 (`T`, from the float's mantissa, truncated), the cell offset `d` in Q21, the
     /// result in Q29 (π < 2²).
@@ -486,7 +648,7 @@ pub mod poly {
     /// firmware's emulator test `no_mul_result_is_clobbered_by_a_frame_pointer_adjustment`);
     /// hosts do not use this kernel in their backends, so the call costs them nothing.
     #[inline(never)]
-    pub fn atan2_fixed(y: f32, x: f32) -> f32 {
+    pub fn atan2_fixed<M: Math>(y: f32, x: f32) -> f32 {
         const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
         const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
         let (yb, xb) = (y.to_bits(), x.to_bits());
@@ -518,10 +680,11 @@ pub mod poly {
             let k = (big_t >> 19) as usize;
             let d = ((big_t & 0x7_ffff) >> 3) as u16;
             // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
-            let lin = (mul_16x16(d, ATAN_CELL_B_Q15[k]) + (1 << 6)) >> 7;
+            let [a_lo, a_hi, b, c] = M::read_table_cell(ATAN_CELLS.entry(k));
+            let lin = (mul_16x16(d, b) + (1 << 6)) >> 7;
             let d_sq = (mul_16x16(d, d) >> 16) as u16;
-            let quad = (mul_16x16(d_sq, ATAN_CELL_C_Q16[k]) + (1 << 12)) >> 13;
-            ATAN_CELL_A_Q29[k] + lin - quad
+            let quad = (mul_16x16(d_sq, c) + (1 << 12)) >> 13;
+            join(a_lo, a_hi) + lin - quad
         };
         let r = match octant & 3 {
             0 => p,
@@ -581,14 +744,16 @@ pub mod poly {
     /// products for both), two integer-to-float conversions: on the ATmega2560 far fewer
     /// cycles than [`sin_cos_deg5`]'s twelve software-float operations (see
     /// `BENCHMARKS.md`). Absolute error ≤ 1e-6 (tests; the cells' 8.4e-7 in this arithmetic).
-    /// `sin_cos_fixed(0) = (0, 1)`; odd in the sine, even in the cosine.
+    /// `sin_cos_fixed(0) = (0, 1)`; odd in the sine, even in the cosine. The backend `M` reads
+    /// the tables, as for [`atan2_fixed`].
     ///
     /// Never inlined, for [`atan2_fixed`]'s reason (its `mul` instructions in a small frame).
     #[inline(never)]
-    pub fn sin_cos_fixed(x: f32) -> (f32, f32) {
+    pub fn sin_cos_fixed<M: Math>(x: f32) -> (f32, f32) {
         const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
-                                                 // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
-                                                 // range reduction of huge arguments, for which any bounded value will do.
+
+        // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
+        // range reduction of huge arguments, for which any bounded value will do.
         const CELLS_END_Q24: u32 = (26 << 19) - 1;
         let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
         let (k, r) = if reduced { reduce(x) } else { (0.0, x) };
@@ -609,11 +774,13 @@ pub mod poly {
         let d = ((big_r & 0x7_ffff) >> 3) as u16;
         let d_sq = (mul_16x16(d, d) >> 16) as u16;
         // b·d: Q36 (sine) or Q37 (cosine) → Q29; c·d²: Q42 → Q29.
-        let sin_q = SIN_CELL_A_Q29[cell] + ((mul_16x16(d, SIN_CELL_B_Q15[cell]) + (1 << 6)) >> 7)
-            - ((mul_16x16(d_sq, SIN_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
-        let cos_q = COS_CELL_A_Q29[cell]
-            - ((mul_16x16(d, COS_CELL_B_Q16[cell]) + (1 << 7)) >> 8)
-            - ((mul_16x16(d_sq, COS_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
+        let [sa_lo, sa_hi, sb, sc, ca_lo, ca_hi, cb, cc] =
+            M::read_table_cell(SIN_COS_CELLS.entry(cell));
+        let sin_q = join(sa_lo, sa_hi) + ((mul_16x16(d, sb) + (1 << 6)) >> 7)
+            - ((mul_16x16(d_sq, sc) + (1 << 12)) >> 13);
+        let cos_q = join(ca_lo, ca_hi)
+            - ((mul_16x16(d, cb) + (1 << 7)) >> 8)
+            - ((mul_16x16(d_sq, cc) + (1 << 12)) >> 13);
         let sin = f32::from_bits(q29_bits(sin_q) | (rb & SIGN));
         let cos = f32::from_bits(q29_bits(cos_q));
         if reduced {
@@ -848,7 +1015,7 @@ mod tests {
 
     #[test]
     fn atan2_fixed_matches_f64_everywhere() {
-        let worst = worst_atan2_error(poly::atan2_fixed);
+        let worst = worst_atan2_error(poly::atan2_fixed::<SoftFloat>);
         assert!(
             worst < ATAN2_FIXED_TOL_RAD,
             "worst atan2_fixed error {worst}"
@@ -856,14 +1023,15 @@ mod tests {
         let mut worst = 0.0f64;
         let mut t = 1.0e-12f32;
         while t < 1.0 {
-            let d = (poly::atan2_fixed(t, 1.0) as f64 - (t as f64).atan()).abs();
+            let d = (poly::atan2_fixed::<SoftFloat>(t, 1.0) as f64 - (t as f64).atan()).abs();
             worst = worst.max(d);
             t *= 1.001;
         }
         for i in 0..=200_000 {
             let t = i as f32 / 200_000.0;
             for (y, x) in [(t, 1.0f32), (1.0, t), (-t, -1.0), (-1.0, t * 3.0)] {
-                let d = (poly::atan2_fixed(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+                let d = (poly::atan2_fixed::<SoftFloat>(y, x) as f64 - (y as f64).atan2(x as f64))
+                    .abs();
                 worst = worst.max(d);
             }
         }
@@ -879,7 +1047,7 @@ mod tests {
                 f32::from_bits(state as u32),
                 f32::from_bits((state >> 32) as u32),
             );
-            let r = poly::atan2_fixed(y, x);
+            let r = poly::atan2_fixed::<SoftFloat>(y, x);
             if !(y.is_nan() || x.is_nan() || (y.is_infinite() && x.is_infinite())) {
                 let want = (y as f64).atan2(x as f64);
                 assert!(
@@ -895,11 +1063,12 @@ mod tests {
     #[test]
     fn atan2_fixed_cells_are_within_2e_6() {
         const TOL_RAD: f64 = 2.0e-6;
-        let mut worst = worst_atan2_error(poly::atan2_fixed);
+        let mut worst = worst_atan2_error(poly::atan2_fixed::<SoftFloat>);
         for i in 0..=400_000 {
             let t = i as f32 / 400_000.0;
             for (y, x) in [(t, 1.0f32), (1.0, t), (-t, -1.0), (-1.0, -t)] {
-                let d = (poly::atan2_fixed(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+                let d = (poly::atan2_fixed::<SoftFloat>(y, x) as f64 - (y as f64).atan2(x as f64))
+                    .abs();
                 worst = worst.max(d);
             }
         }
@@ -910,7 +1079,7 @@ mod tests {
                 edge,
                 f32::from_bits(edge.to_bits() + 1).min(1.0),
             ] {
-                let d = (poly::atan2_fixed(t, 1.0) as f64 - (t as f64).atan()).abs();
+                let d = (poly::atan2_fixed::<SoftFloat>(t, 1.0) as f64 - (t as f64).atan()).abs();
                 worst = worst.max(d);
             }
         }
@@ -943,7 +1112,11 @@ mod tests {
             for (name, got, tol) in [
                 ("deg15", poly::atan2_deg15(y, x), 3.0e-7),
                 ("deg9", poly::atan2_deg9(y, x), ATAN2_DEG9_TOL_RAD as f32),
-                ("fixed", poly::atan2_fixed(y, x), ATAN2_FIXED_TOL_RAD as f32),
+                (
+                    "fixed",
+                    poly::atan2_fixed::<SoftFloat>(y, x),
+                    ATAN2_FIXED_TOL_RAD as f32,
+                ),
             ] {
                 assert!(
                     (got - want).abs() < tol,
@@ -960,9 +1133,9 @@ mod tests {
         assert_eq!(poly::atan2_deg9(0.0, -1.0), PI);
         assert_eq!(poly::atan2_deg9(1.0, 0.0), FRAC_PI_2);
         assert_eq!(poly::atan2_deg9(-1.0, 0.0), -FRAC_PI_2);
-        assert_eq!(poly::atan2_fixed(0.0, -1.0), PI);
-        assert_eq!(poly::atan2_fixed(1.0, 0.0), FRAC_PI_2);
-        assert_eq!(poly::atan2_fixed(-1.0, 0.0), -FRAC_PI_2);
+        assert_eq!(poly::atan2_fixed::<SoftFloat>(0.0, -1.0), PI);
+        assert_eq!(poly::atan2_fixed::<SoftFloat>(1.0, 0.0), FRAC_PI_2);
+        assert_eq!(poly::atan2_fixed::<SoftFloat>(-1.0, 0.0), -FRAC_PI_2);
     }
 
     /// `atan2_3` returns exactly three `atan2` calls, including
@@ -1024,12 +1197,12 @@ mod tests {
         let mut worst = 0.0f64;
         for i in -400_000..=400_000 {
             let x = i as f32 * 0.000_025; // ±10 rad, across the ±π/4 switch and every cell
-            let (s, c) = poly::sin_cos_fixed(x);
+            let (s, c) = poly::sin_cos_fixed::<SoftFloat>(x);
             worst = worst
                 .max((s as f64 - (x as f64).sin()).abs())
                 .max((c as f64 - (x as f64).cos()).abs());
             assert_eq!(
-                poly::sin_cos_fixed(-x),
+                poly::sin_cos_fixed::<SoftFloat>(-x),
                 (-s, c),
                 "odd sine, even cosine at {x}"
             );
@@ -1043,20 +1216,20 @@ mod tests {
             f32::MIN_POSITIVE,
             1e-7,
         ] {
-            let (s, c) = poly::sin_cos_fixed(x);
+            let (s, c) = poly::sin_cos_fixed::<SoftFloat>(x);
             worst = worst
                 .max((s as f64 - (x as f64).sin()).abs())
                 .max((c as f64 - (x as f64).cos()).abs());
         }
         std::eprintln!("sin_cos_fixed: worst error {worst:e}");
         assert!(worst < TOL, "worst sin/cos error {worst}");
-        assert_eq!(poly::sin_cos_fixed(0.0), (0.0, 1.0));
+        assert_eq!(poly::sin_cos_fixed::<SoftFloat>(0.0), (0.0, 1.0));
         // Bounded on any finite argument (huge ones are not reduced exactly).
         let mut rng = SplitMix64::new(0x5eed_5eed_0000_0001u64);
         for _ in 0..100_000 {
             let x = f32::from_bits(rng.next_u64() as u32);
             if x.is_finite() {
-                let (s, c) = poly::sin_cos_fixed(x);
+                let (s, c) = poly::sin_cos_fixed::<SoftFloat>(x);
                 assert!(
                     s.abs() <= 1.0 && c.abs() <= 1.0,
                     "sin_cos_fixed({x:e}) = ({s}, {c})"
@@ -1131,6 +1304,21 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The default table read is a plain load of the entry, and an entry's `Debug` shows its
+    /// address, not its value.
+    #[test]
+    fn table_entries_read_and_print_without_a_second_path() {
+        use std::format;
+        let entry = poly::ATAN_CELLS.entry(32);
+        assert_eq!(
+            Libm::read_table_cell(entry),
+            SoftFloat::<Libm>::read_table_cell(entry)
+        );
+        assert_eq!(Libm::read_table_cell(entry)[2], 16_383);
+        let shown = format!("{entry:?}");
+        assert!(shown.starts_with("TableEntry(0x"), "{shown}");
     }
 
     #[test]

@@ -21,8 +21,11 @@
 
 #![no_std]
 #![cfg(target_arch = "avr")]
+// `asm!` on the AVR (the `lpm` of `read_table_cell`).
+#![feature(asm_experimental_arch)]
 
-use kin_core::math::SoftFloat;
+use core::arch::asm;
+use kin_core::math::{SoftFloat, TableEntry};
 use kin_core::Math;
 
 /// Links avr-libc's `libm.a` (and `libc.a`, for its `memcpy`/`memset`) ahead of
@@ -70,11 +73,66 @@ impl Math for AvrLibm {
         // SAFETY: pure functions of their argument.
         unsafe { (sin(x), cos(x)) }
     }
+
+    // kin-core links its fixed-point kernels' tables into flash on the AVR
+    // (`kin_core::math::TABLES_IN_PROGRAM_MEMORY`), so that avr-gcc's startup does not copy
+    // them into SRAM; `lpm` reads them there. Written here rather than with the `avr-progmem`
+    // crate: its reads go byte by byte through a buffer in memory (a store and a load per
+    // byte, and stack space in the kernels, which keep small frames for the reason given on
+    // `poly::atan2_fixed`), where a cell is a run of `lpm Rd, Z+` straight into the registers
+    // the kernel computes with; and it has had no release for the toolchains since 2023.
+
+    #[inline(always)]
+    fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
+        const { assert!(N <= 8, "kin-core's cells are at most 8 words") };
+        let mut z = entry.addr().cast::<u8>();
+        let mut cell = [0u16; N];
+        // Straight-line code, one read per word (each `N > i` is a constant): a loop, which
+        // opt-level "s" does not unroll, would keep the cell in memory.
+        for_each_word!(i in 0 1 2 3 4 5 6 7 => {
+            if N > i {
+                cell[i] = lpm_word(&mut z);
+            }
+        });
+        cell
+    }
+}
+
+/// Repeats `$body` with `$i` bound to each listed index in turn.
+macro_rules! for_each_word {
+    ($i:ident in $($n:literal)+ => $body:block) => {
+        $({
+            let $i: usize = $n;
+            $body
+        })+
+    };
+}
+use for_each_word;
+
+/// The 16-bit word at `*z` in flash (little-endian), advancing `z` past it.
+#[inline(always)]
+fn lpm_word(z: &mut *const u8) -> u16 {
+    let (lo, hi): (u8, u8);
+    // SAFETY: `z` walks a cell of a kin-core table in `.progmem.data` (`read_table_cell`), which
+    // the avr6 linker script places at the start of flash, below 64 KB (`lpm`'s reach; a table
+    // beyond it would fail to link, its address truncated). `lpm` only reads flash.
+    unsafe {
+        asm!(
+            "lpm {lo}, Z+",
+            "lpm {hi}, Z+",
+            lo = out(reg) lo,
+            hi = out(reg) hi,
+            inout("Z") *z,
+            options(pure, readonly, nostack, preserves_flags),
+        );
+    }
+    u16::from_le_bytes([lo, hi])
 }
 
 /// The firmware's backend: kin-core's [`SoftFloat`] (the kernels, comparisons and leg staging
 /// for CPUs without floating-point hardware; the host tests run the same choices) over
-/// avr-libc's `sqrt`, with all float arithmetic on avr-libc's primitives. The fastest mix
+/// avr-libc's `sqrt` and [`AvrLibm`]'s reads of the kernels' tables from flash, with all float
+/// arithmetic on avr-libc's primitives. The fastest mix
 /// measured in simavr (see `BENCHMARKS.md`).
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by

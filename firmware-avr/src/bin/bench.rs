@@ -71,14 +71,14 @@ static PRIMS: [bench::PrimFn; 16] = [
         );
         core::hint::black_box(feet)[0].x
     },
-    |a, b| poly::atan2_fixed(a, b),
+    |a, b| poly::atan2_fixed::<AvrFast>(a, b),
     |a, b| poly::atan2_deg9(a, b),
     |a, _| {
         let (s, c) = poly::sin_cos_deg5(a);
         s + c
     },
     |a, _| {
-        let (s, c) = poly::sin_cos_fixed(a);
+        let (s, c) = poly::sin_cos_fixed::<AvrFast>(a);
         s + c
     },
 ];
