@@ -74,7 +74,10 @@ fn trot_pairs_diagonals_and_walk_keeps_three_feet_down() {
         let down = c.iter().filter(|&&x| x == Contact::Stance).count();
         assert!(down >= 3, "t={t}: {c:?}");
     }
-    assert!(first_pair_swings && second_pair_swings, "each pair swings once per cycle");
+    assert!(
+        first_pair_swings && second_pair_swings,
+        "each pair swings once per cycle"
+    );
 }
 
 #[test]
