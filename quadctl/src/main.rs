@@ -32,6 +32,7 @@ enum Command {
     Stream(cmd::stream::Args),
     Calibrate(cmd::calibrate::Args),
     Demo(cmd::demo::Args),
+    Serve(cmd::serve::Args),
 }
 
 fn main() -> ExitCode {
@@ -52,5 +53,6 @@ fn main() -> ExitCode {
         Command::Stream(args) => cmd::stream::main(&args),
         Command::Calibrate(args) => cmd::calibrate::main(&args),
         Command::Demo(args) => cmd::demo::main(&args),
+        Command::Serve(args) => cmd::serve::main(&args),
     }
 }

@@ -776,35 +776,14 @@ impl<L: Link> PoseStream<L> {
         &mut self.client
     }
 
-    /// What the host's kin-core and calibration make of `pose`.
+    /// What the host's kin-core and calibration make of `pose` ([`expected`]).
     pub fn expected(&self, pose: &Pose) -> Expected {
-        let config = BodyConfig {
-            order: self.pose_config.order,
-            pivot_m: Vec3::ZERO,
-        };
-        match body::inverse_at_stance_with::<DefaultMath>(
+        expected(
             &self.setup.robot,
+            &self.pose_config,
+            &self.calibration,
             pose,
-            &config,
-            self.pose_config.stance_height_m,
-            ReachPolicy::Reject,
-        ) {
-            Err(e) => Expected::Nack(e.into()),
-            Ok(solution) => {
-                let angles = solution.flat();
-                for s in ServoId::ALL {
-                    if let Err(fault) = self.calibration[s.index()].pulse_half_us(angles[s.index()])
-                    {
-                        return Expected::Nack(NackReason::ServoRange {
-                            leg: s.leg,
-                            joint: s.joint,
-                            fault,
-                        });
-                    }
-                }
-                Expected::Angles(angles)
-            }
-        }
+        )
     }
 
     /// Compares a readback with the expected angles (see [`check_readback`]).
@@ -939,6 +918,44 @@ impl<L: Link> PoseStream<L> {
         };
         s.timeouts = self.client.counters.timeouts;
         s
+    }
+}
+
+/// What the host's kin-core makes of `pose` on a device with `pose_config` and `calibration`:
+/// the angles of `body::inverse_at_stance_with::<DefaultMath>` (reject policy) when every one
+/// maps to a pulse within its servo's travel, else the nack the device must answer. The check
+/// every body pose of the host passes before it is sent.
+pub fn expected(
+    robot: &Robot,
+    pose_config: &PoseConfig,
+    calibration: &[Calibration; 12],
+    pose: &Pose,
+) -> Expected {
+    let config = BodyConfig {
+        order: pose_config.order,
+        pivot_m: Vec3::ZERO,
+    };
+    match body::inverse_at_stance_with::<DefaultMath>(
+        robot,
+        pose,
+        &config,
+        pose_config.stance_height_m,
+        ReachPolicy::Reject,
+    ) {
+        Err(e) => Expected::Nack(e.into()),
+        Ok(solution) => {
+            let angles = solution.flat();
+            for s in ServoId::ALL {
+                if let Err(fault) = calibration[s.index()].pulse_half_us(angles[s.index()]) {
+                    return Expected::Nack(NackReason::ServoRange {
+                        leg: s.leg,
+                        joint: s.joint,
+                        fault,
+                    });
+                }
+            }
+            Expected::Angles(angles)
+        }
     }
 }
 

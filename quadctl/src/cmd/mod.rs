@@ -14,4 +14,5 @@ pub mod ik;
 pub mod motion;
 pub mod plot;
 pub mod pose;
+pub mod serve;
 pub mod stream;
