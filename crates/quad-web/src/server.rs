@@ -164,12 +164,12 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
         .worker_threads(2)
         .enable_all()
         .build()?;
-    let listener = runtime
-        .block_on(tokio::net::TcpListener::bind(config.listen))
-        .map_err(|source| Error::Bind {
-            addr: config.listen,
-            source,
-        })?;
+    // Bound here, outside the runtime, so that `start` may be called from async code too.
+    let listener = std::net::TcpListener::bind(config.listen).map_err(|source| Error::Bind {
+        addr: config.listen,
+        source,
+    })?;
+    listener.set_nonblocking(true)?;
     let addr = listener.local_addr()?;
     let shared = Arc::new(Shared {
         events: Mutex::new(events_tx),
@@ -204,6 +204,7 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
         .name("server".to_owned())
         .spawn(move || {
             let result = runtime.block_on(async move {
+                let listener = tokio::net::TcpListener::from_std(listener)?;
                 let stop = async move {
                     if ctrl_c {
                         tokio::select! {
@@ -254,6 +255,13 @@ async fn ws_upgrade(ws: WebSocketUpgrade, AxumState(shared): AxumState<Arc<Share
         .max_frame_size(64 * 1024)
         .on_upgrade(move |socket| page(socket, shared))
 }
+
+/// How often a page is pinged (browsers answer WebSocket pings by themselves).
+const PING_PERIOD: Duration = Duration::from_millis(250);
+
+/// A page silent this long (no message, no pong) is dropped: a closed tab whose socket was not
+/// closed, a network gone. For the controlling page this is the link loss.
+const SILENCE_LIMIT: Duration = Duration::from_millis(1000);
 
 fn log(page: u64, what: &str) {
     eprintln!("quadctl serve: page {page}: {what}");
@@ -328,8 +336,19 @@ async fn serve_page(
     state: &mut watch::Receiver<State>,
     id: u64,
 ) {
+    let mut ping = tokio::time::interval(PING_PERIOD);
+    let mut last_heard = tokio::time::Instant::now();
     loop {
         tokio::select! {
+            _ = ping.tick() => {
+                if last_heard.elapsed() > SILENCE_LIMIT {
+                    log(id, &format!("no answer for {} ms: dropped", SILENCE_LIMIT.as_millis()));
+                    return;
+                }
+                if socket.send(Message::Ping(Default::default())).await.is_err() {
+                    return;
+                }
+            }
             changed = state.changed() => {
                 if changed.is_err() {
                     return;
@@ -340,6 +359,7 @@ async fn serve_page(
                 }
             }
             incoming = socket.recv() => {
+                last_heard = tokio::time::Instant::now();
                 let text = match incoming {
                     None | Some(Err(_)) | Some(Ok(Message::Close(_))) => return,
                     Some(Ok(Message::Text(t))) => t,
