@@ -3,12 +3,18 @@
 //! line rate).
 //!
 //! ```text
-//! USART0 RX interrupt ─▶ ring buffer ─▶ Device::receive ─▶ answer frames ─▶ USART0 TX (polled)
-//!                                            │
-//!                      Timer1/3/4/5 compare outputs ◀─ ServoOutputs      Clock ◀─ Timer2 (1 kHz)
-//!                                                       Storage ◀─ EEPROM (EE_READY interrupt)
+//! USART0 RX interrupt ─▶ RX ring ─▶ Device::receive ─▶ answer frames ─▶ TX ring ─▶ USART0 UDRE
+//!                                        │                                           interrupt
+//!   Timer1/3/4/5 compare outputs ◀─ staged state ◀─ ServoOutputs        Clock ◀─ Timer2 (1 kHz)
+//!                    ▲ written between pulses, by the main loop or the Timer2 tick
+//!                                                   Storage ◀─ EEPROM (EE_READY interrupt)
 //! main loop: feed the watchdog, hand received bytes to the controller, Device::poll (failsafe)
 //! ```
+//!
+//! The main loop never waits for the line or for a servo window: answers leave by interrupt
+//! while the next request is solved, and the servo widths are applied between pulses by
+//! whoever comes first (the request's own call, or the clock's tick). Neither path turns
+//! interrupts off for longer than a few instructions (`usart`, `servo`).
 //!
 //! - Robot and defaults: [`DEVICE_CONFIG`], [`quad_device::Config::shahriar2023`] (seed 000's
 //!   robot, the one with the Arduino Mega): body poses in rotation order zyx at its default
@@ -32,8 +38,9 @@ use quad_device::{Config, Device};
 /// What the device runs: seed 000's robot with the controller's defaults.
 pub const DEVICE_CONFIG: Config = Config::shahriar2023();
 
-/// Watchdog timeout: far above the longest main-loop iteration (one body-pose solve, about
-/// 7 ms, plus sending its answer, 8 ms at 115,200 baud).
+/// Watchdog timeout: far above the longest main-loop iteration (one body-pose solve plus, when
+/// the transmit ring is full, waiting for room in it: a few ms each at 115,200 baud; see
+/// BENCHMARKS.md).
 pub const WATCHDOG_TIMEOUT: Timeout = Timeout::Ms250;
 
 /// Received bytes handed to the controller per call.
@@ -44,6 +51,15 @@ pub type BoardDevice = Device<Servos, Clock, Eeprom, AvrFast>;
 
 /// Brings the board up and runs the device forever at `baud`.
 pub fn run(baud: Baud) -> ! {
+    run_with_receive_hold(baud, 0)
+}
+
+/// [`run`], but each pass of the main loop takes the received bytes with interrupts off and
+/// keeps them off for `hold_cycles` more cycles — **a defect on purpose**, for the
+/// `firmware-1mbaud-cli-hold` binary only: the emulator tests show that a receive path which
+/// blocks interrupts for longer than the chip's two-byte buffer covers loses bytes, and that
+/// the emulator counts them. [`run`] passes 0 (no interrupts-off stretch at all).
+pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
     crate::stack::paint();
     let Some(dp) = crate::pac::Peripherals::take() else {
         panic!()
@@ -66,7 +82,7 @@ pub fn run(baud: Baud) -> ! {
     device.boot();
     loop {
         watchdog.feed();
-        serve(&mut device, &mut usart);
+        serve(&mut device, &mut usart, hold_cycles);
     }
 }
 
@@ -90,24 +106,37 @@ fn new_device(servos: Servos, clock: Clock, eeprom: Eeprom) -> BoardDevice {
 /// access to a local would need a frame pointer beyond the AVR's 63-byte displacement (about
 /// 8 instructions per access) — it doubled the firmware's flash.
 #[inline(never)]
-fn serve(device: &mut BoardDevice, usart: &mut Usart0) {
+fn serve(device: &mut BoardDevice, usart: &mut Usart0, hold_cycles: u32) {
     let mut chunk = [0u8; CHUNK];
-    let n = usart.read_into(&mut chunk);
+    let n = if hold_cycles == 0 {
+        usart.read_into(&mut chunk)
+    } else {
+        avr_device::interrupt::free(|_| {
+            let n = usart.read_into(&mut chunk);
+            avr_device::asm::delay_cycles(hold_cycles);
+            n
+        })
+    };
     if n > 0 {
-        device.receive(&chunk[..n], |frame| usart.write_all(frame));
+        device.receive(&chunk[..n], |frame| usart.send(frame));
     }
     device.poll();
 }
 
 /// Defines the interrupt handlers of a binary that calls [`run`] (handlers must live in the
-/// binary crate to be linked): `USART0_RX`, `TIMER2_COMPA` and `EE_READY`. The binary needs
-/// `#![feature(abi_avr_interrupt)]`.
+/// binary crate to be linked): `USART0_RX`, `USART0_UDRE`, `TIMER2_COMPA` and `EE_READY`.
+/// The binary needs `#![feature(abi_avr_interrupt)]`.
 #[macro_export]
 macro_rules! forward_interrupts {
     () => {
         #[avr_device::interrupt(atmega2560)]
         fn USART0_RX() {
             $crate::usart::on_rx_interrupt();
+        }
+
+        #[avr_device::interrupt(atmega2560)]
+        fn USART0_UDRE() {
+            $crate::usart::on_udre_interrupt();
         }
 
         #[avr_device::interrupt(atmega2560)]

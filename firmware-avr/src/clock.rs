@@ -1,6 +1,7 @@
 //! Millisecond clock on Timer2 (8-bit, CTC mode, prescaler 64, OCR2A = 249: 1 kHz).
 //!
-//! The binary forwards the `TIMER2_COMPA` interrupt to [`on_tick_interrupt`].
+//! The binary forwards the `TIMER2_COMPA` interrupt to [`on_tick_interrupt`], which also gives
+//! the servo outputs their chance to apply a staged state ([`crate::servo::on_tick`]).
 
 use crate::pac;
 use avr_device::interrupt::{self, Mutex};
@@ -45,11 +46,21 @@ pub fn now_ms() -> u32 {
     interrupt::free(|cs| MILLIS.borrow(cs).get())
 }
 
-/// Advances the clock by one millisecond; call from the `TIMER2_COMPA` interrupt.
+/// Advances the clock by one millisecond, then (with interrupts enabled again) lets the servo
+/// outputs apply a staged state; call from the `TIMER2_COMPA` interrupt.
+///
+/// Interrupts are re-enabled for the servo part because writing the twelve compare registers
+/// takes longer than one byte time at 1 Mbaud: the receive interrupt must be able to come in
+/// between. Nothing else of this handler runs then, and this handler itself cannot come again
+/// before the next millisecond.
 #[inline(always)]
 pub fn on_tick_interrupt() {
     interrupt::free(|cs| {
         let c = MILLIS.borrow(cs);
         c.set(c.get().wrapping_add(1));
     });
+    // SAFETY: the clock's state is updated; the servo code guards itself (`BUSY`) and touches
+    // nothing the other handlers use.
+    unsafe { interrupt::enable() };
+    crate::servo::on_tick();
 }

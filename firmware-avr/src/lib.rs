@@ -6,10 +6,10 @@
 //! | module | what |
 //! |---|---|
 //! | [`app`] | bring-up and main loop around the device controller (`quad_device::Device`) |
-//! | [`servo`] | 12 servo outputs on the output-compare units of Timer1/3/4/5 (50 Hz, 0.5 µs ticks), `embedded_hal::pwm::SetDutyCycle` per channel, `quad_device::ServoOutputs` |
+//! | [`servo`] | 12 servo outputs on the output-compare units of Timer1/3/4/5 (50 Hz, 0.5 µs ticks), applied between pulses without waiting, `embedded_hal::pwm::SetDutyCycle` per channel, `quad_device::ServoOutputs` |
 //! | [`clock`] | millisecond clock on Timer2 (`quad_device::Clock`) |
 //! | [`eeprom`] | the EEPROM as calibration storage (`quad_device::Storage`) |
-//! | [`usart`] | USART0: interrupt-driven receive into a bounded ring buffer, polled transmit |
+//! | [`usart`] | USART0: receive and transmit by interrupt through lock-free rings |
 //! | [`watchdog`] | watchdog enable/feed and the reset cause |
 //! | [`stack`] | SRAM painting at boot and the high-water mark of the stack |
 //! | [`bench`] | the cycle benchmark's request loop (used by the `bench` binaries only) |
@@ -21,7 +21,8 @@
 //!
 //! Interrupt handlers must be defined in the binary crate (a handler in a library is not
 //! pulled in by the linker): each binary forwards `USART0_RX` to [`usart::on_rx_interrupt`],
-//! `TIMER2_COMPA` to [`clock::on_tick_interrupt`] and `EE_READY` to
+//! `USART0_UDRE` to [`usart::on_udre_interrupt`] (the firmware binaries; the benchmark
+//! transmits by polling), `TIMER2_COMPA` to [`clock::on_tick_interrupt`] and `EE_READY` to
 //! [`eeprom::on_ready_interrupt`] (the firmware binaries through [`forward_interrupts!`]).
 
 #![no_std]

@@ -27,15 +27,19 @@
 //! widths are double-buffered by the hardware (OCRn is taken over at the start of a period), so
 //! a change never produces a runt or doubled pulse.
 //!
-//! **Whole poses per period.** The four timers are started together (the synchronous prescaler
-//! reset of GTCCR) and run in lockstep. [`Servos::set_all_pulse_ticks`] writes the twelve
-//! compare registers with interrupts off, between the end of the longest pulse and the last
-//! [`WRITE_GUARD_TICKS`] of a period, so every period shows either the old or the new widths
-//! on all twelve pins, never a mix.
-//! [`Servos::enable`] and [`Servos::disable`] (re)connect the compare units only after the
-//! longest pulse of the period has ended: switching never cuts a pulse short or starts one late.
+//! **Whole poses per period, without waiting.** The four timers are started together (the
+//! synchronous prescaler reset of GTCCR) and run in lockstep. [`Servos::set_all_pulse_ticks`],
+//! [`Servos::enable`] and [`Servos::disable`] stage the outputs' next state and return; the
+//! state is written (all twelve compare registers, then the compare-unit connections) between
+//! the end of the longest pulse and the last [`WRITE_GUARD_TICKS`] of a period — at once when
+//! the call falls there, else by the Timer2 millisecond interrupt ([`on_tick`]) at the first
+//! tick that does. Every period thus shows either the old or the new widths on all twelve
+//! pins, never a mix; switching never cuts a pulse short or starts one late; the main loop never
+//! waits for the window and no interrupts-off stretch is needed.
 
 use crate::pac;
+use core::cell::UnsafeCell;
+use core::sync::atomic::{compiler_fence, Ordering};
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
 
 /// Number of servo channels.
@@ -50,9 +54,9 @@ pub const TICKS_PER_US: u16 = 2;
 /// Period of the servo signal, µs.
 pub const PERIOD_US: u32 = 20_000;
 
-/// Ticks at the end of each period in which the compare registers are not written (writing all
-/// twelve takes about 150 cycles, 19 ticks; the margin also covers timers that are a few ticks
-/// apart, as in simulators that ignore GTCCR).
+/// Ticks at the end of each period in which the compare registers are not written: the writes
+/// after the window check, plus the interrupts that may come between them, plus timers that
+/// are a few ticks apart (as in simulators that ignore GTCCR).
 pub const WRITE_GUARD_TICKS: u16 = 64;
 
 /// Ticks after the longest pulse before the compare units may be switched.
@@ -112,20 +116,201 @@ impl embedded_hal::pwm::Error for Error {
     }
 }
 
-/// The four 16-bit timers as servo outputs.
+/// A value shared between the main loop and the Timer2 tick interrupt, written whole.
+///
+/// Bytes and the staged widths are plain volatile memory: a byte access is one instruction, and
+/// the staging protocol ([`stage`]) keeps the widths from being read while they are written.
+/// Not atomics: LLVM's AVR backend turns every atomic access into a `cli` stretch.
+struct Shared<T>(UnsafeCell<T>);
+
+// SAFETY: single core; the access rules are those of [`stage`] and [`apply_staged`]: the main
+// loop writes the staged values only while `PENDING` is clear, the interrupt reads them only
+// while it is set, and `BUSY` keeps the two appliers apart.
+unsafe impl<T> Sync for Shared<T> {}
+
+impl<T: Copy> Shared<T> {
+    const fn new(v: T) -> Shared<T> {
+        Shared(UnsafeCell::new(v))
+    }
+
+    #[inline(always)]
+    fn get(&self) -> T {
+        // SAFETY: see the `Sync` impl.
+        unsafe { self.0.get().read_volatile() }
+    }
+
+    #[inline(always)]
+    fn set(&self, v: T) {
+        // SAFETY: see the `Sync` impl.
+        unsafe { self.0.get().write_volatile(v) }
+    }
+}
+
+/// The staged outputs: widths (ticks, 0 = off) and whether the outputs are on.
+static STAGED_TICKS: Shared<[u16; CHANNELS]> = Shared::new([0; CHANNELS]);
+static STAGED_ENABLED: Shared<bool> = Shared::new(false);
+/// 1 while a staged state waits to be applied.
+static PENDING: Shared<u8> = Shared::new(0);
+/// 1 while the main loop applies (the tick interrupt then leaves it alone).
+static BUSY: Shared<u8> = Shared::new(0);
+/// The longest width the hardware may still be producing in this or the next period, ticks
+/// (written by whoever applies, under `BUSY` or inside the interrupt).
+static ACTIVE_LONGEST: Shared<u16> = Shared::new(0);
+
+/// Publishes the outputs' next state: the widths and the enable of every channel. Applied at
+/// once when no pulse is in progress and the period does not end soon, else by the next tick
+/// of the millisecond clock that falls in such a moment (at most the longest pulse later):
+/// the main loop never waits for the window.
+fn stage(ticks: &[u16; CHANNELS], enabled: bool) {
+    PENDING.set(0);
+    compiler_fence(Ordering::SeqCst);
+    STAGED_TICKS.set(*ticks);
+    STAGED_ENABLED.set(enabled);
+    compiler_fence(Ordering::SeqCst);
+    PENDING.set(1);
+    BUSY.set(1);
+    compiler_fence(Ordering::SeqCst);
+    apply_staged();
+    compiler_fence(Ordering::SeqCst);
+    BUSY.set(0);
+}
+
+/// Applies the staged state if one is pending and the moment is quiet (see [`stage`]); call
+/// from the `TIMER2_COMPA` interrupt (with interrupts re-enabled: this takes longer than one
+/// byte time at 1 Mbaud and needs no protection from the receive interrupt).
+#[inline(never)]
+pub fn on_tick() {
+    if BUSY.get() != 0 {
+        return;
+    }
+    BUSY.set(1);
+    compiler_fence(Ordering::SeqCst);
+    apply_staged();
+    compiler_fence(Ordering::SeqCst);
+    BUSY.set(0);
+}
+
+/// Writes the staged widths and connections when a state is pending and every timer is in the
+/// quiet part of its period: after the longest pulse (old or new) and before the last
+/// [`WRITE_GUARD_TICKS`]. The guard also covers the interrupts that may delay the writes
+/// after the check (a few hundred cycles at most, under the guard's 512). With pulses so long
+/// that no such moment exists, applies at once.
+fn apply_staged() {
+    if PENDING.get() == 0 {
+        return;
+    }
+    compiler_fence(Ordering::SeqCst);
+    let ticks = STAGED_TICKS.get();
+    let enabled = STAGED_ENABLED.get();
+    let longest_new = ticks.iter().copied().max().unwrap_or(0);
+    let after = ACTIVE_LONGEST
+        .get()
+        .max(longest_new)
+        .saturating_add(QUIET_MARGIN_TICKS);
+    let before = PERIOD_TICKS - WRITE_GUARD_TICKS;
+    // SAFETY: after `Servos::new` the timers' compare and control registers and the servo
+    // bits of the ports are written only here, under `BUSY` (or by the panic handler, which
+    // never returns).
+    let dp = unsafe { pac::Peripherals::steal() };
+    if after < before && !all_in_window(&dp, after, before) {
+        return;
+    }
+    for (channel, &t) in ticks.iter().enumerate() {
+        if t > 0 {
+            // Fast PWM: the pin is high for OCR + 1 ticks; OCR = TOP keeps it high.
+            write_ocr(&dp, channel, t - 1);
+        }
+    }
+    for t in 0..4 {
+        apply_connections(&dp, t, enabled, &ticks);
+    }
+    ACTIVE_LONGEST.set(longest_new);
+    compiler_fence(Ordering::SeqCst);
+    PENDING.set(0);
+}
+
+/// True when every timer is in the window `(after, before)` of its period. The timers run in
+/// lockstep on the chip; checking all four keeps the window right where they do not
+/// (simulators that ignore GTCCR, or reconfigure a timer's phase).
+fn all_in_window(dp: &pac::Peripherals, after: u16, before: u16) -> bool {
+    let inside = |t: u16| t > after && t < before;
+    inside(dp.TC1.tcnt1().read().bits())
+        && inside(dp.TC3.tcnt3().read().bits())
+        && inside(dp.TC4.tcnt4().read().bits())
+        && inside(dp.TC5.tcnt5().read().bits())
+}
+
+fn write_ocr(dp: &pac::Peripherals, channel: usize, ocr: u16) {
+    match channel {
+        0 => dp.TC1.ocr1a().write(|w| w.set(ocr)),
+        1 => dp.TC1.ocr1b().write(|w| w.set(ocr)),
+        2 => dp.TC1.ocr1c().write(|w| w.set(ocr)),
+        3 => dp.TC3.ocr3a().write(|w| w.set(ocr)),
+        4 => dp.TC3.ocr3b().write(|w| w.set(ocr)),
+        5 => dp.TC3.ocr3c().write(|w| w.set(ocr)),
+        6 => dp.TC4.ocr4a().write(|w| w.set(ocr)),
+        7 => dp.TC4.ocr4b().write(|w| w.set(ocr)),
+        8 => dp.TC4.ocr4c().write(|w| w.set(ocr)),
+        9 => dp.TC5.ocr5a().write(|w| w.set(ocr)),
+        10 => dp.TC5.ocr5b().write(|w| w.set(ocr)),
+        _ => dp.TC5.ocr5c().write(|w| w.set(ocr)),
+    };
+}
+
+/// Writes TCCRnA of timer `t` (0..4) with the compare units of the channels that should drive
+/// their pins (outputs `enabled` and a non-zero width).
+fn apply_connections(dp: &pac::Peripherals, t: usize, enabled: bool, ticks: &[u16; CHANNELS]) {
+    let mut v = TCCRA_MODE14;
+    // Port bits of the disconnected channels of this timer.
+    let mut low = 0u8;
+    for (unit, com) in COM_CLEAR.iter().enumerate() {
+        if enabled && ticks[3 * t + unit] != 0 {
+            v |= com;
+        } else {
+            low |= PIN_BIT[t][unit];
+        }
+    }
+    // SAFETY: mode-14 bits plus COM bits: a valid TCCRnA value; any PORTx value is valid.
+    // Clearing the PORT bits after disconnecting is a no-op on the chip (the compare unit never
+    // writes PORTx) and keeps simulators that model the output through PORTx right.
+    match t {
+        0 => {
+            dp.TC1.tccr1a().write(|w| unsafe { w.bits(v) });
+            dp.PORTB
+                .portb()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+        }
+        1 => {
+            dp.TC3.tccr3a().write(|w| unsafe { w.bits(v) });
+            dp.PORTE
+                .porte()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+        }
+        2 => {
+            dp.TC4.tccr4a().write(|w| unsafe { w.bits(v) });
+            dp.PORTH
+                .porth()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+        }
+        _ => {
+            dp.TC5.tccr5a().write(|w| unsafe { w.bits(v) });
+            dp.PORTL
+                .portl()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+        }
+    }
+}
+
+/// The four 16-bit timers as servo outputs. After [`Servos::new`] it holds the outputs' target
+/// state; the registers are written when the state is applied ([`stage`]).
 pub struct Servos {
-    tc1: pac::TC1,
-    tc3: pac::TC3,
-    tc4: pac::TC4,
-    tc5: pac::TC5,
-    portb: pac::PORTB,
-    porte: pac::PORTE,
-    porth: pac::PORTH,
-    portl: pac::PORTL,
+    _tc1: pac::TC1,
+    _tc3: pac::TC3,
+    _tc4: pac::TC4,
+    _tc5: pac::TC5,
+    _ports: (pac::PORTB, pac::PORTE, pac::PORTH, pac::PORTL),
     /// Pulse width of each channel, ticks (0 = no pulse).
     pulse_ticks: [u16; CHANNELS],
-    /// The longest pulse the hardware may still be producing in this or the next period, ticks.
-    longest_ticks: u16,
     enabled: bool,
 }
 
@@ -196,16 +381,12 @@ impl Servos {
         tc0.gtccr().write(|w| unsafe { w.bits(0) });
 
         Servos {
-            tc1,
-            tc3,
-            tc4,
-            tc5,
-            portb,
-            porte,
-            porth,
-            portl,
+            _tc1: tc1,
+            _tc3: tc3,
+            _tc4: tc4,
+            _tc5: tc5,
+            _ports: (portb, porte, porth, portl),
             pulse_ticks: [0; CHANNELS],
-            longest_ticks: 0,
             enabled: false,
         }
     }
@@ -216,59 +397,19 @@ impl Servos {
     }
 
     /// Connects the compare units of every channel with a non-zero pulse width, after the
-    /// longest pulse of the current period (the first pulse is complete). Waits at most one
-    /// period.
+    /// longest pulse of the current period (the first pulse is complete): at once, or by the
+    /// clock's tick within at most one period. Does not wait.
     pub fn enable(&mut self) {
-        self.switch_outputs(true);
+        self.enabled = true;
+        stage(&self.pulse_ticks, true);
     }
 
     /// Disconnects every compare unit: all twelve pins low from the end of the longest pulse of
-    /// the current period on (no pulse is cut short; waits at most one period). The panic
-    /// handler uses [`force_all_low`], which does not wait.
+    /// the current period on (no pulse is cut short; at most one period later). Does not wait.
+    /// The panic handler uses [`force_all_low`], which acts at once.
     pub fn disable(&mut self) {
-        self.switch_outputs(false);
-    }
-
-    fn switch_outputs(&mut self, enabled: bool) {
-        self.at_quiet_moment(|s| {
-            s.enabled = enabled;
-            for t in 0..4 {
-                s.apply_connections(t);
-            }
-        });
-    }
-
-    /// True when every timer is in the window `(after, before)` of its period. The timers run
-    /// in lockstep on the chip; checking all four keeps the window right where they do not
-    /// (simulators that ignore GTCCR, or reconfigure a timer's phase).
-    fn all_in_window(&self, after: u16, before: u16) -> bool {
-        let inside = |t: u16| t > after && t < before;
-        inside(self.tc1.tcnt1().read().bits())
-            && inside(self.tc3.tcnt3().read().bits())
-            && inside(self.tc4.tcnt4().read().bits())
-            && inside(self.tc5.tcnt5().read().bits())
-    }
-
-    /// Runs `f` with interrupts off at a moment when no pulse is in progress on any channel and
-    /// the period does not end within [`WRITE_GUARD_TICKS`]: spins (interrupts on) until then,
-    /// at most one period. With pulses so long that no such moment exists, runs `f` at once.
-    fn at_quiet_moment(&mut self, f: impl FnOnce(&mut Self)) {
-        let after = self.longest_ticks.saturating_add(QUIET_MARGIN_TICKS);
-        let before = PERIOD_TICKS - WRITE_GUARD_TICKS;
-        if after >= before {
-            avr_device::interrupt::free(|_| f(self));
-            return;
-        }
-        let mut f = Some(f);
-        while f.is_some() {
-            avr_device::interrupt::free(|_| {
-                if self.all_in_window(after, before) {
-                    if let Some(f) = f.take() {
-                        f(self);
-                    }
-                }
-            });
-        }
+        self.enabled = false;
+        stage(&self.pulse_ticks, false);
     }
 
     /// The pulse width of `channel`, ticks (0: no pulse).
@@ -282,8 +423,9 @@ impl Servos {
     }
 
     /// Sets the pulse width of `channel` to `ticks` (0.5 µs each): high for exactly `ticks`
-    /// ticks at the start of every period from the next period on; 0 keeps the pin low and
-    /// [`PERIOD_TICKS`] keeps it high.
+    /// ticks at the start of every period from the next quiet moment on (see
+    /// [`Servos::set_all_pulse_ticks`]); 0 keeps the pin low and [`PERIOD_TICKS`] keeps it
+    /// high.
     pub fn set_pulse_ticks(&mut self, channel: usize, ticks: u16) -> Result<(), Error> {
         if channel >= CHANNELS {
             return Err(Error::NoSuchChannel);
@@ -291,48 +433,23 @@ impl Servos {
         if ticks > PERIOD_TICKS {
             return Err(Error::PulseTooLong);
         }
-        let was_zero = self.pulse_ticks[channel] == 0;
-        self.longest_ticks = self.longest_ticks.max(ticks);
         self.pulse_ticks[channel] = ticks;
-        if ticks > 0 {
-            // Fast PWM: the pin is high for OCR + 1 ticks; OCR = TOP keeps it high.
-            self.write_ocr(channel, ticks - 1);
-        }
-        if was_zero != (ticks == 0) {
-            self.apply_connections(channel / 3);
-        }
+        stage(&self.pulse_ticks, self.enabled);
         Ok(())
     }
 
     /// Sets all twelve pulse widths so that they take effect in the same period (see the
-    /// module docs); nothing changes when any of them is refused. The compare registers are
-    /// written between pulses (waiting, interrupts on, while a pulse is in progress or the
-    /// period ends within [`WRITE_GUARD_TICKS`]: at most the longest pulse, ≤ 2.7 ms for a
-    /// servo). The chip takes them over at the next period either way; writing between pulses
+    /// module docs); nothing changes when any of them is refused. Does not wait: the widths
+    /// are staged and written between pulses — at once when the call falls between pulses,
+    /// else by the millisecond clock's interrupt after the longest pulse, before the period
+    /// ends. The chip takes them over at the next period either way; writing between pulses
     /// also keeps simulators right that apply a compare register at once (simavr does).
     pub fn set_all_pulse_ticks(&mut self, ticks: &[u16; CHANNELS]) -> Result<(), Error> {
         if ticks.iter().any(|&t| t > PERIOD_TICKS) {
             return Err(Error::PulseTooLong);
         }
-        let old = self.pulse_ticks;
-        let longest_old = old.iter().copied().max().unwrap_or(0);
-        let longest_new = ticks.iter().copied().max().unwrap_or(0);
-        self.longest_ticks = self.longest_ticks.max(longest_new);
-        self.at_quiet_moment(|s| {
-            for (channel, &t) in ticks.iter().enumerate() {
-                if t > 0 {
-                    s.write_ocr(channel, t - 1);
-                }
-            }
-        });
         self.pulse_ticks = *ticks;
-        self.longest_ticks = longest_old.max(longest_new);
-        for t in 0..4 {
-            let changed = (0..3).any(|u| (old[3 * t + u] == 0) != (ticks[3 * t + u] == 0));
-            if changed {
-                self.apply_connections(t);
-            }
-        }
+        stage(&self.pulse_ticks, self.enabled);
         Ok(())
     }
 
@@ -346,67 +463,6 @@ impl Servos {
             servos: self,
             index: channel as u8,
         })
-    }
-
-    fn write_ocr(&mut self, channel: usize, ocr: u16) {
-        match channel {
-            0 => self.tc1.ocr1a().write(|w| w.set(ocr)),
-            1 => self.tc1.ocr1b().write(|w| w.set(ocr)),
-            2 => self.tc1.ocr1c().write(|w| w.set(ocr)),
-            3 => self.tc3.ocr3a().write(|w| w.set(ocr)),
-            4 => self.tc3.ocr3b().write(|w| w.set(ocr)),
-            5 => self.tc3.ocr3c().write(|w| w.set(ocr)),
-            6 => self.tc4.ocr4a().write(|w| w.set(ocr)),
-            7 => self.tc4.ocr4b().write(|w| w.set(ocr)),
-            8 => self.tc4.ocr4c().write(|w| w.set(ocr)),
-            9 => self.tc5.ocr5a().write(|w| w.set(ocr)),
-            10 => self.tc5.ocr5b().write(|w| w.set(ocr)),
-            _ => self.tc5.ocr5c().write(|w| w.set(ocr)),
-        };
-    }
-
-    /// Writes TCCRnA of timer `t` (0..4) with the compare units of the channels that should
-    /// drive their pins.
-    fn apply_connections(&mut self, t: usize) {
-        let mut v = TCCRA_MODE14;
-        // Port bits of the disconnected channels of this timer.
-        let mut low = 0u8;
-        for (unit, com) in COM_CLEAR.iter().enumerate() {
-            if self.enabled && self.pulse_ticks[3 * t + unit] != 0 {
-                v |= com;
-            } else {
-                low |= PIN_BIT[t][unit];
-            }
-        }
-        // SAFETY: mode-14 bits plus COM bits: a valid TCCRnA value; any PORTx value is valid.
-        // Clearing the PORT bits after disconnecting is a no-op on the chip (the compare unit
-        // never writes PORTx) and keeps simulators that model the output through PORTx right.
-        match t {
-            0 => {
-                self.tc1.tccr1a().write(|w| unsafe { w.bits(v) });
-                self.portb
-                    .portb()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-            1 => {
-                self.tc3.tccr3a().write(|w| unsafe { w.bits(v) });
-                self.porte
-                    .porte()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-            2 => {
-                self.tc4.tccr4a().write(|w| unsafe { w.bits(v) });
-                self.porth
-                    .porth()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-            _ => {
-                self.tc5.tccr5a().write(|w| unsafe { w.bits(v) });
-                self.portl
-                    .portl()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-        }
     }
 }
 

@@ -1,16 +1,50 @@
-//! USART0 (the Mega's USB serial, pins D0/D1): 8N1, double speed (U2X), interrupt-driven
-//! receive into a bounded ring buffer, polled transmit.
+//! USART0 (the Mega's USB serial, pins D0/D1): 8N1, double speed (U2X); receive and transmit
+//! by interrupt through two lock-free single-producer/single-consumer rings.
 //!
-//! The binary forwards the `USART0_RX` interrupt to [`on_rx_interrupt`]. Bytes that arrive
-//! while the buffer is full are dropped and counted ([`Usart0::rx_dropped`]); the frame layer
-//! above detects the damage by its CRC.
+//! - **Receive**: the `USART0_RX` interrupt ([`on_rx_interrupt`]) moves each byte from UDR0 into
+//!   the receive ring; the main loop takes them out ([`Usart0::read_into`]). Neither side turns
+//!   interrupts off: the chip holds only two received bytes plus the one in its shift register,
+//!   so at 1 Mbaud (160 cycles per byte) an interrupts-off stretch on the read path would lose
+//!   bytes. Bytes that arrive while the ring is full are dropped and counted
+//!   ([`Usart0::rx_dropped`]), bytes the chip itself lost (data overrun, DOR0) or received
+//!   with a framing error are counted too ([`Usart0::line_errors`]); the frame layer above
+//!   detects the damage by its CRC.
+//! - **Transmit**: [`Usart0::send`] puts an answer into the transmit ring and returns; the
+//!   `USART0_UDRE` interrupt ([`on_udre_interrupt`]) feeds UDR0 from it, so the device computes
+//!   the next request while the previous answer is on the wire. `send` waits only when the
+//!   ring is full (interrupts on).
+//!
+//! The binary forwards both interrupts (`forward_interrupts!` in [`crate::app`]). The cycle
+//! benchmark instead transmits by polling ([`Usart0::write`]), which must not be mixed with
+//! [`Usart0::send`].
 
 use crate::{pac, F_CPU_HZ};
-use avr_device::interrupt::{self, Mutex};
-use core::cell::RefCell;
+use avr_device::interrupt;
+use core::cell::UnsafeCell;
+use core::sync::atomic::{compiler_fence, Ordering};
+
+/// Capacity of each ring, bytes (a power of two that divides 256: the ring indices are `u8`
+/// that wrap).
+pub const RING_CAPACITY: usize = 128;
 
 /// Capacity of the receive buffer, bytes.
-pub const RX_CAPACITY: usize = 128;
+pub const RX_CAPACITY: usize = RING_CAPACITY;
+
+/// Capacity of the transmit buffer, bytes: the longest answer frame fits.
+pub const TX_CAPACITY: usize = RING_CAPACITY;
+
+const _: () = assert!(RING_CAPACITY.is_power_of_two() && RING_CAPACITY <= 128);
+const _: () = assert!(quad_device::device::TX_LEN <= TX_CAPACITY);
+
+/// UCSR0B: RXCIE0 | UDRIE0 | RXEN0 | TXEN0.
+const UCSR0B_RXCIE: u8 = 1 << 7;
+const UCSR0B_UDRIE: u8 = 1 << 5;
+const UCSR0B_RXEN: u8 = 1 << 4;
+const UCSR0B_TXEN: u8 = 1 << 3;
+/// Receiver, transmitter and receive interrupt on; the transmit interrupt off (nothing to send).
+const UCSR0B_IDLE: u8 = UCSR0B_RXCIE | UCSR0B_RXEN | UCSR0B_TXEN;
+/// As [`UCSR0B_IDLE`] with the data-register-empty interrupt on (bytes waiting).
+const UCSR0B_SENDING: u8 = UCSR0B_IDLE | UCSR0B_UDRIE;
 
 /// Supported line rates. With U2X at 16 MHz, 1,000,000 baud is exact and 115,200 baud is
 /// 2.1 % fast (UBRR 16), within the receivers' tolerance.
@@ -38,21 +72,134 @@ impl Baud {
     }
 }
 
-struct Ring {
-    buf: [u8; RX_CAPACITY],
-    head: u8,
-    len: u8,
-    dropped: u16,
-    line_errors: u16,
+/// A byte shared between the main loop and one interrupt handler, read and written whole.
+///
+/// A `u8` load or store is one instruction on the AVR, so it cannot tear. Not an `AtomicU8`:
+/// LLVM's AVR backend brackets every atomic access with `cli` and a restore of SREG, the very
+/// interrupts-off stretches this module avoids. Volatile accesses plus compiler fences give
+/// the ordering a single core needs.
+struct SharedU8(UnsafeCell<u8>);
+
+// SAFETY: single-core MCU; each `SharedU8` has one writer (documented at its use) and its
+// accesses are single-instruction volatile loads and stores.
+unsafe impl Sync for SharedU8 {}
+
+impl SharedU8 {
+    const fn new(v: u8) -> SharedU8 {
+        SharedU8(UnsafeCell::new(v))
+    }
+
+    #[inline(always)]
+    fn load(&self) -> u8 {
+        // SAFETY: a valid, aligned byte; see the `Sync` impl.
+        unsafe { self.0.get().read_volatile() }
+    }
+
+    #[inline(always)]
+    fn store(&self, v: u8) {
+        // SAFETY: as in `load`.
+        unsafe { self.0.get().write_volatile(v) }
+    }
 }
 
-static RX: Mutex<RefCell<Ring>> = Mutex::new(RefCell::new(Ring {
-    buf: [0; RX_CAPACITY],
-    head: 0,
-    len: 0,
-    dropped: 0,
-    line_errors: 0,
-}));
+/// A counter written only by an interrupt handler (saturating).
+struct IsrCounter(UnsafeCell<u16>);
+
+// SAFETY: written only inside one interrupt handler (no nesting of that handler); read by the
+// main code with interrupts off (a `u16` takes two loads).
+unsafe impl Sync for IsrCounter {}
+
+impl IsrCounter {
+    const fn new() -> IsrCounter {
+        IsrCounter(UnsafeCell::new(0))
+    }
+
+    /// Adds one; call only from the owning interrupt handler.
+    #[inline(always)]
+    fn bump(&self) {
+        // SAFETY: only the owning handler writes, and nothing preempts it.
+        unsafe {
+            let p = self.0.get();
+            p.write_volatile(p.read_volatile().saturating_add(1));
+        }
+    }
+
+    /// The count (interrupts off for the two loads: a few cycles, outside the read path).
+    fn get(&self) -> u16 {
+        // SAFETY: interrupts are off: the handler cannot write between the two byte loads.
+        interrupt::free(|_| unsafe { self.0.get().read_volatile() })
+    }
+}
+
+/// A single-producer/single-consumer byte ring: the producer only writes `head` and the slot
+/// at `head`, the consumer only writes `tail`; each publishes its index after (producer) or
+/// before reusing (consumer) the slot, so neither needs interrupts off.
+struct Ring {
+    buf: UnsafeCell<[u8; RING_CAPACITY]>,
+    /// Next slot to write (free-running, wraps at 256); written by the producer only.
+    head: SharedU8,
+    /// Next slot to read (free-running); written by the consumer only.
+    tail: SharedU8,
+}
+
+// SAFETY: see the type's docs: one producer context and one consumer context, each touching
+// only its own index and the slots the other has published to it.
+unsafe impl Sync for Ring {}
+
+const MASK: u8 = (RING_CAPACITY - 1) as u8;
+
+impl Ring {
+    const fn new() -> Ring {
+        Ring {
+            buf: UnsafeCell::new([0; RING_CAPACITY]),
+            head: SharedU8::new(0),
+            tail: SharedU8::new(0),
+        }
+    }
+
+    /// Bytes waiting (producer or consumer side).
+    #[inline(always)]
+    fn len(&self) -> u8 {
+        self.head.load().wrapping_sub(self.tail.load())
+    }
+
+    /// Producer: appends `byte`; false when the ring is full.
+    #[inline(always)]
+    fn push(&self, byte: u8) -> bool {
+        let head = self.head.load();
+        if usize::from(head.wrapping_sub(self.tail.load())) >= RING_CAPACITY {
+            return false;
+        }
+        // SAFETY: the slot at `head` is not published to the consumer until `head` moves.
+        unsafe { (*self.buf.get())[usize::from(head & MASK)] = byte };
+        compiler_fence(Ordering::Release);
+        self.head.store(head.wrapping_add(1));
+        true
+    }
+
+    /// Consumer: takes the oldest byte.
+    #[inline(always)]
+    fn pop(&self) -> Option<u8> {
+        let tail = self.tail.load();
+        if self.head.load() == tail {
+            return None;
+        }
+        compiler_fence(Ordering::Acquire);
+        // SAFETY: the producer published the slot at `tail` and does not touch it until
+        // `tail` moves past it.
+        let byte = unsafe { (*self.buf.get())[usize::from(tail & MASK)] };
+        compiler_fence(Ordering::Release);
+        self.tail.store(tail.wrapping_add(1));
+        Some(byte)
+    }
+}
+
+/// Received bytes: produced by `USART0_RX`, consumed by the main loop.
+static RX: Ring = Ring::new();
+/// Bytes to send: produced by the main loop, consumed by `USART0_UDRE`.
+static TX: Ring = Ring::new();
+static RX_DROPPED: IsrCounter = IsrCounter::new();
+static LINE_ERRORS: IsrCounter = IsrCounter::new();
 
 /// USART0 in 8N1 at a [`Baud`].
 pub struct Usart0 {
@@ -71,41 +218,62 @@ impl Usart0 {
         usart
             .ucsr0c()
             .write(|w| w.ucsz0().chr8().usbs0().stop1().upm0().disabled());
-        usart
-            .ucsr0b()
-            .write(|w| w.rxen0().set_bit().txen0().set_bit().rxcie0().set_bit());
+        // SAFETY: a valid UCSR0B value (receiver, transmitter, receive interrupt).
+        usart.ucsr0b().write(|w| unsafe { w.bits(UCSR0B_IDLE) });
         Usart0 { usart, sent: false }
     }
 
     /// The oldest received byte, if any.
     pub fn read(&mut self) -> Option<u8> {
-        interrupt::free(|cs| {
-            let mut r = RX.borrow(cs).borrow_mut();
-            if r.len == 0 {
-                return None;
-            }
-            let b = r.buf[r.head as usize];
-            r.head = ((r.head as usize + 1) % RX_CAPACITY) as u8;
-            r.len -= 1;
-            Some(b)
-        })
+        RX.pop()
     }
 
     /// Moves the received bytes, oldest first, into `buf` (as many as fit); returns how many.
+    /// Lock-free: the receive interrupt stays enabled throughout.
     pub fn read_into(&mut self, buf: &mut [u8]) -> usize {
-        interrupt::free(|cs| {
-            let mut r = RX.borrow(cs).borrow_mut();
-            let n = (r.len as usize).min(buf.len());
-            for b in buf.iter_mut().take(n) {
-                *b = r.buf[r.head as usize];
-                r.head = ((r.head as usize + 1) % RX_CAPACITY) as u8;
+        let mut n = 0;
+        for slot in buf.iter_mut() {
+            match RX.pop() {
+                Some(b) => *slot = b,
+                None => break,
             }
-            r.len -= n as u8;
-            n
-        })
+            n += 1;
+        }
+        n
     }
 
-    /// Sends one byte, waiting for room in the transmit register.
+    /// Queues `bytes` for the transmit interrupt and returns; waits (interrupts on) only while
+    /// the transmit ring is full.
+    pub fn send(&mut self, bytes: &[u8]) {
+        for (i, &b) in bytes.iter().enumerate() {
+            while !TX.push(b) {
+                // Full: make sure the transmitter is draining it.
+                self.start_transmitter();
+            }
+            if i == 0 {
+                // The first byte leaves while the others are queued.
+                self.start_transmitter();
+            }
+        }
+        self.start_transmitter();
+    }
+
+    fn start_transmitter(&mut self) {
+        self.sent = true;
+        // SAFETY: a valid UCSR0B value. One store: the interrupt handler, which writes the
+        // same register when the ring runs empty, cannot come between a read and a write.
+        self.usart
+            .ucsr0b()
+            .write(|w| unsafe { w.bits(UCSR0B_SENDING) });
+    }
+
+    /// Bytes queued by [`Usart0::send`] and not yet handed to the transmitter.
+    pub fn tx_pending(&self) -> usize {
+        usize::from(TX.len())
+    }
+
+    /// Sends one byte by polling, waiting for room in the transmit register (the benchmark's
+    /// transmitter; not to be mixed with [`Usart0::send`]).
     pub fn write(&mut self, byte: u8) {
         while self.usart.ucsr0a().read().udre0().bit_is_clear() {}
         // Writing 1 to TXC0 clears it (U2X0 written again to keep double speed).
@@ -116,51 +284,70 @@ impl Usart0 {
         self.sent = true;
     }
 
-    /// Sends all bytes.
+    /// Sends all bytes by polling ([`Usart0::write`]).
     pub fn write_all(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.write(b);
         }
     }
 
-    /// Waits until the last byte written has left the shift register.
+    /// Waits until every byte queued or written has left the shift register.
     pub fn flush(&mut self) {
+        while TX.len() != 0 {}
         if self.sent {
             while self.usart.ucsr0a().read().txc0().bit_is_clear() {}
         }
     }
 
-    /// Bytes dropped because the receive buffer was full, since boot (saturating).
+    /// Bytes dropped because the receive ring was full, since boot (saturating).
     pub fn rx_dropped(&self) -> u16 {
-        interrupt::free(|cs| RX.borrow(cs).borrow().dropped)
+        RX_DROPPED.get()
     }
 
-    /// Bytes received with a framing or overrun error, since boot (saturating).
+    /// Bytes received with a framing error or after a data overrun of the chip's own
+    /// two-byte buffer (bytes lost before the interrupt could read them), since boot
+    /// (saturating).
     pub fn line_errors(&self) -> u16 {
-        interrupt::free(|cs| RX.borrow(cs).borrow().line_errors)
+        LINE_ERRORS.get()
     }
 }
 
-/// Moves the received byte into the ring buffer; call from the `USART0_RX` interrupt.
+/// Moves the received byte into the receive ring; call from the `USART0_RX` interrupt.
 #[inline(always)]
 pub fn on_rx_interrupt() {
-    // SAFETY: only UCSR0A and UDR0 are read, which the main code never reads concurrently
-    // (it only writes UDR0/reads UDRE0 and TXC0: reading UCSR0A has no side effect).
+    // SAFETY: only UCSR0A and UDR0 are read here; the main code reads UCSR0A (no side effect)
+    // and never reads UDR0.
     let usart = unsafe { pac::USART0::steal() };
+    // The status belongs to the byte at the head of the chip's buffer: read it before UDR0.
     let status = usart.ucsr0a().read();
     let line_error = status.fe0().bit_is_set() || status.dor0().bit_is_set();
     let byte = usart.udr0().read().bits();
-    interrupt::free(|cs| {
-        let mut r = RX.borrow(cs).borrow_mut();
-        if line_error {
-            r.line_errors = r.line_errors.saturating_add(1);
+    if line_error {
+        LINE_ERRORS.bump();
+    }
+    if !RX.push(byte) {
+        RX_DROPPED.bump();
+    }
+}
+
+/// Hands the next queued byte to the transmitter, or turns this interrupt off when none is
+/// left; call from the `USART0_UDRE` interrupt.
+#[inline(always)]
+pub fn on_udre_interrupt() {
+    // SAFETY: UDR0 (write) and UCSR0A/B: the main code writes UCSR0B only with single stores
+    // and UCSR0A only in the polled `write`, which is not used together with `send`.
+    let usart = unsafe { pac::USART0::steal() };
+    match TX.pop() {
+        Some(byte) => {
+            // Clears TXC0 (written 1) so that `flush` waits for this byte; keeps U2X0.
+            usart
+                .ucsr0a()
+                .write(|w| w.u2x0().set_bit().txc0().set_bit());
+            usart.udr0().write(|w| w.set(byte));
         }
-        if (r.len as usize) < RX_CAPACITY {
-            let tail = (r.head as usize + r.len as usize) % RX_CAPACITY;
-            r.buf[tail] = byte;
-            r.len += 1;
-        } else {
-            r.dropped = r.dropped.saturating_add(1);
+        None => {
+            // SAFETY: a valid UCSR0B value.
+            usart.ucsr0b().write(|w| unsafe { w.bits(UCSR0B_IDLE) });
         }
-    });
+    }
 }

@@ -9,7 +9,7 @@
 
 use integration_tests::avr_bench::{self, STACK_PAINT, STANCE_HEIGHT_M};
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, ReachPolicy, RotationOrder};
+use kin_core::{BodyConfig, ReachPolicy, RotationOrder};
 use quad_host::client::{
     AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
 };
@@ -57,8 +57,13 @@ fn firmware(bin: &str) -> PathBuf {
     build::firmware_elf(bin).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// Both builds pass the same tests: `firmware` (115,200 baud) and `firmware-1mbaud`.
+const BAUDS: [u32; 2] = [115_200, 1_000_000];
+
+/// The firmware built for `config.baud`, booted.
 fn boot(config: EmulatorConfig) -> EmulatorLink {
-    EmulatorLink::boot(&firmware(build::FIRMWARE), config).unwrap_or_else(|e| panic!("{e}"))
+    let bin = build::firmware_for_baud(config.baud).expect("a firmware for this line rate");
+    EmulatorLink::boot(&firmware(bin), config).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Handshake, the benchmark stance (0.277 m, zyx), calibration read-back, outputs on.
@@ -77,15 +82,15 @@ fn connect(link: EmulatorLink) -> PoseStream<EmulatorLink> {
 /// The twelve pulse widths the host expects for `pose`: its own kin-core IK mapped through the
 /// device's calibration, in timer ticks.
 fn host_pulses(stream: &PoseStream<EmulatorLink>, pose: &Pose) -> [u16; 12] {
-    let angles = body::inverse_at_stance_with::<DefaultMath>(
-        &avr_bench::robot(),
-        pose,
-        &BodyConfig::default(),
-        STANCE_HEIGHT_M,
-        ReachPolicy::Reject,
-    )
-    .expect("the host solves the pose")
-    .flat();
+    let angles = body::Solver::new(&avr_bench::robot())
+        .inverse_at_stance(
+            pose,
+            &BodyConfig::default(),
+            STANCE_HEIGHT_M,
+            ReachPolicy::Reject,
+        )
+        .expect("the host solves the pose")
+        .flat();
     std::array::from_fn(|i| {
         stream.calibration()[i]
             .pulse_half_us(angles[i])
@@ -244,7 +249,14 @@ fn flash_and_sram_fit_the_board() {
 
 #[test]
 fn handshake_then_outputs_stay_low_until_enabled() {
-    let mut link = boot(EmulatorConfig::new(115_200));
+    for baud in BAUDS {
+        handshake_then_outputs_stay_low_until_enabled_at(baud);
+    }
+}
+
+/// [`handshake_then_outputs_stay_low_until_enabled`] with the firmware of one line rate.
+fn handshake_then_outputs_stay_low_until_enabled_at(baud: u32) {
+    let mut link = boot(EmulatorConfig::new(baud));
     for (port, bit) in SERVO_PINS {
         assert!(link.mcu().is_output(port, bit), "P{port}{bit} is an output");
     }
@@ -280,9 +292,16 @@ fn handshake_then_outputs_stay_low_until_enabled() {
 
 #[test]
 fn fifty_random_targets_put_the_host_calibration_of_the_host_ik_on_all_twelve_pins() {
+    for baud in BAUDS {
+        fifty_random_targets_put_the_host_calibration_of_the_host_ik_on_all_twelve_pins_at(baud);
+    }
+}
+
+/// [`fifty_random_targets_put_the_host_calibration_of_the_host_ik_on_all_twelve_pins`] with the firmware of one line rate.
+fn fifty_random_targets_put_the_host_calibration_of_the_host_ik_on_all_twelve_pins_at(baud: u32) {
     let targets = avr_bench::targets();
     assert_eq!(targets.poses.len(), 50);
-    let mut stream = connect(boot(EmulatorConfig::new(115_200)));
+    let mut stream = connect(boot(EmulatorConfig::new(baud)));
     for (i, pose) in targets.poses.iter().enumerate() {
         let result = stream.send(pose).expect("link");
         assert!(
@@ -304,8 +323,15 @@ fn fifty_random_targets_put_the_host_calibration_of_the_host_ik_on_all_twelve_pi
 
 #[test]
 fn unreachable_target_is_nacked_and_the_pins_keep_their_pulses() {
+    for baud in BAUDS {
+        unreachable_target_is_nacked_and_the_pins_keep_their_pulses_at(baud);
+    }
+}
+
+/// [`unreachable_target_is_nacked_and_the_pins_keep_their_pulses`] with the firmware of one line rate.
+fn unreachable_target_is_nacked_and_the_pins_keep_their_pulses_at(baud: u32) {
     let targets = avr_bench::targets();
-    let mut stream = connect(boot(EmulatorConfig::new(115_200)));
+    let mut stream = connect(boot(EmulatorConfig::new(baud)));
     let pose = targets.poses[7];
     assert!(matches!(
         stream.send(&pose).expect("link"),
@@ -378,7 +404,14 @@ fn frame(seq: u16, request: Request) -> Vec<u8> {
 
 #[test]
 fn garbage_and_bad_crc_frames_are_nacked_and_the_next_good_frame_works() {
-    let mut link = boot(EmulatorConfig::new(115_200));
+    for baud in BAUDS {
+        garbage_and_bad_crc_frames_are_nacked_and_the_next_good_frame_works_at(baud);
+    }
+}
+
+/// [`garbage_and_bad_crc_frames_are_nacked_and_the_next_good_frame_works`] with the firmware of one line rate.
+fn garbage_and_bad_crc_frames_are_nacked_and_the_next_good_frame_works_at(baud: u32) {
+    let mut link = boot(EmulatorConfig::new(baud));
     // Long enough for the oversize frame (258 bytes, 24 ms) and an answer.
     let wait = Duration::from_millis(60);
     let hello = frame(
@@ -430,11 +463,18 @@ fn garbage_and_bad_crc_frames_are_nacked_and_the_next_good_frame_works() {
 
 #[test]
 fn link_loss_stops_the_outputs_within_the_timeout() {
+    for baud in BAUDS {
+        link_loss_stops_the_outputs_within_the_timeout_at(baud);
+    }
+}
+
+/// [`link_loss_stops_the_outputs_within_the_timeout`] with the firmware of one line rate.
+fn link_loss_stops_the_outputs_within_the_timeout_at(baud: u32) {
     const TIMEOUT_MS: u64 = 100;
     // The main loop's poll interval is far below 1 ms; the outputs stop after the pulse in
     // progress (at most 2.5 ms) and the last pulse started up to one period before.
     const LATE_MS: u64 = 25;
-    let mut stream = connect(boot(EmulatorConfig::new(115_200)));
+    let mut stream = connect(boot(EmulatorConfig::new(baud)));
     assert!(matches!(
         stream.send(&avr_bench::targets().poses[3]).expect("link"),
         PoseResult::Acked { .. }
@@ -496,14 +536,14 @@ fn soak_poses(n: usize) -> Vec<Pose> {
             y_m: rng.range(-0.02, 0.02) as f32,
             z_m: rng.range(-0.02, 0.02) as f32,
         };
-        if body::inverse_at_stance_with::<DefaultMath>(
-            &robot,
-            &pose,
-            &BodyConfig::default(),
-            STANCE_HEIGHT_M,
-            ReachPolicy::Reject,
-        )
-        .is_ok()
+        if body::Solver::new(&robot)
+            .inverse_at_stance(
+                &pose,
+                &BodyConfig::default(),
+                STANCE_HEIGHT_M,
+                ReachPolicy::Reject,
+            )
+            .is_ok()
         {
             out.push(pose);
         }
@@ -558,7 +598,14 @@ fn soak_of_1000_poses_with_line_corruption_has_no_wrong_pulse_and_no_reset() {
 
 #[test]
 fn watchdog_is_on_survives_a_long_eeprom_save_and_resets_a_hung_cpu() {
-    let mut stream = connect(boot(EmulatorConfig::new(115_200)));
+    for baud in BAUDS {
+        watchdog_is_on_survives_a_long_eeprom_save_and_resets_a_hung_cpu_at(baud);
+    }
+}
+
+/// [`watchdog_is_on_survives_a_long_eeprom_save_and_resets_a_hung_cpu`] with the firmware of one line rate.
+fn watchdog_is_on_survives_a_long_eeprom_save_and_resets_a_hung_cpu_at(baud: u32) {
+    let mut stream = connect(boot(EmulatorConfig::new(baud)));
     let wdtcsr = stream.client().link().mcu().wdtcsr();
     assert_eq!(wdtcsr & WDTCSR_WDE, WDTCSR_WDE, "watchdog in reset mode");
     assert_eq!(wdtcsr & WDTCSR_WDIE, 0, "no interrupt mode");
@@ -626,9 +673,16 @@ fn watchdog_is_on_survives_a_long_eeprom_save_and_resets_a_hung_cpu() {
 
 #[test]
 fn angle_tolerance_bounds_the_firmware_against_the_host() {
+    for baud in BAUDS {
+        angle_tolerance_bounds_the_firmware_against_the_host_at(baud);
+    }
+}
+
+/// [`angle_tolerance_bounds_the_firmware_against_the_host`] with the firmware of one line rate.
+fn angle_tolerance_bounds_the_firmware_against_the_host_at(baud: u32) {
     // The bound the client applies to the ATmega2560's angles, checked on 100 poses: every
     // readback within it, and the bound not looser than ten times the largest difference.
-    let mut stream = connect(boot(EmulatorConfig::new(115_200)));
+    let mut stream = connect(boot(EmulatorConfig::new(baud)));
     for pose in soak_poses(100) {
         let result = stream.send(&pose).expect("link");
         assert!(

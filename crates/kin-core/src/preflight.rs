@@ -20,7 +20,7 @@
 use crate::body::{self, BodyConfig};
 use crate::jacobian::{self, SINGULARITY_THRESHOLD};
 use crate::leg::{self, Unreachable};
-use crate::math::{wrap_pi, DefaultMath};
+use crate::math::wrap_pi;
 use crate::motion::{finite, positive, Error, Frame, Motion};
 use crate::robot::{Joint, JointAngles, JointLimits, LegId, Robot};
 use crate::vec::Vec3;
@@ -384,8 +384,7 @@ impl Checker {
         self.report.samples = sample.saturating_add(1);
         let mut out = [Err(Unreachable::NonFinite); 4];
         let finite_input = t_s.is_finite() && frame.pose.is_finite();
-        let local = body::feet_in_hips_with::<DefaultMath>(
-            &self.robot,
+        let local = body::Solver::new(&self.robot).feet_in_hips(
             &frame.pose,
             &self.config,
             &frame.feet_in_world,
@@ -400,7 +399,8 @@ impl Checker {
                 }
             }
             let solved = if finite_input {
-                leg::inverse(&self.geometric, leg, local[i], ReachPolicy::Reject)
+                leg::Solver::new(&self.geometric)
+                    .inverse(leg, local[i], ReachPolicy::Reject)
                     .map(|s| s.angles)
                     .map_err(|e| e.kind)
             } else {

@@ -134,9 +134,8 @@ pub fn preview(robot: &Robot, order: RotationOrder, pose: &Pose, stance_height_m
         order,
         pivot_m: Vec3::ZERO,
     };
-    let result = solver
-        .inverse_at_stance(pose, &config, stance_height_m, ReachPolicy::Reject)
-        .map(|_| ());
+    let solution = solver.inverse_at_stance(pose, &config, stance_height_m, ReachPolicy::Reject);
+    let result = solution.map(|_| ());
     let mut p = Preview {
         result,
         angles_rad: [0.0; 12],
@@ -148,7 +147,10 @@ pub fn preview(robot: &Robot, order: RotationOrder, pose: &Pose, stance_height_m
         p.status = [status_code(Some(Unreachable::NonFinite)); 4];
         return p;
     }
-    let feet = solver.stance_feet_in_hips_with::<DefaultMath>(pose, &config, stance_height_m);
+    // Per leg, through the general transform of the stance feet (the same feet as the body
+    // solve's closed form up to f32 rounding); the angles of a reachable pose are the body
+    // solve's own, below.
+    let feet = solver.feet_in_hips(pose, &config, &robot.stance_feet(stance_height_m));
     for leg in LegId::ALL {
         let i = leg.index();
         let foot = feet[i];
@@ -170,6 +172,9 @@ pub fn preview(robot: &Robot, order: RotationOrder, pose: &Pose, stance_height_m
         p.angles_rad[3 * i..3 * i + 3].copy_from_slice(&angles.to_array());
         p.status[i] = status_code(kind);
         p.joint_margin_rad[i] = margin;
+    }
+    if let Ok(s) = solution {
+        p.angles_rad = s.flat();
     }
     p
 }
@@ -194,7 +199,7 @@ pub fn points(
     pose: &Pose,
     angles_rad: &[f32; 12],
 ) -> [f32; 48] {
-    let r = rotation::matrix(order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+    let r = rotation::matrix::<DefaultMath>(order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
     let t = pose.translation();
     let mut out = [0.0; 48];
     for leg in LegId::ALL {
@@ -351,7 +356,8 @@ mod tests {
         let config = BodyConfig::default();
         let pose = Pose::rotation(0.1, -0.05, 0.2);
         let p = preview(&robot, config.order, &pose, 0.4);
-        let want = body::inverse_at_stance(&robot, &pose, &config, 0.4, ReachPolicy::Reject)
+        let want = body::Solver::new(&robot)
+            .inverse_at_stance(&pose, &config, 0.4, ReachPolicy::Reject)
             .unwrap()
             .flat();
         assert_eq!(p.result, Ok(()));

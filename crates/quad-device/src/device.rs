@@ -2,20 +2,19 @@
 //! answer bytes out.
 
 use crate::config::{
-    body_inverse, validate_pose_config, write_default_calibration, BodyFeet, Config, ConfigError,
-    UNBOOTED_CALIBRATION,
+    validate_pose_config, write_default_calibration, Config, ConfigError, UNBOOTED_CALIBRATION,
 };
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use core::marker::PhantomData;
-use kin_core::body::{BodySolution, Pose};
-use kin_core::{DefaultMath, IkError, Math, Vec3};
+use kin_core::body::{self, BodySolution, Pose};
+use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,
-    LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
-    DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    check_request, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags,
+    HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
+    Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -25,6 +24,13 @@ pub const RX_LEN: usize = MAX_DECODED_LEN;
 /// once the request is decoded), so it must fit there.
 pub const TX_LEN: usize = encoded_len_max(DEVICE_TO_HOST_MAX_LEN);
 const _: () = assert!(TX_LEN <= RX_LEN);
+
+/// The shortest time between two nacks of unreadable frames (`BadCrc`, `BadFrame`,
+/// `Oversize`), ms: the others in between are only counted (`frames_bad`). Noise rich in `0x00`
+/// makes a "frame" every few bytes; answering each would keep the transmitter busy with nacks
+/// and delay the answers to the valid frames among them. At 115,200 baud an 8-byte nack per
+/// 10 ms takes 7 % of the line.
+pub const FRAMING_NACK_INTERVAL_MS: u32 = 10;
 
 /// The joint angles the device holds and the pulses they map to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,12 +58,17 @@ struct Held {
 ///   motion request succeeds.
 /// - Every pulse written lies within its servo's calibrated `[min_us, max_us]`; a calibration
 ///   change that would put the held angle outside the new travel is refused.
+/// - Every request is range-checked first ([`quad_protocol::check_request`], the host's own
+///   check): a finite value outside its field's range is [`NackReason::OutOfRange`].
+/// - Configuration requests are answered with [`DeviceToHost::Configured`], echoing the setting
+///   as applied.
 /// - Link loss: when no valid frame arrived for `timeout_ms` (≠ 0), the failsafe holds the
 ///   pulses or stops the outputs ([`LinkLossAction`]) and sets [`Flags::FAILSAFE_ACTIVE`],
-///   which the answer to the next valid frame reports once. Stopped outputs stay stopped until
-///   the host enables them again.
+///   latched until an answer that carries a readback has reported it. Stopped outputs stay
+///   stopped until the host enables them again.
 /// - Unreadable frames are answered with a nack without a sequence number (`BadCrc`,
-///   `BadFrame`, `Oversize`) and change nothing but the frame counters.
+///   `BadFrame`, `Oversize`), at most one per [`FRAMING_NACK_INTERVAL_MS`], and change nothing
+///   but the frame counters.
 pub struct Device<O, C, S, M = DefaultMath> {
     outputs: O,
     clock: C,
@@ -76,6 +87,8 @@ pub struct Device<O, C, S, M = DefaultMath> {
     calibration_unsaved: bool,
     calibration_default: bool,
     last_valid_ms: u32,
+    /// When the last nack of an unreadable frame was sent (`None`: never).
+    last_framing_nack_ms: Option<u32>,
     _math: PhantomData<fn() -> M>,
 }
 
@@ -140,6 +153,7 @@ where
             calibration_unsaved: false,
             calibration_default: true,
             last_valid_ms: now,
+            last_framing_nack_ms: None,
             _math: PhantomData,
         })
     }
@@ -168,10 +182,14 @@ where
     }
 
     /// Feeds received bytes (any chunking) and sends one answer frame through `tx` for every
-    /// frame that ends in them, in order.
+    /// frame that ends in them, in order (nacks of unreadable frames rate-limited, see
+    /// [`FRAMING_NACK_INTERVAL_MS`]).
     pub fn receive(&mut self, mut bytes: &[u8], mut tx: impl FnMut(&[u8])) {
         while let Some((frame_len, remaining)) = self.receive_one(bytes) {
             bytes = remaining;
+            if frame_len == 0 {
+                continue;
+            }
             if let Some(frame) = self.acc.scratch().and_then(|b| b.get(..frame_len)) {
                 tx(frame);
             }
@@ -183,19 +201,35 @@ where
     /// not be encoded) and the bytes left; `None` when no frame ended in `bytes`. Not generic
     /// over the caller's closure, so that the firmware has one instance of it.
     fn receive_one<'a>(&mut self, bytes: &'a [u8]) -> Option<(usize, &'a [u8])> {
-        let (answer, remaining) = match feed_request(&mut self.acc, bytes) {
+        let (reason, remaining) = match feed_request(&mut self.acc, bytes) {
             Feed::NeedMore => return None,
-            Feed::Frame { msg, remaining } => (self.handle(msg), remaining),
-            Feed::BadCrc { remaining } => (nack(None, NackReason::BadCrc), remaining),
-            Feed::BadFrame { remaining, .. } => (nack(None, NackReason::BadFrame), remaining),
-            Feed::Oversize { remaining } => (nack(None, NackReason::Oversize), remaining),
+            Feed::Frame { msg, remaining } => {
+                let answer = self.handle(msg);
+                return Some((self.encode(&answer), remaining));
+            }
+            Feed::BadCrc { remaining } => (NackReason::BadCrc, remaining),
+            Feed::BadFrame { remaining, .. } => (NackReason::BadFrame, remaining),
+            Feed::Oversize { remaining } => (NackReason::Oversize, remaining),
         };
+        let now = self.clock.now_ms();
+        let due = self
+            .last_framing_nack_ms
+            .is_none_or(|t| now.wrapping_sub(t) >= FRAMING_NACK_INTERVAL_MS);
+        if !due {
+            return Some((0, remaining));
+        }
+        self.last_framing_nack_ms = Some(now);
+        Some((self.encode(&nack(None, reason)), remaining))
+    }
+
+    /// Encodes `answer` into the accumulator's buffer (free between frames); its length, 0 when
+    /// it could not be encoded.
+    fn encode(&mut self, answer: &DeviceToHost) -> usize {
         // The buffer holds the largest answer (`TX_LEN`); a failure would only drop this answer.
-        let len = match self.acc.scratch() {
-            Some(buf) => encode_answer(&answer, buf),
+        match self.acc.scratch() {
+            Some(buf) => encode_answer(answer, buf),
             None => 0,
-        };
-        Some((len, remaining))
+        }
     }
 
     /// Runs the link-loss failsafe; call it from the main loop.
@@ -222,14 +256,18 @@ where
         self.last_valid_ms = self.clock.now_ms();
         self.failsafe_armed = true;
         let answer = self.answer(msg);
-        // Reported once, in the answer to the first valid frame after the failsafe acted.
-        self.failsafe = false;
+        // Latched until an answer reports it (only the readback carries the flags).
+        if answer.readback().is_some() {
+            self.failsafe = false;
+        }
         answer
     }
 
     #[inline(never)]
     fn answer(&mut self, msg: HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
+        // The host's own check (`Ok` for the requests answered before the handshake).
+        let in_range = check_request(&msg.request, &self.config.robot);
         let result = match msg.request {
             Request::Hello { version } => {
                 return if is_compatible(version) {
@@ -256,19 +294,34 @@ where
                 };
             }
             _ if !self.hello_done => Err(NackReason::HelloRequired),
+            _ if in_range.is_err() => in_range,
             Request::SetBodyPose(pose) => self.set_body_pose(&pose),
             Request::SetFeet { feet_in_body_m } => self.set_feet(&feet_in_body_m),
             Request::SetJoints { angles_rad } => self.set_joints(&angles_rad),
             Request::SetOutputs { enabled } => self.set_outputs(enabled),
             Request::SetLinkTimeout(t) => {
                 self.config.link_timeout = t;
-                Ok(())
+                return self.configured(seq, Setting::LinkTimeout(self.config.link_timeout));
             }
             Request::SetCalibration { servo, calibration } => {
-                self.set_calibration(servo, calibration)
+                return match self.set_calibration(servo, calibration) {
+                    Ok(()) => self.configured(
+                        seq,
+                        Setting::Calibration {
+                            servo,
+                            calibration: self.calibration[servo.index()],
+                        },
+                    ),
+                    Err(reason) => nack(Some(seq), reason),
+                };
             }
             Request::SaveCalibration => self.save_calibration(),
-            Request::SetPoseConfig(p) => self.set_pose_config(p),
+            Request::SetPoseConfig(p) => {
+                return match self.set_pose_config(p) {
+                    Ok(()) => self.configured(seq, Setting::PoseConfig(self.config.pose_config)),
+                    Err(reason) => nack(Some(seq), reason),
+                };
+            }
         };
         match result {
             Ok(()) => DeviceToHost::Ack {
@@ -276,6 +329,15 @@ where
                 readback: self.readback(),
             },
             Err(reason) => nack(Some(seq), reason),
+        }
+    }
+
+    /// The answer to a configuration request that was carried out: `setting` as now held.
+    fn configured(&self, seq: u16, setting: Setting) -> DeviceToHost {
+        DeviceToHost::Configured {
+            seq,
+            setting,
+            readback: self.readback(),
         }
     }
 
@@ -354,25 +416,27 @@ where
         (self.outputs, self.clock, self.storage)
     }
 
+    /// `SetBodyPose`: the pose at the stance of the pose configuration's height, about the body
+    /// centre in its rotation order. Out of line (as `set_feet`), so that the body
+    /// solve's locals stay out of the dispatcher's stack frame.
+    #[inline(never)]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
-        self.solve_body(pose, BodyFeet::Stance)
+        let c = &self.config.pose_config;
+        let solution = body::Solver::<M>::with_math(&self.config.robot).inverse_at_stance(
+            pose,
+            &BodyConfig::about_centre(c.order),
+            c.stance_height_m,
+            c.policy,
+        );
+        self.apply_solution(solution)
     }
 
+    /// `SetFeet`: the feet in the body frame at the zero pose.
+    #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
-        self.solve_body(&Pose::default(), BodyFeet::World(&feet))
-    }
-
-    #[inline(never)]
-    fn solve_body(&mut self, pose: &Pose, feet: BodyFeet<'_>) -> Result<(), NackReason> {
-        let pose_config = &self.config.pose_config;
-        let solution = body_inverse::<M>(
-            &self.config.robot,
-            pose,
-            pose_config,
-            feet,
-            pose_config.policy,
-        );
+        let solution = body::Solver::<M>::with_math(&self.config.robot)
+            .inverse_feet_in_body(&feet, self.config.pose_config.policy);
         self.apply_solution(solution)
     }
 

@@ -4,18 +4,20 @@ mod common;
 
 use common::*;
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, Joint, LegId, ReachPolicy, Vec3};
+use kin_core::{BodyConfig, Joint, LegId, ReachPolicy, Vec3};
 use quad_device::config::DEFAULT_CENTER_US;
 use quad_device::{Config, Device};
 use quad_protocol::servo::{self, Calibration};
 use quad_protocol::{
-    DeviceToHost, Flags, LinkLossAction, LinkTimeout, NackReason, PoseConfig, ReachFault, Readback,
-    Request, ServoId,
+    DeviceToHost, Field, Flags, LinkLossAction, LinkTimeout, NackReason, PoseConfig, ReachFault,
+    Readback, Request, ServoId, Setting,
 };
 
+/// The readback of an answer that carried the request out: an `Ack`, or the `Configured` echo
+/// of a configuration request.
 fn ack(answer: DeviceToHost) -> Readback {
     match answer {
-        DeviceToHost::Ack { readback, .. } => readback,
+        DeviceToHost::Ack { readback, .. } | DeviceToHost::Configured { readback, .. } => readback,
         other => panic!("expected an ack, got {other:?}"),
     }
 }
@@ -29,18 +31,18 @@ fn nack_reason(answer: DeviceToHost) -> NackReason {
 
 /// Host-side expectation for a body pose with the device's configuration.
 fn expected_angles(config: &Config, pose: &Pose) -> [f32; 12] {
-    body::inverse_at_stance_with::<DefaultMath>(
-        &config.robot,
-        pose,
-        &BodyConfig {
-            order: config.pose_config.order,
-            pivot_m: Vec3::ZERO,
-        },
-        config.pose_config.stance_height_m,
-        config.pose_config.policy,
-    )
-    .unwrap()
-    .flat()
+    body::Solver::new(&config.robot)
+        .inverse_at_stance(
+            pose,
+            &BodyConfig {
+                order: config.pose_config.order,
+                pivot_m: Vec3::ZERO,
+            },
+            config.pose_config.stance_height_m,
+            config.pose_config.policy,
+        )
+        .unwrap()
+        .flat()
 }
 
 const POSE: Pose = Pose {
@@ -112,14 +114,14 @@ fn requests_before_hello_are_refused_except_reads() {
 fn hello_checks_the_major_version() {
     let mut dev = device(Config::fernando2025());
     assert_eq!(
-        nack_reason(ask(&mut dev, 1, Request::Hello { version: 0x0200 })),
-        NackReason::UnknownVersion { supported: 0x0100 }
+        nack_reason(ask(&mut dev, 1, Request::Hello { version: 0x0100 })),
+        NackReason::UnknownVersion { supported: 0x0200 }
     );
     assert_eq!(
         nack_reason(ask(&mut dev, 2, Request::SetBodyPose(POSE))),
         NackReason::HelloRequired
     );
-    match ask(&mut dev, 3, Request::Hello { version: 0x0107 }) {
+    match ask(&mut dev, 3, Request::Hello { version: 0x0207 }) {
         DeviceToHost::HelloAck { info, .. } => {
             assert_eq!(info.version, quad_protocol::PROTOCOL_VERSION);
             assert_eq!(info.robot, quad_protocol::RobotPreset::Fernando2025);
@@ -164,18 +166,18 @@ fn set_feet_runs_the_body_ik_at_the_zero_pose() {
             feet_in_body_m: feet.map(|v| [v.x + 0.03, v.y, v.z]),
         },
     ));
-    let want = body::inverse_with::<DefaultMath>(
-        &config.robot,
-        &Pose::default(),
-        &BodyConfig {
-            order: config.pose_config.order,
-            pivot_m: Vec3::ZERO,
-        },
-        &feet.map(|v| Vec3::new(v.x + 0.03, v.y, v.z)),
-        ReachPolicy::Reject,
-    )
-    .unwrap()
-    .flat();
+    let want = body::Solver::new(&config.robot)
+        .inverse(
+            &Pose::default(),
+            &BodyConfig {
+                order: config.pose_config.order,
+                pivot_m: Vec3::ZERO,
+            },
+            &feet.map(|v| Vec3::new(v.x + 0.03, v.y, v.z)),
+            ReachPolicy::Reject,
+        )
+        .unwrap()
+        .flat();
     assert_eq!(rb.angles_rad, want);
 }
 
@@ -247,8 +249,7 @@ fn invalid_or_unreachable_requests_move_nothing() {
         ),
     ];
     for (i, (pose, reason)) in cases.into_iter().enumerate() {
-        let host = body::inverse_at_stance(
-            &config.robot,
+        let host = body::Solver::new(&config.robot).inverse_at_stance(
             &pose,
             &BodyConfig {
                 order: config.pose_config.order,
@@ -644,7 +645,16 @@ fn readback_angles_are_finite_and_zero_when_nothing_is_held() {
                 calibration: c,
             },
         );
-        assert!(matches!(a[0], DeviceToHost::Ack { .. }), "{a:?}");
+        assert!(
+            matches!(
+                a[0],
+                DeviceToHost::Configured {
+                    setting: quad_protocol::Setting::Calibration { calibration, .. },
+                    ..
+                } if calibration == c
+            ),
+            "{a:?}"
+        );
         let a = send(&mut dev, Request::SaveCalibration);
         assert!(matches!(a[0], DeviceToHost::Ack { .. }), "{a:?}");
     }
@@ -663,4 +673,212 @@ fn readback_angles_are_finite_and_zero_when_nothing_is_held() {
         NackReason::InvalidArgument
     );
     assert!(dev.outputs().writes.is_empty() && !dev.outputs().enabled);
+}
+
+#[test]
+fn configuration_requests_echo_what_was_applied() {
+    let config = Config::fernando2025();
+    let mut dev = device(config);
+    hello(&mut dev);
+    let t = LinkTimeout {
+        timeout_ms: 321,
+        action: LinkLossAction::Disable,
+    };
+    let p = PoseConfig {
+        stance_height_m: 0.8,
+        ..config.pose_config
+    };
+    let servo = ServoId::ALL[7];
+    let c = Calibration {
+        center_us: 1510,
+        ..dev.calibration()[servo.index()]
+    };
+    let cases = [
+        (Request::SetLinkTimeout(t), Setting::LinkTimeout(t)),
+        (Request::SetPoseConfig(p), Setting::PoseConfig(p)),
+        (
+            Request::SetCalibration {
+                servo,
+                calibration: c,
+            },
+            Setting::Calibration {
+                servo,
+                calibration: c,
+            },
+        ),
+    ];
+    for (seq, (request, want)) in (10..).zip(cases) {
+        assert_eq!(Setting::of_request(&request), Some(want));
+        match ask(&mut dev, seq, request) {
+            DeviceToHost::Configured {
+                seq: s,
+                setting,
+                readback,
+            } => {
+                assert_eq!((s, setting), (seq, want));
+                assert_eq!(readback, dev.readback());
+            }
+            other => panic!("{request:?}: {other:?}"),
+        }
+    }
+    assert_eq!(dev.config().link_timeout, t);
+    assert_eq!(dev.config().pose_config, p);
+    assert_eq!(dev.calibration()[servo.index()], c);
+}
+
+#[test]
+fn finite_values_out_of_range_are_named_and_move_nothing() {
+    let mut dev = device(Config::fernando2025());
+    hello(&mut dev);
+    ack(ask(&mut dev, 1, Request::SetOutputs { enabled: true }));
+    let before = ack(ask(&mut dev, 2, Request::SetBodyPose(POSE)));
+    let writes = dev.outputs().writes.len();
+    let cases = [
+        (
+            Request::SetBodyPose(Pose {
+                yaw_rad: 1e38,
+                ..POSE
+            }),
+            Field::BodyYaw,
+        ),
+        (
+            Request::SetBodyPose(Pose {
+                x_m: -3.4e38,
+                ..POSE
+            }),
+            Field::BodyX,
+        ),
+        (
+            Request::SetFeet {
+                feet_in_body_m: [
+                    [0.5, 0.25, -0.9],
+                    [0.5, -0.25, -0.9],
+                    [9e9, 0.0, 0.0],
+                    [-0.5, -0.25, -0.9],
+                ],
+            },
+            Field::Foot(LegId::RL),
+        ),
+        (
+            Request::SetJoints {
+                angles_rad: [0.0, 0.0, 7.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            },
+            Field::JointAngle {
+                leg: LegId::FL,
+                joint: Joint::Knee,
+            },
+        ),
+        (
+            Request::SetPoseConfig(PoseConfig {
+                stance_height_m: 3.4e38,
+                ..Config::fernando2025().pose_config
+            }),
+            Field::StanceHeight,
+        ),
+        (
+            Request::SetPoseConfig(PoseConfig {
+                stance_height_m: 1e-45,
+                ..Config::fernando2025().pose_config
+            }),
+            Field::StanceHeight,
+        ),
+    ];
+    for (seq, (request, field)) in (3..).zip(cases) {
+        assert_eq!(
+            nack_reason(ask(&mut dev, seq, request)),
+            NackReason::OutOfRange { field },
+            "{request:?}"
+        );
+        // The host's check gives the same answer.
+        assert_eq!(
+            quad_protocol::check_request(&request, &dev.config().robot),
+            Err(NackReason::OutOfRange { field })
+        );
+    }
+    let after = ack(ask(&mut dev, 20, Request::GetState));
+    assert_eq!(after.angles_rad, before.angles_rad);
+    assert_eq!(dev.outputs().writes.len(), writes);
+    assert_eq!(dev.config().pose_config, Config::fernando2025().pose_config);
+}
+
+#[test]
+fn the_failsafe_flag_is_latched_until_an_answer_reports_it() {
+    let (mut dev, clock) = failsafe_case(LinkLossAction::Hold);
+    clock.set(5_000);
+    dev.poll();
+    // Answers without a readback do not clear it.
+    assert!(matches!(
+        ask(
+            &mut dev,
+            4,
+            Request::GetCalibration {
+                servo: ServoId::ALL[0]
+            }
+        ),
+        DeviceToHost::Calibration { .. }
+    ));
+    assert!(matches!(
+        ask(
+            &mut dev,
+            5,
+            Request::Hello {
+                version: quad_protocol::PROTOCOL_VERSION
+            }
+        ),
+        DeviceToHost::HelloAck { .. }
+    ));
+    assert!(matches!(
+        ask(
+            &mut dev,
+            6,
+            Request::SetBodyPose(Pose {
+                roll_rad: 9.0,
+                ..POSE
+            })
+        ),
+        DeviceToHost::Nack { .. }
+    ));
+    let rb = ack(ask(&mut dev, 7, Request::GetState));
+    assert!(rb.flags.contains(Flags::FAILSAFE_ACTIVE), "{rb:?}");
+    // Reported once.
+    let rb = ack(ask(&mut dev, 8, Request::GetState));
+    assert!(!rb.flags.contains(Flags::FAILSAFE_ACTIVE), "{rb:?}");
+}
+
+#[test]
+fn nacks_of_unreadable_frames_are_rate_limited() {
+    let clock = TestClock::default();
+    let mut dev = Device::new(
+        Config::fernando2025(),
+        Outputs::default(),
+        clock.clone(),
+        Mem::erased(),
+    )
+    .unwrap();
+    hello(&mut dev);
+    let garbage = [0x00, 0x07, 0x41, 0x42, 0x00];
+    let mut burst = Vec::new();
+    for _ in 0..50 {
+        burst.extend_from_slice(&garbage);
+    }
+    burst.extend(frame(9, Request::GetState));
+    let answers = feed(&mut dev, &burst);
+    // One nack for the 50 bad frames, then the answer to the valid one.
+    assert_eq!(answers.len(), 2, "{answers:?}");
+    assert!(matches!(
+        answers[0],
+        DeviceToHost::Nack {
+            seq: None,
+            reason: NackReason::BadFrame
+        }
+    ));
+    let DeviceToHost::Ack { seq: 9, readback } = answers[1] else {
+        panic!("{answers:?}");
+    };
+    assert_eq!(readback.frames_bad, 50);
+    // Within the interval: counted only; after it, answered again.
+    clock.set(quad_device::device::FRAMING_NACK_INTERVAL_MS - 1);
+    assert!(feed(&mut dev, &garbage).is_empty());
+    clock.set(quad_device::device::FRAMING_NACK_INTERVAL_MS);
+    assert_eq!(feed(&mut dev, &garbage).len(), 1);
 }

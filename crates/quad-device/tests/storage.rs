@@ -44,7 +44,16 @@ fn save(mem: Mem, t: &Table) -> (DeviceToHost, Mem) {
                 calibration: *c,
             },
         );
-        assert!(matches!(a, DeviceToHost::Ack { .. }), "{a:?}");
+        assert!(
+            matches!(
+                a,
+                DeviceToHost::Configured {
+                    setting: quad_protocol::Setting::Calibration { calibration, .. },
+                    ..
+                } if calibration == *c
+            ),
+            "{a:?}"
+        );
     }
     let answer = ask(&mut dev, 100, Request::SaveCalibration);
     let (_, _, mem) = dev.into_parts();

@@ -18,9 +18,9 @@ use quad_device::device::{encode_answer, feed_request};
 use quad_device::Config;
 use quad_protocol::servo::{self, Calibration};
 use quad_protocol::{
-    crc, Accumulator, DeviceInfo, DeviceToHost, Feed, FirmwareVersion, Flags, HostToDevice,
+    crc, Accumulator, DeviceInfo, DeviceToHost, Feed, Field, FirmwareVersion, Flags, HostToDevice,
     LinkLossAction, LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request,
-    RobotPreset, ServoId, MAX_DECODED_LEN, MAX_FRAME_LEN,
+    RobotPreset, ServoId, Setting, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 
 // ---- The expected index of every variant (written here, independently of the declarations).
@@ -47,6 +47,7 @@ fn answer_index(a: &DeviceToHost) -> u8 {
         DeviceToHost::HelloAck { .. } => 1,
         DeviceToHost::Ack { .. } => 2,
         DeviceToHost::Calibration { .. } => 3,
+        DeviceToHost::Configured { .. } => 4,
     }
 }
 
@@ -134,6 +135,12 @@ fn nack_reasons() -> Vec<NackReason> {
         NackReason::OutputsDisabled,
         NackReason::Storage,
         NackReason::InvalidArgument,
+        NackReason::OutOfRange {
+            field: Field::JointAngle {
+                leg: LegId::FR,
+                joint: Joint::Abduction,
+            },
+        },
     ]
 }
 
@@ -180,6 +187,20 @@ fn answers() -> Vec<DeviceToHost> {
             seq: 10,
             servo: SERVO,
             calibration: CAL,
+        },
+        DeviceToHost::Configured {
+            seq: 11,
+            setting: Setting::Calibration {
+                servo: SERVO,
+                calibration: CAL,
+            },
+            readback: Readback {
+                angles_rad: [0.25; 12],
+                pulses_half_us: [3000; 12],
+                flags: Flags(Flags::CALIBRATION_UNSAVED),
+                frames_ok: 20,
+                frames_bad: 0,
+            },
         },
     ]
 }
@@ -307,22 +328,31 @@ fn every_answer_and_nack_variant_has_its_index_and_round_trips() {
     // `wire` tests, where the non-exhaustive enum can be matched exhaustively).
     for (i, reason) in nack_reasons().into_iter().enumerate() {
         let nack = DeviceToHost::Nack { seq: None, reason };
-        check_answer(nack, 2, i as u8, 14);
+        check_answer(nack, 2, i as u8, 15);
     }
 }
 
 // ---- Differential: the device's receive path against the protocol's frame decoder.
 
-/// What a device answers to one decoded frame, computed at message level on `twin`.
-fn expected_answer(twin: &mut Dev, feed: Feed<'_, HostToDevice>) -> Option<DeviceToHost> {
-    let nack = |reason| DeviceToHost::Nack { seq: None, reason };
-    match feed {
-        Feed::NeedMore => None,
-        Feed::Frame { msg, .. } => Some(twin.handle(msg)),
-        Feed::BadCrc { .. } => Some(nack(NackReason::BadCrc)),
-        Feed::BadFrame { .. } => Some(nack(NackReason::BadFrame)),
-        Feed::Oversize { .. } => Some(nack(NackReason::Oversize)),
+/// What a device answers to one decoded frame, computed at message level on `twin`: `None`
+/// when no frame ended, `Some(None)` for an unreadable frame whose nack the rate limit drops
+/// (the test clock stands still: only the first one is answered, `framing_nacked` tells).
+fn expected_answer(
+    twin: &mut Dev,
+    framing_nacked: &mut bool,
+    feed: Feed<'_, HostToDevice>,
+) -> Option<Option<DeviceToHost>> {
+    let reason = match feed {
+        Feed::NeedMore => return None,
+        Feed::Frame { msg, .. } => return Some(Some(twin.handle(msg))),
+        Feed::BadCrc { .. } => NackReason::BadCrc,
+        Feed::BadFrame { .. } => NackReason::BadFrame,
+        Feed::Oversize { .. } => NackReason::Oversize,
+    };
+    if std::mem::replace(framing_nacked, true) {
+        return Some(None);
     }
+    Some(Some(DeviceToHost::Nack { seq: None, reason }))
 }
 
 /// Feeds `chunks` to a device and, through the protocol's own `Accumulator`, to a twin at
@@ -332,6 +362,7 @@ fn same_as_reference(chunks: &[Vec<u8>]) {
     let mut dev = device(Config::fernando2025());
     let mut twin = device(Config::fernando2025());
     let mut reference = Accumulator::<MAX_DECODED_LEN>::new();
+    let mut framing_nacked = false;
     for chunk in chunks {
         let mut wire = Vec::new();
         dev.receive(chunk, |f| wire.extend_from_slice(f));
@@ -341,14 +372,17 @@ fn same_as_reference(chunks: &[Vec<u8>]) {
         loop {
             let feed = reference.feed::<HostToDevice>(input);
             input = feed.remaining();
-            match expected_answer(&mut twin, feed) {
-                Some(mut a) => {
-                    if let DeviceToHost::Ack { readback, .. } = &mut a {
+            match expected_answer(&mut twin, &mut framing_nacked, feed) {
+                Some(Some(mut a)) => {
+                    if let DeviceToHost::Ack { readback, .. }
+                    | DeviceToHost::Configured { readback, .. } = &mut a
+                    {
                         readback.frames_ok = reference.frames_ok();
                         readback.frames_bad = reference.frames_bad();
                     }
                     expected.push(a);
                 }
+                Some(None) => {}
                 None => break,
             }
         }

@@ -21,7 +21,7 @@
 //! port, USB latency).
 //!
 //! ## Readback check ([`PoseStream`])
-//! For every body pose the host runs kin-core itself (`inverse_at_stance_with::<DefaultMath>`,
+//! For every body pose the host runs kin-core itself (`body::Solver::inverse_at_stance` on `DefaultMath`,
 //! the device's robot, stance height, rotation order and reject policy) and maps the angles
 //! through the device's calibration (read at connection):
 //! - a pose the host solves must be acked, with the twelve angles equal to the host's
@@ -35,7 +35,7 @@
 
 use crate::link::{self, byte_time, Link};
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, ReachPolicy, Robot, RotationOrder, Vec3};
+use kin_core::{BodyConfig, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     encode_frame, frame, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,
@@ -258,6 +258,7 @@ pub fn answer_name(a: &DeviceToHost) -> &'static str {
         DeviceToHost::HelloAck { .. } => "HelloAck",
         DeviceToHost::Ack { .. } => "Ack",
         DeviceToHost::Calibration { .. } => "Calibration",
+        DeviceToHost::Configured { .. } => "Configured",
     }
 }
 
@@ -519,14 +520,19 @@ impl<L: Link> Client<L> {
         }
     }
 
-    /// A request answered by an `Ack`; returns its readback.
+    /// A request answered by an `Ack`, or a configuration request answered by a `Configured`
+    /// that echoes exactly the setting sent; returns its readback.
     ///
     /// # Errors
-    /// As [`Client::request`], or [`Error::Unexpected`].
+    /// As [`Client::request`], or [`Error::Unexpected`] (an echo that differs included).
     pub fn ack(&mut self, request: Request) -> Result<Readback, Error> {
         let name = request_name(&request);
+        let sent = quad_protocol::Setting::of_request(&request);
         match self.request(request)? {
             DeviceToHost::Ack { readback, .. } => Ok(readback),
+            DeviceToHost::Configured {
+                setting, readback, ..
+            } if Some(setting) == sent => Ok(readback),
             other => Err(Error::Unexpected {
                 request: name,
                 answer: Box::new(other),
@@ -776,7 +782,7 @@ impl<L: Link> PoseStream<L> {
         &mut self.client
     }
 
-    /// What the host's kin-core and calibration make of `pose` ([`expected`]).
+    /// What the host's range check, kin-core and calibration make of `pose` ([`expected`]).
     pub fn expected(&self, pose: &Pose) -> Expected {
         expected(
             &self.setup.robot,
@@ -921,22 +927,25 @@ impl<L: Link> PoseStream<L> {
     }
 }
 
-/// What the host's kin-core makes of `pose` on a device with `pose_config` and `calibration`:
-/// the angles of `body::inverse_at_stance_with::<DefaultMath>` (reject policy) when every one
-/// maps to a pulse within its servo's travel, else the nack the device must answer. The check
-/// every body pose of the host passes before it is sent.
+/// What the host makes of `pose` on a device with `pose_config` and `calibration`: after the
+/// range check the device runs too (`quad_protocol::range`), the angles of kin-core's
+/// `inverse_at_stance` (reject policy) when every one maps to a pulse within its servo's
+/// travel, else the nack the device must answer. The check every body pose of the host passes
+/// before it is sent.
 pub fn expected(
     robot: &Robot,
     pose_config: &PoseConfig,
     calibration: &[Calibration; 12],
     pose: &Pose,
 ) -> Expected {
+    if let Err(reason) = quad_protocol::range::check_pose(pose, robot) {
+        return Expected::Nack(reason);
+    }
     let config = BodyConfig {
         order: pose_config.order,
         pivot_m: Vec3::ZERO,
     };
-    match body::inverse_at_stance_with::<DefaultMath>(
-        robot,
+    match body::Solver::new(robot).inverse_at_stance(
         pose,
         &config,
         pose_config.stance_height_m,

@@ -350,7 +350,7 @@ struct Drawing {
 }
 
 fn drawing(robot: &Robot, config: &BodyConfig, s: &Snapshot) -> Drawing {
-    let r = rotation::matrix(
+    let r = rotation::matrix::<kin_core::DefaultMath>(
         config.order,
         s.pose.roll_rad,
         s.pose.pitch_rad,

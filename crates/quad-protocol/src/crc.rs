@@ -1,12 +1,18 @@
-//! CRC-16/IBM-3740 (better known as CRC-16/CCITT-FALSE), bitwise and table-free.
+//! CRC-16/GENIBUS, bitwise and table-free.
 //!
 //! Parameters (Rocksoft/reveng model): width 16, poly `0x1021`, init `0xFFFF`, refin false,
-//! refout false, xorout `0x0000`, check (`"123456789"`) `0x29B1`. No lookup table: eight
-//! shift/xor steps per byte cost no SRAM on the ATmega2560 (whose default linker script copies
-//! read-only tables into RAM) and about 100 cycles per byte.
+//! refout false, xorout `0xFFFF`, check (`"123456789"`) `0xD64E`, residue `0x1D0F`. No lookup
+//! table: a few shifts per byte ([`update`]) cost no SRAM on the ATmega2560 (whose default
+//! linker script copies read-only tables into RAM). Hand-written rather than taken from the
+//! `crc` crate for that reason: its algorithms are table-driven.
 //!
-//! On the wire the CRC follows the postcard bytes **most significant byte first**, so that the
-//! CRC computed over payload and CRC together is `0x0000` (the residue of this model).
+//! Why a final XOR: without one (CRC-16/IBM-3740, protocol 1.x) the register over a payload and
+//! its own CRC is `0x0000`, and zero bytes fed into a zero register keep it at zero — so a frame
+//! with `0x00` bytes added after its CRC (one flipped closing delimiter does that) still passed
+//! the check. With xorout `0xFFFF` the register after payload and CRC is the residue `0x1D0F`,
+//! which a zero byte changes.
+//!
+//! On the wire the CRC follows the postcard bytes **most significant byte first**.
 
 /// Initial register value.
 pub const INIT: u16 = 0xFFFF;
@@ -14,9 +20,34 @@ pub const INIT: u16 = 0xFFFF;
 /// Generator polynomial (x¹⁶ + x¹² + x⁵ + 1, normal form).
 pub const POLY: u16 = 0x1021;
 
+/// Final XOR applied to the register to give the CRC ([`finish`]).
+pub const XOROUT: u16 = 0xFFFF;
+
+/// The CRC of the bytes fed into the register `crc` so far ([`INIT`], then [`update`] per
+/// byte): the register with [`XOROUT`] applied.
+#[inline]
+pub const fn finish(crc: u16) -> u16 {
+    crc ^ XOROUT
+}
+
 /// Feeds one byte into the CRC register `crc`.
+///
+/// The byte-at-a-time form of the definition (eight steps of "shift left, xor [`POLY`] when the
+/// top bit was set", [`update_bitwise`]): for `x = (crc >> 8) ^ byte` folded as `x ^= x >> 4`,
+/// the eight steps xor `x·0x1021 = (x << 12) ^ (x << 5) ^ x` into `crc << 8`. Same bits, a few
+/// shifts instead of eight conditional steps: about 6× faster on the ATmega2560, where the
+/// CRC of every frame sits between a request's last byte and its answer's first.
 #[inline]
 pub const fn update(crc: u16, byte: u8) -> u16 {
+    let x = (crc >> 8) as u8 ^ byte;
+    let x = (x ^ (x >> 4)) as u16;
+    (crc << 8) ^ (x << 12) ^ (x << 5) ^ x
+}
+
+/// [`update`] written as the definition: eight shift/xor steps. The tests hold [`update`] to
+/// it for every register value and byte.
+#[inline]
+pub const fn update_bitwise(crc: u16, byte: u8) -> u16 {
     let mut crc = crc ^ ((byte as u16) << 8);
     let mut bit = 0;
     while bit < 8 {
@@ -38,7 +69,7 @@ pub const fn checksum(data: &[u8]) -> u16 {
         crc = update(crc, data[i]);
         i += 1;
     }
-    crc
+    finish(crc)
 }
 
 #[cfg(test)]
@@ -46,20 +77,52 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_byte_wise_update_is_the_bitwise_definition() {
+        for crc in 0..=u16::MAX {
+            for byte in [0u8, 1, 0x10, 0x7F, 0x80, 0xA5, 0xFF, crc as u8] {
+                assert_eq!(
+                    update(crc, byte),
+                    update_bitwise(crc, byte),
+                    "{crc:#x} {byte:#x}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn catalogue_check_value() {
-        assert_eq!(checksum(b"123456789"), 0x29B1);
+        assert_eq!(checksum(b"123456789"), 0xD64E);
     }
 
     #[test]
-    fn empty_input_is_init() {
-        assert_eq!(checksum(&[]), INIT);
+    fn empty_input_is_init_xored() {
+        assert_eq!(checksum(&[]), INIT ^ XOROUT);
     }
 
     #[test]
-    fn residue_of_payload_and_big_endian_crc_is_zero() {
+    fn register_over_payload_and_big_endian_crc_is_the_residue() {
         let mut data = *b"123456789\0\0";
         let crc = checksum(&data[..9]).to_be_bytes();
         data[9..].copy_from_slice(&crc);
-        assert_eq!(checksum(&data), 0);
+        let register = data.iter().fold(INIT, |c, &b| update(c, b));
+        assert_eq!(register, 0x1D0F);
+    }
+
+    #[test]
+    fn zero_bytes_after_the_crc_change_the_check() {
+        // The weakness of a CRC without final XOR: payload ‖ CRC ‖ 00 00 split as
+        // (payload ‖ CRC) + trailer 00 00 passed. Here it does not.
+        let payload = [0x02u8, 0x01, 0x05, 0x01];
+        let mut longer = [0u8; 10];
+        longer[..4].copy_from_slice(&payload);
+        longer[4..6].copy_from_slice(&checksum(&payload).to_be_bytes());
+        for extra in 1..=4 {
+            let (body, trailer) = longer[..6 + extra].split_at(4 + extra);
+            assert_ne!(
+                checksum(body).to_be_bytes(),
+                [trailer[0], trailer[1]],
+                "{extra} zeros"
+            );
+        }
     }
 }

@@ -178,7 +178,7 @@ impl<'b> Flavor for CobsCrcSlice<'b> {
     }
 
     fn finalize(mut self) -> postcard::Result<&'b [u8]> {
-        let [hi, lo] = self.crc.to_be_bytes();
+        let [hi, lo] = crc::finish(self.crc).to_be_bytes();
         self.put(hi)?;
         self.put(lo)?;
         self.write(self.code_idx, self.code)?;

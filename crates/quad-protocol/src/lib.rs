@@ -8,7 +8,8 @@
 //!   `Ack` with the [`Readback`], `Calibration`, or `Nack` with a typed [`NackReason`]).
 //! - [`frame`]: `COBS(postcard(message) ‖ CRC-16) ‖ 0x00` — [`encode_frame`] and the
 //!   bounded [`Accumulator`] for split, concatenated, oversize and garbled input.
-//! - [`crc`]: CRC-16/IBM-3740 (CCITT-FALSE), bitwise, no table.
+//! - [`crc`]: CRC-16/GENIBUS (CCITT-FALSE with a final XOR), a byte at a time, no table.
+//! - [`range`]: the admissible range of every request field, one check for host and device.
 //! - [`servo`]: per-joint [`servo::Calibration`] and the angle ↔ pulse mapping.
 //! - [`wire`]: the explicit wire index of every enum variant, and the tables of the kin-core
 //!   types the messages carry.
@@ -31,6 +32,7 @@
 pub mod crc;
 pub mod frame;
 pub mod msg;
+pub mod range;
 pub mod servo;
 pub mod wire;
 
@@ -38,12 +40,14 @@ pub use frame::{
     decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 pub use msg::{
-    DeviceInfo, DeviceToHost, FirmwareVersion, Flags, HostToDevice, LinkLossAction, LinkTimeout,
-    NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+    DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
+    LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+    Setting,
 };
+pub use range::check_request;
 
-/// This crate's protocol version: `major << 8 | minor` (1.0).
-pub const PROTOCOL_VERSION: u16 = 0x0100;
+/// This crate's protocol version: `major << 8 | minor` (2.0).
+pub const PROTOCOL_VERSION: u16 = 0x0200;
 
 /// Major part of a protocol version.
 #[inline]
@@ -79,10 +83,14 @@ pub const fn negotiated_minor(a: u16, b: u16) -> u8 {
 /// seq (≤ 3) + variant (1) + `SetFeet`/`SetJoints` (48) + CRC (2).
 pub const HOST_TO_DEVICE_MAX_LEN: usize = 3 + 1 + 48 + frame::CRC_LEN;
 
-/// Largest decoded [`DeviceToHost`] frame of this version (postcard bytes + CRC), bytes:
-/// variant (1) + seq (≤ 3) + angles (48) + pulses (12 × ≤ 3) + flags (1) + two counters
-/// (2 × ≤ 5) + CRC (2).
-pub const DEVICE_TO_HOST_MAX_LEN: usize = 1 + 3 + 48 + 12 * 3 + 1 + 2 * 5 + frame::CRC_LEN;
+/// Largest [`Readback`] in postcard bytes: angles (48) + pulses (12 × ≤ 3) + flags (1) + two
+/// counters (2 × ≤ 5).
+pub const READBACK_MAX_LEN: usize = 48 + 12 * 3 + 1 + 2 * 5;
+
+/// Largest decoded [`DeviceToHost`] frame of this version (postcard bytes + CRC), bytes: a
+/// [`DeviceToHost::Configured`] echoing a calibration — variant (1) + seq (≤ 3) + setting
+/// (variant 1 + servo 2 + calibration ≤ 18) + [`READBACK_MAX_LEN`] + CRC (2).
+pub const DEVICE_TO_HOST_MAX_LEN: usize = 1 + 3 + (1 + 2 + 18) + READBACK_MAX_LEN + frame::CRC_LEN;
 
 const _: () = assert!(HOST_TO_DEVICE_MAX_LEN <= MAX_DECODED_LEN);
 const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);

@@ -344,6 +344,50 @@ wire_enum! {
             /// Its calibration in RAM.
             calibration: servo::Calibration,
         },
+        /// Answer to a configuration request ([`Request::SetLinkTimeout`],
+        /// [`Request::SetPoseConfig`], [`Request::SetCalibration`]) that was carried out: the
+        /// setting as the device now holds it, so that a request corrupted into another valid
+        /// one does not go unnoticed, and the state after it.
+        4 => Configured {
+            /// The request's sequence number.
+            seq: u16,
+            /// The setting as applied.
+            setting: Setting,
+            /// The state after the request.
+            readback: Readback,
+        },
+    }
+}
+
+wire_enum! {
+    /// A configuration setting as the device holds it (the echo of [`DeviceToHost::Configured`]).
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub enum Setting {
+        /// The link-loss failsafe.
+        0 => LinkTimeout(LinkTimeout),
+        /// How body poses are interpreted.
+        1 => PoseConfig(PoseConfig),
+        /// One servo's calibration in RAM.
+        2 => Calibration {
+            /// Which servo.
+            servo: ServoId,
+            /// Its calibration.
+            calibration: servo::Calibration,
+        },
+    }
+}
+
+impl Setting {
+    /// The setting `request` asks for; `None` for a request that is not a configuration.
+    pub const fn of_request(request: &Request) -> Option<Setting> {
+        match *request {
+            Request::SetLinkTimeout(t) => Some(Setting::LinkTimeout(t)),
+            Request::SetPoseConfig(p) => Some(Setting::PoseConfig(p)),
+            Request::SetCalibration { servo, calibration } => {
+                Some(Setting::Calibration { servo, calibration })
+            }
+            _ => None,
+        }
     }
 }
 
@@ -354,7 +398,20 @@ impl DeviceToHost {
             DeviceToHost::Nack { seq, .. } => *seq,
             DeviceToHost::HelloAck { seq, .. }
             | DeviceToHost::Ack { seq, .. }
-            | DeviceToHost::Calibration { seq, .. } => Some(*seq),
+            | DeviceToHost::Calibration { seq, .. }
+            | DeviceToHost::Configured { seq, .. } => Some(*seq),
+        }
+    }
+
+    /// The readback an answer carries (`Ack`, `Configured`); `None` for the others.
+    pub const fn readback(&self) -> Option<&Readback> {
+        match self {
+            DeviceToHost::Ack { readback, .. } | DeviceToHost::Configured { readback, .. } => {
+                Some(readback)
+            }
+            DeviceToHost::Nack { .. }
+            | DeviceToHost::HelloAck { .. }
+            | DeviceToHost::Calibration { .. } => None,
         }
     }
 }
@@ -428,6 +485,57 @@ wire_enum! {
         12 => Storage,
         /// A configuration value is out of its admissible range.
         13 => InvalidArgument,
+        /// A finite value outside its field's admissible range ([`crate::range`]).
+        14 => OutOfRange {
+            /// The field.
+            field: Field,
+        },
+    }
+}
+
+wire_enum! {
+    /// A field of a request, as named by [`NackReason::OutOfRange`].
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Field {
+        /// `Pose::roll_rad`.
+        0 => BodyRoll,
+        /// `Pose::pitch_rad`.
+        1 => BodyPitch,
+        /// `Pose::yaw_rad`.
+        2 => BodyYaw,
+        /// `Pose::x_m`.
+        3 => BodyX,
+        /// `Pose::y_m`.
+        4 => BodyY,
+        /// `Pose::z_m`.
+        5 => BodyZ,
+        /// One foot of `SetFeet` (any of its coordinates).
+        6 => Foot(LegId as wire::leg_id),
+        /// One angle of `SetJoints`.
+        7 => JointAngle {
+            /// The leg.
+            leg: LegId as wire::leg_id,
+            /// The joint.
+            joint: Joint as wire::joint,
+        },
+        /// `PoseConfig::stance_height_m`.
+        8 => StanceHeight,
+    }
+}
+
+impl fmt::Display for Field {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Field::BodyRoll => f.write_str("roll_rad"),
+            Field::BodyPitch => f.write_str("pitch_rad"),
+            Field::BodyYaw => f.write_str("yaw_rad"),
+            Field::BodyX => f.write_str("x_m"),
+            Field::BodyY => f.write_str("y_m"),
+            Field::BodyZ => f.write_str("z_m"),
+            Field::Foot(leg) => write!(f, "foot {leg}"),
+            Field::JointAngle { leg, joint } => write!(f, "angle {leg}.{joint}"),
+            Field::StanceHeight => f.write_str("stance_height_m"),
+        }
     }
 }
 
@@ -480,6 +588,7 @@ impl fmt::Display for NackReason {
             NackReason::OutputsDisabled => f.write_str("outputs disabled"),
             NackReason::Storage => f.write_str("storage error"),
             NackReason::InvalidArgument => f.write_str("invalid argument"),
+            NackReason::OutOfRange { field } => write!(f, "out of range: {field}"),
         }
     }
 }

@@ -414,8 +414,9 @@ mod tests {
     use super::*;
     use crate::frame::{encode_frame, Accumulator, Feed, MAX_DECODED_LEN, MAX_FRAME_LEN};
     use crate::msg::{
-        DeviceInfo, DeviceToHost, FirmwareVersion, HostToDevice, LinkLossAction, LinkTimeout,
-        NackReason, PoseConfig, ReachFault, Request, RobotPreset, ServoId,
+        DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
+        LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+        Setting,
     };
     use crate::servo;
     use serde::de::DeserializeOwned;
@@ -438,6 +439,29 @@ mod tests {
             NackReason::OutputsDisabled => 11,
             NackReason::Storage => 12,
             NackReason::InvalidArgument => 13,
+            NackReason::OutOfRange { .. } => 14,
+        }
+    }
+
+    fn field_index(f: &Field) -> u8 {
+        match f {
+            Field::BodyRoll => 0,
+            Field::BodyPitch => 1,
+            Field::BodyYaw => 2,
+            Field::BodyX => 3,
+            Field::BodyY => 4,
+            Field::BodyZ => 5,
+            Field::Foot(_) => 6,
+            Field::JointAngle { .. } => 7,
+            Field::StanceHeight => 8,
+        }
+    }
+
+    fn setting_index(s: &Setting) -> u8 {
+        match s {
+            Setting::LinkTimeout(_) => 0,
+            Setting::PoseConfig(_) => 1,
+            Setting::Calibration { .. } => 2,
         }
     }
 
@@ -583,6 +607,9 @@ mod tests {
             NackReason::OutputsDisabled,
             NackReason::Storage,
             NackReason::InvalidArgument,
+            NackReason::OutOfRange {
+                field: Field::BodyZ,
+            },
         ]
         .into();
         // Nack | seq None (00) | reason ...
@@ -695,5 +722,55 @@ mod tests {
             joint: Joint::Knee,
         };
         check(h2d(Request::GetCalibration { servo }), 2, 2, 4);
+
+        let fields = [
+            Field::BodyRoll,
+            Field::BodyPitch,
+            Field::BodyYaw,
+            Field::BodyX,
+            Field::BodyY,
+            Field::BodyZ,
+            Field::Foot(LegId::RR),
+            Field::JointAngle {
+                leg: LegId::FR,
+                joint: Joint::Knee,
+            },
+            Field::StanceHeight,
+        ];
+        for (i, field) in fields.iter().enumerate() {
+            assert_eq!(usize::from(field_index(field)), i);
+            // Nack | seq None (00) | OutOfRange (0e) | field
+            let r = NackReason::OutOfRange { field: *field };
+            check(nack(r), 3, i as u8, fields.len() as u8);
+        }
+        let readback = Readback {
+            angles_rad: [0.5; 12],
+            pulses_half_us: [3000; 12],
+            flags: Flags(Flags::OUTPUTS_ENABLED),
+            frames_ok: 3,
+            frames_bad: 0,
+        };
+        let settings = [
+            Setting::LinkTimeout(LinkTimeout::default()),
+            Setting::PoseConfig(PoseConfig {
+                stance_height_m: 0.25,
+                order: RotationOrder::Zyx,
+                policy: ReachPolicy::Reject,
+            }),
+            Setting::Calibration {
+                servo,
+                calibration: servo::Calibration::default(),
+            },
+        ];
+        for (i, setting) in settings.iter().enumerate() {
+            assert_eq!(usize::from(setting_index(setting)), i);
+            // Configured (04) | seq | setting
+            let answer = DeviceToHost::Configured {
+                seq: 9,
+                setting: *setting,
+                readback,
+            };
+            check(answer, 2, i as u8, settings.len() as u8);
+        }
     }
 }

@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use quad_protocol::frame::Error;
 use quad_protocol::{
     encode_frame, servo, Accumulator, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction,
-    LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId, MAX_DECODED_LEN,
+    LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId, Setting, MAX_DECODED_LEN,
     MAX_FRAME_LEN,
 };
 use serde::Serialize;
@@ -377,15 +377,32 @@ fn encode_into_too_small_buffer_is_an_error_at_every_size() {
 #[test]
 fn largest_messages_fit_the_declared_bounds() {
     // Worst-case varints everywhere.
+    let readback = Readback {
+        angles_rad: [f32::MAX; 12],
+        pulses_half_us: [u16::MAX; 12],
+        flags: Flags(0xFF),
+        frames_ok: u32::MAX,
+        frames_bad: u32::MAX,
+    };
     let ack = DeviceToHost::Ack {
         seq: u16::MAX,
-        readback: Readback {
-            angles_rad: [f32::MAX; 12],
-            pulses_half_us: [u16::MAX; 12],
-            flags: Flags(0xFF),
-            frames_ok: u32::MAX,
-            frames_bad: u32::MAX,
+        readback,
+    };
+    // The largest answer: a calibration echo with a full readback.
+    let configured = DeviceToHost::Configured {
+        seq: u16::MAX,
+        setting: Setting::Calibration {
+            servo: ServoId::ALL[11],
+            calibration: servo::Calibration {
+                zero_rad: f32::MAX,
+                reversed: true,
+                us_per_rad: f32::MAX,
+                center_us: u16::MAX,
+                min_us: u16::MAX,
+                max_us: u16::MAX,
+            },
         },
+        readback,
     };
     let joints = HostToDevice {
         seq: u16::MAX,
@@ -401,7 +418,9 @@ fn largest_messages_fit_the_declared_bounds() {
     };
     let mut buf = [0u8; MAX_DECODED_LEN];
     let ack_len = postcard::to_slice(&ack, &mut buf).unwrap().len() + 2;
-    assert_eq!(ack_len, quad_protocol::DEVICE_TO_HOST_MAX_LEN);
+    let configured_len = postcard::to_slice(&configured, &mut buf).unwrap().len() + 2;
+    assert_eq!(configured_len, quad_protocol::DEVICE_TO_HOST_MAX_LEN);
+    assert!(ack_len < configured_len);
     let joints_len = postcard::to_slice(&joints, &mut buf).unwrap().len() + 2;
     assert_eq!(joints_len, quad_protocol::HOST_TO_DEVICE_MAX_LEN);
     let nack_len = postcard::to_slice(&nack, &mut buf).unwrap().len() + 2;
@@ -410,6 +429,10 @@ fn largest_messages_fit_the_declared_bounds() {
     assert_eq!(
         encode_frame(&ack, &mut wire).unwrap().len(),
         quad_protocol::frame::encoded_len_max(ack_len)
+    );
+    assert_eq!(
+        encode_frame(&configured, &mut wire).unwrap().len(),
+        quad_protocol::frame::encoded_len_max(configured_len)
     );
 }
 

@@ -80,7 +80,14 @@ fn every_request_has_its_golden_bytes() {
 #[test]
 fn every_answer_has_its_golden_bytes() {
     let cases = answers();
-    let variants = ["Nack UnknownVersion", "HelloAck", "Ack", "Calibration"];
+    let variants = [
+        "Nack UnknownVersion",
+        "HelloAck",
+        "Ack",
+        "Calibration",
+        "Configured",
+        "Nack OutOfRange",
+    ];
     for v in variants {
         assert!(cases.iter().any(|(n, _, _)| *n == v), "{v} has no golden");
     }
@@ -91,38 +98,39 @@ fn every_answer_has_its_golden_bytes() {
 
 #[test]
 fn hand_written_frames() {
-    // Hello: payload 01 00 80 02, CRC 0xC9AE → 01 00 80 02 c9 ae → COBS 02 01 | 05 80 02 c9 ae,
+    // Hello: payload 01 00 80 02, CRC 0x3651 → 01 00 80 02 36 51 → COBS 02 01 | 05 80 02 36 51,
     // between two delimiters.
     let mut buf = [0u8; MAX_FRAME_LEN];
     let hello = h2d(1, Request::Hello { version: 0x0100 });
     assert_eq!(
         to_hex(encode_frame(&hello, &mut buf).unwrap()),
-        "00 02 01 05 80 02 c9 ae 00"
+        "00 02 01 05 80 02 36 51 00"
     );
-    // GetState seq 300: ac 02 01 + CRC 0x7222, no zero → one block of 5.
+    // GetState seq 300: ac 02 01 + CRC 0x8DDD, no zero → one block of 5.
     let get = h2d(300, Request::GetState);
     assert_eq!(
         to_hex(encode_frame(&get, &mut buf).unwrap()),
-        "00 06 ac 02 01 72 22 00"
+        "00 06 ac 02 01 8d dd 00"
     );
-    // Nack BadCrc: 00 00 01 + CRC 0xDCBD → two empty blocks, then 01 dc bd.
+    // Nack BadCrc: 00 00 01 + CRC 0x2342 → two empty blocks, then 01 23 42.
     let nack = DeviceToHost::Nack {
         seq: None,
         reason: NackReason::BadCrc,
     };
     assert_eq!(
         to_hex(encode_frame(&nack, &mut buf).unwrap()),
-        "00 01 01 04 01 dc bd 00"
+        "00 01 01 04 01 23 42 00"
     );
 }
 
 #[test]
-fn version_is_one_zero() {
-    assert_eq!(PROTOCOL_VERSION, 0x0100);
-    assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 1);
+fn version_is_two_zero() {
+    assert_eq!(PROTOCOL_VERSION, 0x0200);
+    assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
     assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 0);
-    assert!(quad_protocol::is_compatible(0x0107));
-    assert!(!quad_protocol::is_compatible(0x0200));
+    assert!(quad_protocol::is_compatible(0x0207));
+    assert!(!quad_protocol::is_compatible(0x0100));
+    assert!(!quad_protocol::is_compatible(0x0300));
     assert!(!quad_protocol::is_compatible(0x0001));
 }
 

@@ -37,7 +37,7 @@ fn hello_with_the_same_major_is_acked_whatever_the_minor() {
 #[test]
 fn hello_with_another_major_is_nacked_with_the_device_version() {
     let dev = info(PROTOCOL_VERSION);
-    for host in [0x0000, 0x00FF, 0x0200, 0xFF00] {
+    for host in [0x0000, 0x00FF, 0x0100, 0x0300, 0xFF00] {
         assert_eq!(
             dev.answer_hello(3, host),
             DeviceToHost::Nack {

@@ -246,7 +246,12 @@ impl Plan {
                 (f.pose, f.feet_in_world, f.contact)
             }
         };
-        let r = rotation::matrix(self.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+        let r = rotation::matrix::<kin_core::DefaultMath>(
+            self.order,
+            pose.roll_rad,
+            pose.pitch_rad,
+            pose.yaw_rad,
+        );
         let t = pose.translation();
         Ok(Target {
             pose,

@@ -274,6 +274,12 @@ impl<L: Link> Session<L> {
             stance_height_m,
             ..self.pose_config
         };
+        quad_protocol::range::check_pose_config(&config, &self.robot).map_err(|reason| {
+            Error::Stance {
+                stance_height_m,
+                reason,
+            }
+        })?;
         let (pose, id) = self.pose.unwrap_or((Pose::rotation(0.0, 0.0, 0.0), 0));
         if let Expected::Nack(reason) = expected(&self.robot, &config, &self.calibration, &pose) {
             return Err(Error::Stance {

@@ -77,8 +77,9 @@ pub fn main(args: &Args) -> ExitCode {
     let mut target = describe_info(&run.info);
     if let Some(mcu) = run.mcu {
         target.push_str(&format!(
-            "\n  MCU: {} resets, stack peak {} B",
-            mcu.resets, mcu.stack_peak_bytes
+            "\n  MCU: {} resets, stack peak {} B, longest interrupts-off stretch while receiving \
+             {} cycles",
+            mcu.resets, mcu.stack_peak_bytes, mcu.interrupts_off_receiving_cycles
         ));
     }
     if let Err(e) = print_summary(
@@ -146,6 +147,12 @@ fn print_summary(
             }
         }
         _ => writeln!(out, "  pins: not measured (real board)")?,
+    }
+    if let Some(n) = s.rx_overruns {
+        writeln!(
+            out,
+            "  receive: {n} bytes lost by the chip's two-byte receive buffer (data overruns)"
+        )?;
     }
     writeln!(
         out,

@@ -33,16 +33,17 @@ on stderr as <input>:<line>: ...
 Output: the last line of stdout is one JSON object:
 {\"sent\",\"acked\",\"nacked\",\"retries\",\"lost\",\"readback_mismatches\",\"max_angle_err_rad\",
 \"pulses_out_of_range\",\"poses_per_s\", then transient_mismatches (answers a retry corrected),
-timeouts, elapsed_s (link time) and reenabled}; with --emulator also pulses_checked and
-pulse_width_errors: every pulse measured on the 12 servo pins compared with the readback in
+timeouts, elapsed_s (link time) and reenabled}; with --emulator also rx_overruns (bytes the
+chip's two-byte receive buffer lost because the firmware did not read them in time), pulses_checked
+and pulse_width_errors: every pulse measured on the 12 servo pins compared with the readback in
 force when it started (the last one sent before it, or the next), an error when it differs by
 more than one 0.5 us timer tick. poses_per_s counts acked + nacked poses per second of link time
 (simulated time with --sim and --emulator).
 
 Exit status: 0 all poses answered or lost, every check passed; 1 malformed input records (the
 others were streamed); 2 nothing or not everything could be streamed (arguments, robot, input,
-link, firmware build, handshake); 3 a readback mismatch, a pulse out of its travel or a pulse
-width error on the pins.";
+link, firmware build, handshake); 3 a readback mismatch, a pulse out of its travel, a pulse
+width error on the pins or a receive overrun.";
 
 /// Arguments of `quadctl stream`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]

@@ -197,10 +197,7 @@ impl Motion for Sway {
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig {
-            order: self.p.order,
-            pivot_m: Vec3::ZERO,
-        }
+        BodyConfig::about_centre(self.p.order)
     }
 
     fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
@@ -384,10 +381,7 @@ impl Motion for YawTurn {
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig {
-            order: self.p.order,
-            pivot_m: Vec3::ZERO,
-        }
+        BodyConfig::about_centre(self.p.order)
     }
 
     fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {

@@ -19,6 +19,11 @@ pub const BENCH: &str = "bench";
 /// The cycle benchmark of the straightforward build (Rust libm, soft-float).
 pub const BENCH_LIBM: &str = "bench-libm";
 
+/// Test only, defective on purpose: the 1 Mbaud firmware whose receive path keeps interrupts
+/// off too long (`firmware-avr/src/bin/firmware_1mbaud_cli_hold.rs`); the emulator tests show
+/// that the emulated USART catches it.
+pub const FIRMWARE_1MBAUD_CLI_HOLD: &str = "firmware-1mbaud-cli-hold";
+
 /// The firmware binary that runs at `baud`, if there is one.
 pub fn firmware_for_baud(baud: u32) -> Option<&'static str> {
     match baud {

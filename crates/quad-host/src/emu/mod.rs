@@ -20,7 +20,7 @@ pub mod elf;
 #[allow(unsafe_code)]
 mod simavr;
 
-pub use simavr::{EmuError, Mega2560, Pulse, Resets, EEPROM_LEN};
+pub use simavr::{EmuError, InterruptsOff, Mega2560, Pulse, Resets, EEPROM_LEN};
 
 /// CPU clock of the Mega 2560, Hz.
 pub const F_CPU_HZ: u32 = 16_000_000;

@@ -6,11 +6,23 @@
 //! registers, the EEPROM, reset detection and setting the program counter.
 //!
 //! Simulator facts that matter (simavr as vendored by `simavr-ffi` 1.2):
-//! - USART: received bytes are delivered at the rate the firmware configured (UBRR, U2X, frame
-//!   format), one per byte time; simavr holds them in a 64-byte FIFO with XON/XOFF towards the
-//!   host instead of overrunning (a real USART would drop bytes that the firmware does not read
-//!   in time). A transmitted byte is reported when the firmware writes it to UDR; it has
-//!   crossed the line one byte time later.
+//! - USART receive, **as strict as the chip**: simavr itself holds received bytes in a 64-byte
+//!   FIFO and never overruns; the ATmega2560 holds two plus the one in its shift register.
+//!   [`Mega2560`] therefore paces the bytes handed to [`Mega2560::uart_write`] itself, one per
+//!   byte time (simavr's `cycles_per_byte`, back to back), handing each to simavr when it starts
+//!   on the line; simavr raises RXC one byte time later, when its stop bit has arrived. When a
+//!   byte starts while the two-byte buffer is full and the previous byte waits in the shift
+//!   register — three complete bytes unread in simavr's FIFO — that previous byte is lost as
+//!   the chip loses it: removed from the FIFO, counted ([`Mega2560::rx_overruns`]), and the
+//!   data-overrun flag DOR0 set in UCSR0A until the firmware next reads UDR0 (simavr would
+//!   clear it on any write to UCSR0A; the chip does not, so it is set again after every step).
+//!   A transmitted byte is reported when the firmware writes it to UDR; it has crossed the line
+//!   one byte time later.
+//! - Interrupt latency: after every step the global interrupt flag (SREG.I) is read — from
+//!   simavr's own flag array, as the SREG byte of the data space is only updated when the
+//!   program reads it; the longest stretch with interrupts off — interrupt handlers included,
+//!   which run with I clear — is kept, overall and while bytes are arriving or waiting unread
+//!   ([`Mega2560::interrupts_off`]).
 //! - Output-compare pins are driven through the port registers, so the PORT bits show the pin
 //!   levels; a pin whose DDR bit is clear is not driven (reads as low here).
 //! - The watchdog resets the MCU (MCUSR.WDRF set) and simavr restarts its cycle counter at 0;
@@ -55,6 +67,13 @@ pub const EEPROM_LEN: usize = 4096;
 
 /// Data-space addresses of USART0's registers.
 const UCSR0A: u16 = 0xC0;
+const UDR0: u16 = 0xC6;
+/// UCSR0A's data-overrun flag.
+const UCSR0A_DOR0: u8 = 1 << 3;
+/// Slots of simavr's USART receive FIFO (`DECLARE_FIFO(uint16_t, uart_fifo, 64)`).
+const RX_FIFO_SLOTS: u16 = 64;
+/// The global interrupt flag's bit in SREG (simavr's `sreg[S_I]`).
+const SREG_I_BIT: usize = 7;
 const UCSR0B: u16 = 0xC1;
 const UBRR0L: u16 = 0xC4;
 const UBRR0H: u16 = 0xC5;
@@ -167,6 +186,19 @@ impl Pulse {
     }
 }
 
+/// The longest stretches with interrupts off (SREG.I clear, interrupt handlers included).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct InterruptsOff {
+    /// The longest, cycles.
+    pub longest_cycles: u64,
+    /// The longest during which bytes were arriving or waiting unread in the receiver, cycles.
+    pub longest_receiving_cycles: u64,
+    /// Where that one began ([`Mega2560::cycle`]).
+    pub longest_receiving_at_cycle: u64,
+    /// The program counter (byte address) at which it began.
+    pub longest_receiving_pc: u32,
+}
+
 /// Resets seen since the simulator was created.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Resets {
@@ -214,8 +246,18 @@ pub struct Mega2560 {
     avr: NonNull<ffi::avr_t>,
     hooks: NonNull<Hooks>,
     uart_in: NonNull<ffi::avr_irq_t>,
-    /// Bytes for USART0's receiver not yet taken by simavr (XOFF).
+    /// Bytes for USART0's receiver not yet on the line.
     input: VecDeque<u8>,
+    /// Cycle from which the next byte may start on the host → device line.
+    rx_line_free: u64,
+    /// Bytes the receive buffer lost (overruns).
+    rx_overruns: u64,
+    /// simavr's FIFO read index when the last overrun happened, while its DOR0 is owed.
+    dor_owed: Option<u16>,
+    /// The interrupts-off stretch in progress: its first cycle, the program counter there and
+    /// whether bytes were arriving during it.
+    cli_since: Option<(u64, u32, bool)>,
+    interrupts_off: InterruptsOff,
     /// simavr's cycle counter after the last step.
     last_raw: u64,
     resets: Resets,
@@ -319,6 +361,11 @@ impl Mega2560 {
                 hooks,
                 uart_in,
                 input: VecDeque::new(),
+                rx_line_free: 0,
+                rx_overruns: 0,
+                dor_owed: None,
+                cli_since: None,
+                interrupts_off: InterruptsOff::default(),
                 last_raw: (*avr.as_ptr()).cycle,
                 resets: Resets::default(),
                 levels: 0,
@@ -366,6 +413,7 @@ impl Mega2560 {
     pub fn step(&mut self) -> Result<u64, EmuError> {
         self.feed_uart();
         let before = self.cycle();
+        let pc_before = self.pc();
         // SAFETY: a valid, initialised simulator; hooks registered with live parameters.
         let state = unsafe { ffi::avr_run(self.avr.as_ptr()) } as u32;
         let raw = self.avr().cycle;
@@ -399,6 +447,8 @@ impl Mega2560 {
         let hooks = unsafe { self.hooks.as_mut() };
         self.output.extend(hooks.out.drain(..));
         self.fix_ocr_writes();
+        self.owe_dor();
+        self.track_interrupts_off(before, pc_before);
         let step = self.cycle().saturating_sub(before).max(1);
         self.track_servos(step);
         let sp = self.sp();
@@ -429,26 +479,145 @@ impl Mega2560 {
         self.run_cycles(us * CYCLES_PER_US)
     }
 
-    /// Hands bytes to USART0's receiver; simavr delivers them at the firmware's line rate,
-    /// back to back, starting now.
+    /// Hands bytes to USART0's receiver: they go on the line back to back at the firmware's
+    /// line rate, starting now (or when the bytes before them are through), and reach the
+    /// receiver as the chip's would (see the module docs: a byte the firmware is too slow for
+    /// is lost).
     pub fn uart_write(&mut self, bytes: &[u8]) {
         self.input.extend(bytes);
         self.feed_uart();
     }
 
-    /// Bytes handed to [`Mega2560::uart_write`] that simavr has not taken yet.
+    /// Bytes handed to [`Mega2560::uart_write`] that have not started on the line yet.
     pub fn uart_input_pending(&self) -> usize {
         self.input.len()
     }
 
+    /// Bytes the receive buffer lost since power-on because the firmware did not read them in
+    /// time (data overruns, see the module docs).
+    pub fn rx_overruns(&self) -> u64 {
+        self.rx_overruns
+    }
+
+    /// The longest interrupts-off stretches seen since power-on (or the last
+    /// [`Mega2560::reset_interrupts_off`]).
+    pub fn interrupts_off(&self) -> InterruptsOff {
+        self.interrupts_off
+    }
+
+    /// Forgets the interrupts-off stretches seen so far (e.g. those of the boot code).
+    pub fn reset_interrupts_off(&mut self) {
+        self.interrupts_off = InterruptsOff::default();
+        self.cli_since = None;
+    }
+
+    /// simavr's USART0 (the parameter of its UDR0 read handler).
+    fn uart0(&self) -> *mut ffi::avr_uart_t {
+        // SAFETY: the I/O table is part of the live simulator; UDR0 has a read handler
+        // registered by simavr's USART0 module, whose parameter is its `avr_uart_t`.
+        unsafe {
+            (*self.avr.as_ptr()).io[usize::from(UDR0) - 0x20]
+                .r
+                .param
+                .cast()
+        }
+    }
+
+    /// simavr's receive FIFO: bytes in it (received or arriving, not yet read by the firmware)
+    /// and its read index.
+    fn rx_fifo(&self) -> (u16, u16) {
+        let uart = self.uart0();
+        if uart.is_null() {
+            return (0, 0);
+        }
+        // SAFETY: a live `avr_uart_t`; nothing runs inside simavr now.
+        let fifo = unsafe { &(*uart).input };
+        let len = fifo.write.wrapping_sub(fifo.read) & (RX_FIFO_SLOTS - 1);
+        (len, fifo.read)
+    }
+
+    /// One byte time on the line as simavr's receiver counts it, cycles (0 before the firmware
+    /// configured USART0).
+    fn rx_byte_cycles(&self) -> u64 {
+        let uart = self.uart0();
+        if uart.is_null() {
+            return 0;
+        }
+        // SAFETY: as in `rx_fifo`.
+        unsafe { (*uart).cycles_per_byte }
+    }
+
+    /// Puts the bytes whose line slot has come into simavr's receiver, applying the chip's
+    /// overrun (see the module docs).
     fn feed_uart(&mut self) {
-        // SAFETY: `xon` is only written by hooks, which run inside `avr_raise_irq` below.
-        while unsafe { self.hooks.as_ref().xon } {
+        let now = self.cycle();
+        let byte_cycles = self.rx_byte_cycles().max(1);
+        while !self.input.is_empty() && self.rx_line_free <= now {
+            let (unread, read_index) = self.rx_fifo();
+            if unread >= 3 {
+                // Two bytes in the buffer, one complete in the shift register, and a new start
+                // bit: the shift register's byte — the newest in the FIFO — is lost.
+                let uart = self.uart0();
+                // SAFETY: as in `rx_fifo`; the newest entry is dropped by moving the write
+                // index back one slot.
+                unsafe {
+                    let fifo = &mut (*uart).input;
+                    fifo.write = fifo.write.wrapping_sub(1) & (RX_FIFO_SLOTS - 1);
+                }
+                self.rx_overruns += 1;
+                self.dor_owed = Some(read_index);
+            }
             let Some(b) = self.input.pop_front() else {
                 break;
             };
-            // SAFETY: a valid IRQ of this simulator; the hooks may run and update `xon`.
+            // SAFETY: a valid IRQ of this simulator.
             unsafe { ffi::avr_raise_irq(self.uart_in.as_ptr(), u32::from(b)) };
+            self.rx_line_free = self.rx_line_free.max(now) + byte_cycles;
+        }
+        self.owe_dor();
+    }
+
+    /// Keeps DOR0 set after an overrun until the firmware reads UDR0 (see the module docs).
+    fn owe_dor(&mut self) {
+        let Some(read_at_overrun) = self.dor_owed else {
+            return;
+        };
+        if self.rx_fifo().1 != read_at_overrun {
+            self.dor_owed = None;
+            return;
+        }
+        let avr = self.avr.as_ptr();
+        // SAFETY: UCSR0A is within the data space; nothing runs inside simavr now.
+        unsafe { *(*avr).data.add(usize::from(UCSR0A)) |= UCSR0A_DOR0 };
+    }
+
+    /// True while bytes are on their way to the receiver or wait unread in it.
+    fn receiving(&self) -> bool {
+        !self.input.is_empty() || self.cycle() < self.rx_line_free || self.rx_fifo().0 > 0
+    }
+
+    /// Follows SREG.I after a step that started at cycle `before` at program counter `pc`.
+    fn track_interrupts_off(&mut self, before: u64, pc: u32) {
+        // simavr keeps the flags in `sreg[]` and updates SREG's data byte only when the program
+        // reads it.
+        let off = self.avr().sreg[SREG_I_BIT] == 0;
+        let receiving = self.receiving();
+        match (&mut self.cli_since, off) {
+            (None, true) => self.cli_since = Some((before, pc, receiving)),
+            (Some((_, _, seen)), true) => *seen |= receiving,
+            (Some((start, at_pc, seen)), false) => {
+                let (start, at_pc, seen) = (*start, *at_pc, *seen);
+                self.cli_since = None;
+                let len = self.cycle() - start;
+                let s = &mut self.interrupts_off;
+                s.longest_cycles = s.longest_cycles.max(len);
+                if seen && len > s.longest_receiving_cycles {
+                    s.longest_receiving_cycles = len;
+                    s.longest_receiving_at_cycle = start;
+                    s.longest_receiving_pc = at_pc;
+                }
+            }
+            (None, false) => {}
         }
     }
 

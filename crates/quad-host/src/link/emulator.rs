@@ -3,16 +3,19 @@
 //! ## Timing
 //! Time is the emulated MCU's cycle counter (16 MHz); nothing sleeps, and simavr runs slower
 //! than real time, so every rate measured on this link is in **simulated** time.
-//! - **Host → device**: [`Link::send`] puts a frame on the line at the current cycle; simavr's
-//!   USART model delivers its bytes at the line rate the firmware configured (checked against
-//!   [`EmulatorConfig::baud`] at boot), one per byte time of [`SIMAVR_BITS_PER_BYTE`] bits.
+//! - **Host → device**: [`Link::send`] puts a frame on the line at the current cycle; its bytes
+//!   reach the firmware at the line rate it configured (checked against
+//!   [`EmulatorConfig::baud`] at boot), one per byte time of [`SIMAVR_BITS_PER_BYTE`] bits,
+//!   through a receiver as strict as the chip's: two bytes of buffer plus the shift register,
+//!   a byte the firmware does not read in time is lost and counted (data overrun, see
+//!   [`crate::emu::Mega2560`]; [`EmulatorLink::rx_overruns`], `LineStats::rx_overflow`).
 //! - **Device → host**: a byte the firmware writes to UDR0 arrives one byte time later (simavr
 //!   paces the transmitter at the same byte time).
 //!   [`Link::recv`] runs the MCU until a byte has arrived (or the timeout passed) and returns
 //!   the bytes up to the end of that frame.
-//! - The firmware's own timing (IK, answer encoding, polled transmission, EEPROM writes of
-//!   3.4 ms per byte, its 1 kHz clock and link-loss failsafe) is emulated instruction by
-//!   instruction.
+//! - The firmware's own timing (IK, answer encoding, interrupt-driven transmission, EEPROM
+//!   writes of 3.4 ms per byte, its 1 kHz clock and link-loss failsafe) is emulated instruction
+//!   by instruction.
 //!
 //! ## Faults
 //! [`Faults`] apply to both directions, drawn from one seeded generator: per frame a stall, a
@@ -23,9 +26,11 @@
 //! ## Pin check
 //! Every pulse on the twelve servo pins (Timer1/3/4/5 incl. port L) is measured and compared
 //! with the readbacks the firmware sent (decoded from its UART output before any line fault):
-//! the device writes the compare registers before it answers, and the hardware takes them over
-//! at the start of a period, so a pulse that starts at cycle `t` must be as wide as the pulses
-//! of the last readback sent before `t` or of the next one, within one timer tick (0.5 µs). A
+//! the device writes the compare registers between pulses — before it answers, or, when the
+//! request came during the pulses, after them and before the period ends — and the hardware
+//! takes them over at the start of a period, so a pulse that starts at cycle `t` must be as wide
+//! as the pulses of the last readback sent before `t` or of the next one, within one timer tick
+//! (0.5 µs). A
 //! pulse while both say the outputs are off, or at power-on before any answer, is an error
 //! too. See [`PulseStats`].
 
@@ -177,7 +182,7 @@ impl PulseCheck {
                 Feed::NeedMore => break,
                 Feed::Frame { msg, remaining } => {
                     rest = remaining;
-                    if let DeviceToHost::Ack { readback, .. } = msg {
+                    if let Some(readback) = msg.readback() {
                         let on = readback.flags.contains(Flags::OUTPUTS_ENABLED);
                         self.expects.push_back(Expect {
                             start_cycle: self.frame_start_cycle,
@@ -382,9 +387,18 @@ impl EmulatorLink {
         &self.config
     }
 
-    /// What the line did so far.
+    /// What the line did so far; `rx_overflow` counts the bytes the chip's receive buffer
+    /// lost (data overruns, see [`crate::emu::Mega2560::rx_overruns`]).
     pub fn line_stats(&self) -> LineStats {
-        self.stats
+        LineStats {
+            rx_overflow: self.mcu.rx_overruns(),
+            ..self.stats
+        }
+    }
+
+    /// Bytes the chip's receive buffer lost because the firmware did not read them in time.
+    pub fn rx_overruns(&self) -> u64 {
+        self.mcu.rx_overruns()
     }
 
     /// The pin check so far, with every pulse judged that can be (pulses that started after

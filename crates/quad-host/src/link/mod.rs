@@ -391,8 +391,8 @@ pub struct LineStats {
     pub truncated: u64,
     /// Stalls.
     pub stalls: u64,
-    /// Bytes lost because the simulated device's receive FIFO was full (always 0 on the
-    /// emulator, whose firmware counts its own overruns).
+    /// Bytes lost because the device's receive buffer was full: the simulated device's FIFO,
+    /// or on the emulator the chip's two-byte buffer (data overruns).
     pub rx_overflow: u64,
 }
 

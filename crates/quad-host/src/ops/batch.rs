@@ -56,10 +56,11 @@ pub fn ik(
     } else {
         IK_OUTPUT_HEADER
     };
+    let solver = leg::Solver::new(robot);
     csv::for_each_row(input, IK_INPUT, out, diag, Some(header), |row, out| {
         let leg = row.leg(0)?;
         let foot_in_hip = Vec3::new(row.number(1)?, row.number(2)?, row.number(3)?);
-        match leg::inverse(robot, leg, foot_in_hip, policy) {
+        match solver.inverse(leg, foot_in_hip, policy) {
             Ok(solution) => {
                 let q = solution.angles;
                 write!(
@@ -170,14 +171,14 @@ pub fn pose(
         PoseFormat::Csv => POSE_OUTPUT_HEADER.to_owned(),
         PoseFormat::Table => table_preamble(robot_name, robot, stance_height_m, config),
     };
+    let solver = body::Solver::new(robot);
     csv::for_each_row(input, POSE_INPUT, out, diag, Some(&header), |row, out| {
         let mut v = [0.0f32; 6];
         for (i, slot) in v.iter_mut().enumerate() {
             *slot = row.number(i)?;
         }
         let pose = Pose::from_array(v);
-        let result =
-            body::inverse_at_stance(robot, &pose, config, stance_height_m, ReachPolicy::Reject);
+        let result = solver.inverse_at_stance(&pose, config, stance_height_m, ReachPolicy::Reject);
         match format {
             PoseFormat::Csv => write_csv(out, &result)?,
             PoseFormat::Table => write_table(out, row.line, &pose, &result)?,

@@ -85,6 +85,8 @@ pub struct Summary {
     pub pulse_width_errors: Option<u64>,
     /// The first pulse error, described.
     pub first_pulse_error: Option<String>,
+    /// Bytes the chip's receive buffer lost (emulator only).
+    pub rx_overruns: Option<u64>,
     /// Answered poses per second of link time.
     pub poses_per_s: f64,
     /// Mean command → readback time, link time.
@@ -104,6 +106,7 @@ impl Summary {
             && self.mismatches == 0
             && self.pulse_width_errors.unwrap_or(0) == 0
             && self.pulses_checked != Some(0)
+            && self.rx_overruns.unwrap_or(0) == 0
     }
 }
 
@@ -177,6 +180,8 @@ pub struct Mcu {
     pub resets: u32,
     /// Deepest stack, bytes.
     pub stack_peak_bytes: u16,
+    /// The longest stretch with interrupts off while bytes were arriving, cycles.
+    pub interrupts_off_receiving_cycles: u64,
 }
 
 /// What the demo did.
@@ -261,9 +266,11 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
         summary.pulses_checked = Some(pulses.checked);
         summary.pulse_width_errors = Some(pulses.errors);
         summary.first_pulse_error = pulses.first_error;
+        summary.rx_overruns = Some(link.rx_overruns());
         Mcu {
             resets: link.mcu().resets().count,
             stack_peak_bytes: link.mcu().stack_peak_bytes(),
+            interrupts_off_receiving_cycles: link.mcu().interrupts_off().longest_receiving_cycles,
         }
     });
     Ok(Demo {
@@ -289,14 +296,14 @@ mod tests {
         assert!((max(|q| q.yaw_rad).to_degrees() - 21.0).abs() < 0.5);
         let robot = Robot::shahriar2023();
         for q in &p {
-            kin_core::body::inverse_at_stance(
-                &robot,
-                q,
-                &kin_core::BodyConfig::default(),
-                SEED000_SWEEP_STANCE_HEIGHT_M,
-                kin_core::ReachPolicy::Reject,
-            )
-            .expect("every demo pose is reachable");
+            kin_core::body::Solver::new(&robot)
+                .inverse_at_stance(
+                    q,
+                    &kin_core::BodyConfig::default(),
+                    SEED000_SWEEP_STANCE_HEIGHT_M,
+                    kin_core::ReachPolicy::Reject,
+                )
+                .expect("every demo pose is reachable");
         }
     }
 }

@@ -427,6 +427,7 @@ pub fn write_motion<T: Motion>(
     let keep_every = (n as usize).div_ceil(plot::MAX_POINTS).max(1) as u32;
     let rate = f64::from(sweep.rate_hz());
     let config = m.body_config();
+    let solver = body::Solver::new(m.robot());
     let mut line = String::with_capacity(512);
     let (mut ryu32, mut ryu64) = (ryu::Buffer::new(), ryu::Buffer::new());
     let mut w = Written::default();
@@ -434,8 +435,7 @@ pub fn write_motion<T: Motion>(
         let t64 = f64::from(k) / rate;
         let t = sweep.time_s(k);
         let frame = m.frame(t).map_err(param_err)?;
-        let sol = body::inverse(
-            m.robot(),
+        let sol = solver.inverse(
             &frame.pose,
             &config,
             &frame.feet_in_world,

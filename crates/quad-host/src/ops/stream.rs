@@ -68,9 +68,12 @@ pub enum Error {
     Tolerance(f32),
 }
 
-/// The pin check of the emulator, in the summary.
+/// The emulator's checks of the chip, in the summary: the receive buffer and the pins.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Pins {
+    /// Bytes the chip's two-byte receive buffer lost because the firmware did not read them in
+    /// time (data overruns).
+    pub rx_overruns: u64,
     /// Pulses measured on the 12 servo pins and compared with the readbacks.
     pub pulses_checked: u64,
     /// Pulses off their readback by more than one 0.5 µs timer tick.
@@ -90,12 +93,14 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// True when a readback disagreed with the host, a pulse left its travel or a pulse on
-    /// the pins matched no readback.
+    /// True when a readback disagreed with the host, a pulse left its travel, a pulse on
+    /// the pins matched no readback or the chip's receive buffer overran.
     pub fn check_failed(&self) -> bool {
         self.stream.readback_mismatches > 0
             || self.stream.pulses_out_of_range > 0
-            || self.pins.is_some_and(|p| p.pulse_width_errors > 0)
+            || self
+                .pins
+                .is_some_and(|p| p.pulse_width_errors > 0 || p.rx_overruns > 0)
     }
 }
 
@@ -181,7 +186,16 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
             writeln!(diag.borrow_mut(), "{name}: PULSE WIDTH ERROR: {e}")
                 .map_err(|source| csv::Error::Write { path: None, source })?;
         }
+        let rx_overruns = emu.rx_overruns();
+        if rx_overruns > 0 {
+            writeln!(
+                diag.borrow_mut(),
+                "{name}: RECEIVE OVERRUN: {rx_overruns} bytes lost by the chip's receive buffer"
+            )
+            .map_err(|source| csv::Error::Write { path: None, source })?;
+        }
         pins = Some(Pins {
+            rx_overruns,
             pulses_checked: pulses.checked,
             pulse_width_errors: pulses.errors,
         });
@@ -226,6 +240,7 @@ mod tests {
             "{json}"
         );
         summary.pins = Some(Pins {
+            rx_overruns: 0,
             pulses_checked: 7,
             pulse_width_errors: 0,
         });
@@ -234,5 +249,6 @@ mod tests {
             json.ends_with(",\"pulses_checked\":7,\"pulse_width_errors\":0}"),
             "{json}"
         );
+        assert!(json.contains(",\"rx_overruns\":0,"), "{json}");
     }
 }

@@ -6,8 +6,9 @@
 
 use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 use quad_protocol::{
-    servo, DeviceInfo, DeviceToHost, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
+    servo, DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
     LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+    Setting,
 };
 
 pub fn h2d(seq: u16, request: Request) -> HostToDevice {
@@ -231,6 +232,17 @@ pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
             "00 01 0e 09 04",
         ),
         (
+            "Nack OutOfRange",
+            // variant 0 | Some, seq 15 | reason 14 = 0e | Foot = 6 | RL = 2
+            DeviceToHost::Nack {
+                seq: Some(15),
+                reason: NackReason::OutOfRange {
+                    field: Field::Foot(LegId::RL),
+                },
+            },
+            "00 01 0f 0e 06 02",
+        ),
+        (
             "HelloAck",
             // variant 1 | seq 1 | version 80 02 | fw 0.1.0 | Fernando2025 = 1 | 128 = 80 01 |
             // 0.5 m, Zyx = 5, Reject = 0 | 250 ms = fa 01, Hold = 0
@@ -296,6 +308,32 @@ pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
                 calibration: CAL,
             },
             "03 03 01 02 00 00 80 3d 01 00 00 20 44 f0 0b e8 07 d0 0f",
+        ),
+        (
+            "Configured",
+            // variant 4 | seq 6 | setting LinkTimeout = 0 | 250 ms = fa 01, Disable = 1 |
+            // readback: 12 angles 0 | pulses 3000 = b8 17 | flags 0x08 | frames_ok 7 | bad 0
+            DeviceToHost::Configured {
+                seq: 6,
+                setting: Setting::LinkTimeout(LinkTimeout {
+                    timeout_ms: 250,
+                    action: LinkLossAction::Disable,
+                }),
+                readback: Readback {
+                    angles_rad: [0.0; 12],
+                    pulses_half_us: [3000; 12],
+                    flags: Flags(Flags::FAILSAFE_ACTIVE),
+                    frames_ok: 7,
+                    frames_bad: 0,
+                },
+            },
+            "04 06 00 fa 01 01 \
+             00 00 00 00 00 00 00 00 00 00 00 00 \
+             00 00 00 00 00 00 00 00 00 00 00 00 \
+             00 00 00 00 00 00 00 00 00 00 00 00 \
+             00 00 00 00 00 00 00 00 00 00 00 00 \
+             b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 \
+             08 07 00",
         ),
     ]
 }

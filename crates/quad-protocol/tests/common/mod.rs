@@ -1,4 +1,4 @@
-//! Independent reference implementations for the tests: a table-driven CRC-16/IBM-3740 and a
+//! Independent reference implementations for the tests: a table-driven CRC-16/GENIBUS and a
 //! batch COBS encoder/decoder written from the COBS paper (Cheshire & Baker 1999), sharing no
 //! code with the crate.
 
@@ -21,7 +21,8 @@ pub fn to_hex(b: &[u8]) -> String {
         .join(" ")
 }
 
-/// CRC-16/IBM-3740 (poly 0x1021, init 0xFFFF, no reflection, xorout 0) with a 256-entry table.
+/// CRC-16/GENIBUS (poly 0x1021, init 0xFFFF, no reflection, xorout 0xFFFF) with a 256-entry
+/// table.
 pub fn ref_crc(data: &[u8]) -> u16 {
     let table: Vec<u16> = (0..256u16)
         .map(|i| {
@@ -36,9 +37,10 @@ pub fn ref_crc(data: &[u8]) -> u16 {
             c
         })
         .collect();
-    data.iter().fold(0xFFFF, |crc, &b| {
+    let register = data.iter().fold(0xFFFF, |crc, &b| {
         (crc << 8) ^ table[usize::from((crc >> 8) as u8 ^ b)]
-    })
+    });
+    register ^ 0xFFFF
 }
 
 /// COBS encoding of `data` (without delimiter): split at zeros into runs of ≤ 254 bytes.

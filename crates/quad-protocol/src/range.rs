@@ -1,0 +1,300 @@
+//! The admissible range of every request field: one check, [`check_request`], that the device
+//! runs on every request it reads and the host runs before sending, so that both refuse the
+//! same requests with the same [`NackReason`].
+//!
+//! Why ranges on finite values: the IK is only meaningful, and host and device only agree, on
+//! values a robot can take. Far outside them the device's fast sine/cosine kernels lose
+//! accuracy (they reduce the angle in single precision) while the host's do not, and a body
+//! shifted by 10³⁸ m is not a pose but a corrupted request. The limits:
+//!
+//! | field | admissible | refusal |
+//! |---|---|---|
+//! | body roll, pitch, yaw | `[−π, π]` rad | [`Field::BodyRoll`] … |
+//! | body x, y, z | `|v| ≤` [`reach_limit_m`] | [`Field::BodyX`] … |
+//! | foot x (y, z) in the body frame | `|v| ≤` half the body length (width, 0) + [`reach_limit_m`] | [`Field::Foot`] |
+//! | joint angle | `[−π, π]` rad (the robot's joint limits then apply) | [`Field::JointAngle`] |
+//! | stance height | `[`[`MIN_STANCE_HEIGHT_M`]`, reach_limit_m]` | ≤ 0: [`NackReason::InvalidArgument`]; else [`Field::StanceHeight`] |
+//!
+//! The lengths are bounded by twice the leg's span ([`reach_limit_m`]), not by the span itself:
+//! near the edge of the reach the IK answers, naming the leg and the fault
+//! ([`NackReason::Unreachable`]); the range only keeps out values that are no pose at all.
+//!
+//! A NaN or infinite value is [`NackReason::NonFinite`] (for the stance height
+//! [`NackReason::InvalidArgument`], as in protocol 1.x); a finite value outside its range is
+//! [`NackReason::OutOfRange`] naming the field. Calibrations have their own check
+//! ([`crate::servo::Calibration::validate`]); the other fields (sequence numbers, flags, enum
+//! indices, `timeout_ms`) admit every value their type can hold.
+
+use crate::msg::{Field, NackReason, PoseConfig, Request};
+use core::f32::consts::PI;
+use kin_core::{Joint, LegId, Pose, Robot};
+
+/// The lowest admissible stance height, m: below it the hips sit on the feet' level, a
+/// stance no legged robot of this shape takes (the bound only has to keep absurd values such
+/// as 1e-45 m out; the IK refuses what the geometry cannot reach).
+pub const MIN_STANCE_HEIGHT_M: f32 = 0.01;
+
+/// The farthest a foot can be from its hip, m: `d_lat + d_ax + femur + tibia` (the leg
+/// stretched, its offsets in line — more than any real pose reaches).
+pub fn leg_span_m(robot: &Robot) -> f32 {
+    let l = &robot.leg;
+    l.d_lat_m + l.d_ax_m + l.femur_m + l.tibia_m
+}
+
+/// The bound of every length in a request, m: twice [`leg_span_m`] (see the module docs).
+pub fn reach_limit_m(robot: &Robot) -> f32 {
+    2.0 * leg_span_m(robot)
+}
+
+/// True when `angle_rad` lies in `[−π, π]`.
+fn angle_in_range(angle_rad: f32) -> bool {
+    (-PI..=PI).contains(&angle_rad)
+}
+
+/// Checks every field of `request` for `robot` (see the module docs for the ranges).
+///
+/// # Errors
+/// [`NackReason::NonFinite`], [`NackReason::OutOfRange`] naming the first field out of range
+/// (in declaration order), or [`NackReason::InvalidArgument`] for a stance height that is not
+/// positive.
+pub fn check_request(request: &Request, robot: &Robot) -> Result<(), NackReason> {
+    match request {
+        Request::SetBodyPose(pose) => check_pose(pose, robot),
+        Request::SetFeet { feet_in_body_m } => check_feet(feet_in_body_m, robot),
+        Request::SetJoints { angles_rad } => check_joints(angles_rad),
+        Request::SetPoseConfig(p) => check_pose_config(p, robot),
+        Request::Hello { .. }
+        | Request::GetState
+        | Request::SetOutputs { .. }
+        | Request::SetLinkTimeout(_)
+        | Request::SetCalibration { .. }
+        | Request::GetCalibration { .. }
+        | Request::SaveCalibration => Ok(()),
+    }
+}
+
+/// A body pose: finite, angles within `[−π, π]`, translations within [`reach_limit_m`].
+///
+/// # Errors
+/// As [`check_request`].
+pub fn check_pose(pose: &Pose, robot: &Robot) -> Result<(), NackReason> {
+    let Pose {
+        roll_rad,
+        pitch_rad,
+        yaw_rad,
+        x_m,
+        y_m,
+        z_m,
+    } = *pose;
+    let values = [roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m];
+    if !values.iter().all(|v| v.is_finite()) {
+        return Err(NackReason::NonFinite);
+    }
+    let span = reach_limit_m(robot);
+    let checks = [
+        (angle_in_range(roll_rad), Field::BodyRoll),
+        (angle_in_range(pitch_rad), Field::BodyPitch),
+        (angle_in_range(yaw_rad), Field::BodyYaw),
+        (x_m.abs() <= span, Field::BodyX),
+        (y_m.abs() <= span, Field::BodyY),
+        (z_m.abs() <= span, Field::BodyZ),
+    ];
+    first_out_of_range(&checks)
+}
+
+/// Four feet in the body frame: finite, each within the body's half size plus
+/// [`reach_limit_m`] per axis.
+///
+/// # Errors
+/// As [`check_request`].
+pub fn check_feet(feet_in_body_m: &[[f32; 3]; 4], robot: &Robot) -> Result<(), NackReason> {
+    if !feet_in_body_m.iter().flatten().all(|v| v.is_finite()) {
+        return Err(NackReason::NonFinite);
+    }
+    let span = reach_limit_m(robot);
+    let bound = [
+        0.5 * robot.body_length_m + span,
+        0.5 * robot.body_width_m + span,
+        span,
+    ];
+    for (leg, foot) in LegId::ALL.iter().zip(feet_in_body_m) {
+        if foot.iter().zip(bound).any(|(v, b)| v.abs() > b) {
+            return Err(NackReason::OutOfRange {
+                field: Field::Foot(*leg),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Twelve joint angles: finite, within `[−π, π]`.
+///
+/// # Errors
+/// As [`check_request`].
+pub fn check_joints(angles_rad: &[f32; 12]) -> Result<(), NackReason> {
+    if !angles_rad.iter().all(|a| a.is_finite()) {
+        return Err(NackReason::NonFinite);
+    }
+    match angles_rad.iter().position(|&a| !angle_in_range(a)) {
+        None => Ok(()),
+        Some(i) => Err(NackReason::OutOfRange {
+            field: Field::JointAngle {
+                leg: LegId::ALL[i / 3],
+                joint: Joint::ALL[i % 3],
+            },
+        }),
+    }
+}
+
+/// A pose configuration: a stance height in `[MIN_STANCE_HEIGHT_M, reach_limit_m]`.
+///
+/// # Errors
+/// As [`check_request`].
+pub fn check_pose_config(p: &PoseConfig, robot: &Robot) -> Result<(), NackReason> {
+    let h = p.stance_height_m;
+    if !(h.is_finite() && h > 0.0) {
+        return Err(NackReason::InvalidArgument);
+    }
+    let admissible = (MIN_STANCE_HEIGHT_M..=reach_limit_m(robot)).contains(&h);
+    first_out_of_range(&[(admissible, Field::StanceHeight)])
+}
+
+fn first_out_of_range(checks: &[(bool, Field)]) -> Result<(), NackReason> {
+    match checks.iter().find(|(ok, _)| !ok) {
+        None => Ok(()),
+        Some(&(_, field)) => Err(NackReason::OutOfRange { field }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ROBOT: Robot = Robot::shahriar2023();
+
+    fn out(field: Field) -> Result<(), NackReason> {
+        Err(NackReason::OutOfRange { field })
+    }
+
+    #[test]
+    fn a_huge_finite_angle_is_out_of_range_not_non_finite() {
+        let pose = Pose {
+            yaw_rad: 1e38,
+            ..Pose::default()
+        };
+        assert_eq!(check_pose(&pose, &ROBOT), out(Field::BodyYaw));
+        let pose = Pose {
+            roll_rad: f32::NAN,
+            yaw_rad: 1e38,
+            ..Pose::default()
+        };
+        assert_eq!(check_pose(&pose, &ROBOT), Err(NackReason::NonFinite));
+    }
+
+    #[test]
+    fn every_pose_field_is_named() {
+        let span = reach_limit_m(&ROBOT);
+        let big = span * 1.01;
+        let cases = [
+            (
+                Pose {
+                    roll_rad: -3.2,
+                    ..Pose::default()
+                },
+                Field::BodyRoll,
+            ),
+            (
+                Pose {
+                    pitch_rad: 3.2,
+                    ..Pose::default()
+                },
+                Field::BodyPitch,
+            ),
+            (
+                Pose {
+                    yaw_rad: 4.0,
+                    ..Pose::default()
+                },
+                Field::BodyYaw,
+            ),
+            (
+                Pose {
+                    x_m: big,
+                    ..Pose::default()
+                },
+                Field::BodyX,
+            ),
+            (
+                Pose {
+                    y_m: -big,
+                    ..Pose::default()
+                },
+                Field::BodyY,
+            ),
+            (
+                Pose {
+                    z_m: 3.4e38,
+                    ..Pose::default()
+                },
+                Field::BodyZ,
+            ),
+        ];
+        for (pose, field) in cases {
+            assert_eq!(
+                check_request(&Request::SetBodyPose(pose), &ROBOT),
+                out(field)
+            );
+        }
+        let edge = Pose {
+            roll_rad: PI,
+            pitch_rad: -PI,
+            yaw_rad: PI,
+            x_m: span,
+            y_m: -span,
+            z_m: span,
+        };
+        assert_eq!(check_pose(&edge, &ROBOT), Ok(()));
+    }
+
+    #[test]
+    fn feet_joints_and_stance_height() {
+        let mut feet = [[0.3, 0.2, -0.4]; 4];
+        assert_eq!(check_feet(&feet, &ROBOT), Ok(()));
+        feet[2][2] = -1e30;
+        assert_eq!(check_feet(&feet, &ROBOT), out(Field::Foot(LegId::RL)));
+        feet[2][2] = f32::INFINITY;
+        assert_eq!(check_feet(&feet, &ROBOT), Err(NackReason::NonFinite));
+
+        let mut q = [0.0f32; 12];
+        assert_eq!(check_joints(&q), Ok(()));
+        q[7] = 1e38;
+        assert_eq!(
+            check_joints(&q),
+            out(Field::JointAngle {
+                leg: LegId::RL,
+                joint: Joint::Hip
+            })
+        );
+
+        let p = |h| PoseConfig {
+            stance_height_m: h,
+            order: kin_core::RotationOrder::Zyx,
+            policy: kin_core::ReachPolicy::Reject,
+        };
+        assert_eq!(check_pose_config(&p(0.3), &ROBOT), Ok(()));
+        assert_eq!(
+            check_pose_config(&p(3.4e38), &ROBOT),
+            out(Field::StanceHeight)
+        );
+        assert_eq!(
+            check_pose_config(&p(1e-45), &ROBOT),
+            out(Field::StanceHeight)
+        );
+        for bad in [0.0, -0.5, f32::NAN] {
+            assert_eq!(
+                check_pose_config(&p(bad), &ROBOT),
+                Err(NackReason::InvalidArgument)
+            );
+        }
+    }
+}
