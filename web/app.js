@@ -27,7 +27,8 @@ const panel = {
   notSent: 0,
   errors: [],
   done: [],
-  latencies: [],
+  latencies: [], // slider input -> the device's readback of that pose drawn, ms
+  arrivals: [], // slider input -> the device's readback of that pose received, ms
   renderedPoseId: 0,
   renderedAngles: null,
   velocity: { vx: 0, vy: 0, yaw: 0 },
@@ -223,6 +224,7 @@ function onState(msg) {
   }
   if (msg.pose_id && sentAt.has(msg.pose_id)) {
     readbackSeen = { id: msg.pose_id, t0: sentAt.get(msg.pose_id) };
+    panel.arrivals.push(performance.now() - readbackSeen.t0);
     for (const id of sentAt.keys()) if (id <= msg.pose_id) sentAt.delete(id);
   }
   updateControl();
@@ -258,6 +260,7 @@ camera.position.set(1.1, -1.3, 0.6);
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.set(0, 0, -0.2);
 controls.update();
+controls.addEventListener('change', () => { viewDirty = true; });
 scene.add(new THREE.HemisphereLight(0xffffff, 0x334455, 2.0));
 const sun = new THREE.DirectionalLight(0xffffff, 1.5);
 sun.position.set(1, -1, 2);
@@ -272,6 +275,7 @@ function resize() {
   renderer.setSize(w, h, false);
   camera.aspect = w / Math.max(h, 1);
   camera.updateProjectionMatrix();
+  viewDirty = true;
 }
 window.addEventListener('resize', resize);
 
@@ -351,11 +355,13 @@ function setGhost(pose, p) {
   if (!ghost) return;
   drawRobot(ghost, panel.kin.points(pose, p.angles, panel.order));
   p.legs.forEach((l, i) => ghost.legs[i].mat.color.copy(legColour(l)));
+  viewDirty = true;
 }
 
 const NEUTRAL = { roll_rad: 0, pitch_rad: 0, yaw_rad: 0, x_m: 0, y_m: 0, z_m: 0 };
 let readbackSeen = null;
-let dirty = false;
+let dirty = false; // a new readback to draw
+let viewDirty = true; // the camera, the preview or the size changed
 
 function updateReadback(s) {
   if (!actual) return;
@@ -383,9 +389,14 @@ function updateReadback(s) {
   dirty = true;
 }
 
+// Draws only when something changed (a state, the preview, the camera): software WebGL on a
+// busy machine would otherwise keep the page's thread from reading its socket.
 function frame() {
   controls.update();
-  renderer.render(scene, camera);
+  if (dirty || viewDirty) {
+    viewDirty = false;
+    renderer.render(scene, camera);
+  }
   if (dirty && panel.state) {
     dirty = false;
     panel.renderedPoseId = panel.state.pose_id;

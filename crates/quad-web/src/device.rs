@@ -193,8 +193,8 @@ impl<L: Link> Session<L> {
             }
             Outcome::Accepted(answer) => {
                 self.link.acked += 1;
-                if let DeviceToHost::Ack { readback, .. } = answer {
-                    self.readback = readback;
+                if let Some(readback) = answer.readback() {
+                    self.readback = *readback;
                 }
                 Ok(answer)
             }
@@ -206,10 +206,15 @@ impl<L: Link> Session<L> {
         }
     }
 
-    /// A request answered by an ack (any ack is believed).
+    /// A request answered by an ack, or a configuration request answered by a `Configured`
+    /// echoing exactly the setting sent (as [`Client::ack`]).
     fn ack(&mut self, request: Request) -> Result<Readback, Error> {
+        let sent = quad_protocol::Setting::of_request(&request);
         match self.exchange(request, |_| client::Verdict::Accept)? {
             DeviceToHost::Ack { readback, .. } => Ok(readback),
+            DeviceToHost::Configured {
+                setting, readback, ..
+            } if Some(setting) == sent => Ok(readback),
             other => Err(Error::Client(client::Error::Unexpected {
                 request: client::request_name(&request),
                 answer: Box::new(other),

@@ -63,6 +63,9 @@ struct Shared {
     controller: Mutex<Option<u64>>,
     next_page: AtomicU64,
     welcome: Welcome,
+    /// True once the server stops: every page's connection ends (graceful shutdown waits for
+    /// open WebSockets otherwise).
+    closing: watch::Receiver<bool>,
 }
 
 #[derive(Clone)]
@@ -171,7 +174,9 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
     })?;
     listener.set_nonblocking(true)?;
     let addr = listener.local_addr()?;
+    let (closing_tx, closing) = watch::channel(false);
     let shared = Arc::new(Shared {
+        closing,
         events: Mutex::new(events_tx),
         state: state_rx,
         state_tx,
@@ -214,6 +219,7 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
                     } else {
                         let _ = shutdown_rx.await;
                     }
+                    let _ = closing_tx.send(true);
                 };
                 axum::serve(listener, app)
                     .with_graceful_shutdown(stop)
@@ -336,10 +342,12 @@ async fn serve_page(
     state: &mut watch::Receiver<State>,
     id: u64,
 ) {
+    let mut closing = shared.closing.clone();
     let mut ping = tokio::time::interval(PING_PERIOD);
     let mut last_heard = tokio::time::Instant::now();
     loop {
         tokio::select! {
+            _ = closing.changed() => return,
             _ = ping.tick() => {
                 if last_heard.elapsed() > SILENCE_LIMIT {
                     log(id, &format!("no answer for {} ms: dropped", SILENCE_LIMIT.as_millis()));
