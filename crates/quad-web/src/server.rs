@@ -263,11 +263,12 @@ async fn ws_upgrade(ws: WebSocketUpgrade, AxumState(shared): AxumState<Arc<Share
 }
 
 /// How often a page is pinged (browsers answer WebSocket pings by themselves).
-const PING_PERIOD: Duration = Duration::from_millis(250);
+const PING_PERIOD: Duration = Duration::from_millis(500);
 
 /// A page silent this long (no message, no pong) is dropped: a closed tab whose socket was not
 /// closed, a network gone. For the controlling page this is the link loss.
-const SILENCE_LIMIT: Duration = Duration::from_millis(1000);
+/// Generous enough for a browser on a busy machine (its pongs come from its network thread).
+const SILENCE_LIMIT: Duration = Duration::from_millis(3000);
 
 fn log(page: u64, what: &str) {
     eprintln!("quadctl serve: page {page}: {what}");
