@@ -274,9 +274,15 @@ fn log(page: u64, what: &str) {
     eprintln!("quadctl serve: page {page}: {what}");
 }
 
+/// Sends `msg`; false when the page is gone or does not take it within [`SILENCE_LIMIT`] (a
+/// peer that vanished without closing fills the socket's buffer, and a send would wait for
+/// ever).
 async fn send(socket: &mut WebSocket, msg: &ServerMsg) -> bool {
     match serde_json::to_string(msg) {
-        Ok(text) => socket.send(Message::Text(text.into())).await.is_ok(),
+        Ok(text) => matches!(
+            tokio::time::timeout(SILENCE_LIMIT, socket.send(Message::Text(text.into()))).await,
+            Ok(Ok(()))
+        ),
         Err(_) => false,
     }
 }
@@ -387,7 +393,13 @@ async fn serve_page(
                         log(id, &format!("refused: {e}"));
                         ServerMsg::Error { message: e.to_string() }
                     }
-                    Ok(cmd) => command(shared, id, cmd).await,
+                    Ok(cmd) => {
+                        let reply = command(shared, id, cmd).await;
+                        // The page's pongs waited unread while the device worked (a dozen
+                        // requests on an emulated device take seconds): no silence to count.
+                        last_heard = tokio::time::Instant::now();
+                        reply
+                    }
                 };
                 if !send(socket, &reply).await {
                     return;
