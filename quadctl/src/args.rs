@@ -50,27 +50,42 @@ pub fn exit_status<E: std::error::Error>(result: Result<(), E>) -> ExitCode {
 
 /// Help text shared by the batch commands: input rules and exit codes.
 pub const BATCH_RULES: &str = "\
-Input: CSV, one record per line, fields separated by commas (no quoting), spaces around fields
-ignored. Blank lines and lines starting with `#` are skipped. The header row is optional: the
-first record is taken as a header when its first field is not a value of the first column; it
-must then name exactly the expected columns, or nothing is processed. Leg names are FL, FR, RL,
-RR (any case).
+Input: CSV in UTF-8 (a byte-order mark at the start is ignored), one record per line, fields
+separated by commas (no quoting; a line using `;` or tabs is refused with that hint), spaces
+around fields ignored. Blank lines and lines starting with `#` are skipped. The header row is
+optional: the first record is taken as a header when its first field is not a value of the
+first column; it must then name exactly the expected columns, optionally followed by the columns
+another batch command writes (status, clamp_distance_m, line: so `ik | fk` and `fk | ik` pipe),
+or nothing is processed. Leg names are FL, FR, RL, RR (any case). An input without any record
+is an error.
 
 Output: CSV on stdout with a header row. Numbers are printed with the shortest decimal that reads
-back to the same f32.
+back to the same f32. The last column, line, is the input line of the record, so that output
+rows can be matched to input rows although malformed records get no row; when the input carries
+a line column (piped from another batch command), its value is kept, naming the line of the
+first input. A piped record that was not answered (status other than ok or clamped:...) is
+passed on with its status and empty cells.
 
-Malformed records (wrong number of fields, a field that is not a number or not a leg name) are
-reported on stderr as `<input>:<line>: <what is wrong>` and get NO output row; the other records
-are still answered, in input order.
+Numbers that are nan, inf or beyond the f32 range (e.g. 1e300) are answered with the status
+non_finite and empty cells, the same way by ik, fk and pose.
+
+Malformed records (wrong number of fields, a field that is not a number or not a leg name, a
+line that is not UTF-8) are reported on stderr as `<input>:<line>: <what is wrong>` and
+get NO output row; the other records are still answered, in input order.
 
 Exit status: 0 every record answered (unreachable targets are answers, see `status`); 1 at least
 one malformed record; 2 nothing processed or processing stopped (bad arguments, robot file or
-input not readable or invalid, foreign header, output error).
+input not readable or invalid, foreign header, no record, output error).
 
 Robot files (TOML): d_lat_m, d_ax_m, femur_m, tibia_m, body_length_m, body_width_m (metres,
 required); knee_bend = \"backward\" | \"forward\" (optional, default backward); optional
 [limits] table with abduction_rad, hip_rad, knee_rad = [min, max] (radians; a joint left out is
 limited only to the full turn [-pi, pi]). Unknown keys are refused.";
+
+/// The text after a batch command's `--help`: its examples, then [`BATCH_RULES`].
+pub fn batch_help(examples: &str) -> String {
+    format!("{examples}\n\n{BATCH_RULES}")
+}
 
 /// `--robot`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -100,22 +115,24 @@ pub struct InputArgs {
     pub input: PathBuf,
 }
 
-/// Where the device is: `--sim`, `--emulator` or `--port`, and the line (`stream`,
+/// Where the device is: `--sim`, `--emulator` or `--port` (exactly one: the group `target`,
+/// so that a missing one is reported with the three choices), and the line (`stream`,
 /// `calibrate`).
 #[derive(Debug, Clone, PartialEq, clap::Args)]
+#[command(group = clap::ArgGroup::new("target").required(true).multiple(false))]
 pub struct TargetArgs {
     /// Run against the device controller behind a simulated UART.
-    #[arg(long, conflicts_with_all = ["port", "emulator"], required_unless_present_any = ["port", "emulator"])]
+    #[arg(long, group = "target")]
     pub sim: bool,
     /// Run the real firmware in simavr (an emulated ATmega2560; simulated time).
-    #[arg(long, conflicts_with = "port")]
+    #[arg(long, group = "target")]
     pub emulator: bool,
     /// Firmware ELF for --emulator; default: built from firmware-avr/ for --baud (115200:
     /// firmware.elf, 1000000: firmware-1mbaud.elf).
     #[arg(long, value_name = "PATH", requires = "emulator")]
     pub elf: Option<PathBuf>,
     /// Serial port of a real device, e.g. /dev/ttyACM0.
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, value_name = "PATH", group = "target")]
     pub port: Option<String>,
     /// Line rate, bit/s (8N1).
     #[arg(long, value_name = "B", default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(300..))]

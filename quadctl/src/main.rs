@@ -33,6 +33,8 @@ enum Command {
     Calibrate(cmd::calibrate::Args),
     Demo(cmd::demo::Args),
     Serve(cmd::serve::Args),
+    Sim(cmd::sim::Args),
+    Export(cmd::export::Args),
 }
 
 fn main() -> ExitCode {
@@ -54,5 +56,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => cmd::calibrate::main(&args),
         Command::Demo(args) => cmd::demo::main(&args),
         Command::Serve(args) => cmd::serve::main(&args),
+        Command::Sim(args) => cmd::sim::run(&args),
+        Command::Export(args) => cmd::export::run(&args),
     }
 }

@@ -50,11 +50,11 @@ fn fk_of_zero_angles_hangs_each_foot_straight_down() {
         let g = robot.leg;
         // (0, s·d_lat, −d_ax − L1 − L2), evaluated in f32.
         let z = -g.d_ax_m - g.femur_m - g.tibia_m;
-        let expected: String = std::iter::once("leg,x_m,y_m,z_m\n".to_owned())
-            .chain(LegId::ALL.iter().map(|l| {
+        let expected: String = std::iter::once("leg,x_m,y_m,z_m,status,line\n".to_owned())
+            .chain(LegId::ALL.iter().enumerate().map(|(i, l)| {
                 let y = l.side() * g.d_lat_m;
                 let y = if y == 0.0 { 0.0 } else { y };
-                format!("{l},0,{y},{z}\n")
+                format!("{l},0,{y},{z},ok,{}\n", i + 1)
             }))
             .collect();
         assert_eq!(run.stdout, expected, "{name}");
@@ -172,15 +172,15 @@ fn unreachable_targets_get_a_status_and_empty_angle_cells() {
     );
     assert_eq!(run.code, 0, "{}", run.stderr);
     let lines: Vec<&str> = run.stdout.lines().collect();
-    assert_eq!(lines[0], "leg,abduction_rad,hip_rad,knee_rad,status");
-    assert_eq!(lines[1], "FL,,,,too_far");
-    assert_eq!(lines[2], "FR,,,,too_close");
-    assert_eq!(lines[3], "RL,,,,inside_offset");
-    assert_eq!(lines[4], "RR,,,,non_finite");
-    assert!(lines[5].ends_with(",ok"), "{}", lines[5]);
+    assert_eq!(lines[0], "leg,abduction_rad,hip_rad,knee_rad,status,line");
+    assert_eq!(lines[1], "FL,,,,too_far,1");
+    assert_eq!(lines[2], "FR,,,,too_close,2");
+    assert_eq!(lines[3], "RL,,,,inside_offset,3");
+    assert_eq!(lines[4], "RR,,,,non_finite,4");
+    assert!(lines[5].ends_with(",ok,5"), "{}", lines[5]);
     // fernando2025 limits abduction to ±0.8 rad; this foot needs about 1.01 rad.
     let run = quadctl(&["ik", "--robot", "fernando2025"], "FL,0,0.8,-0.5\n");
-    assert_eq!(run.stdout.lines().nth(1), Some("FL,,,,joint_limit"));
+    assert_eq!(run.stdout.lines().nth(1), Some("FL,,,,joint_limit,1"));
     assert!(!run.stdout.to_lowercase().contains("nan,"));
 }
 
@@ -194,7 +194,7 @@ fn clamp_policy_reports_the_distance_moved() {
     let lines: Vec<&str> = run.stdout.lines().collect();
     assert_eq!(
         lines[0],
-        "leg,abduction_rad,hip_rad,knee_rad,status,clamp_distance_m"
+        "leg,abduction_rad,hip_rad,knee_rad,status,clamp_distance_m,line"
     );
     let far: Vec<&str> = lines[1].split(',').collect();
     assert_eq!(far[4], "clamped:too_far");
@@ -202,8 +202,8 @@ fn clamp_policy_reports_the_distance_moved() {
     // knee limit (≤ −0.05 rad) keeps it from straightening fully, so the distance is ≥ 0.95 m.
     let d = num(far[5]);
     assert!((0.95..0.96).contains(&d), "clamp distance {d}");
-    assert!(lines[2].ends_with(",ok,0"), "{}", lines[2]);
-    assert_eq!(lines[3], "FL,,,,non_finite,");
+    assert!(lines[2].ends_with(",ok,0,2"), "{}", lines[2]);
+    assert_eq!(lines[3], "FL,,,,non_finite,,3");
 }
 
 #[test]
@@ -225,12 +225,14 @@ fn pose_of_the_zero_pose_gives_the_stance_angles() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     let header = run.stdout.lines().next().expect("header");
     let columns: Vec<&str> = header.split(',').collect();
-    assert_eq!(columns.len(), 13);
+    assert_eq!(columns.len(), 14);
     assert_eq!(columns[0], "FL_abduction_rad");
     assert_eq!(columns[5], "FR_knee_rad");
     assert_eq!(columns[12], "status");
+    assert_eq!(columns[13], "line");
     let row = &records(&run.stdout)[0];
     assert_eq!(row[12], "ok");
+    assert_eq!(row[13], "2");
     for leg in 0..4 {
         assert_close(num(&row[3 * leg]), 0.0, TOL_RAD, "abduction");
         assert_close(num(&row[3 * leg + 1]), 30f32.to_radians(), TOL_RAD, "hip");
@@ -290,9 +292,9 @@ fn pose_names_the_first_leg_that_cannot_reach() {
     assert_eq!(
         lines,
         [
-            format!("{empty}FR:too_far"),
-            format!("{empty}FL:too_far"),
-            format!("{empty}FL:non_finite"),
+            format!("{empty}FR:too_far,1"),
+            format!("{empty}FL:too_far,2"),
+            format!("{empty}FL:non_finite,3"),
         ]
     );
 }
@@ -306,8 +308,17 @@ fn header_row_is_optional() {
     );
     let without = quadctl(&["fk", "--robot", "shahriar2023"], body);
     assert_eq!(with.code, 0, "{}", with.stderr);
-    assert_eq!(with.stdout, without.stdout);
+    let without_line = |out: &str| -> Vec<Vec<String>> {
+        records(out)
+            .into_iter()
+            .map(|r| r[..r.len() - 1].to_vec())
+            .collect()
+    };
+    assert_eq!(without_line(&with.stdout), without_line(&without.stdout));
     assert_eq!(records(&with.stdout).len(), 2);
+    // The rows name their input lines: after a comment, a header and a blank line.
+    assert_eq!(records(&with.stdout)[0][5], "4");
+    assert_eq!(records(&without.stdout)[0][5], "1");
 }
 
 #[test]
@@ -323,7 +334,10 @@ fn a_foreign_header_stops_everything() {
         "{}",
         run.stderr
     );
-    assert_eq!(run.stdout, "leg,abduction_rad,hip_rad,knee_rad,status\n");
+    assert_eq!(
+        run.stdout,
+        "leg,abduction_rad,hip_rad,knee_rad,status,line\n"
+    );
 }
 
 #[test]
@@ -339,8 +353,10 @@ fn malformed_rows_are_reported_by_line_and_the_rest_answered() {
     let run = quadctl(&["fk", "--robot", "shahriar2023"], input);
     assert_eq!(run.code, 1);
     let rows = records(&run.stdout);
-    assert_eq!(rows.len(), 2);
-    assert_eq!((rows[0][0].as_str(), rows[1][0].as_str()), ("FL", "RR"));
+    assert_eq!(rows.len(), 3);
+    assert_eq!((rows[0][0].as_str(), rows[2][0].as_str()), ("FL", "RR"));
+    // A nan angle is answered as ik and pose answer a nan target.
+    assert_eq!(rows[1].join(","), "RR,,,,non_finite,7");
     let errors: Vec<&str> = run.stderr.lines().collect();
     assert_eq!(
         errors,
@@ -348,8 +364,7 @@ fn malformed_rows_are_reported_by_line_and_the_rest_answered() {
             "<stdin>:3: field 1 (leg): `XX` is not a leg (FL, FR, RL, RR)",
             "<stdin>:5: field 3 (hip_rad): `zero` is not a number",
             "<stdin>:6: expected 4 fields (leg,abduction_rad,hip_rad,knee_rad), found 3",
-            "<stdin>:7: field 3 (hip_rad): `nan` is not a finite number",
-            "quadctl: 4 malformed record(s) skipped, 2 answered",
+            "quadctl: 3 malformed record(s) skipped, 3 answered",
         ]
     );
     // Same for pose and ik, with a file as input: the message names the file.

@@ -15,6 +15,9 @@
 //!
 //! `cargo xtask ci --list` prints the steps; `cargo xtask ci STEP...` runs only those.
 //!
+//! `cargo xtask demo [ARGS...]` is the main job on a fresh machine: the same `deps` step, then
+//! `cargo run --release -p quadctl -- demo ARGS...`.
+//!
 //! Child processes do not inherit the toolchain selection of the cargo that started this
 //! program (`RUSTUP_TOOLCHAIN`): each directory's `rust-toolchain.toml` decides, as it does for
 //! a developer typing the same command.
@@ -36,7 +39,7 @@ struct Step {
     /// Directory relative to the workspace root.
     dir: &'static str,
     /// Program and arguments.
-    argv: Vec<&'static str>,
+    argv: Vec<String>,
     /// Extra environment variables.
     env: Vec<(&'static str, String)>,
     /// Environment variables removed for this step (besides the common ones).
@@ -48,10 +51,16 @@ impl Step {
         Step {
             name,
             dir: ".",
-            argv: argv.to_vec(),
+            argv: argv.iter().map(|a| (*a).to_owned()).collect(),
             env: Vec::new(),
             env_remove: Vec::new(),
         }
+    }
+
+    /// Appends arguments given at run time (e.g. passed through from the command line).
+    fn with_args(mut self, args: &[String]) -> Step {
+        self.argv.extend(args.iter().cloned());
+        self
     }
 
     fn in_dir(mut self, dir: &'static str) -> Step {
@@ -86,10 +95,29 @@ impl Step {
     }
 }
 
+/// `scripts/install-deps.sh`: installs what is missing (saying what), does nothing otherwise.
+/// The first step of both `cargo xtask ci` and `cargo xtask demo`.
+fn deps_step() -> Step {
+    Step::new("deps", &["bash", "scripts/install-deps.sh"])
+}
+
+/// The steps of `cargo xtask demo ARGS...`: the install step of `cargo xtask ci`, then the demo
+/// with `ARGS` passed through (`cargo xtask demo --port /dev/ttyACM0` drives a real board).
+fn demo_steps(args: &[String]) -> Vec<Step> {
+    vec![
+        deps_step(),
+        Step::new(
+            "demo",
+            &["cargo", "run", "--release", "-p", "quadctl", "--", "demo"],
+        )
+        .with_args(args),
+    ]
+}
+
 /// The checks run by `cargo xtask ci`, in order. Add new checks here.
 fn ci_steps(root: &Path) -> Vec<Step> {
     let mut steps = vec![
-        Step::new("deps", &["bash", "scripts/install-deps.sh"]),
+        deps_step(),
         Step::new("fmt", &["cargo", "fmt", "--all", "--check"]),
         Step::new(
             "clippy",
@@ -247,12 +275,18 @@ fn ci(args: &[String]) -> ExitCode {
         .filter(|s| args.is_empty() || args.iter().any(|a| a == s.name))
         .collect();
 
+    run_steps(&root, &steps, "ci")
+}
+
+/// Runs `steps` in order from the workspace root, stopping at the first failure; prints each
+/// command before it runs and a table of times at the end. `what` names the task in messages.
+fn run_steps(root: &Path, steps: &[&Step], what: &str) -> ExitCode {
     let start = Instant::now();
     let mut done: Vec<(&str, Duration)> = Vec::new();
     for step in steps {
         println!("\n==> [{}] {}", step.name, step.display());
         let t = Instant::now();
-        let result = run_step(&root, step);
+        let result = run_step(root, step);
         let took = t.elapsed();
         done.push((step.name, took));
         match result {
@@ -260,7 +294,7 @@ fn ci(args: &[String]) -> ExitCode {
             Err(e) => {
                 eprintln!("<== [{}] FAILED in {}: {e}", step.name, fmt_duration(took));
                 eprintln!(
-                    "xtask ci: FAILED at step `{}` after {}",
+                    "xtask {what}: FAILED at step `{}` after {}",
                     step.name,
                     fmt_duration(start.elapsed())
                 );
@@ -268,7 +302,7 @@ fn ci(args: &[String]) -> ExitCode {
             }
         }
     }
-    println!("\nxtask ci: all steps passed");
+    println!("\nxtask {what}: all steps passed");
     for (name, took) in &done {
         println!("  {name:<14} {:>10}", fmt_duration(*took));
     }
@@ -276,12 +310,26 @@ fn ci(args: &[String]) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-const USAGE: &str = "usage: cargo xtask ci [--list | STEP...] | cargo xtask avr-bench";
+/// `cargo xtask demo ARGS...`: installs what the demo needs, then runs it.
+fn demo(args: &[String]) -> ExitCode {
+    let steps = demo_steps(args);
+    println!(
+        "xtask demo: first installing what the demo needs, as `cargo xtask ci` does \
+         (scripts/install-deps.sh: the AVR toolchain, simavr and the libraries its bindings \
+         build against, nightly rust-src; it names what it installs and does nothing when all \
+         is present), then building and running the demo"
+    );
+    run_steps(&workspace_root(), &steps.iter().collect::<Vec<_>>(), "demo")
+}
+
+const USAGE: &str =
+    "usage: cargo xtask ci [--list | STEP...] | cargo xtask demo [DEMO ARGS...] | cargo xtask avr-bench";
 
 fn main() -> ExitCode {
     let args: Vec<String> = env::args().skip(1).collect();
     match args.split_first() {
         Some((cmd, rest)) if cmd == "ci" => ci(rest),
+        Some((cmd, rest)) if cmd == "demo" => demo(rest),
         Some((cmd, rest)) if cmd == "avr-bench" => avr_bench::run(&workspace_root(), rest),
         Some((cmd, _)) if cmd == "-h" || cmd == "--help" => {
             println!("{USAGE}");
@@ -330,6 +378,24 @@ mod tests {
             pos("budget"),
             pos("firmware") + 1,
             "the budget follows the firmware build"
+        );
+    }
+
+    #[test]
+    fn the_demo_installs_its_dependencies_first_as_ci_does() {
+        let args = ["--port".to_owned(), "/dev/ttyACM0".to_owned()];
+        let demo = demo_steps(&args);
+        let ci = ci_steps(&workspace_root());
+        assert_eq!(names(&demo), ["deps", "demo"]);
+        assert_eq!(
+            demo[0].display(),
+            ci[0].display(),
+            "the same install step as ci"
+        );
+        assert_eq!(demo[0].display(), "bash scripts/install-deps.sh");
+        assert_eq!(
+            demo[1].display(),
+            "cargo run --release -p quadctl -- demo --port /dev/ttyACM0"
         );
     }
 

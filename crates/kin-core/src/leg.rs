@@ -469,6 +469,19 @@ impl<M: Math> Solver<M> {
         foot_in_hip: Vec3,
         policy: ReachPolicy,
     ) -> Result<LegSolution, IkError> {
+        self.inverse_inline(leg, foot_in_hip, policy)
+    }
+
+    /// [`Solver::inverse`], always inlined into its two wrappers: the public one, which the
+    /// compiler may then inline into the caller (a host's loop keeps the solve, its `atan2`
+    /// kernels included, in one piece), and [`Solver::inverse_out_of_line`].
+    #[inline(always)]
+    fn inverse_inline(
+        &self,
+        leg: LegId,
+        foot_in_hip: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<LegSolution, IkError> {
         let err = |kind| IkError { leg, kind };
         if !(finite(foot_in_hip.x) && finite(foot_in_hip.y) && finite(foot_in_hip.z)) {
             return Err(err(Unreachable::NonFinite));
@@ -479,10 +492,7 @@ impl<M: Math> Solver<M> {
         // Clamp: the Reject path, the hot one, stays free of it.)
         let target = match policy {
             ReachPolicy::Clamp => {
-                let m = libm::fmaxf(
-                    libm::fabsf(foot_in_hip.x),
-                    libm::fmaxf(libm::fabsf(foot_in_hip.y), libm::fabsf(foot_in_hip.z)),
-                );
+                let m = max_abs(foot_in_hip);
                 if m > FAR_M {
                     foot_in_hip * (FAR_M / m)
                 } else {
@@ -535,7 +545,7 @@ impl<M: Math> Solver<M> {
         foot_in_hip: Vec3,
         policy: ReachPolicy,
     ) -> Result<LegSolution, IkError> {
-        self.inverse(leg, foot_in_hip, policy)
+        self.inverse_inline(leg, foot_in_hip, policy)
     }
 
     /// Solves the abduction and planar problem exactly for a point known to be reachable
@@ -688,15 +698,22 @@ impl<M: Math> Solver<M> {
 /// shrunk towards the hip to this distance.
 const FAR_M: f32 = 1.0e6;
 
+/// The largest absolute coordinate of `v` (its maximum norm): what decides whether squaring
+/// `v`'s coordinates could overflow.
+#[inline(always)]
+fn max_abs(v: Vec3) -> f32 {
+    libm::fmaxf(
+        libm::fabsf(v.x),
+        libm::fmaxf(libm::fabsf(v.y), libm::fabsf(v.z)),
+    )
+}
+
 /// `|a − b|` without overflowing the squares of far targets, with the backend's square root
 /// (a firmware then links one square root, its backend's).
 #[inline]
 fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     let d = a - b;
-    let m = libm::fmaxf(
-        libm::fabsf(d.x),
-        libm::fmaxf(libm::fabsf(d.y), libm::fabsf(d.z)),
-    );
+    let m = max_abs(d);
     if m > FAR_M {
         m * M::sqrt((d * (1.0 / m)).norm_squared())
     } else {

@@ -549,7 +549,7 @@ pub fn check<T: Motion>(
     let mut c = Checker::new(motion.robot(), motion.body_config(), max_joint_speed_rad_s)?;
     for k in 0..sweep.samples() {
         let t = sweep.time_s(k);
-        let frame = motion.frame(t)?;
+        let frame = motion.frame::<crate::DefaultMath>(t)?;
         let _ = c.push_frame(t, &frame);
     }
     Ok(c.finish())

@@ -138,23 +138,17 @@ fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32)
 /// ```
 #[inline]
 pub fn matrix<M: Math>(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
-    // One arm per order with the axes as constants, so that each compiles to its own closed
-    // form without index arithmetic.
+    // The three `sin_cos` once, ahead of the order's arm: one copy of the kernels, not one per
+    // arm. One arm per order with the axes as constants, so that each compiles to its own
+    // closed form without index arithmetic.
+    let sc = sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
     match order {
-        RotationOrder::Zyx => zyx::<M>(roll_rad, pitch_rad, yaw_rad),
-        RotationOrder::Zxy => zxy::<M>(roll_rad, pitch_rad, yaw_rad),
-        RotationOrder::Xyz => {
-            closed_form(0, 1, 2, true, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
-        }
-        RotationOrder::Xzy => {
-            closed_form(0, 2, 1, false, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
-        }
-        RotationOrder::Yxz => {
-            closed_form(1, 0, 2, false, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
-        }
-        RotationOrder::Yzx => {
-            closed_form(1, 2, 0, true, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
-        }
+        RotationOrder::Zyx => zyx_of(&sc),
+        RotationOrder::Zxy => zxy_of(&sc),
+        RotationOrder::Xyz => closed_form(0, 1, 2, true, &sc),
+        RotationOrder::Xzy => closed_form(0, 2, 1, false, &sc),
+        RotationOrder::Yxz => closed_form(1, 0, 2, false, &sc),
+        RotationOrder::Yzx => closed_form(1, 2, 0, true, &sc),
     }
 }
 
@@ -181,8 +175,13 @@ pub fn matrix<M: Math>(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_
 /// ```
 #[inline(always)]
 pub fn zyx<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
-    let [(s_phi, c_phi), (s_theta, c_theta), (s_psi, c_psi)] =
-        sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
+    zyx_of(&sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
+}
+
+/// [`zyx`] from the `(sin, cos)` of roll φ, pitch θ and yaw ψ.
+#[inline(always)]
+fn zyx_of(sc: &[(f32, f32); 3]) -> Mat3 {
+    let [(s_phi, c_phi), (s_theta, c_theta), (s_psi, c_psi)] = *sc;
     // The shared products first (the same roundings as the general closed form).
     let (s_psi_s_theta, c_psi_s_theta) = (s_psi * s_theta, c_psi * s_theta);
     Mat3 {
@@ -224,8 +223,13 @@ pub fn zyx<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
 /// ```
 #[inline(always)]
 pub fn zxy<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
-    let [(s_theta, c_theta), (s_gamma, c_gamma), (s_psi, c_psi)] =
-        sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
+    zxy_of(&sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
+}
+
+/// [`zxy`] from the `(sin, cos)` of roll θ, pitch γ and yaw ψ.
+#[inline(always)]
+fn zxy_of(sc: &[(f32, f32); 3]) -> Mat3 {
+    let [(s_theta, c_theta), (s_gamma, c_gamma), (s_psi, c_psi)] = *sc;
     let (s_psi_s_theta, c_psi_s_theta) = (s_psi * s_theta, c_psi * s_theta);
     Mat3 {
         rows: [

@@ -5,7 +5,7 @@
 use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
 use kin_core::motion::path::PathKind;
 use kin_core::motion::{self, Contact, Error, Motion};
-use kin_core::{body, preflight, LegId, ReachPolicy, Robot, Vec3};
+use kin_core::{body, preflight, DefaultMath, LegId, ReachPolicy, Robot, Vec3};
 
 /// Largest allowed drift of a stance foot in the world, m.
 const DRIFT_TOL_M: f32 = 1e-6;
@@ -30,7 +30,7 @@ fn stance_drift(gait: &Gait, cycles: f32) -> (f32, f32) {
     let (mut worst, mut worst_fk) = (0.0f32, 0.0f32);
     for k in 0..n {
         let t = k as f32 * DT_S;
-        let (frame, sol) = motion::solve(gait, t, ReachPolicy::Reject).unwrap();
+        let (frame, sol) = motion::solve::<DefaultMath>(gait, t, ReachPolicy::Reject).unwrap();
         let fk = body::forward(
             gait.robot(),
             &frame.pose,
@@ -59,11 +59,11 @@ fn trot_pairs_diagonals_and_walk_keeps_three_feet_down() {
     let w = Gait::new(p).unwrap();
     for k in 0..800 {
         let t = k as f32 * 0.001;
-        let c = g.frame(t).unwrap().contact;
+        let c = g.frame::<DefaultMath>(t).unwrap().contact;
         assert_eq!(c[LegId::FL.index()], c[LegId::RR.index()]);
         assert_eq!(c[LegId::FR.index()], c[LegId::RL.index()]);
         assert_ne!(c[LegId::FL.index()], c[LegId::FR.index()]);
-        let c = w.frame(t).unwrap().contact;
+        let c = w.frame::<DefaultMath>(t).unwrap().contact;
         let down = c.iter().filter(|&&x| x == Contact::Stance).count();
         assert!(down >= 3, "t={t}: {c:?}");
     }
@@ -81,7 +81,7 @@ fn straight_trot_stance_feet_do_not_slip_and_the_body_advances() {
     println!("straight trot: stance drift {drift:.2e} m (frames), {drift_fk:.2e} m (FK of IK)");
     assert!(drift <= DRIFT_TOL_M && drift_fk <= DRIFT_TOL_M);
     let cycle = g.period_s().unwrap();
-    let f = g.frame(2.0 * cycle).unwrap();
+    let f = g.frame::<DefaultMath>(2.0 * cycle).unwrap();
     assert!((f.pose.x_m - 0.15 * 2.0 * cycle).abs() < 1e-6);
     // Stride = v · stance time.
     assert!((g.step_length_m(LegId::FL) - 0.15 * 0.5 * cycle).abs() < 1e-6);
@@ -105,7 +105,7 @@ fn turning_crab_trot_stance_feet_do_not_slip() {
     // The body turns at the commanded rate and moves on a circle of radius |v|/ω.
     let g = trot(v, PathKind::Bezier);
     let t = 2.0;
-    let f = g.frame(t).unwrap();
+    let f = g.frame::<DefaultMath>(t).unwrap();
     assert!((f.pose.yaw_rad - 0.8).abs() < 1e-6);
     let r = (0.1f32.hypot(0.05)) / 0.4;
     let chord = f.pose.x_m.hypot(f.pose.y_m);
@@ -124,8 +124,8 @@ fn joint_angles_repeat_every_cycle_while_the_body_moves_on() {
     let mut worst = 0.0f32;
     for k in 0..300 {
         let t = k as f32 * DT_S;
-        let (_, a) = motion::solve(&g, t, ReachPolicy::Reject).unwrap();
-        let (_, b) = motion::solve(&g, t + cycle, ReachPolicy::Reject).unwrap();
+        let (_, a) = motion::solve::<DefaultMath>(&g, t, ReachPolicy::Reject).unwrap();
+        let (_, b) = motion::solve::<DefaultMath>(&g, t + cycle, ReachPolicy::Reject).unwrap();
         for (x, y) in a.flat().iter().zip(b.flat()) {
             worst = worst.max((x - y).abs());
         }
@@ -144,7 +144,7 @@ fn bezier_lift_off_and_touch_down_are_smooth_in_the_world() {
     let g = trot(v, PathKind::Bezier);
     let cycle = g.period_s().unwrap();
     let h = 1e-4 * cycle;
-    let foot = |t: f32| g.frame(t).unwrap().feet_in_world[LegId::FL.index()];
+    let foot = |t: f32| g.frame::<DefaultMath>(t).unwrap().feet_in_world[LegId::FL.index()];
     for join in [cycle, 1.5 * cycle] {
         // FL lifts off at t = k·cycle and lands half a cycle later.
         let after = (foot(join + h) - foot(join)).norm() / h;

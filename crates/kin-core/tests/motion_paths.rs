@@ -6,7 +6,7 @@ use kin_core::motion::path::{
     AnyPath, Bezier, Cycloid, Ellipse, FootPath, PathKind, Rectangle, Semicircle, Stride,
 };
 use kin_core::motion::{Contact, Error, Motion, Phase};
-use kin_core::{preflight, LegId, Vec3};
+use kin_core::{preflight, DefaultMath, LegId, Vec3};
 
 /// Geometric tolerance of the shape checks, m.
 const TOL_M: f32 = 1e-6;
@@ -33,9 +33,9 @@ fn strides() -> Vec<Stride> {
 
 fn max_step(path: &AnyPath, n: u32) -> f32 {
     let mut worst = 0.0f32;
-    let mut prev = path.offset(p(0.0));
+    let mut prev = path.offset::<DefaultMath>(p(0.0));
     for k in 1..=n {
-        let cur = path.offset(p(k as f32 / n as f32)); // k = n wraps to phase 0
+        let cur = path.offset::<DefaultMath>(p(k as f32 / n as f32)); // k = n wraps to phase 0
         worst = worst.max((cur - prev).norm());
         prev = cur;
     }
@@ -73,16 +73,16 @@ fn every_path_lifts_off_behind_lands_in_front_peaks_at_its_height_and_stands_on_
                 s.height_m()
             };
             let swing = 1.0 - d;
-            let lift_off = path.offset(p(0.0));
+            let lift_off = path.offset::<DefaultMath>(p(0.0));
             assert!((lift_off - Vec3::new(-0.5 * l, 0.0, 0.0)).norm() < TOL_M);
-            let touch = path.offset(p(swing));
+            let touch = path.offset::<DefaultMath>(p(swing));
             assert!((touch - Vec3::new(0.5 * l, 0.0, 0.0)).norm() < TOL_M);
-            let apex = path.offset(p(0.5 * swing));
+            let apex = path.offset::<DefaultMath>(p(0.5 * swing));
             assert!((apex.z - h).abs() < TOL_M, "{:?}: {apex:?}", path.kind());
             assert_eq!(path.contact(p(0.5 * swing)), Contact::Swing);
             for k in 0..100 {
                 let ph = swing + d * k as f32 / 100.0;
-                let o = path.offset(p(ph));
+                let o = path.offset::<DefaultMath>(p(ph));
                 assert_eq!(path.contact(p(ph)), Contact::Stance);
                 assert!(o.z.abs() < TOL_M && o.y == 0.0);
                 // Constant stance speed L/d per cycle.
@@ -91,7 +91,7 @@ fn every_path_lifts_off_behind_lands_in_front_peaks_at_its_height_and_stands_on_
             }
             // Never below the ground, never above the apex (+ the Bézier's margin of 0).
             for k in 0..1000 {
-                let o = path.offset(p(k as f32 / 1000.0));
+                let o = path.offset::<DefaultMath>(p(k as f32 / 1000.0));
                 assert!(o.z >= -TOL_M && o.z <= h + TOL_M, "{:?} {o:?}", path.kind());
             }
         }
@@ -100,7 +100,7 @@ fn every_path_lifts_off_behind_lands_in_front_peaks_at_its_height_and_stands_on_
 
 /// One-sided velocities (per cycle) at phase `at`, second-order differences.
 fn one_sided(path: &AnyPath, at: f32) -> (Vec3, Vec3) {
-    let o = |d: f32| path.offset(p(at + d));
+    let o = |d: f32| path.offset::<DefaultMath>(p(at + d));
     let left = (o(0.0) * 3.0 - o(-H) * 4.0 + o(-2.0 * H)) * (0.5 / H);
     let right = (o(H) * 4.0 - o(0.0) * 3.0 - o(2.0 * H)) * (0.5 / H);
     (left, right)
@@ -148,7 +148,7 @@ fn bezier_apex_is_exact_and_its_end_tangents_match_the_stance() {
     let v0 = 5.0 * (cp[1].0 - cp[0].0) / sigma;
     let v5 = 5.0 * (cp[5].0 - cp[4].0) / sigma;
     assert!((v0 + 0.2 / 0.6).abs() < 1e-6 && (v5 + 0.2 / 0.6).abs() < 1e-6);
-    assert!((b.offset(p(0.2)).z - 0.08).abs() < 1e-7);
+    assert!((b.offset::<DefaultMath>(p(0.2)).z - 0.08).abs() < 1e-7);
 }
 
 #[test]
@@ -157,7 +157,7 @@ fn seed000_rectangle_matches_fig8() {
     let r = Rectangle::seed000();
     let (mut zmin, mut zmax, mut xmin, mut xmax) = (1f32, -1f32, 1f32, -1f32);
     for k in 0..3000 {
-        let o = r.offset(p(k as f32 / 3000.0));
+        let o = r.offset::<DefaultMath>(p(k as f32 / 3000.0));
         let z = o.z - Rectangle::SEED000_STANCE_HEIGHT_M;
         zmin = zmin.min(z);
         zmax = zmax.max(z);
@@ -181,13 +181,13 @@ fn shapes_are_what_their_names_say() {
     let cyc = Cycloid::new(s);
     for k in 0..50 {
         let ph = 0.5 * k as f32 / 50.0;
-        let o = semi.offset(p(ph));
+        let o = semi.offset::<DefaultMath>(p(ph));
         assert!((o.x.hypot(o.z) - 0.1).abs() < 1e-6);
-        let o = ell.offset(p(ph));
+        let o = ell.offset::<DefaultMath>(p(ph));
         assert!(((o.x / 0.1).powi(2) + (o.z / 0.06).powi(2) - 1.0).abs() < 1e-5);
     }
     // Cycloid: zero velocity at lift-off and touch-down (within the swing).
-    let d = (cyc.offset(p(1e-3)) - cyc.offset(p(0.0))).norm() / 1e-3;
+    let d = (cyc.offset::<DefaultMath>(p(1e-3)) - cyc.offset::<DefaultMath>(p(0.0))).norm() / 1e-3;
     assert!(d < 0.01, "{d}");
 }
 
@@ -231,8 +231,8 @@ fn rect_path_motion_is_reachable_and_periodic() {
         report.min_inverse_condition().unwrap().1.value
     );
     assert!(report.ok(), "{:?}", report.first_failure);
-    let a = m.frame(0.4).unwrap();
-    let b = m.frame(3.4).unwrap();
+    let a = m.frame::<DefaultMath>(0.4).unwrap();
+    let b = m.frame::<DefaultMath>(3.4).unwrap();
     for l in LegId::ALL {
         assert!((a.feet_in_world[l.index()] - b.feet_in_world[l.index()]).norm() < 1e-6);
     }

@@ -6,7 +6,7 @@ use kin_core::jacobian::SINGULARITY_THRESHOLD;
 use kin_core::motion::laws::{self, Axis, Sway, SwayParams, YawTurn, YawTurnParams};
 use kin_core::motion::{self, Contact, Motion};
 use kin_core::preflight::{self, Sweep};
-use kin_core::{body, leg, paper, LegId, ReachPolicy, Robot, Vec3};
+use kin_core::{body, leg, paper, DefaultMath, LegId, ReachPolicy, Robot, Vec3};
 use std::f64::consts::PI;
 
 /// Largest allowed change of a joint angle between `t` and `t + period` (issue 5).
@@ -20,7 +20,8 @@ const DT_S: f32 = 0.0137;
 
 /// FK of the solved angles of `motion` at `t`: the feet in the world frame.
 fn solved_feet<T: Motion>(motion: &T, t: f32) -> ([Vec3; 4], [f32; 12], motion::Frame) {
-    let (frame, sol) = motion::solve(motion, t, ReachPolicy::Reject).expect("reachable");
+    let (frame, sol) =
+        motion::solve::<DefaultMath>(motion, t, ReachPolicy::Reject).expect("reachable");
     let feet = body::forward(
         motion.robot(),
         &frame.pose,
@@ -381,7 +382,7 @@ fn yaw_turn_swing_moves_twice_as_fast_as_the_body_and_lands_where_the_body_will_
     // FL lifts at 0 and lands at T1/2, ω·T1 further along its circle; the body has turned only
     // ω·T1/2 by then, and catches up by the end of the period.
     let a = |t: f32| {
-        let f = turn.frame(t).unwrap().feet_in_world[LegId::FL.index()];
+        let f = turn.frame::<DefaultMath>(t).unwrap().feet_in_world[LegId::FL.index()];
         (f.y as f64).atan2(f.x as f64)
     };
     let alpha1 = 0.25f64.atan2(0.5);
@@ -389,7 +390,7 @@ fn yaw_turn_swing_moves_twice_as_fast_as_the_body_and_lands_where_the_body_will_
     assert!((a(0.5 * t1) - (alpha1 - OMEGA * T1)).abs() < 1e-5);
     assert!((a(0.99 * t1) - (alpha1 - OMEGA * T1)).abs() < 1e-5);
     // Apex at T1/4, h_K above the ground.
-    let f = turn.frame(0.25 * t1).unwrap();
+    let f = turn.frame::<DefaultMath>(0.25 * t1).unwrap();
     let ground = turn.params().stance_feet[0].z;
     assert!((f.feet_in_world[LegId::FL.index()].z - ground - 0.3).abs() < 1e-6);
     assert!((f.feet_in_world[LegId::FR.index()].z - ground).abs() < 1e-7);
@@ -453,5 +454,8 @@ fn bad_parameters_are_named() {
         })
     ));
     let sway = Sway::new(SwayParams::seed001(Axis::Pitch)).unwrap();
-    assert_eq!(sway.frame(f32::NAN), Err(Error::NonFinite("t_s")));
+    assert_eq!(
+        sway.frame::<DefaultMath>(f32::NAN),
+        Err(Error::NonFinite("t_s"))
+    );
 }

@@ -234,7 +234,11 @@ pub enum Error {
         device: u16,
     },
     /// The device runs another robot than the host was asked for.
-    #[error("the device runs robot {device:?}, the host was given {host:?}")]
+    #[error(
+        "the device runs robot {}, the host was given {}",
+        crate::names::robot_preset_name(*device),
+        crate::names::robot_preset_name(*host)
+    )]
     Robot {
         /// The device's robot.
         device: RobotPreset,

@@ -54,6 +54,15 @@ pub fn reach_policy(name: &str) -> Option<ReachPolicy> {
         .map(|(_, p)| *p)
 }
 
+/// The name of a device's robot preset in messages: kin-core's preset name, or `custom`.
+pub fn robot_preset_name(preset: quad_protocol::RobotPreset) -> &'static str {
+    match preset {
+        quad_protocol::RobotPreset::Shahriar2023 => "shahriar2023",
+        quad_protocol::RobotPreset::Fernando2025 => "fernando2025",
+        _ => "custom",
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -57,17 +57,53 @@ pub enum Error {
         FONT_CANDIDATES.join(", ")
     )]
     NoFont,
-    /// Drawing or writing the file failed: the drawing backend's message (its error types
-    /// are generic over the backend, so the message is what can be kept).
-    #[error("cannot draw the plot: {0}")]
-    Draw(String),
+    /// The directory the plot would be written to does not exist (or is not a directory).
+    #[error("cannot write the plot `{}`: directory `{}` does not exist", .path.display(), .dir.display())]
+    NoDirectory {
+        /// The plot file.
+        path: PathBuf,
+        /// Its directory.
+        dir: PathBuf,
+    },
+    /// Drawing or writing the file failed: the file and the drawing backend's message (its
+    /// error types are generic over the backend, so the message is what can be kept).
+    #[error("cannot draw the plot `{}`: {message}", .path.display())]
+    Draw {
+        /// The plot file.
+        path: PathBuf,
+        /// The backend's message.
+        message: String,
+    },
     /// Nothing to draw.
     #[error("nothing to plot: {0}")]
     Empty(&'static str),
 }
 
-fn draw_err<E: std::fmt::Display>(e: E) -> Error {
-    Error::Draw(e.to_string())
+/// A backend error inside a drawing function, which does not know the file: the canvas adds it
+/// ([`with_path`]).
+fn backend_err<E: std::fmt::Display>(e: E) -> Error {
+    Error::Draw {
+        path: PathBuf::new(),
+        message: e.to_string(),
+    }
+}
+
+/// Names the file in an [`Error::Draw`] raised by a drawing function.
+fn with_path(e: Error, path: &Path) -> Error {
+    match e {
+        Error::Draw { message, .. } => Error::Draw {
+            path: path.to_owned(),
+            message,
+        },
+        other => other,
+    }
+}
+
+fn draw_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
+    move |e| Error::Draw {
+        path: path.to_owned(),
+        message: e.to_string(),
+    }
 }
 
 /// Registers the font once per process.
@@ -99,7 +135,26 @@ enum Kind {
     Png,
 }
 
+/// Checks a plot file name before anything is computed or written: a `.svg` or `.png` name in
+/// a directory that exists.
+///
+/// # Errors
+/// [`Error::Format`], [`Error::NoDirectory`].
+pub fn check_output(path: &Path) -> Result<(), Error> {
+    kind(path).map(|_| ())
+}
+
 fn kind(path: &Path) -> Result<Kind, Error> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(Error::NoDirectory {
+            path: path.to_owned(),
+            dir: dir.to_owned(),
+        });
+    }
     match path
         .extension()
         .and_then(|e| e.to_str())
@@ -121,15 +176,15 @@ macro_rules! on_canvas {
         match k {
             Kind::Svg => {
                 let root = SVGBackend::new($path, $size).into_drawing_area();
-                root.fill(&WHITE).map_err(draw_err)?;
-                $draw(&root, $($arg),*)?;
-                root.present().map_err(draw_err)
+                root.fill(&WHITE).map_err(draw_err($path))?;
+                $draw(&root, $($arg),*).map_err(|e| with_path(e, $path))?;
+                root.present().map_err(draw_err($path))
             }
             Kind::Png => {
                 let root = BitMapBackend::new($path, $size).into_drawing_area();
-                root.fill(&WHITE).map_err(draw_err)?;
-                $draw(&root, $($arg),*)?;
-                root.present().map_err(draw_err)
+                root.fill(&WHITE).map_err(draw_err($path))?;
+                $draw(&root, $($arg),*).map_err(|e| with_path(e, $path))?;
+                root.present().map_err(draw_err($path))
             }
         }
     }};
@@ -275,7 +330,9 @@ fn draw_joints<DB: DrawingBackend>(
     idx: &[usize],
 ) -> Result<(), Error> {
     {
-        let root = root.titled(title, ("sans-serif", 22)).map_err(draw_err)?;
+        let root = root
+            .titled(title, ("sans-serif", 22))
+            .map_err(backend_err)?;
         let panels = root.split_evenly((3, 1));
         let (t0, t1) = (series.t_s[0], *series.t_s.last().expect("non-empty"));
         let t1 = if t1 > t0 { t1 } else { t0 + 1.0 };
@@ -294,13 +351,13 @@ fn draw_joints<DB: DrawingBackend>(
                 .y_label_area_size(56)
                 .caption(format!("{} angle", JOINT_NAMES[j]), ("sans-serif", 16))
                 .build_cartesian_2d(t0..t1, lo..hi)
-                .map_err(draw_err)?;
+                .map_err(backend_err)?;
             chart
                 .configure_mesh()
                 .x_desc("t (s)")
                 .y_desc("deg")
                 .draw()
-                .map_err(draw_err)?;
+                .map_err(backend_err)?;
             for leg in LegId::ALL {
                 let c = leg_color(leg);
                 let pts = idx.iter().map(|&k| {
@@ -313,7 +370,7 @@ fn draw_joints<DB: DrawingBackend>(
                 for run in runs(pts) {
                     let s = chart
                         .draw_series(LineSeries::new(run, c.stroke_width(2)))
-                        .map_err(draw_err)?;
+                        .map_err(backend_err)?;
                     if std::mem::take(&mut first) {
                         s.label(leg.name()).legend(move |(x, y)| {
                             PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
@@ -326,7 +383,7 @@ fn draw_joints<DB: DrawingBackend>(
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
                 .draw()
-                .map_err(draw_err)?;
+                .map_err(backend_err)?;
         }
         Ok(())
     }
@@ -446,7 +503,9 @@ fn draw_views<DB: DrawingBackend>(
     let ground = frame.ground;
     let rows = snapshots.len();
     {
-        let root = root.titled(title, ("sans-serif", 22)).map_err(draw_err)?;
+        let root = root
+            .titled(title, ("sans-serif", 22))
+            .map_err(backend_err)?;
         let cells = root.split_evenly((rows, 3));
         for (row, (snap, d)) in snapshots.iter().zip(drawings).enumerate() {
             for (col, (name, a, b)) in views.iter().enumerate() {
@@ -459,13 +518,13 @@ fn draw_views<DB: DrawingBackend>(
                     .y_label_area_size(44)
                     .caption(format!("t = {:.2} s, {name}", snap.t_s), ("sans-serif", 14))
                     .build_cartesian_2d(centred(ranges[*a]), centred(ranges[*b]))
-                    .map_err(draw_err)?;
+                    .map_err(backend_err)?;
                 chart
                     .configure_mesh()
                     .x_desc("m")
                     .light_line_style(WHITE)
                     .draw()
-                    .map_err(draw_err)?;
+                    .map_err(backend_err)?;
                 if *b == 2 {
                     let x = centred(ranges[*a]);
                     chart
@@ -473,14 +532,14 @@ fn draw_views<DB: DrawingBackend>(
                             [(x.start, ground), (x.end, ground)],
                             BLACK.mix(0.4).stroke_width(1),
                         ))
-                        .map_err(draw_err)?;
+                        .map_err(backend_err)?;
                 }
                 chart
                     .draw_series(LineSeries::new(
                         d.body.iter().map(|p| (axis(p), ord(p))),
                         BLACK.stroke_width(3),
                     ))
-                    .map_err(draw_err)?;
+                    .map_err(backend_err)?;
                 for leg in LegId::ALL {
                     let c = leg_color(leg);
                     let pts: Vec<(f64, f64)> = d.legs[leg.index()]
@@ -489,10 +548,10 @@ fn draw_views<DB: DrawingBackend>(
                         .collect();
                     chart
                         .draw_series(LineSeries::new(pts.clone(), c.stroke_width(3)))
-                        .map_err(draw_err)?;
+                        .map_err(backend_err)?;
                     chart
                         .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
-                        .map_err(draw_err)?;
+                        .map_err(backend_err)?;
                 }
             }
         }
@@ -529,7 +588,9 @@ fn draw_accuracy<DB: DrawingBackend>(
     idx: &[usize],
 ) -> Result<(), Error> {
     {
-        let root = root.titled(title, ("sans-serif", 22)).map_err(draw_err)?;
+        let root = root
+            .titled(title, ("sans-serif", 22))
+            .map_err(backend_err)?;
         let panels = root.split_evenly((3, 1));
         for (j, panel) in panels.iter().enumerate() {
             let deg = |v: f32| f64::from(v).to_degrees();
@@ -544,13 +605,13 @@ fn draw_accuracy<DB: DrawingBackend>(
                 .y_label_area_size(56)
                 .caption(labels[j], ("sans-serif", 16))
                 .build_cartesian_2d(0.0..(n - 1.0).max(1.0), lo..hi)
-                .map_err(draw_err)?;
+                .map_err(backend_err)?;
             chart
                 .configure_mesh()
                 .x_desc("sample")
                 .y_desc("deg")
                 .draw()
-                .map_err(draw_err)?;
+                .map_err(backend_err)?;
             for (name, data, color) in [
                 ("target", target, RGBColor(31, 119, 180)),
                 ("measured", measured, RGBColor(214, 39, 40)),
@@ -559,21 +620,21 @@ fn draw_accuracy<DB: DrawingBackend>(
                     idx.iter().map(|&k| (k as f64, deg(data[k][j]))).collect();
                 chart
                     .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-                    .map_err(draw_err)?
+                    .map_err(backend_err)?
                     .label(name)
                     .legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
                     });
                 chart
                     .draw_series(pts.iter().map(|&p| Circle::new(p, 2, color.filled())))
-                    .map_err(draw_err)?;
+                    .map_err(backend_err)?;
             }
             chart
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
                 .draw()
-                .map_err(draw_err)?;
+                .map_err(backend_err)?;
         }
         Ok(())
     }

@@ -2,10 +2,11 @@
 //!
 //! ```sh
 //! cargo run --release -p quad-twin --example twin_run -- shahriar2023 trot target/twin/shahriar2023-trot --render
-//! # options: --servo NAME (another servo preset), --stance-height-m H (another stance)
+//! # options: --servo NAME (another servo preset), --stance-height-m H (another stance),
+//! #          --emulator (the firmware in simavr instead of the in-process device)
 //! ```
 //!
-//! (the `quadctl sim` command will do the same once the host library exists).
+//! `quadctl sim` is the command; this example keeps the parameter studies scriptable.
 
 use quad_device::Config;
 use quad_model::Physical;
@@ -65,57 +66,16 @@ fn main() -> ExitCode {
     let options = RunOptions {
         out_dir: args.get(2).filter(|a| !a.starts_with("--")).map(Into::into),
         render: args.iter().any(|a| a == "--render"),
+        driver: if args.iter().any(|a| a == "--emulator") {
+            quad_twin::Driver::Emulator { elf: None }
+        } else {
+            quad_twin::Driver::Device
+        },
+        ..RunOptions::default()
     };
     match run(&config, &physical, kind, &options) {
         Ok(r) => {
-            let s = &r.summary;
-            println!(
-                "{robot} {motion}: fell={} min_height={:.3} m max_tilt={:.3} rad",
-                s.fell, s.min_height_m, s.max_tilt_rad
-            );
-            if let Some(reason) = &s.fall_reason {
-                println!("  fall: {reason}");
-            }
-            if let Some(y) = &s.yaw {
-                println!(
-                    "  yaw: commanded {:.3} rad, achieved {:.3} rad, ratio {:.2}",
-                    y.commanded_rad, y.achieved_rad, y.ratio
-                );
-            }
-            if let Some(t) = &s.travel {
-                println!(
-                    "  travel: commanded {:.3} m, achieved {:.3} m, ratio {:.2}, heading error {:.3} rad",
-                    t.commanded_m, t.achieved_m, t.ratio, t.heading_error_rad
-                );
-            }
-            println!(
-                "  slip: max {:.4} m per stance {:?}",
-                s.slip.max_stance_slip_m, s.slip.per_leg_max_m
-            );
-            println!(
-                "  torque: peak {:.3} N·m at {} (stall {:.2}), saturated {:.1} % of steps",
-                s.torque.peak_nm,
-                s.torque.peak_joint,
-                s.torque.stall_nm,
-                100.0 * s.torque.saturated_fraction
-            );
-            for j in &s.torque.joints {
-                print!(" {}={:.2}/{:.2}", j.name, j.peak_nm, j.rms_nm);
-            }
-            println!();
-            println!(
-                "  tracking: roll rms {:.4} rad, pitch rms {:.4} rad, amplitude ratio {:?}",
-                s.tracking.roll_rms_error_rad,
-                s.tracking.pitch_rms_error_rad,
-                s.tracking.amplitude_ratio
-            );
-            println!(
-                "  speed: physics {:.1} sim s / wall s; whole loop {:.1} sim s / wall s ({:.2} s wall)",
-                s.sim_per_wall, r.sim_per_wall, r.wall_s
-            );
-            for f in &s.files {
-                println!("  wrote {}", f.display());
-            }
+            print!("{r}");
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -11,15 +11,20 @@
 //! - [`device`]: the controller on the host (RAM storage, a frame clock, recording outputs).
 //! - [`motions`]: the motions of the twin's catalogue, from kin-core's motion laws.
 //! - [`source`]: [`source::FrameSource`], where frames come from ([`source::HostDriven`]: a
-//!   host sending `SetFeet` every frame) — the one place to change for onboard motions.
+//!   host sending `SetFeet` every frame to the in-process device;
+//!   [`emulated::Emulated`]: the firmware ELF in simavr, its pin pulses measured).
 //! - [`link`]: the JSON-lines protocol and the twin process.
+//! - [`command`]: `quadctl sim` and `quadctl export` (robot argument to a run or a file).
 
+pub mod command;
 pub mod device;
+pub mod emulated;
 pub mod link;
 pub mod motions;
 pub mod source;
 
 use core::fmt;
+use quad_device::Config;
 use quad_model::{Model, Physical};
 use serde::Deserialize;
 use source::FrameSource;
@@ -58,6 +63,22 @@ pub enum Error {
     },
     /// The twin exited with a failure.
     Exit(std::process::ExitStatus),
+    /// The emulated firmware or its link failed.
+    Emulator(quad_host::client::Error),
+    /// The emulated firmware runs another robot or stance than the one asked for.
+    FirmwareConfig {
+        /// The robot the firmware reports.
+        firmware: quad_protocol::RobotPreset,
+    },
+    /// A servo pin showed no complete pulse within three periods while the outputs were on.
+    NoPulse {
+        /// The frame index.
+        frame: u32,
+        /// The servo.
+        servo: quad_protocol::ServoId,
+    },
+    /// The rendered picture could not be copied to its file (nothing is left at its path).
+    Picture(quad_model::Error),
 }
 
 impl fmt::Display for Error {
@@ -72,6 +93,16 @@ impl fmt::Display for Error {
             Error::Protocol(what) => write!(f, "twin protocol: {what}"),
             Error::Twin { message } => write!(f, "twin: {message}"),
             Error::Exit(status) => write!(f, "twin exited with {status}"),
+            Error::Emulator(e) => write!(f, "emulated firmware: {e}"),
+            Error::FirmwareConfig { firmware } => write!(
+                f,
+                "the firmware runs robot {firmware:?} at its default stance; the emulator can \
+                 only drive that robot and stance"
+            ),
+            Error::NoPulse { frame, servo } => {
+                write!(f, "frame {frame}: no pulse on servo {servo}'s pin")
+            }
+            Error::Picture(e) => write!(f, "picture: {e}"),
         }
     }
 }
@@ -186,14 +217,34 @@ pub struct Summary {
     pub files: Vec<PathBuf>,
 }
 
+/// Where the device's frames come from.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Driver {
+    /// The device controller (`quad-device`) in-process, as behind the simulated link
+    /// ([`source::HostDriven`]).
+    #[default]
+    Device,
+    /// The firmware ELF in simavr ([`emulated::Emulated`]; none: built from `firmware-avr/`).
+    Emulator {
+        /// The ELF.
+        elf: Option<PathBuf>,
+    },
+}
+
 /// How to run the twin.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
     /// Where the model, summary, plots and pictures go (none: a temporary directory for the
-    /// model and no other file).
+    /// model and no other file, unless `picture` asks for one).
     pub out_dir: Option<PathBuf>,
-    /// Render a GIF and a strip of frames (needs `out_dir`).
+    /// Render a GIF and a strip of frames (into `out_dir`).
     pub render: bool,
+    /// Also copy the rendered animation to this file (a GIF; the strip of frames, a PNG, when
+    /// the name ends in `.png`); renders even without `render` and `out_dir`.
+    pub picture: Option<PathBuf>,
+    /// Where the frames come from.
+    pub driver: Driver,
 }
 
 /// Time the first frame is held before the motion starts, s: the robot, placed with its feet
@@ -211,8 +262,72 @@ pub struct Run {
     pub sim_per_wall: f64,
 }
 
-/// Runs `kind` on the device of `config` with the physical model `physical`: the device is
-/// driven as a host would ([`source::HostDriven`]), the twin steps the physics.
+impl fmt::Display for Run {
+    /// The run's metrics for people, one aspect a line.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = &self.summary;
+        writeln!(
+            f,
+            "{} {} ({} servos): fell={} min_height={:.3} m max_tilt={:.3} rad",
+            s.robot, s.motion, s.servo, s.fell, s.min_height_m, s.max_tilt_rad
+        )?;
+        if let Some(reason) = &s.fall_reason {
+            writeln!(f, "  fall: {reason}")?;
+        }
+        if let Some(y) = &s.yaw {
+            writeln!(
+                f,
+                "  yaw: commanded {:.3} rad, achieved {:.3} rad, ratio {:.2}",
+                y.commanded_rad, y.achieved_rad, y.ratio
+            )?;
+        }
+        if let Some(t) = &s.travel {
+            writeln!(
+                f,
+                "  travel: commanded {:.3} m, achieved {:.3} m, ratio {:.2}, heading error {:.3} rad",
+                t.commanded_m, t.achieved_m, t.ratio, t.heading_error_rad
+            )?;
+        }
+        writeln!(
+            f,
+            "  slip: max {:.4} m per stance {:?}",
+            s.slip.max_stance_slip_m, s.slip.per_leg_max_m
+        )?;
+        writeln!(
+            f,
+            "  torque: peak {:.3} N·m at {} (stall {:.2}), saturated {:.1} % of steps",
+            s.torque.peak_nm,
+            s.torque.peak_joint,
+            s.torque.stall_nm,
+            100.0 * s.torque.saturated_fraction
+        )?;
+        write!(f, " ")?;
+        for j in &s.torque.joints {
+            write!(f, " {}={:.2}/{:.2}", j.name, j.peak_nm, j.rms_nm)?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "  tracking: roll rms {:.4} rad, pitch rms {:.4} rad, amplitude ratio {:?}",
+            s.tracking.roll_rms_error_rad,
+            s.tracking.pitch_rms_error_rad,
+            s.tracking.amplitude_ratio
+        )?;
+        writeln!(
+            f,
+            "  speed: physics {:.1} sim s / wall s; whole loop {:.2} sim s / wall s ({:.2} s wall)",
+            s.sim_per_wall, self.sim_per_wall, self.wall_s
+        )?;
+        for file in &s.files {
+            writeln!(f, "  wrote {}", file.display())?;
+        }
+        Ok(())
+    }
+}
+
+/// Runs `kind` on the device of `config` with the physical model `physical`: the device (or
+/// the firmware in simavr, [`RunOptions::driver`]) is driven as a host would, the twin steps
+/// the physics.
 ///
 /// # Errors
 /// [`Error`].
@@ -224,25 +339,67 @@ pub fn run(
 ) -> Result<Run, Error> {
     let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
     let plan = Plan::new(kind, config).map_err(Error::Motion)?;
-    let device =
-        device::SimDevice::start(*config).map_err(|error| Error::Device { frame: 0, error })?;
-    let mut source = source::HostDriven::new(plan, device);
+    let mut source: Box<dyn FrameSource> = match &options.driver {
+        Driver::Device => {
+            let device = device::SimDevice::start(*config)
+                .map_err(|error| Error::Device { frame: 0, error })?;
+            Box::new(source::HostDriven::new(plan, device))
+        }
+        Driver::Emulator { elf } => {
+            Box::new(emulated::Emulated::boot(plan, config, elf.as_deref())?)
+        }
+    };
     let tmp = tempfile::tempdir().map_err(Error::Io)?;
-    let out_dir = options.out_dir.as_deref();
+    let out_dir = match (&options.out_dir, &options.picture) {
+        (Some(dir), _) => Some(dir.as_path()),
+        (None, Some(_)) => Some(tmp.path()),
+        (None, None) => None,
+    };
     if let Some(dir) = out_dir {
         std::fs::create_dir_all(dir).map_err(Error::Io)?;
     }
     let model_path = link::model_path(out_dir, tmp.path());
     quad_model::mjcf::write(&model, &model_path).map_err(Error::Model)?;
     let robot_name = quad_model::mjcf::robot_name(&model);
-    run_source(
-        &mut source,
+    let mut run = run_source(
+        source.as_mut(),
         &model_path,
         robot_name,
         &plan,
         out_dir,
-        options.render,
-    )
+        options.render || options.picture.is_some(),
+    )?;
+    if let (Some(picture), Some(dir)) = (&options.picture, out_dir) {
+        let strip = picture
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let rendered = dir.join(if strip { "strip.png" } else { "motion.gif" });
+        let bytes = std::fs::read(&rendered).map_err(Error::Io)?;
+        quad_model::write_atomic(picture, &bytes).map_err(Error::Picture)?;
+        if options.out_dir.is_none() {
+            run.summary.files.clear();
+        }
+        run.summary.files.push(picture.clone());
+    }
+    Ok(run)
+}
+
+/// The device configuration of `robot`: its preset's when it is a preset's geometry, else
+/// seed 000's robot's device settings on this geometry (reported as a custom robot);
+/// `stance_height_m` overrides the stance.
+pub fn config_for(robot: &kin_core::Robot, stance_height_m: Option<f32>) -> Config {
+    let mut config = [Config::shahriar2023(), Config::fernando2025()]
+        .into_iter()
+        .find(|c| c.robot == *robot)
+        .unwrap_or(Config {
+            preset: quad_protocol::RobotPreset::Custom,
+            robot: *robot,
+            ..Config::shahriar2023()
+        });
+    if let Some(h) = stance_height_m {
+        config.pose_config.stance_height_m = h;
+    }
+    config
 }
 
 /// The loop on any frame source.

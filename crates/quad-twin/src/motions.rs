@@ -87,6 +87,21 @@ impl MotionKind {
         }
     }
 
+    /// One line for people (`quadctl sim --help`).
+    pub const fn summary(self) -> &'static str {
+        match self {
+            MotionKind::Stand => "Rise from the rest crouch to the stance and hold it",
+            MotionKind::Roll => "Seed 001's roll sway (eq. 6), one period",
+            MotionKind::Pitch => "Seed 001's pitch sway (eq. 8), one period",
+            MotionKind::SweepRoll => "Seed 000's roll sweep (±28°), one period",
+            MotionKind::SweepPitch => "Seed 000's pitch sweep (±21°), one period",
+            MotionKind::SweepYaw => "Seed 000's yaw sweep (±21°), one period",
+            MotionKind::YawTurn => "Seed 001's crossed-pair yaw turn (eq. 9-11, T1 = 6 s)",
+            MotionKind::YawTurnFast => "The yaw turn with a trot's step period, same turn rate",
+            MotionKind::Trot => "A trot forward, 10 s",
+        }
+    }
+
     /// Parses a [`MotionKind::name`].
     pub fn parse(name: &str) -> Option<MotionKind> {
         MotionKind::ALL.into_iter().find(|m| m.name() == name)
@@ -242,7 +257,7 @@ impl Plan {
                 (pose, self.robot.stance_feet(stance_m), [Contact::Stance; 4])
             }
             Script::Law(m) => {
-                let f = m.frame(t_s)?;
+                let f = m.frame::<kin_core::DefaultMath>(t_s)?;
                 (f.pose, f.feet_in_world, f.contact)
             }
         };

@@ -56,9 +56,14 @@ impl HostDriven {
     }
 }
 
+/// Frames of a run of `plan`: its duration in frames and the final one.
+pub fn frame_count(plan: &Plan) -> u32 {
+    (plan.duration_s() / FRAME_S).round() as u32 + 1
+}
+
 impl FrameSource for HostDriven {
     fn frame_count(&self) -> u32 {
-        (self.plan.duration_s() / FRAME_S).round() as u32 + 1
+        frame_count(&self.plan)
     }
 
     fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {

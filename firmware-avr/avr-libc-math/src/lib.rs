@@ -8,10 +8,11 @@
 //! binary's own native libraries before the upstream crates, so `-lm` then precedes Rust's
 //! compiler-builtins on the linker command line. Besides the functions named here, the float
 //! primitives `__addsf3`, `__mulsf3`, `__divsf3`, … of the whole program then come from
-//! avr-libc (about four times faster than compiler-builtins' soft-float, and smaller). The same
-//! attribute in this library crate puts `-lm` *after* compiler-builtins, and then the
-//! `extern "C" fn atan2` below silently binds to compiler-builtins' weak 64-bit `atan2` — wrong
-//! values and ~20 KB of soft-double code. Check the linked ELF with
+//! avr-libc (faster than compiler-builtins' soft-float, and smaller; the per-primitive cycles
+//! are in `BENCHMARKS.md`). The same attribute in this library crate puts `-lm` *after*
+//! compiler-builtins, and then the `extern "C" fn atan2` below silently binds to
+//! compiler-builtins' weak 64-bit `atan2` — wrong values and a large soft-double
+//! implementation. Check the linked ELF with
 //! `avr-nm firmware.elf | grep -E ' (atan2|sqrt|sin|cos)$'`: each must be `T`, not `W` (the
 //! emulator tests do).
 //!
@@ -32,7 +33,7 @@ macro_rules! link_avr_libc {
         #[link(name = "m")]
         extern "C" {}
         // avr-libc's assembly `memcpy`/`memset` instead of compiler-builtins' byte loops (the
-        // IK moves its results through memory: about 1,000 cycles per body pose saved).
+        // IK moves its results through memory; the saving is in `BENCHMARKS.md`).
         #[link(name = "c")]
         extern "C" {}
     };

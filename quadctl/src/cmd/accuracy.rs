@@ -37,11 +37,18 @@ are comments.
 Output: a table; with --json also one JSON object as the last line. --plot draws target and
 measured per joint over the samples (seed 000 Fig. 9-11) for --leg.";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl accuracy --target examples/accuracy-target.csv --measured examples/accuracy-measured.csv
+  quadctl accuracy --target examples/accuracy-target.csv --measured examples/accuracy-measured.csv --robot shahriar2023 --plot acc.svg --json";
+
 /// Arguments of `quadctl accuracy`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Seed 000's accuracy metric: per-joint mean deviation %, RSSE, 100 − RSSE; foot error",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// Target (commanded) angles, CSV.

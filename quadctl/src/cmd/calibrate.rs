@@ -39,8 +39,12 @@ first). With --sim the simulated device powers on at every run: keep its EEPROM 
 #[derive(Debug, Clone, PartialEq, Eq, clap::Subcommand)]
 pub enum Action {
     /// Print the device's 12 calibrations as TOML.
+    #[command(after_help = "Example: quadctl calibrate --sim get > cal.toml")]
     Get,
     /// Send the calibrations of FILE.toml to the device's RAM.
+    #[command(
+        after_help = "Example: quadctl calibrate --sim --sim-storage eeprom.bin set cal.toml --save"
+    )]
     Set {
         /// TOML file with one table per servo to change.
         file: PathBuf,
@@ -49,14 +53,23 @@ pub enum Action {
         save: bool,
     },
     /// Persist the calibration held in the device's RAM.
+    #[command(after_help = "Example: quadctl calibrate --sim --sim-storage eeprom.bin save")]
     Save,
 }
+
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl calibrate --sim get > cal.toml
+  quadctl calibrate --sim --sim-storage eeprom.bin set cal.toml --save
+  quadctl calibrate --port /dev/ttyACM0 get";
 
 /// Arguments of `quadctl calibrate`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Read, edit (TOML) and save the device's servo calibration (--sim or --port)",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     #[command(flatten)]

@@ -28,12 +28,20 @@ file's `# quadctl motion … rotation_order=…` line, else --rotation-order, el
 Output: a table (angles in rad with degrees in brackets); with --json, also one JSON object as
 the last line (SI units). Exit status: 0 all samples pass, 1 some fail, 2 bad input.";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl motion yaw-turn --robot fernando2025 --duration-s 12 --rate-hz 50 --output yaw.csv
+  quadctl check --robot fernando2025 yaw.csv
+  quadctl check --motion pitch-sway --robot fernando2025 --amplitude-rad -0.1 --json";
+
 /// Arguments of `quadctl check`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Preflight report of a motion (file or law): reach, margins, singularity, joint speed",
     long_about = LONG_ABOUT,
-    allow_negative_numbers = true
+    allow_negative_numbers = true,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// Motion CSV written by `quadctl motion` (`-` for stdin).

@@ -33,11 +33,19 @@ the readback in force within one 0.5 us timer tick. Times are simulated time on 
 Exit status: 0 every check passed; 2 the firmware could not be built or the link failed; 3 a
 check failed.";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl demo
+  quadctl demo --poses-per-sweep 20 --baud 1000000
+  quadctl demo --port /dev/ttyACM0";
+
 /// Arguments of `quadctl demo`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Demo: body-pose sweeps on the firmware in an emulated Mega (or --port), all checked",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// Drive a real Arduino Mega on this serial port instead of the emulator.
@@ -100,13 +108,13 @@ pub fn main(args: &Args) -> ExitCode {
 
 fn describe_info(info: &quad_protocol::DeviceInfo) -> String {
     format!(
-        "  device: protocol {}.{}, firmware {}.{}.{}, robot {:?}",
+        "  device: protocol {}.{}, firmware {}.{}.{}, robot {}",
         info.version >> 8,
         info.version & 0xFF,
         info.firmware.major,
         info.firmware.minor,
         info.firmware.patch,
-        info.robot
+        quad_host::names::robot_preset_name(info.robot)
     )
 }
 

@@ -1,6 +1,6 @@
 //! `quadctl fk`: leg forward kinematics, one set of joint angles per record.
 
-use crate::args::{Error, InputArgs, RobotArgs, BATCH_RULES};
+use crate::args::{self, Error, InputArgs, RobotArgs};
 use quad_host::csv::{Input, Summary};
 use quad_host::ops::batch;
 use std::io::Write;
@@ -10,22 +10,32 @@ Leg forward kinematics: joint angles -> foot position in the hip frame.
 
 Input columns: leg,abduction_rad,hip_rad,knee_rad — joint angles in RADIANS in the canonical
 convention (all zero: leg straight down; abduction about x, hip and knee about the abducted y
-axis, knee relative to the femur). Angles must be finite (nan or inf make the record
-malformed). Joint limits are NOT checked: any finite angles give the foot they put it at.
+axis, knee relative to the femur). Joint limits are NOT checked: any finite angles give the
+foot they put it at.
 
-Output columns: leg,x_m,y_m,z_m — the foot in the HIP FRAME of that leg, metres: origin at the
+Output columns: leg,x_m,y_m,z_m,status,line — status is `ok`, or `non_finite` with the three
+position cells left empty when an angle is nan, inf or beyond the f32 range (e.g. 1e300), as
+`ik` and `pose` answer such numbers; line is the record's input line (see below). The foot in the HIP FRAME of that leg, metres: origin at the
 leg's hip (abduction-axis) mount, axes parallel to the body frame (x forward, y left, z up):
 
   foot = Rx(abduction)·([0, s·d_lat, −d_ax] + Ry(hip)·[0,0,−femur] + Ry(hip+knee)·[0,0,−tibia])
 
 with s = +1 for the left legs (FL, RL) and −1 for the right legs (FR, RR).";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl fk --robot shahriar2023 --input examples/angles.csv
+  quadctl fk --robot examples/robots/fernando2025.toml --input examples/angles.csv
+  quadctl fk --robot shahriar2023 --input examples/angles.csv | quadctl ik --robot shahriar2023";
+
 /// Arguments of `quadctl fk`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 #[command(
     about = "Leg FK: joint angles (rad) -> foot in hip frame (m), CSV",
     long_about = LONG_ABOUT,
-    after_long_help = BATCH_RULES
+    after_help = EXAMPLES,
+    after_long_help = args::batch_help(EXAMPLES)
 )]
 pub struct Args {
     #[command(flatten)]

@@ -1,6 +1,6 @@
 //! `quadctl ik`: leg inverse kinematics, one foot target per record.
 
-use crate::args::{self, Error, InputArgs, RobotArgs, BATCH_RULES};
+use crate::args::{self, Error, InputArgs, RobotArgs};
 use kin_core::{KneeBend, ReachPolicy};
 use quad_host::csv::{Input, Summary};
 use quad_host::ops::batch;
@@ -12,25 +12,34 @@ Leg inverse kinematics: foot positions in the hip frame -> joint angles.
 Input columns: leg,x_m,y_m,z_m — the foot in the HIP FRAME of that leg, metres: origin at the
 leg's hip (abduction-axis) mount, axes parallel to the body frame (x forward, y left, z up).
 
-Output columns: leg,abduction_rad,hip_rad,knee_rad,status — joint angles in RADIANS in the
+Output columns: leg,abduction_rad,hip_rad,knee_rad,status,line — joint angles in RADIANS in the
 canonical convention (all zero: leg straight down; abduction about x, hip and knee about the
-abducted y axis, knee relative to the femur).
+abducted y axis, knee relative to the femur); line is the record's input line (see below).
 
 status is `ok`, or why the target is unreachable, with the three angle cells left empty:
 too_far, too_close, inside_offset (foot within d_lat of the abduction axis), joint_limit,
-non_finite (a coordinate is nan or inf).
+non_finite (a coordinate is nan, inf or beyond the f32 range, e.g. 1e300: `fk` and `pose`
+answer such numbers the same way).
 
 With --policy clamp an unreachable target is moved to the nearest reachable point (and the
 angles clamped to the joint limits): the row then has angles, status `clamped:<reason>` and a
-last column clamp_distance_m, the distance in metres between the requested foot and the foot the
+column clamp_distance_m before line, the distance in metres between the requested foot and the foot the
 angles reach (0 for `ok` rows; empty for non_finite rows, which are still rejected).";
+
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl ik --robot shahriar2023 --input examples/feet.csv
+  quadctl ik --robot fernando2025 --policy clamp --knee forward --input examples/feet.csv
+  quadctl ik --robot shahriar2023 --input examples/feet.csv | quadctl fk --robot shahriar2023";
 
 /// Arguments of `quadctl ik`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 #[command(
     about = "Leg IK: foot in hip frame (m) -> joint angles (rad), CSV",
     long_about = LONG_ABOUT,
-    after_long_help = BATCH_RULES
+    after_help = EXAMPLES,
+    after_long_help = args::batch_help(EXAMPLES)
 )]
 pub struct Args {
     #[command(flatten)]

@@ -7,12 +7,19 @@ use quad_host::ops::motion::{self, Law, Request};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl motion roll-sway --robot fernando2025 --duration-s 20 --rate-hz 50 --output roll.csv
+  quadctl motion trot --robot shahriar2023 --forward-m-s 0.1 --duration-s 4 --rate-hz 100 --output trot.csv --plot trot.svg";
+
 /// Arguments of `quadctl motion`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Sample a motion law into CSV: t, 12 joint angles, 4 feet, body pose, status",
     long_about = LONG_ABOUT,
-    allow_negative_numbers = true
+    allow_negative_numbers = true,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// The motion law.

@@ -24,11 +24,19 @@ Needs --robot; the rotation order is read from the file's `# quadctl motion` lin
 Text needs a TrueType font, read at run time: $QUADCTL_FONT or a system font (DejaVu Sans,
 Liberation Sans, FreeSans; Debian: apt-get install fonts-dejavu-core).";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl motion roll-sway --robot fernando2025 --duration-s 20 --rate-hz 50 --output roll.csv
+  quadctl plot roll.csv --output roll.svg
+  quadctl plot roll.csv --output views.png --robot fernando2025 --at-s 0,5,15";
+
 /// Arguments of `quadctl plot`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Draw a motion CSV: joint angles over time, or the robot in three views (SVG/PNG)",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// Motion CSV written by `quadctl motion` (`-` for stdin).

@@ -1,6 +1,6 @@
 //! `quadctl pose`: body pose → the twelve joint angles, feet held at the nominal stance.
 
-use crate::args::{self, Error, InputArgs, RobotArgs, BATCH_RULES};
+use crate::args::{self, Error, InputArgs, RobotArgs};
 use kin_core::{BodyConfig, KneeBend, RotationOrder, Vec3};
 use quad_host::csv::{Input, Summary};
 use quad_host::ops::batch::{self, PoseFormat, PoseSetup};
@@ -22,20 +22,29 @@ Rz(yaw)·Rx(roll)·Ry(pitch) (seed 001). With --pivot-m c (body frame, metres) t
 about c: foot_in_hip = Rᵀ·(foot_in_world − t − c) + c − hip_in_body.
 
 Output (CSV): FL_abduction_rad,FL_hip_rad,FL_knee_rad, then FR, RL, RR likewise (RADIANS, the
-canonical convention: all zero is the leg straight down), then status: `ok`, or `<leg>:<reason>`
+canonical convention: all zero is the leg straight down), then status and line (the record's input line, see below): status is `ok`, or `<leg>:<reason>`
 for the first leg (in the order FL, FR, RL, RR) that cannot reach, e.g. `FR:too_far`, with all
 twelve angle cells empty (all or nothing). Reasons: too_far, too_close, inside_offset,
-joint_limit, non_finite (a nan or inf in the pose is reported as FL:non_finite).
+joint_limit, non_finite (a nan, inf or 1e300 in the pose is reported as FL:non_finite, as `ik`
+and `fk` answer such numbers).
 
 Output (--table): a human-readable table per pose, angles in DEGREES (pose angles too), for
 reading, not for parsing.";
+
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl pose --robot shahriar2023 --stance-height-m 0.4 --input examples/poses.csv
+  quadctl pose --robot fernando2025 --stance-height-m 0.9294 --rotation-order zxy --table --input examples/poses.csv";
 
 /// Arguments of `quadctl pose`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Body IK: body pose (rad, m) -> 12 joint angles (rad) at the nominal stance, CSV",
     long_about = LONG_ABOUT,
-    after_long_help = BATCH_RULES
+    after_help = EXAMPLES,
+    after_long_help = args::batch_help(EXAMPLES),
+    allow_negative_numbers = true
 )]
 pub struct Args {
     #[command(flatten)]

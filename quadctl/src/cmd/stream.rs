@@ -45,11 +45,21 @@ others were streamed); 2 nothing or not everything could be streamed (arguments,
 link, firmware build, handshake); 3 a readback mismatch, a pulse out of its travel, a pulse
 width error on the pins or a receive overrun.";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl stream --robot shahriar2023 --sim --input examples/poses.csv
+  quadctl stream --robot shahriar2023 --sim --faults drop=0.01,flip=0.001 --seed 7 --input examples/poses.csv
+  quadctl stream --robot shahriar2023 --emulator --input examples/poses.csv
+  quadctl stream --robot shahriar2023 --port /dev/ttyACM0 --input examples/poses.csv";
+
 /// Arguments of `quadctl stream`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Stream body poses (rad, m) to the device (--sim or --port) and check every readback",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES,
+    allow_negative_numbers = true
 )]
 pub struct Args {
     #[command(flatten)]

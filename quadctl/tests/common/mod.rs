@@ -7,6 +7,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+pub mod shell;
+
 /// What one run of `quadctl` printed, and how it exited.
 pub struct Run {
     /// Everything written to stdout.

@@ -181,7 +181,7 @@ impl Gait {
         let zero = Pose::default();
         check_reach(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
         let at = |phase: f32| {
-            LegId::ALL.map(|leg| gait.foot_in_body_with::<crate::DefaultMath>(leg, phase).0)
+            LegId::ALL.map(|leg| gait.foot_in_body::<crate::DefaultMath>(leg, phase).0)
         };
         check_reach(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
         check_reach(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
@@ -215,7 +215,7 @@ impl Gait {
     }
 
     /// Foot of `leg` in the body frame at leg phase `phase` (cycles; wrapped), and its contact.
-    pub fn foot_in_body_with<M: Math>(&self, leg: LegId, phase: f32) -> (Vec3, Contact) {
+    pub fn foot_in_body<M: Math>(&self, leg: LegId, phase: f32) -> (Vec3, Contact) {
         let phase = Phase::wrap(phase);
         let (t, d) = (self.p.cycle_s, self.p.duty_factor);
         let n = self.neutral[leg.index()];
@@ -240,7 +240,7 @@ impl Gait {
             self.p.swing,
             Stride::unchecked(length, self.p.step_height_m, d),
         );
-        let o = path.offset_with::<M>(phase);
+        let o = path.offset::<M>(phase);
         (
             Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z),
             Contact::Swing,
@@ -272,7 +272,7 @@ impl Motion for Gait {
         BodyConfig::about_centre(self.p.order)
     }
 
-    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+    fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
         finite(t_s, "t_s")?;
         let body = self.displaced::<M>(t_s, Vec3::ZERO);
         let yaw = wrap_pi(self.p.velocity.yaw_rad_s * t_s);
@@ -280,7 +280,7 @@ impl Motion for Gait {
         let mut feet = [Vec3::ZERO; 4];
         let mut contact = [Contact::Stance; 4];
         for leg in LegId::ALL {
-            let (f, c) = self.foot_in_body_with::<M>(leg, self.leg_phase(leg, t_s));
+            let (f, c) = self.foot_in_body::<M>(leg, self.leg_phase(leg, t_s));
             feet[leg.index()] = Vec3::new(
                 body.x + cs * f.x - sn * f.y,
                 body.y + sn * f.x + cs * f.y,

@@ -175,7 +175,7 @@ impl Sway {
     }
 
     /// The oscillating angle's offset from its constant, `A·sin(2πt/T)`, rad.
-    pub fn offset_rad_with<M: Math>(&self, t_s: f32) -> f32 {
+    pub fn offset_rad<M: Math>(&self, t_s: f32) -> f32 {
         let phase = fract01(t_s / self.p.period_s);
         self.p.amplitude_rad * M::sin_cos(2.0 * PI * phase).0
     }
@@ -200,10 +200,10 @@ impl Motion for Sway {
         BodyConfig::about_centre(self.p.order)
     }
 
-    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+    fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
         finite(t_s, "t_s")?;
         Ok(Frame {
-            pose: self.pose_at(self.offset_rad_with::<M>(t_s)),
+            pose: self.pose_at(self.offset_rad::<M>(t_s)),
             feet_in_world: self.p.feet_in_world,
             contact: [Contact::Stance; 4],
         })
@@ -319,7 +319,7 @@ impl YawTurn {
             (0.499 * t1, "omega_rad_s"),
             (0.999 * t1, "omega_rad_s"),
         ] {
-            let f = turn.frame_with::<crate::DefaultMath>(t)?;
+            let f = turn.frame::<crate::DefaultMath>(t)?;
             check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
         }
         Ok(turn)
@@ -384,7 +384,7 @@ impl Motion for YawTurn {
         BodyConfig::about_centre(self.p.order)
     }
 
-    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+    fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
         finite(t_s, "t_s")?;
         let p = &self.p;
         let t1 = p.step_period_s;
@@ -491,7 +491,8 @@ impl LegPaths {
         let cfg = lp.body_config();
         for i in 0..Self::REACH_SAMPLES {
             let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
-            let feet = LegId::ALL.map(|leg| p.stance_feet[leg.index()] + p.path.offset(phase));
+            let feet = LegId::ALL
+                .map(|leg| p.stance_feet[leg.index()] + p.path.offset::<crate::DefaultMath>(phase));
             check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
         }
         Ok(lp)
@@ -512,7 +513,7 @@ impl Motion for LegPaths {
         BodyConfig::default()
     }
 
-    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+    fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
         finite(t_s, "t_s")?;
         let base = fract01(t_s / self.p.cycle_s);
         let mut feet = self.p.stance_feet;
@@ -520,7 +521,7 @@ impl Motion for LegPaths {
         for leg in LegId::ALL {
             let i = leg.index();
             let phase = Phase::wrap(base + self.p.phase_offsets[i]);
-            feet[i] = feet[i] + self.p.path.offset_with::<M>(phase);
+            feet[i] = feet[i] + self.p.path.offset::<M>(phase);
             contact[i] = self.p.path.contact(phase);
         }
         Ok(Frame {

@@ -23,7 +23,7 @@
 
 use crate::body::{self, BodyConfig, BodySolution, Pose};
 use crate::leg::{IkError, Unreachable};
-use crate::math::{DefaultMath, Math};
+use crate::math::Math;
 use crate::robot::{LegId, Robot, RobotError};
 use crate::vec::Vec3;
 use crate::ReachPolicy;
@@ -212,13 +212,9 @@ pub trait Motion {
     /// Rotation order and pivot the motion's poses are meant for.
     fn body_config(&self) -> BodyConfig;
 
-    /// The frame at time `t_s` (s) on math backend `M`. Only a non-finite `t_s` fails.
-    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error>;
-
-    /// [`Motion::frame_with`] on the [`DefaultMath`] backend.
-    fn frame(&self, t_s: f32) -> Result<Frame, Error> {
-        self.frame_with::<DefaultMath>(t_s)
-    }
+    /// The frame at time `t_s` (s) on math backend `M` (`motion.frame::<DefaultMath>(t_s)` for
+    /// the default, [`DefaultMath`](crate::math::DefaultMath)). Only a non-finite `t_s` fails.
+    fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error>;
 
     /// Period (s) of the joint angles, i.e. of the feet relative to the body, if the motion is
     /// periodic. The body itself may keep turning or moving (yaw turn, gait).
@@ -226,13 +222,15 @@ pub trait Motion {
 }
 
 /// Frame and joint angles of `motion` at `t_s` on backend `M`: the motion's frame solved by
-/// [`crate::body::Solver::inverse`] under `policy`.
-pub fn solve_with<M: Math, T: Motion>(
-    motion: &T,
+/// [`crate::body::Solver::inverse`] under `policy`
+/// (`motion::solve::<DefaultMath>(&motion, t_s, policy)` for the default backend,
+/// [`DefaultMath`](crate::math::DefaultMath)).
+pub fn solve<M: Math>(
+    motion: &impl Motion,
     t_s: f32,
     policy: ReachPolicy,
 ) -> Result<(Frame, BodySolution), Error> {
-    let frame = motion.frame_with::<M>(t_s)?;
+    let frame = motion.frame::<M>(t_s)?;
     let sol = body::Solver::<M>::with_math(motion.robot())
         .inverse(
             &frame.pose,
@@ -242,15 +240,6 @@ pub fn solve_with<M: Math, T: Motion>(
         )
         .map_err(Error::Ik)?;
     Ok((frame, sol))
-}
-
-/// [`solve_with`] on the [`DefaultMath`] backend.
-pub fn solve<T: Motion>(
-    motion: &T,
-    t_s: f32,
-    policy: ReachPolicy,
-) -> Result<(Frame, BodySolution), Error> {
-    solve_with::<DefaultMath, T>(motion, t_s, policy)
 }
 
 /// Any of the motions of this module, for choosing one at run time.
@@ -286,12 +275,12 @@ impl Motion for AnyMotion {
         }
     }
 
-    fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+    fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
         match self {
-            AnyMotion::Sway(m) => m.frame_with::<M>(t_s),
-            AnyMotion::YawTurn(m) => m.frame_with::<M>(t_s),
-            AnyMotion::LegPaths(m) => m.frame_with::<M>(t_s),
-            AnyMotion::Gait(m) => m.frame_with::<M>(t_s),
+            AnyMotion::Sway(m) => m.frame::<M>(t_s),
+            AnyMotion::YawTurn(m) => m.frame::<M>(t_s),
+            AnyMotion::LegPaths(m) => m.frame::<M>(t_s),
+            AnyMotion::Gait(m) => m.frame::<M>(t_s),
         }
     }
 

@@ -22,20 +22,16 @@
 //! | [`Bezier`] | yes | end control points chosen to match the stance velocity |
 
 use super::{finite, non_negative, Contact, Error, Phase};
-use crate::math::{DefaultMath, Math};
+use crate::math::Math;
 use crate::vec::Vec3;
 use core::f32::consts::PI;
 
 /// A closed foot path over one gait cycle.
 pub trait FootPath {
     /// Foot offset from the neutral foothold at `phase` (m, x along the stride, z up), on math
-    /// backend `M`.
-    fn offset_with<M: Math>(&self, phase: Phase) -> Vec3;
-
-    /// [`FootPath::offset_with`] on the [`DefaultMath`] backend.
-    fn offset(&self, phase: Phase) -> Vec3 {
-        self.offset_with::<DefaultMath>(phase)
-    }
+    /// backend `M` (`path.offset::<DefaultMath>(phase)` for the default,
+    /// [`DefaultMath`](crate::math::DefaultMath)).
+    fn offset<M: Math>(&self, phase: Phase) -> Vec3;
 
     /// Whether the foot is in stance or swing at `phase`.
     fn contact(&self, phase: Phase) -> Contact {
@@ -168,7 +164,7 @@ impl Rectangle {
 }
 
 impl FootPath for Rectangle {
-    fn offset_with<M: Math>(&self, phase: Phase) -> Vec3 {
+    fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
         let (l, h) = (self.stride.length_m, self.stride.height_m);
         match self.stride.split(phase) {
             Part::Stance(u) => self.stride.stance(u),
@@ -219,7 +215,7 @@ impl Semicircle {
 }
 
 impl FootPath for Semicircle {
-    fn offset_with<M: Math>(&self, phase: Phase) -> Vec3 {
+    fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
         match self.stride.split(phase) {
             Part::Stance(u) => self.stride.stance(u),
             Part::Swing(s) => {
@@ -259,7 +255,7 @@ impl Ellipse {
 }
 
 impl FootPath for Ellipse {
-    fn offset_with<M: Math>(&self, phase: Phase) -> Vec3 {
+    fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
         match self.stride.split(phase) {
             Part::Stance(u) => self.stride.stance(u),
             Part::Swing(s) => {
@@ -303,7 +299,7 @@ impl Cycloid {
 }
 
 impl FootPath for Cycloid {
-    fn offset_with<M: Math>(&self, phase: Phase) -> Vec3 {
+    fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
         match self.stride.split(phase) {
             Part::Stance(u) => self.stride.stance(u),
             Part::Swing(s) => {
@@ -373,7 +369,7 @@ impl Bezier {
 }
 
 impl FootPath for Bezier {
-    fn offset_with<M: Math>(&self, phase: Phase) -> Vec3 {
+    fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
         match self.stride.split(phase) {
             Part::Stance(u) => self.stride.stance(u),
             Part::Swing(s) => {
@@ -510,13 +506,13 @@ impl AnyPath {
 }
 
 impl FootPath for AnyPath {
-    fn offset_with<M: Math>(&self, phase: Phase) -> Vec3 {
+    fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
         match self {
-            AnyPath::Rectangle(p) => p.offset_with::<M>(phase),
-            AnyPath::Semicircle(p) => p.offset_with::<M>(phase),
-            AnyPath::Ellipse(p) => p.offset_with::<M>(phase),
-            AnyPath::Cycloid(p) => p.offset_with::<M>(phase),
-            AnyPath::Bezier(p) => p.offset_with::<M>(phase),
+            AnyPath::Rectangle(p) => p.offset::<M>(phase),
+            AnyPath::Semicircle(p) => p.offset::<M>(phase),
+            AnyPath::Ellipse(p) => p.offset::<M>(phase),
+            AnyPath::Cycloid(p) => p.offset::<M>(phase),
+            AnyPath::Bezier(p) => p.offset::<M>(phase),
         }
     }
 

@@ -8,9 +8,15 @@
 //!   not a value of the first column (not a number, or for `leg` columns not a leg name). A
 //!   header must then name exactly the expected columns (case-insensitive), otherwise the whole
 //!   input is refused — a different header usually means a different file format;
-//! - a malformed record (wrong field count, a field that is not a number or not a leg) is
-//!   reported on stderr as `<input>:<line>: <what is wrong>` and produces no output row; the
-//!   other records are still answered.
+//! - a header may be followed by [`CARRIED_COLUMNS`] (`status`, `clamp_distance_m`, `line`),
+//!   so that one batch command's output is another's input;
+//! - UTF-8, a byte-order mark at the start skipped ([`Lines`]); a first record using `;` or tabs
+//!   instead of commas stops the input with that hint;
+//! - a malformed record (wrong field count, a field that is not a number or not a leg, a line
+//!   that is not UTF-8) is reported on stderr as `<input>:<line>: <what is wrong>` and produces
+//!   no output row; the other records are still answered (their output rows carry their input
+//!   line, [`Row::source_line`]);
+//! - an input without any record is an error ([`Error::NoRecords`]).
 //!
 //! Numbers are written with Rust's shortest round-trip formatting of `f32` (`{}`), so parsing a
 //! printed value as `f32` gives back the same value; `-0` is printed as `0`.
@@ -128,6 +134,20 @@ pub enum RowError {
         /// 1-based field number.
         field: usize,
     },
+    /// The line is not UTF-8 text.
+    NotUtf8 {
+        /// 1-based column (character) of the first byte that is not UTF-8.
+        column: usize,
+        /// That byte.
+        byte: u8,
+    },
+    /// The line has a single field holding a `;` or a tab: another separator than the comma.
+    Separator {
+        /// The separator found.
+        found: char,
+        /// The columns expected.
+        header: String,
+    },
     /// A field is not one of `FL`, `FR`, `RL`, `RR`.
     NotALeg {
         /// 1-based field number.
@@ -171,6 +191,15 @@ impl fmt::Display for RowError {
                 write!(f, "field {field}: `{text}` is not a finite number")
             }
             RowError::BadTime { field } => write!(f, "field {field}: t_s is not a number"),
+            RowError::NotUtf8 { column, byte } => write!(
+                f,
+                "not UTF-8 text: byte 0x{byte:02X} at column {column} (save the file as UTF-8)"
+            ),
+            RowError::Separator { found, header } => write!(
+                f,
+                "fields must be separated by commas ({header}); this line uses {}",
+                separator_name(*found)
+            ),
             RowError::NotALeg {
                 field,
                 column,
@@ -184,6 +213,83 @@ impl fmt::Display for RowError {
 }
 
 impl std::error::Error for RowError {}
+
+/// How a separator is named in messages.
+fn separator_name(c: char) -> &'static str {
+    match c {
+        ';' => "`;` (semicolons)",
+        '\t' => "tabs",
+        _ => "another separator",
+    }
+}
+
+/// The separator of a line that has no comma but a `;` or a tab, if any.
+fn foreign_separator(text: &str) -> Option<char> {
+    if text.contains(',') {
+        return None;
+    }
+    [';', '\t'].into_iter().find(|&c| text.contains(c))
+}
+
+/// A line split at commas, or [`RowError::Separator`] when it has no comma but a `;` or a tab
+/// and `expected` columns are more than one.
+pub fn split_fields<'a>(text: &'a str, expected: &[&str]) -> Result<Vec<&'a str>, RowError> {
+    match foreign_separator(text) {
+        Some(found) if expected.len() > 1 => Err(RowError::Separator {
+            found,
+            header: expected.join(","),
+        }),
+        _ => Ok(text.split(',').map(str::trim).collect()),
+    }
+}
+
+/// Reads an input line by line with 1-based line numbers. A UTF-8 byte-order mark at the start
+/// is skipped (editors on Windows write one); a line that is not UTF-8 is returned as a
+/// [`RowError::NotUtf8`] naming its column, and the lines after it are still read.
+pub struct Lines {
+    reader: Box<dyn BufRead>,
+    bytes: Vec<u8>,
+    line: usize,
+}
+
+impl Lines {
+    /// Reads `reader` from its start.
+    pub fn new(reader: Box<dyn BufRead>) -> Lines {
+        Lines {
+            reader,
+            bytes: Vec::new(),
+            line: 0,
+        }
+    }
+
+    /// The next line: its number and its text without the line end, or why it is not text;
+    /// `None` at the end of the input.
+    ///
+    /// # Errors
+    /// Reading failed.
+    pub fn next_line(&mut self) -> io::Result<Option<(usize, Result<&str, RowError>)>> {
+        self.bytes.clear();
+        if self.reader.read_until(b'\n', &mut self.bytes)? == 0 {
+            return Ok(None);
+        }
+        self.line += 1;
+        let mut bytes = self.bytes.as_slice();
+        if self.line == 1 {
+            bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+        }
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            let valid = &bytes[..e.valid_up_to()];
+            RowError::NotUtf8 {
+                column: String::from_utf8_lossy(valid).chars().count() + 1,
+                byte: bytes[e.valid_up_to()],
+            }
+        });
+        Ok(Some((
+            self.line,
+            text.map(|t| t.trim_end_matches(['\n', '\r'])),
+        )))
+    }
+}
 
 /// Errors that stop a whole batch.
 #[derive(Debug)]
@@ -207,6 +313,13 @@ pub enum Error {
         /// The header found.
         found: String,
         /// The header expected.
+        expected: String,
+    },
+    /// The input holds no record (only a header, comments or nothing).
+    NoRecords {
+        /// Input name.
+        input: String,
+        /// The columns expected.
         expected: String,
     },
     /// Reading a named input failed.
@@ -271,11 +384,23 @@ impl fmt::Display for Error {
                 line,
                 found,
                 expected,
-            } => write!(
-                f,
-                "{input}:{line}: header `{found}` does not match the expected `{expected}` \
-                 (nothing was processed)"
-            ),
+            } => {
+                write!(
+                    f,
+                    "{input}:{line}: header `{found}` does not match the expected `{expected}`"
+                )?;
+                if let Some(c) = foreign_separator(found) {
+                    write!(
+                        f,
+                        ": fields must be separated by commas, this header uses {}",
+                        separator_name(c)
+                    )?;
+                }
+                write!(f, " (nothing was processed)")
+            }
+            Error::NoRecords { input, expected } => {
+                write!(f, "{input}: no records (expected {expected})")
+            }
             Error::Read { input, source } => write!(f, "cannot read `{input}`: {source}"),
             Error::Empty { input, expected } => {
                 write!(f, "{input}: empty file: expected a header {expected}")
@@ -360,6 +485,21 @@ impl Input {
     }
 }
 
+/// Columns that a batch input may carry after its own, as the output of another batch command
+/// has them (`ik | fk`, `fk | ik`): named by the header, in any order.
+pub const CARRIED_COLUMNS: [&str; 3] = ["status", "clamp_distance_m", "line"];
+
+/// Where the carried columns of an input are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Carried {
+    /// Index of `status`.
+    status: Option<usize>,
+    /// Index of `line`.
+    line: Option<usize>,
+    /// How many carried columns there are.
+    count: usize,
+}
+
 /// One record: its line number and its trimmed fields.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
@@ -368,12 +508,40 @@ pub struct Row {
     /// The fields, trimmed.
     pub fields: Vec<String>,
     schema: Schema,
+    carried: Carried,
 }
 
 impl Row {
+    /// The line of this record in the first input of a pipe: the `line` column when the input
+    /// carries one (the output of another batch command), else [`Row::line`].
+    ///
+    /// # Errors
+    /// The `line` field is not a line number.
+    pub fn source_line(&self) -> Result<usize, RowError> {
+        match self.carried.line {
+            None => Ok(self.line),
+            Some(i) => {
+                let text = self.fields[i].as_str();
+                text.parse::<usize>().map_err(|_| RowError::NotANumber {
+                    field: i + 1,
+                    column: "line",
+                    text: text.to_owned(),
+                })
+            }
+        }
+    }
+
+    /// The carried `status` of a record that another batch command could not answer (anything
+    /// but `ok` and `clamped:…`, e.g. `too_far`): such a record has no values, and its answer
+    /// carries the status on.
+    pub fn unanswered_status(&self) -> Option<&str> {
+        let status = self.fields[self.carried.status?].as_str();
+        (status != "ok" && !status.starts_with("clamped:")).then_some(status)
+    }
+
     /// Checks that there is one field per column.
     pub fn check_count(&self) -> Result<(), RowError> {
-        let expected = self.schema.columns.len();
+        let expected = self.schema.columns.len() + self.carried.count;
         if self.fields.len() == expected {
             Ok(())
         } else {
@@ -475,45 +643,63 @@ pub fn for_each_row(
     header: Option<&str>,
     mut answer: impl FnMut(&Row, &mut dyn Write) -> Result<(), AnswerError>,
 ) -> Result<Summary, Error> {
-    let Input { name, mut reader } = input;
+    let Input { name, reader } = input;
     if let Some(h) = header {
         writeln!(out, "{h}")?;
     }
     let mut summary = Summary::default();
-    let mut buf = String::new();
-    let mut line = 0usize;
+    let mut lines = Lines::new(reader);
     let mut first_record = true;
-    loop {
-        buf.clear();
-        if reader.read_line(&mut buf)? == 0 {
-            break;
-        }
-        line += 1;
-        let text = buf.trim();
+    let mut carried = Carried::default();
+    while let Some((line, text)) = lines.next_line()? {
+        let text = match text {
+            Ok(t) => t.trim(),
+            Err(e) => {
+                summary.malformed += 1;
+                writeln!(diag, "{name}:{line}: {e}")?;
+                continue;
+            }
+        };
         if text.is_empty() || text.starts_with('#') {
             continue;
         }
-        let row = Row {
-            line,
-            fields: text.split(',').map(|f| f.trim().to_owned()).collect(),
-            schema,
-        };
-        if std::mem::take(&mut first_record) && is_header(&row, schema) {
-            let matches = row.fields.len() == schema.columns.len()
-                && row
-                    .fields
-                    .iter()
-                    .zip(schema.columns)
-                    .all(|(f, c)| f.eq_ignore_ascii_case(c));
-            if matches {
+        let fields = match split_fields(text, schema.columns) {
+            Ok(f) => f.into_iter().map(str::to_owned).collect(),
+            // A whole file in another separator: one message, not one per line.
+            Err(error) if first_record => {
+                return Err(Error::Row {
+                    input: name,
+                    line,
+                    error,
+                })
+            }
+            Err(e) => {
+                summary.malformed += 1;
+                writeln!(diag, "{name}:{line}: {e}")?;
                 continue;
             }
-            return Err(Error::Header {
-                input: name,
-                line,
-                found: text.to_owned(),
-                expected: schema.header(),
-            });
+        };
+        let row = Row {
+            line,
+            fields,
+            schema,
+            carried,
+        };
+        if std::mem::take(&mut first_record) && is_header(&row, schema) {
+            match header_columns(&row.fields, schema) {
+                Some(c) => {
+                    carried = c;
+                    continue;
+                }
+                None => {
+                    return Err(Error::Header {
+                        input: name,
+                        line,
+                        found: text.to_owned(),
+                        expected: schema.header(),
+                    })
+                }
+            }
         }
         let result = row
             .check_count()
@@ -529,7 +715,46 @@ pub fn for_each_row(
         }
     }
     out.flush()?;
+    if summary.answered == 0 && summary.malformed == 0 {
+        return Err(Error::NoRecords {
+            input: name,
+            expected: format!("lines of `{}`", schema.header()),
+        });
+    }
     Ok(summary)
+}
+
+/// The carried columns of a header that names the schema's columns (case-insensitive)
+/// followed by carried columns ([`CARRIED_COLUMNS`], each at most once); `None` for any other
+/// header.
+fn header_columns(fields: &[String], schema: Schema) -> Option<Carried> {
+    let n = schema.columns.len();
+    if fields.len() < n
+        || !fields
+            .iter()
+            .zip(schema.columns)
+            .all(|(f, c)| f.eq_ignore_ascii_case(c))
+    {
+        return None;
+    }
+    let mut carried = Carried::default();
+    let mut seen = Vec::new();
+    for (i, f) in fields.iter().enumerate().skip(n) {
+        let name = CARRIED_COLUMNS
+            .into_iter()
+            .find(|c| f.eq_ignore_ascii_case(c))?;
+        if seen.contains(&name) {
+            return None;
+        }
+        seen.push(name);
+        match name {
+            "status" => carried.status = Some(i),
+            "line" => carried.line = Some(i),
+            _ => {}
+        }
+        carried.count += 1;
+    }
+    Some(carried)
 }
 
 fn is_header(row: &Row, schema: Schema) -> bool {

@@ -5,9 +5,9 @@
 //! (`ok`, or `<leg>:<reason>` with empty angle cells). A comment line before the header,
 //! `# quadctl motion <law> robot=… rotation_order=… …`, names the rotation order.
 
-use super::{Error, Input, RowError};
+use super::{split_fields, Error, Input, Lines, RowError};
 use kin_core::{JointAngles, LegId, Pose, RotationOrder, Vec3};
-use std::io::{self, BufRead, Write};
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 /// The CSV header of a motion.
@@ -140,14 +140,14 @@ pub struct MotionCsv {
     /// header (as `quadctl motion` writes it), if any.
     pub rotation_order: Option<RotationOrder>,
     name: String,
-    reader: Box<dyn BufRead>,
+    lines: Lines,
     line: usize,
     t: usize,
     angles: [usize; 12],
     feet: Option<[usize; 12]>,
     pose: Option<[usize; 6]>,
     status: usize,
-    buf: String,
+    rows: usize,
 }
 
 impl MotionCsv {
@@ -158,24 +158,27 @@ impl MotionCsv {
 
     /// Reads the header of `input`.
     pub fn from_input(input: Input) -> Result<MotionCsv, Error> {
-        let Input { name, mut reader } = input;
-        let mut buf = String::new();
-        let mut line = 0;
+        let Input { name, reader } = input;
+        let mut lines = Lines::new(reader);
         let mut rotation_order = None;
-        let header = loop {
-            buf.clear();
-            let n = reader.read_line(&mut buf).map_err(|source| Error::Read {
+        let (line, header) = loop {
+            let Some((line, text)) = lines.next_line().map_err(|source| Error::Read {
                 input: name.clone(),
                 source,
-            })?;
-            if n == 0 {
+            })?
+            else {
                 return Err(Error::Empty {
                     input: name,
                     expected: "starting with t_s",
                 });
-            }
-            line += 1;
-            let t = buf.trim();
+            };
+            let t = text
+                .map_err(|error| Error::Row {
+                    input: name.clone(),
+                    line,
+                    error,
+                })?
+                .trim();
             if let Some(comment) = t.strip_prefix('#') {
                 for token in comment.split_whitespace() {
                     if let Some(o) = token.strip_prefix("rotation_order=") {
@@ -183,9 +186,14 @@ impl MotionCsv {
                     }
                 }
             } else if !t.is_empty() {
-                break t.to_owned();
+                break (line, t.to_owned());
             }
         };
+        split_fields(&header, &["t_s", "…"]).map_err(|error| Error::Row {
+            input: name.clone(),
+            line,
+            error,
+        })?;
         let cols: Vec<&str> = header.split(',').map(str::trim).collect();
         let at = |c: &str| cols.iter().position(|x| x.eq_ignore_ascii_case(c));
         let need = |c: &str| {
@@ -226,36 +234,50 @@ impl MotionCsv {
         Ok(MotionCsv {
             rotation_order,
             name,
-            reader,
+            lines,
             line,
             t,
             angles,
             feet,
             pose,
             status,
-            buf,
+            rows: 0,
         })
     }
 
     /// The next row, `None` at the end.
+    ///
+    /// # Errors
+    /// Reading failed, a line is not UTF-8, a field is missing or not a number, an angle of an
+    /// `ok` row is not finite, or the file has no row at all ([`Error::NoRecords`]: a header
+    /// alone claims nothing).
     pub fn next_row(&mut self) -> Result<Option<MotionRow>, Error> {
         loop {
-            self.buf.clear();
-            let n = self
-                .reader
-                .read_line(&mut self.buf)
-                .map_err(|source| Error::Read {
-                    input: self.name.clone(),
-                    source,
-                })?;
-            if n == 0 {
+            let Some((line, text)) = self.lines.next_line().map_err(|source| Error::Read {
+                input: self.name.clone(),
+                source,
+            })?
+            else {
+                if self.rows == 0 {
+                    return Err(Error::NoRecords {
+                        input: self.name.clone(),
+                        expected: "samples after the header".to_owned(),
+                    });
+                }
                 return Ok(None);
-            }
-            self.line += 1;
-            let text = self.buf.trim();
+            };
+            self.line = line;
+            let text = text
+                .map_err(|error| Error::Row {
+                    input: self.name.clone(),
+                    line,
+                    error,
+                })?
+                .trim();
             if text.is_empty() || text.starts_with('#') {
                 continue;
             }
+            self.rows += 1;
             let fields: Vec<&str> = text.split(',').map(str::trim).collect();
             let row_err = |error| Error::Row {
                 input: self.name.clone(),
@@ -287,6 +309,13 @@ impl MotionCsv {
                 let mut a = [0.0f32; 12];
                 for (slot, &i) in a.iter_mut().zip(&self.angles) {
                     *slot = num(i)?;
+                    // An `ok` row's angles are a result: nan or inf there is a broken file.
+                    if !slot.is_finite() {
+                        return Err(row_err(RowError::BadFinite {
+                            field: i + 1,
+                            text: fields[i].to_owned(),
+                        }));
+                    }
                 }
                 Some(a)
             } else {
@@ -338,26 +367,29 @@ pub struct Samples {
 pub fn read_samples(path: &Path, single_leg: LegId) -> Result<Samples, Error> {
     let input = Input::open(path)?;
     let name = input.name.clone();
-    let mut lines = input.reader.lines();
-    let mut n = 0usize;
+    let mut lines = Lines::new(input.reader);
     let io = |source| Error::Read {
         input: name.clone(),
         source,
     };
-    let header = loop {
-        let Some(line) = lines.next() else {
+    let row_err = |line, error| Error::Row {
+        input: name.clone(),
+        line,
+        error,
+    };
+    let (mut n, header) = loop {
+        let Some((n, text)) = lines.next_line().map_err(io)? else {
             return Err(Error::Empty {
                 input: name.clone(),
                 expected: "naming the angle columns",
             });
         };
-        n += 1;
-        let line = line.map_err(io)?;
-        let t = line.trim();
+        let t = text.map_err(|e| row_err(n, e))?.trim();
         if !(t.is_empty() || t.starts_with('#')) {
-            break t.to_owned();
+            break (n, t.to_owned());
         }
     };
+    split_fields(&header, &["abduction_rad", "hip_rad", "knee_rad"]).map_err(|e| row_err(n, e))?;
     let cols: Vec<&str> = header.split(',').map(str::trim).collect();
     let find = |c: &str| cols.iter().position(|x| x.eq_ignore_ascii_case(c));
     let joints = ["abduction", "hip", "knee"];
@@ -391,10 +423,9 @@ pub fn read_samples(path: &Path, single_leg: LegId) -> Result<Samples, Error> {
     };
     let status = find("status");
     let mut rows = Vec::new();
-    for line in lines {
-        n += 1;
-        let line = line.map_err(io)?;
-        let t = line.trim();
+    while let Some((line, text)) = lines.next_line().map_err(io)? {
+        n = line;
+        let t = text.map_err(|e| row_err(n, e))?.trim();
         if t.is_empty() || t.starts_with('#') {
             continue;
         }
@@ -426,6 +457,12 @@ pub fn read_samples(path: &Path, single_leg: LegId) -> Result<Samples, Error> {
             angles.push(JointAngles::from_array(v));
         }
         rows.push((n, Some(angles)));
+    }
+    if rows.is_empty() {
+        return Err(Error::NoRecords {
+            input: name,
+            expected: "samples after the header".to_owned(),
+        });
     }
     Ok(Samples { legs, rows })
 }

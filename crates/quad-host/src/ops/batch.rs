@@ -15,11 +15,11 @@ pub const IK_INPUT: Schema = Schema {
 };
 
 /// `ik`'s output header under [`ReachPolicy::Reject`].
-pub const IK_OUTPUT_HEADER: &str = "leg,abduction_rad,hip_rad,knee_rad,status";
+pub const IK_OUTPUT_HEADER: &str = "leg,abduction_rad,hip_rad,knee_rad,status,line";
 
 /// `ik`'s output header under [`ReachPolicy::Clamp`].
 pub const IK_OUTPUT_HEADER_CLAMP: &str =
-    "leg,abduction_rad,hip_rad,knee_rad,status,clamp_distance_m";
+    "leg,abduction_rad,hip_rad,knee_rad,status,clamp_distance_m,line";
 
 /// `fk`'s input columns.
 pub const FK_INPUT: Schema = Schema {
@@ -28,7 +28,7 @@ pub const FK_INPUT: Schema = Schema {
 };
 
 /// `fk`'s output header.
-pub const FK_OUTPUT_HEADER: &str = "leg,x_m,y_m,z_m";
+pub const FK_OUTPUT_HEADER: &str = "leg,x_m,y_m,z_m,status,line";
 
 /// `pose`'s input columns: the body pose.
 pub const POSE_INPUT: Schema = POSE_COLUMNS;
@@ -37,7 +37,7 @@ pub const POSE_INPUT: Schema = POSE_COLUMNS;
 pub const POSE_OUTPUT_HEADER: &str = "FL_abduction_rad,FL_hip_rad,FL_knee_rad,\
 FR_abduction_rad,FR_hip_rad,FR_knee_rad,\
 RL_abduction_rad,RL_hip_rad,RL_knee_rad,\
-RR_abduction_rad,RR_hip_rad,RR_knee_rad,status";
+RR_abduction_rad,RR_hip_rad,RR_knee_rad,status,line";
 
 /// Leg IK of every record of `input` (foot in the hip frame → joint angles).
 ///
@@ -59,6 +59,12 @@ pub fn ik(
     let solver = leg::Solver::new(robot);
     csv::for_each_row(input, IK_INPUT, out, diag, Some(header), |row, out| {
         let leg = row.leg(0)?;
+        let line = row.source_line()?;
+        let tail = if clamp { "," } else { "" };
+        if let Some(status) = row.unanswered_status() {
+            writeln!(out, "{leg},,,,{status}{tail},{line}")?;
+            return Ok(());
+        }
         let foot_in_hip = Vec3::new(row.number(1)?, row.number(2)?, row.number(3)?);
         match solver.inverse(leg, foot_in_hip, policy) {
             Ok(solution) => {
@@ -71,15 +77,17 @@ pub fn ik(
                     Num(q.knee_rad)
                 )?;
                 match solution.clamped {
-                    None if clamp => writeln!(out, "ok,0")?,
-                    None => writeln!(out, "ok")?,
-                    Some(c) => writeln!(out, "clamped:{},{}", c.kind.code(), Num(c.distance_m))?,
+                    None if clamp => writeln!(out, "ok,0,{line}")?,
+                    None => writeln!(out, "ok,{line}")?,
+                    Some(c) => writeln!(
+                        out,
+                        "clamped:{},{},{line}",
+                        c.kind.code(),
+                        Num(c.distance_m)
+                    )?,
                 }
             }
-            Err(e) => {
-                let tail = if clamp { "," } else { "" };
-                writeln!(out, "{leg},,,,{}{tail}", e.kind.code())?;
-            }
+            Err(e) => writeln!(out, "{leg},,,,{}{tail},{line}", e.kind.code())?,
         }
         Ok(())
     })
@@ -103,9 +111,29 @@ pub fn fk(
         Some(FK_OUTPUT_HEADER),
         |row, out| {
             let leg = row.leg(0)?;
-            let q = JointAngles::new(row.finite(1)?, row.finite(2)?, row.finite(3)?);
-            let foot = leg::forward(&robot.leg, leg, q);
-            writeln!(out, "{leg},{},{},{}", Num(foot.x), Num(foot.y), Num(foot.z))?;
+            let line = row.source_line()?;
+            if let Some(status) = row.unanswered_status() {
+                writeln!(out, "{leg},,,,{status},{line}")?;
+                return Ok(());
+            }
+            let q = [row.number(1)?, row.number(2)?, row.number(3)?];
+            // As `ik` and `pose` answer a non-finite target: a status, no values.
+            if q.iter().any(|a| !a.is_finite()) {
+                writeln!(
+                    out,
+                    "{leg},,,,{},{line}",
+                    leg::Unreachable::NonFinite.code()
+                )?;
+                return Ok(());
+            }
+            let foot = leg::forward(&robot.leg, leg, JointAngles::from_array(q));
+            writeln!(
+                out,
+                "{leg},{},{},{},ok,{line}",
+                Num(foot.x),
+                Num(foot.y),
+                Num(foot.z)
+            )?;
             Ok(())
         },
     )
@@ -173,6 +201,14 @@ pub fn pose(
     };
     let solver = body::Solver::new(robot);
     csv::for_each_row(input, POSE_INPUT, out, diag, Some(&header), |row, out| {
+        let line = row.source_line()?;
+        if let Some(status) = row.unanswered_status() {
+            match format {
+                PoseFormat::Csv => writeln!(out, "{}{status},{line}", ",".repeat(12))?,
+                PoseFormat::Table => writeln!(out, "\nline {line}: {status} (no pose)")?,
+            }
+            return Ok(());
+        }
         let mut v = [0.0f32; 6];
         for (i, slot) in v.iter_mut().enumerate() {
             *slot = row.number(i)?;
@@ -180,22 +216,26 @@ pub fn pose(
         let pose = Pose::from_array(v);
         let result = solver.inverse_at_stance(&pose, config, stance_height_m, ReachPolicy::Reject);
         match format {
-            PoseFormat::Csv => write_csv(out, &result)?,
-            PoseFormat::Table => write_table(out, row.line, &pose, &result)?,
+            PoseFormat::Csv => write_csv(out, &result, line)?,
+            PoseFormat::Table => write_table(out, line, &pose, &result)?,
         }
         Ok(())
     })
 }
 
-fn write_csv(out: &mut dyn Write, result: &Result<BodySolution, IkError>) -> io::Result<()> {
+fn write_csv(
+    out: &mut dyn Write,
+    result: &Result<BodySolution, IkError>,
+    line: usize,
+) -> io::Result<()> {
     match result {
         Ok(solution) => {
             for angle in solution.flat() {
                 write!(out, "{},", Num(angle))?;
             }
-            writeln!(out, "ok")
+            writeln!(out, "ok,{line}")
         }
-        Err(e) => writeln!(out, "{}{}:{}", ",".repeat(12), e.leg, e.kind.code()),
+        Err(e) => writeln!(out, "{}{}:{},{line}", ",".repeat(12), e.leg, e.kind.code()),
     }
 }
 

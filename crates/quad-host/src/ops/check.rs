@@ -7,7 +7,7 @@ use crate::{csv, robot_file};
 use kin_core::leg::Unreachable;
 use kin_core::motion::{Contact, Frame, Motion};
 use kin_core::preflight::{Checker, Extremum, Report};
-use kin_core::{BodyConfig, Joint, JointAngles, LegId, RotationOrder};
+use kin_core::{BodyConfig, DefaultMath, Joint, JointAngles, LegId, RotationOrder};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -163,7 +163,7 @@ fn check_law(
     progress(Progress::Start(u64::from(sweep.samples())));
     for k in 0..sweep.samples() {
         let t = sweep.time_s(k);
-        let frame = m.frame(t).map_err(param_err)?;
+        let frame = m.frame::<DefaultMath>(t).map_err(param_err)?;
         let _ = c.push_frame(t, &frame);
         if k % 4096 == 4095 {
             progress(Progress::Done(u64::from(k) + 1));

@@ -12,7 +12,7 @@ use crate::link::emulator::EmulatorConfig;
 use crate::link::{self, Link, Target};
 use kin_core::motion::laws::{Axis, Sway, SwayParams, SEED000_SWEEP_STANCE_HEIGHT_M};
 use kin_core::motion::Motion;
-use kin_core::{Robot, RotationOrder};
+use kin_core::{DefaultMath, Robot, RotationOrder};
 use quad_protocol::{DeviceInfo, RobotPreset};
 use std::io::{self, Write};
 use std::path::PathBuf;
@@ -121,7 +121,7 @@ pub fn poses(n: usize) -> Result<Vec<kin_core::Pose>, Error> {
         let period = sway.params().period_s;
         for k in 0..n {
             let t = period * k as f32 / n as f32;
-            out.push(sway.frame(t)?.pose);
+            out.push(sway.frame::<DefaultMath>(t)?.pose);
         }
     }
     Ok(out)

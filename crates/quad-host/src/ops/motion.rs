@@ -11,10 +11,10 @@ use kin_core::motion::laws::{
 };
 use kin_core::motion::path::{AnyPath, PathKind, Rectangle, Stride};
 use kin_core::motion::{self, AnyMotion, Motion};
-use kin_core::preflight::Sweep;
-use kin_core::{body, ReachPolicy, Robot, RotationOrder, Vec3};
+use kin_core::preflight::{Sweep, MAX_SWEEP_SAMPLES};
+use kin_core::{body, DefaultMath, ReachPolicy, Robot, RotationOrder, Vec3};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The motion laws.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -156,6 +156,30 @@ pub enum Error {
     /// Drawing failed.
     #[error(transparent)]
     Plot(#[from] plot::Error),
+    /// `--duration-s` × `--rate-hz` is more samples than a sweep holds.
+    #[error(
+        "invalid {option}: {duration_s} s at {rate_hz} Hz is {samples:.3e} samples, at most \
+         2^24 = {MAX_SWEEP_SAMPLES}",
+        samples = f64::from(*duration_s) * f64::from(*rate_hz)
+    )]
+    TooManySamples {
+        /// The option blamed.
+        option: &'static str,
+        /// Duration asked, s.
+        duration_s: f32,
+        /// Rate asked, Hz.
+        rate_hz: f32,
+    },
+    /// A time to draw outside the file's samples.
+    #[error("--at-s: {t_s} s is outside the file's samples, from {first_s} s to {last_s} s")]
+    TimeOutOfRange {
+        /// The time asked, s.
+        t_s: f64,
+        /// First sample's time, s.
+        first_s: f64,
+        /// Last sample's time, s.
+        last_s: f64,
+    },
     /// A time to draw that is not finite.
     #[error("--at-s: {0} is not a finite time")]
     NotFiniteTime(f64),
@@ -372,8 +396,32 @@ impl Params {
 }
 
 /// Validates `--duration-s` and `--rate-hz` into a sweep from t = 0.
+///
+/// Too many samples is blamed on the rate when the rate alone is beyond the limit (more than
+/// [`MAX_SWEEP_SAMPLES`] per second), on the duration when the duration alone is (more than
+/// [`MAX_SWEEP_SAMPLES`] seconds), else on both.
 pub fn sweep(duration_s: f32, rate_hz: f32) -> Result<Sweep, Error> {
-    Sweep::new(0.0, duration_s, rate_hz).map_err(param_err)
+    Sweep::new(0.0, duration_s, rate_hz).map_err(|e| match e {
+        motion::Error::OutOfRange {
+            parameter: "duration_s",
+            ..
+        } if duration_s.is_finite() && rate_hz.is_finite() => {
+            let max = MAX_SWEEP_SAMPLES as f32;
+            let option = if rate_hz > max {
+                "--rate-hz"
+            } else if duration_s > max {
+                "--duration-s"
+            } else {
+                "--duration-s × --rate-hz"
+            };
+            Error::TooManySamples {
+                option,
+                duration_s,
+                rate_hz,
+            }
+        }
+        other => param_err(other),
+    })
 }
 
 /// How far a long operation is, for a progress bar.
@@ -434,7 +482,7 @@ pub fn write_motion<T: Motion>(
     for k in 0..n {
         let t64 = f64::from(k) / rate;
         let t = sweep.time_s(k);
-        let frame = m.frame(t).map_err(param_err)?;
+        let frame = m.frame::<DefaultMath>(t).map_err(param_err)?;
         let sol = solver.inverse(
             &frame.pose,
             &config,
@@ -517,10 +565,9 @@ pub fn run(args: &Request, progress: &mut dyn FnMut(Progress)) -> Result<Written
     let m = args.params.build(args.law)?;
     let sw = sweep(args.duration_s, args.rate_hz)?;
     if let Some(p) = &args.plot {
-        // Refuse a bad plot name before the long part.
-        if !is_plot_name(p) {
-            return Err(plot::Error::Format(p.display().to_string()).into());
-        }
+        // Refuse a bad plot name or a missing directory before the long part and before the
+        // CSV is written.
+        plot::check_output(p)?;
     }
     let mut sink = Output::open(args.output.as_deref())?;
     progress(Progress::Start(u64::from(sw.samples())));
@@ -552,15 +599,4 @@ pub fn run(args: &Request, progress: &mut dyn FnMut(Progress)) -> Result<Written
         plot::joint_angles(path, &title, series)?;
     }
     Ok(written)
-}
-
-/// True for a `.svg` or `.png` file name (any case).
-fn is_plot_name(p: &Path) -> bool {
-    matches!(
-        p.extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref(),
-        Some("svg" | "png")
-    )
 }

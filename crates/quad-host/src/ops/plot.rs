@@ -35,6 +35,7 @@ pub fn run(args: &Request) -> Result<(), Error> {
         .title
         .clone()
         .unwrap_or_else(|| args.file.display().to_string());
+    plot::check_output(&args.output)?;
     if args.at_s.is_empty() {
         if args.robot.is_some() {
             return Err(Error::NotApplicable {
@@ -68,7 +69,18 @@ pub fn run(args: &Request) -> Result<(), Error> {
     };
     // Nearest reachable sample to each requested time.
     let mut best: Vec<Option<(f64, Snapshot)>> = vec![None; args.at_s.len()];
+    // Times of the first and last samples, and the largest step between two samples: a time
+    // asked for more than half a step outside the samples is refused, not drawn at the nearest.
+    let mut span: Option<(f64, f64)> = None;
+    let mut max_step_s = 0.0f64;
     while let Some(row) = csv.next_row()? {
+        span = Some(match span {
+            None => (row.t_s, row.t_s),
+            Some((first, last)) => {
+                max_step_s = max_step_s.max(row.t_s - last);
+                (first, row.t_s)
+            }
+        });
         let (Some(a), Some(pose)) = (row.angles, row.pose) else {
             continue;
         };
@@ -86,6 +98,20 @@ pub fn run(args: &Request) -> Result<(), Error> {
                     },
                 ));
             }
+        }
+    }
+    if let Some((first_s, last_s)) = span {
+        let margin = max_step_s / 2.0;
+        if let Some(&t_s) = args
+            .at_s
+            .iter()
+            .find(|&&t| t < first_s - margin || t > last_s + margin)
+        {
+            return Err(Error::TimeOutOfRange {
+                t_s,
+                first_s,
+                last_s,
+            });
         }
     }
     let snaps: Vec<Snapshot> = best.into_iter().flatten().map(|(_, s)| s).collect();

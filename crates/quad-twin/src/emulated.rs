@@ -1,0 +1,115 @@
+//! The firmware in the loop: the firmware ELF runs in simavr (quad-host's emulator link) and
+//! the twin's frames are the pulses measured on its twelve servo pins, mapped back to angles
+//! through the calibration the firmware reports.
+//!
+//! Every frame, the motion's feet go to the firmware as a `SetFeet` request over its emulated
+//! UART; once it has answered, the link runs the MCU until each servo pin has shown a complete
+//! pulse that started afterwards (the hardware takes new compare values over at the start of a
+//! period, so these pulses carry the request). The firmware's own IK, pulse mapping and timer
+//! code make the frame.
+
+use crate::device::DeviceError;
+use crate::link::BodyState;
+use crate::motions::Plan;
+use crate::source::{DeviceFrame, FrameSource};
+use quad_device::Config;
+use quad_host::client::{Client, ClientConfig};
+use quad_host::emu::CYCLES_PER_TICK;
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
+use quad_protocol::servo::Calibration;
+use quad_protocol::{Request, ServoId};
+use std::path::Path;
+
+/// The line rate of the firmware the emulated source boots (`firmware.elf`), bit/s.
+pub const FIRMWARE_BAUD: u32 = 115_200;
+
+/// The firmware in simavr, driven by a host sending `SetFeet` every frame.
+pub struct Emulated {
+    plan: Plan,
+    client: Client<EmulatorLink>,
+    calibration: [Calibration; 12],
+}
+
+impl Emulated {
+    /// Boots `elf` (none: the firmware built from `firmware-avr/` at [`FIRMWARE_BAUD`]), says
+    /// hello, reads its calibration and enables its outputs.
+    ///
+    /// # Errors
+    /// [`crate::Error::Emulator`] when the emulator or the link fails,
+    /// [`crate::Error::FirmwareConfig`] when the firmware runs another robot or stance than
+    /// `config`.
+    pub fn boot(plan: Plan, config: &Config, elf: Option<&Path>) -> Result<Emulated, crate::Error> {
+        let emulator = EmulatorConfig::new(FIRMWARE_BAUD);
+        let link = match elf {
+            Some(path) => EmulatorLink::boot(path, emulator),
+            None => EmulatorLink::boot_built(emulator),
+        }
+        .map_err(|e| crate::Error::Emulator(quad_host::client::Error::Link(e.into())))?;
+        let mut client = Client::new(link, ClientConfig::emulator());
+        let info = client.hello().map_err(crate::Error::Emulator)?;
+        if info.robot != config.preset || info.pose_config != config.pose_config {
+            return Err(crate::Error::FirmwareConfig {
+                firmware: info.robot,
+            });
+        }
+        let calibration = client.calibrations().map_err(crate::Error::Emulator)?;
+        client
+            .ack(Request::SetOutputs { enabled: true })
+            .map_err(crate::Error::Emulator)?;
+        Ok(Emulated {
+            plan,
+            client,
+            calibration,
+        })
+    }
+}
+
+impl FrameSource for Emulated {
+    fn frame_count(&self) -> u32 {
+        crate::source::frame_count(&self.plan)
+    }
+
+    fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
+        let t_s = k as f32 * crate::source::FRAME_S;
+        let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
+        self.client
+            .ack(Request::SetFeet {
+                feet_in_body_m: target.feet_in_body_m,
+            })
+            .map_err(crate::Error::Emulator)?;
+        let pulses = self
+            .client
+            .link_mut()
+            .next_pulses()
+            .map_err(|e| crate::Error::Emulator(e.into()))?;
+        let mut pulses_half_us = [0; 12];
+        let mut angles_rad = [0.0; 12];
+        for s in ServoId::ALL {
+            let i = s.index();
+            let Some(pulse) = pulses[i] else {
+                return Err(crate::Error::NoPulse { frame: k, servo: s });
+            };
+            // Timer ticks (0.5 µs) to the nearest tick: the edges are seen up to one
+            // instruction late.
+            let ticks = (pulse.high_cycles + CYCLES_PER_TICK / 2) / CYCLES_PER_TICK;
+            let half_us =
+                u16::try_from(ticks).map_err(|_| crate::Error::NoPulse { frame: k, servo: s })?;
+            pulses_half_us[i] = half_us;
+            angles_rad[i] =
+                self.calibration[i]
+                    .angle_rad(half_us)
+                    .map_err(|fault| crate::Error::Device {
+                        frame: k,
+                        error: DeviceError::Unmappable { servo: s, fault },
+                    })?;
+        }
+        Ok(DeviceFrame {
+            t_s,
+            enabled: true,
+            pulses_half_us,
+            angles_rad,
+            commanded_pose: target.pose,
+            stance: target.stance,
+        })
+    }
+}

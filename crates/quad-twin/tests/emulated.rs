@@ -1,0 +1,41 @@
+//! The firmware in the loop: the frames the firmware ELF makes in simavr (its measured pin
+//! pulses) against those of the device controller in-process, for the same motion. Bounded:
+//! one second of a trot (50 frames) on the emulated MCU.
+
+use quad_device::Config;
+use quad_twin::device::SimDevice;
+use quad_twin::emulated::Emulated;
+use quad_twin::source::{FrameSource, HostDriven};
+use quad_twin::{MotionKind, Plan};
+
+/// Frames compared.
+const FRAMES: u32 = 50;
+/// A measured pulse may differ from the in-process device's by this much, half-µs: one timer
+/// tick of edge uncertainty, plus one for the AVR's f32 maths against the host's.
+const PULSE_TOLERANCE_HALF_US: u16 = 2;
+
+#[test]
+fn the_firmwares_pulses_equal_the_device_controllers() {
+    let config = Config::shahriar2023();
+    let plan = Plan::new(MotionKind::Trot, &config).unwrap();
+    let mut device = HostDriven::new(plan, SimDevice::start(config).unwrap());
+    let mut firmware = Emulated::boot(plan, &config, None).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(firmware.frame_count(), device.frame_count());
+    let mut worst = 0;
+    for k in 0..FRAMES {
+        let a = device.next(k, None).unwrap();
+        let b = firmware.next(k, None).unwrap_or_else(|e| panic!("{e}"));
+        assert!(b.enabled);
+        for i in 0..12 {
+            let d = a.pulses_half_us[i].abs_diff(b.pulses_half_us[i]);
+            worst = worst.max(d);
+            assert!(
+                d <= PULSE_TOLERANCE_HALF_US,
+                "frame {k} servo {i}: device {} firmware {} half-µs",
+                a.pulses_half_us[i],
+                b.pulses_half_us[i]
+            );
+        }
+    }
+    eprintln!("largest pulse difference over {FRAMES} frames: {worst} half-µs");
+}
