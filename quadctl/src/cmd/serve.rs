@@ -36,11 +36,17 @@ applies the device's link-loss rule (hold, or outputs off).
 --listen sets the address (default 127.0.0.1:8080; port 0 picks a free one). Binding to
 another interface exposes the robot to that network: there is no authentication.";
 
+const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl serve --emulator
+  quadctl serve --sim --listen 127.0.0.1:0";
+
 /// Arguments of `quadctl serve`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Serve the browser control panel (3D view, pose sliders, calibration) of the device",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     #[command(flatten)]
