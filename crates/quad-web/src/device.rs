@@ -237,12 +237,9 @@ impl<L: Link> Session<L> {
     /// [`Error::HostRejects`] (nothing sent), [`Error::Refused`], [`Error::Mismatch`],
     /// [`Error::Lost`], link failures.
     pub fn set_pose(&mut self, pose: Pose, id: u32) -> Result<(), Error> {
-        let want = expected(&self.robot, &self.pose_config, &self.calibration, &pose);
-        let Expected::Angles(angles) = want else {
-            let Expected::Nack(reason) = want else {
-                unreachable!()
-            };
-            return Err(Error::HostRejects(reason));
+        let angles = match expected(&self.robot, &self.pose_config, &self.calibration, &pose) {
+            Expected::Angles(angles) => angles,
+            Expected::Nack(reason) => return Err(Error::HostRejects(reason)),
         };
         let (check, calibration) = (self.check, self.calibration);
         self.poses_sent += 1;
