@@ -477,7 +477,7 @@ pub struct Job {
     /// The command (validated).
     pub cmd: msg::ClientMsg,
     /// The result.
-    pub reply: tokio::sync::oneshot::Sender<Result<(), String>>,
+    pub reply: tokio::sync::oneshot::Sender<Result<(), Error>>,
 }
 
 /// What the device thread tells the server.
@@ -501,7 +501,7 @@ pub fn run(
     setup: DeviceSetup,
     events: std::sync::mpsc::Receiver<Event>,
     state: tokio::sync::watch::Sender<State>,
-    ready: std::sync::mpsc::Sender<Result<Ready, String>>,
+    ready: std::sync::mpsc::Sender<Result<Ready, Error>>,
     started: Instant,
 ) {
     let connect = || -> Result<Session<Box<dyn Link>>, Error> {
@@ -518,7 +518,7 @@ pub fn run(
     let mut session = match connect() {
         Ok(s) => s,
         Err(e) => {
-            let _ = ready.send(Err(e.to_string()));
+            let _ = ready.send(Err(e));
             return;
         }
     };
@@ -543,9 +543,9 @@ pub fn run(
         match events.recv_timeout(setup.poll) {
             Ok(Event::Job(job)) => {
                 let result = if link_up {
-                    session.command(&job.cmd).map_err(|e| e.to_string())
+                    session.command(&job.cmd)
                 } else {
-                    Err(Error::LinkDown.to_string())
+                    Err(Error::LinkDown)
                 };
                 publish(&session, link_up);
                 let _ = job.reply.send(result);

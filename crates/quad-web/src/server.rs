@@ -49,7 +49,10 @@ pub enum Error {
     },
     /// The device could not be reached or refused the session.
     #[error("device: {0}")]
-    Device(String),
+    Device(#[from] device::Error),
+    /// The device or server thread stopped unexpectedly.
+    #[error("the {0} thread stopped unexpectedly")]
+    Thread(&'static str),
     /// The async runtime or the server failed.
     #[error("server: {0}")]
     Io(#[from] std::io::Error),
@@ -99,9 +102,7 @@ impl Running {
             let _ = tx.send(());
         }
         match self.thread.take() {
-            Some(t) => t
-                .join()
-                .unwrap_or_else(|_| Err(Error::Device("server thread panicked".to_owned()))),
+            Some(t) => t.join().unwrap_or(Err(Error::Thread("server"))),
             None => Ok(()),
         }
     }
@@ -112,9 +113,7 @@ impl Running {
     /// The server's.
     pub fn wait(mut self) -> Result<(), Error> {
         match self.thread.take() {
-            Some(t) => t
-                .join()
-                .unwrap_or_else(|_| Err(Error::Device("server thread panicked".to_owned()))),
+            Some(t) => t.join().unwrap_or(Err(Error::Thread("server"))),
             None => Ok(()),
         }
     }
@@ -159,10 +158,7 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
     let device_thread = std::thread::Builder::new()
         .name("device".to_owned())
         .spawn(move || device::run(setup, events_rx, device_state, ready_tx, started))?;
-    let ready = ready_rx
-        .recv()
-        .map_err(|_| Error::Device("the device thread stopped".to_owned()))?
-        .map_err(Error::Device)?;
+    let ready = ready_rx.recv().map_err(|_| Error::Thread("device"))??;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -464,7 +460,7 @@ async fn command(shared: &Shared, id: u64, cmd: ClientMsg) -> ServerMsg {
     }
     match result.await {
         Ok(Ok(())) => done,
-        Ok(Err(message)) => refuse(message),
+        Ok(Err(e)) => refuse(e.to_string()),
         Err(_) => refuse("the device thread has stopped".to_owned()),
     }
 }
