@@ -6,6 +6,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use kin_core::motion::path::PathKind;
 use kin_core::{KneeBend, LegId, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_host::client::DEFAULT_RETRIES;
+use quad_host::csv::play::ColumnKind;
 use quad_host::csv::{self, Input, Summary};
 use quad_host::link::emulator::EmulatorConfig;
 use quad_host::link::sim::{SimConfig, DEFAULT_RX_FIFO_LEN};
@@ -207,8 +208,9 @@ pub struct LawArgs {
     /// fernando2025); rect-path: 0.2 m (seed 000 Fig. 8).
     #[arg(long, value_name = "M")]
     pub stance_height_m: Option<f32>,
-    /// Rotation order of the body pose [default: zxy for the sways and yaw-turn (seed 001),
-    /// zyx otherwise].
+    /// Rotation order of the body pose [default: a preset's device order (fernando2025 zxy,
+    /// shahriar2023 zyx, as the firmware runs it); a robot file: zxy for the sways and
+    /// yaw-turn (seed 001), zyx otherwise].
     #[arg(long, value_parser = rotation_order())]
     pub rotation_order: Option<RotationOrder>,
     /// Sways: amplitude A, rad [default: 0.2].
@@ -352,6 +354,20 @@ pub fn path_kind() -> impl TypedValueParser<Value = PathKind> {
         .to_owned()
     }
     choice(&PathKind::ALL, PathKind::name, help)
+}
+
+/// `--send` of `play`: a kind of setpoint columns.
+pub fn column_kind() -> impl TypedValueParser<Value = ColumnKind> {
+    fn help(k: ColumnKind) -> String {
+        match k {
+            ColumnKind::Joints => "The joint-angle columns, as SetJoints",
+            ColumnKind::Feet => "The foot columns, as SetFeet",
+            ColumnKind::Pose => "The body-pose columns, as SetBodyPose",
+            _ => "",
+        }
+        .to_owned()
+    }
+    choice(&ColumnKind::ALL, ColumnKind::name, help)
 }
 
 /// A motion law by name.

@@ -33,6 +33,7 @@ enum Command {
     Calibrate(cmd::calibrate::Args),
     Demo(cmd::demo::Args),
     Serve(cmd::serve::Args),
+    Play(cmd::play::Args),
     Sim(cmd::sim::Args),
     Export(cmd::export::Args),
 }
@@ -56,6 +57,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => cmd::calibrate::main(&args),
         Command::Demo(args) => cmd::demo::main(&args),
         Command::Serve(args) => cmd::serve::main(&args),
+        Command::Play(args) => cmd::play::main(&args),
         Command::Sim(args) => cmd::sim::run(&args),
         Command::Export(args) => cmd::export::run(&args),
     }

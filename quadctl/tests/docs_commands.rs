@@ -42,6 +42,10 @@ enum Check {
     /// own tests (the physics twin needs MuJoCo's Python environment and minutes; benchmarks
     /// take minutes): the package and its example or benchmarks must exist.
     CargoTarget,
+    /// `quadctl sim`: the physics twin needs MuJoCo's Python environment and, rendering or with
+    /// the firmware in simavr, minutes; `twin_cli` runs it. Run with `--help` appended: the
+    /// arguments must be accepted.
+    SimArgs,
 }
 
 /// (how the command starts, how it is checked), first match wins.
@@ -58,6 +62,7 @@ const RULES: &[(&str, Check)] = &[
         Check::CargoTarget,
     ),
     ("cargo bench -p ", Check::CargoTarget),
+    ("cargo run --release -p quadctl -- sim ", Check::SimArgs),
     ("cargo run --release -p quadctl -- ", Check::Run),
 ];
 
@@ -168,6 +173,10 @@ fn flash_dry_run(args: &str, dir: &Path) -> String {
 fn check_command(command: &str, check: Check, dir: &Path) {
     match check {
         Check::Run => assert_ok(&run_line(&as_quadctl(command), dir), "run as written"),
+        Check::SimArgs => assert_ok(
+            &run_line(&format!("{} --help", as_quadctl(command)), dir),
+            "arguments accepted",
+        ),
         Check::BoardPort => {
             let port = dir.join("no-board");
             let port = port.to_str().expect("utf-8 path");

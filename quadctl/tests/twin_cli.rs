@@ -95,7 +95,7 @@ fn bad_physical_values_exit_2_naming_field_and_line_and_leave_no_file() {
         );
         assert_eq!(run.code, 2, "{line}: {}", run.stderr);
         assert!(run.stderr.contains(named), "{line}: {}", run.stderr);
-        assert!(run.stderr.contains("line 8"), "{line}: {}", run.stderr);
+        assert!(run.stderr.contains(":8: "), "{line}: {}", run.stderr);
         assert!(!out.exists(), "{line}: partial output");
         assert!(run.stdout.is_empty());
     }

@@ -503,6 +503,24 @@ impl<L: Link> Client<L> {
         }
     }
 
+    /// Lets the link's time run until `deadline` (virtual time on a simulated or emulated link,
+    /// wall time on a port), keeping what arrives meanwhile for the next exchange (which drops
+    /// it as stale unless it answers that exchange).
+    ///
+    /// # Errors
+    /// Link failures.
+    pub fn idle_until(&mut self, deadline: Duration) -> Result<(), link::Error> {
+        let mut buf = [0u8; 256];
+        loop {
+            let now = self.link.now();
+            if now >= deadline {
+                return Ok(());
+            }
+            let n = self.link.recv(&mut buf, deadline - now)?;
+            self.pending.extend_from_slice(&buf[..n]);
+        }
+    }
+
     /// [`Client::exchange`] with [`ClientConfig::session_retries`], accepting any answer; a nack
     /// of the request is an error.
     ///
@@ -666,6 +684,30 @@ pub enum Expected {
     Nack(NackReason),
 }
 
+/// A setpoint of the stream: what one request asks the device to hold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Setpoint {
+    /// A body pose, feet at the stance ([`Request::SetBodyPose`]).
+    Pose(Pose),
+    /// The four feet in the body frame, m ([`Request::SetFeet`]).
+    Feet([Vec3; 4]),
+    /// The twelve joint angles, rad, canonical order ([`Request::SetJoints`]).
+    Joints([f32; 12]),
+}
+
+impl Setpoint {
+    /// The request that sends it.
+    pub fn request(&self) -> Request {
+        match *self {
+            Setpoint::Pose(pose) => Request::SetBodyPose(pose),
+            Setpoint::Feet(feet) => Request::SetFeet {
+                feet_in_body_m: feet.map(|f| [f.x, f.y, f.z]),
+            },
+            Setpoint::Joints(angles_rad) => Request::SetJoints { angles_rad },
+        }
+    }
+}
+
 /// How one pose ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PoseResult {
@@ -766,6 +808,11 @@ impl<L: Link> PoseStream<L> {
         &self.info
     }
 
+    /// What the host asked of the stream.
+    pub fn stream_setup(&self) -> &StreamSetup {
+        &self.setup
+    }
+
     /// The pose configuration in force.
     pub fn pose_config(&self) -> &PoseConfig {
         &self.pose_config
@@ -796,6 +843,46 @@ impl<L: Link> PoseStream<L> {
         )
     }
 
+    /// What the host's kin-core, joint limits and calibration make of `setpoint`: the device's
+    /// own steps (the body IK about the body centre in the pose configuration's order for a
+    /// pose, the legs' IK of each foot less its hip mount for feet, the joint limits for joint
+    /// angles; then the calibration of all twelve joints).
+    pub fn expected_for(&self, setpoint: &Setpoint) -> Expected {
+        let angles = match setpoint {
+            Setpoint::Pose(pose) => return self.expected(pose),
+            Setpoint::Feet(feet) => {
+                match body::Solver::new(&self.setup.robot)
+                    .inverse_feet_in_body(feet, ReachPolicy::Reject)
+                {
+                    Err(e) => return Expected::Nack(e.into()),
+                    Ok(solution) => solution.flat(),
+                }
+            }
+            Setpoint::Joints(angles) => {
+                for s in ServoId::ALL {
+                    let a = angles[s.index()];
+                    if !a.is_finite() {
+                        return Expected::Nack(NackReason::NonFinite);
+                    }
+                    if !self.setup.robot.limits.admits(s.joint, a) {
+                        return Expected::Nack(NackReason::JointLimit {
+                            leg: s.leg,
+                            joint: s.joint,
+                        });
+                    }
+                }
+                *angles
+            }
+        };
+        self.expected_angles(angles)
+    }
+
+    /// `angles` through the device's calibration: the angles, or the first servo out of its
+    /// travel.
+    fn expected_angles(&self, angles: [f32; 12]) -> Expected {
+        expected_angles(&self.calibration, angles)
+    }
+
     /// Compares a readback with the expected angles (see [`check_readback`]).
     ///
     /// # Errors
@@ -819,12 +906,21 @@ impl<L: Link> PoseStream<L> {
     /// # Errors
     /// Link failures, and the errors of a new handshake after a device reset.
     pub fn send(&mut self, pose: &Pose) -> Result<PoseResult, Error> {
-        let expected = self.expected(pose);
+        self.send_setpoint(&Setpoint::Pose(*pose))
+    }
+
+    /// Sends one setpoint (a pose, feet or joint angles), checks its answer against
+    /// [`PoseStream::expected_for`], updates the statistics.
+    ///
+    /// # Errors
+    /// Link failures, and the errors of a new handshake after a device reset.
+    pub fn send_setpoint(&mut self, setpoint: &Setpoint) -> Result<PoseResult, Error> {
+        let expected = self.expected_for(setpoint);
         if self.started.is_none() {
             self.started = Some(self.client.link.now());
         }
         self.stats.sent += 1;
-        let mut exchange = self.exchange_pose(pose, expected)?;
+        let mut exchange = self.exchange_pose(setpoint, expected)?;
         if let Outcome::Accepted(DeviceToHost::Nack {
             reason: NackReason::HelloRequired,
             ..
@@ -833,7 +929,7 @@ impl<L: Link> PoseStream<L> {
             // The device was reset: set the session up again and send the pose once more.
             self.setup()?;
             self.stats.retries += u64::from(exchange.attempts);
-            exchange = self.exchange_pose(pose, expected)?;
+            exchange = self.exchange_pose(setpoint, expected)?;
         }
         self.stats.retries += u64::from(exchange.attempts - 1);
         self.finished = self.client.link.now();
@@ -875,14 +971,16 @@ impl<L: Link> PoseStream<L> {
         Ok(result)
     }
 
-    fn exchange_pose(&mut self, pose: &Pose, expected: Expected) -> Result<Exchange, Error> {
+    fn exchange_pose(
+        &mut self,
+        setpoint: &Setpoint,
+        expected: Expected,
+    ) -> Result<Exchange, Error> {
         let rejected_before = self.client.counters.rejected;
         let (check, calibration) = (self.setup.check, self.calibration);
-        let exchange = self
-            .client
-            .exchange(Request::SetBodyPose(*pose), |answer| {
-                judge(check, &calibration, answer, &expected)
-            })?;
+        let exchange = self.client.exchange(setpoint.request(), |answer| {
+            judge(check, &calibration, answer, &expected)
+        })?;
         let rejected = self.client.counters.rejected - rejected_before;
         if matches!(exchange.outcome, Outcome::Accepted(_)) {
             self.stats.transient_mismatches += rejected;
@@ -956,20 +1054,22 @@ pub fn expected(
         ReachPolicy::Reject,
     ) {
         Err(e) => Expected::Nack(e.into()),
-        Ok(solution) => {
-            let angles = solution.flat();
-            for s in ServoId::ALL {
-                if let Err(fault) = calibration[s.index()].pulse_half_us(angles[s.index()]) {
-                    return Expected::Nack(NackReason::ServoRange {
-                        leg: s.leg,
-                        joint: s.joint,
-                        fault,
-                    });
-                }
-            }
-            Expected::Angles(angles)
+        Ok(solution) => expected_angles(calibration, solution.flat()),
+    }
+}
+
+/// `angles` through `calibration`: the angles, or the first servo out of its travel.
+fn expected_angles(calibration: &[Calibration; 12], angles: [f32; 12]) -> Expected {
+    for s in ServoId::ALL {
+        if let Err(fault) = calibration[s.index()].pulse_half_us(angles[s.index()]) {
+            return Expected::Nack(NackReason::ServoRange {
+                leg: s.leg,
+                joint: s.joint,
+                fault,
+            });
         }
     }
+    Expected::Angles(angles)
 }
 
 /// The readback check of one answer against the host's expectation: a nack must carry the

@@ -382,7 +382,7 @@ pub fn parse(text: &str) -> Result<Robot, Error> {
     parse_file(text).map(|(_, robot)| robot)
 }
 
-/// [`parse`], keeping the file's values with their places (for the `[physical]` table).
+/// The file with the places of its values, and its validated robot.
 fn parse_file(text: &str) -> Result<(RobotFile, Robot), Error> {
     let file: RobotFile = toml::from_str(text).map_err(|source| {
         // A missing key is reported on an empty span at the start (or on the whole document):

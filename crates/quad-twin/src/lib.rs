@@ -96,8 +96,9 @@ impl fmt::Display for Error {
             Error::Emulator(e) => write!(f, "emulated firmware: {e}"),
             Error::FirmwareConfig { firmware } => write!(
                 f,
-                "the firmware runs robot {firmware:?} at its default stance; the emulator can \
-                 only drive that robot and stance"
+                "the firmware runs robot {} at its default stance; the emulator can only drive \
+                 that robot and stance",
+                quad_host::names::robot_preset_name(*firmware)
             ),
             Error::NoPulse { frame, servo } => {
                 write!(f, "frame {frame}: no pulse on servo {servo}'s pin")

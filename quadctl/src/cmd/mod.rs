@@ -13,6 +13,7 @@ pub mod export;
 pub mod fk;
 pub mod ik;
 pub mod motion;
+pub mod play;
 pub mod plot;
 pub mod pose;
 pub mod serve;

@@ -50,7 +50,7 @@ Fig. 4-6):
   roll-sway   seed 001 eq. 6: roll(t) = A·sin(2πt/T), feet fixed on the ground (eq. 7)
   pitch-sway  seed 001 eq. 8: pitch(t) = A·sin(2πt/T), feet fixed
   yaw-sway    yaw(t) = A·sin(2πt/T), feet fixed
-              (A = 0.2 rad, T = 20 s, body centre fixed, rotation order zxy)
+              (A = 0.2 rad, T = 20 s, body centre fixed, rotation order: the device's)
   yaw-turn    seed 001 eq. 9-11, corrected (docs/papers.md): yaw(t) = −ω_z·t; the crossed pairs
               (FL, RR) and (FR, RL) step alternately along the circles of their feet with a
               half-wave sine lift (ω_z = 0.085 rad/s, T1 = 6 s, h_K = 0.3 m)

@@ -43,7 +43,7 @@ pub struct Args {
     /// Robot: a preset (shahriar2023, fernando2025), a TOML robot file or a URDF.
     #[arg(long, value_name = "PRESET|FILE", default_value = "shahriar2023")]
     pub robot: String,
-    /// The device controller in-process (the simulated link's device) [default].
+    /// The device controller in-process (the simulated link's device); the default.
     #[arg(long, conflicts_with = "emulator")]
     pub sim: bool,
     /// The firmware in simavr (an emulated ATmega2560), its pin pulses measured.

@@ -25,6 +25,7 @@
 //! has its own reader and writer in [`motion`].
 
 pub mod motion;
+pub mod play;
 
 use kin_core::LegId;
 use std::fmt;

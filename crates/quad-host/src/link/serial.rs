@@ -4,8 +4,15 @@
 //! the next access reopens it (up to [`REOPEN_ATTEMPTS`] times, [`REOPEN_PAUSE`] apart), so a
 //! replugged cable or a board reset costs a few retries of the client, not the session.
 //!
-//! Opening the port of an Arduino Mega pulses DTR, which resets the board: its bootloader runs
-//! for about 1.5 s before the firmware listens. The client's handshake retries cover that.
+//! ## DTR and the Mega's auto-reset
+//! The Mega's USB bridge drives its reset line from DTR: asserting DTR (low on the bridge's pin)
+//! sends a pulse through the board's auto-reset capacitor and resets the ATmega2560, whose
+//! bootloader then runs for about a second before the firmware listens. This link never
+//! toggles DTR itself (`preserve_dtr_on_open`) and, on Unix, clears `HUPCL` on the port so that
+//! closing it leaves DTR asserted: the next open finds DTR already up and resets nothing. The
+//! kernel's own rules, which no program can change, decide the rest (docs/hardware.md, "Serial
+//! link"): on Linux the first open after plugging the board in (or after a close with `HUPCL`
+//! set) still raises DTR and resets it. The client's handshake retries cover that second.
 
 use super::{Error, Link};
 use serialport::SerialPort;
@@ -50,17 +57,29 @@ impl SerialLink {
     }
 
     fn open_port(&self) -> Result<Box<dyn SerialPort>, Error> {
-        serialport::new(&self.path, self.baud)
+        let builder = serialport::new(&self.path, self.baud)
             .data_bits(serialport::DataBits::Eight)
             .parity(serialport::Parity::None)
             .stop_bits(serialport::StopBits::One)
             .flow_control(serialport::FlowControl::None)
             .timeout(Duration::from_millis(100))
-            .open()
-            .map_err(|e| Error::Open {
-                path: self.path.clone(),
-                message: e.to_string(),
-            })
+            // Writing DTR (high or low) on open would make the edge that resets the board
+            // sooner or later; leaving it as it is keeps the board running once it is up.
+            .preserve_dtr_on_open();
+        let failed = |e: serialport::Error| Error::Open {
+            path: self.path.clone(),
+            message: e.to_string(),
+        };
+        #[cfg(unix)]
+        {
+            let port = builder.open_native().map_err(failed)?;
+            // Best effort: a pseudo terminal or an adapter without modem lines may refuse it,
+            // and the link works without it.
+            let _ = keep_dtr_on_close(&port);
+            Ok(Box::new(port))
+        }
+        #[cfg(not(unix))]
+        builder.open().map_err(failed)
     }
 
     /// The open port, reopening it when it was dropped.
@@ -91,6 +110,18 @@ impl SerialLink {
             .as_mut()
             .ok_or_else(|| Error::Io(io::ErrorKind::NotConnected.into()))
     }
+}
+
+/// Clears `HUPCL` on `port`: the kernel then leaves DTR asserted when the port is closed, so
+/// that the next open (which asserts it) makes no edge on the board's reset line.
+#[cfg(unix)]
+fn keep_dtr_on_close(port: &serialport::TTYPort) -> nix::Result<()> {
+    use nix::sys::termios::{tcgetattr, tcsetattr, ControlFlags, SetArg};
+    use std::os::unix::io::AsRawFd;
+    let fd = port.as_raw_fd();
+    let mut termios = tcgetattr(fd)?;
+    termios.control_flags.remove(ControlFlags::HUPCL);
+    tcsetattr(fd, SetArg::TCSANOW, &termios)
 }
 
 impl Link for SerialLink {

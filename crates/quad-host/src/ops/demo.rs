@@ -10,9 +10,9 @@ use crate::client::{
 use crate::emu::{build, elf};
 use crate::link::emulator::EmulatorConfig;
 use crate::link::{self, Link, Target};
-use kin_core::motion::laws::{Axis, Sway, SwayParams, SEED000_SWEEP_STANCE_HEIGHT_M};
+use kin_core::motion::laws::{Axis, Sway, SwayParams};
 use kin_core::motion::Motion;
-use kin_core::{DefaultMath, Robot, RotationOrder};
+use kin_core::{DefaultMath, Robot};
 use quad_protocol::{DeviceInfo, RobotPreset};
 use std::io::{self, Write};
 use std::path::PathBuf;
@@ -110,6 +110,9 @@ impl Summary {
     }
 }
 
+/// The device the demo runs: the firmware's shahriar2023 configuration.
+const DEVICE: quad_device::Config = quad_device::Config::shahriar2023();
+
 /// The demo's poses: seed 000's roll, pitch and yaw sweeps, `n` samples of one period each.
 ///
 /// # Errors
@@ -141,8 +144,9 @@ pub fn stream<L: Link>(
     let setup = StreamSetup {
         robot: Robot::shahriar2023(),
         preset: RobotPreset::Shahriar2023,
-        stance_height_m: Some(SEED000_SWEEP_STANCE_HEIGHT_M),
-        order: Some(RotationOrder::Zyx),
+        // The firmware's own stance and order (quad_device::Config, the one source).
+        stance_height_m: Some(DEVICE.pose_config.stance_height_m),
+        order: Some(DEVICE.pose_config.order),
         check: AngleCheck::Within(AVR_ANGLE_TOLERANCE_RAD),
     };
     let mut stream = PoseStream::connect(Client::new(link, config), setup)?;
@@ -300,7 +304,7 @@ mod tests {
                 .inverse_at_stance(
                     q,
                     &kin_core::BodyConfig::default(),
-                    SEED000_SWEEP_STANCE_HEIGHT_M,
+                    kin_core::motion::laws::SEED000_SWEEP_STANCE_HEIGHT_M,
                     kin_core::ReachPolicy::Reject,
                 )
                 .expect("every demo pose is reachable");

@@ -6,6 +6,8 @@ pub mod batch;
 pub mod calibrate;
 pub mod check;
 pub mod demo;
+pub mod drive;
 pub mod motion;
+pub mod play;
 pub mod plot;
 pub mod stream;

@@ -283,6 +283,15 @@ impl Params {
         Ok(())
     }
 
+    /// The device's pose configuration of a preset robot (`quad_device::Config`, what the
+    /// firmware and the simulated device run): the one source of a preset's rotation order, so
+    /// that a motion's body poses read the same here and on the device. `None` for a robot
+    /// file.
+    pub fn device_pose_config(&self) -> Option<quad_protocol::PoseConfig> {
+        let preset = quad_protocol::RobotPreset::from_name(self.robot.trim())?;
+        quad_device::Config::for_preset(preset).map(|c| c.pose_config)
+    }
+
     /// Stance feet (world frame of the nominal pose) and their height.
     fn stance(&self, robot: &Robot, default_height_m: Option<f32>) -> Result<[Vec3; 4], Error> {
         match self.stance_height_m.or(default_height_m) {
@@ -303,7 +312,9 @@ impl Params {
     pub fn build(&self, law: Law) -> Result<AnyMotion, Error> {
         self.check_applicable(law)?;
         let robot = robot_file::resolve(&self.robot)?;
-        let order = |default: RotationOrder| self.rotation_order.unwrap_or(default);
+        let device_order = self.device_pose_config().map(|c| c.order);
+        let order =
+            |default: RotationOrder| self.rotation_order.or(device_order).unwrap_or(default);
         Ok(match law {
             Law::RollSway | Law::PitchSway | Law::YawSway => {
                 let axis = match law {

@@ -1,0 +1,111 @@
+//! `quadctl play`: a timed setpoint file (joint angles, feet or body poses, or `quadctl motion`'s
+//! output) played to the device in real time, every answer checked; a JSON summary as the last
+//! line of stdout.
+
+use crate::args::{self, RobotArgs, TargetArgs, EXIT_CHECK_FAILED, EXIT_OK};
+use kin_core::RotationOrder;
+use quad_host::csv::play::ColumnKind;
+use quad_host::ops::play::{self, Request};
+use quad_protocol::RobotPreset;
+use std::io::{self, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+const LONG_ABOUT: &str = "\
+Plays a timed setpoint file to the device, paced by its t_s column, and checks every answer.
+
+Input: `quadctl motion` output as it is (every row must be `ok`), or a CSV with t_s (s, strictly
+increasing) and the columns of one or more kinds: joint angles FL_abduction_rad ... RR_knee_rad
+(rad, canonical convention), feet FL_x_m ... RR_z_m (m, world frame of `quadctl motion` = body
+frame of the nominal pose), body pose roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m (rad, m; feet at
+the stance). A comment `# ... rotation_order=zxy ...` before the header names the pose's rotation
+order. The file is read and checked whole first: a missing t_s, a time that does not increase, a
+column of no known kind, a kind with a column missing or a field that is not a number stops the
+run with <file>:<line>: <what is wrong>, before the link is opened.
+
+What is sent: joint angles as SetJoints, else feet as SetFeet (moved into the body frame through
+the row's pose when the file has one), else the pose as SetBodyPose; --send picks a kind.
+
+Pacing: row i is due at start + (t_i - t_0) / --speed on the link's clock: simulated time with
+--sim and --emulator (nothing sleeps), wall time with --port. A row is sent at its due time;
+when the next row is already due before a row could be sent, the row is skipped (never the
+last). Each answer is checked as `quadctl stream` checks it (angles against the host's
+kin-core and joint limits, pulses against the calibration's mapping; the pins with
+--emulator). Nacked, lost and mismatching rows are reported on stderr as <file>:<line>: ...
+
+Output: the last line of stdout is one JSON object: kind, rows, late_mean_ms, late_max_ms
+(sending after the due time), skipped, answer_mean_ms, answer_max_ms (sending to answer),
+motion_s, then the fields of `quadctl stream`'s summary (sent, acked, nacked, retries, lost,
+readback_mismatches, ...) and with --emulator pulses_checked and pulse_width_errors.
+
+Exit status: 0 every row answered or lost, every check passed; 2 nothing or not everything
+could be played (arguments, robot, file, link, handshake); 3 a readback mismatch, a pulse out
+of its travel or a pulse width error on the pins.";
+
+/// Arguments of `quadctl play`.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+#[command(
+    about = "Play a timed file of joint angles, feet or body poses to the device in real time",
+    long_about = LONG_ABOUT
+)]
+pub struct Args {
+    /// The file: `quadctl motion` output or a t_s + joints/feet/pose CSV; `-` for stdin.
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub target: TargetArgs,
+    /// Time scale: 2 plays twice as fast, 0.5 half as fast.
+    #[arg(long, value_name = "X", default_value_t = 1.0)]
+    pub speed: f64,
+    /// The kind of columns to send [default: joints, else feet, else pose].
+    #[arg(long, value_parser = args::column_kind())]
+    pub send: Option<ColumnKind>,
+    /// Stance height H set on the device, metres (for poses); default: the device's own.
+    #[arg(long, value_name = "H", value_parser = args::parse_positive_m)]
+    pub stance_height_m: Option<f32>,
+    /// Rotation order set on the device; default: the file's (rotation_order= comment), else
+    /// the device's own.
+    #[arg(long, value_parser = args::rotation_order())]
+    pub rotation_order: Option<RotationOrder>,
+    /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
+    /// exact with --sim, 5e-5 rad with --emulator and --port.
+    #[arg(long, value_name = "RAD")]
+    pub angle_tolerance_rad: Option<f32>,
+}
+
+/// Runs `quadctl play` and returns its exit status.
+pub fn main(args: &Args) -> ExitCode {
+    let preset = RobotPreset::from_name(args.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
+    let request = Request {
+        robot: args.robot.robot.clone(),
+        target: args.target.target(preset),
+        retries: args.target.retries,
+        speed: args.speed,
+        send: args.send,
+        stance_height_m: args.stance_height_m,
+        rotation_order: args.rotation_order,
+        angle_tolerance_rad: args.angle_tolerance_rad,
+        input: args.file.clone(),
+    };
+    let summary = match play::run(&request, &mut io::stderr().lock()) {
+        Ok(s) => s,
+        Err(e) => return args::fail("quadctl", &e),
+    };
+    let json = match serde_json::to_string(&summary) {
+        Ok(j) => j,
+        Err(e) => return args::fail("quadctl", &e),
+    };
+    let mut out = io::stdout().lock();
+    if let Err(e) = writeln!(out, "{json}").and_then(|()| out.flush()) {
+        return args::fail("quadctl", &e);
+    }
+    ExitCode::from(if summary.check_failed() {
+        EXIT_CHECK_FAILED
+    } else {
+        EXIT_OK
+    })
+}
