@@ -7,6 +7,8 @@
 //!
 //! When the wasm target or `web/node_modules` is missing, the build still succeeds with a
 //! warning and the page says what to install: the rest of the workspace builds without Node.js.
+//! What is missing is passed on as `QUAD_WEB_MISSING` (space-separated `kin.wasm`, `three.js`)
+//! for `assets::check` (`quadctl serve --check`, and a test of the CI).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -43,11 +45,18 @@ fn main() {
         root.join("web/package-lock.json").display()
     );
 
-    build_wasm(&root, &out, &assets.join("kin.wasm"));
-    copy_three(&root.join("web/node_modules"), &assets);
+    let mut missing = Vec::new();
+    if !build_wasm(&root, &out, &assets.join("kin.wasm")) {
+        missing.push("kin.wasm");
+    }
+    if !copy_three(&root.join("web/node_modules"), &assets) {
+        missing.push("three.js");
+    }
+    println!("cargo:rustc-env=QUAD_WEB_MISSING={}", missing.join(" "));
 }
 
-fn build_wasm(root: &Path, out: &Path, dest: &Path) {
+/// True when `kin.wasm` was built.
+fn build_wasm(root: &Path, out: &Path, dest: &Path) -> bool {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let target_dir = out.join("wasm-target");
     let mut cmd = Command::new(cargo);
@@ -82,6 +91,7 @@ fn build_wasm(root: &Path, out: &Path, dest: &Path) {
     match cmd.status() {
         Ok(s) if s.success() => {
             std::fs::copy(&built, dest).unwrap();
+            true
         }
         other => {
             println!(
@@ -90,11 +100,14 @@ fn build_wasm(root: &Path, out: &Path, dest: &Path) {
                  (scripts/install-deps.sh does)."
             );
             std::fs::write(dest, b"").unwrap();
+            false
         }
     }
 }
 
-fn copy_three(node_modules: &Path, assets: &Path) {
+/// True when every three.js file was copied.
+fn copy_three(node_modules: &Path, assets: &Path) -> bool {
+    let mut all = true;
     for (from, to) in THREE_FILES {
         let src = node_modules.join(from);
         let dest = assets.join(to);
@@ -109,6 +122,8 @@ fn copy_three(node_modules: &Path, assets: &Path) {
                 "throw new Error('three.js was not found at build time: run `npm ci` in web/ and rebuild');\n",
             )
             .unwrap();
+            all = false;
         }
     }
+    all
 }

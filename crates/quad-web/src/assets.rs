@@ -73,3 +73,50 @@ pub const ASSETS: &[Asset] = &[
 pub fn get(path: &str) -> Option<&'static Asset> {
     ASSETS.iter().find(|a| a.path == path)
 }
+
+/// A page the build could not complete (see `build.rs`): the server still serves it, and the
+/// page says what is missing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Incomplete {
+    /// `kin.wasm` was not built: no pose preview in the page.
+    #[error(
+        "kin.wasm was not built: run `rustup target add wasm32-unknown-unknown` \
+         (scripts/install-deps.sh does) and rebuild"
+    )]
+    Wasm,
+    /// three.js was not bundled: no 3D view in the page.
+    #[error(
+        "three.js was not bundled: run `npm ci` in web/ (scripts/install-deps.sh does) and rebuild"
+    )]
+    Three,
+}
+
+/// Whether the embedded page is complete: kin-core in WebAssembly and three.js both bundled.
+///
+/// # Errors
+/// The first missing piece.
+pub fn check() -> Result<(), Incomplete> {
+    let missing = env!("QUAD_WEB_MISSING");
+    if missing.split(' ').any(|m| m == "kin.wasm") {
+        return Err(Incomplete::Wasm);
+    }
+    if missing.split(' ').any(|m| m == "three.js") {
+        return Err(Incomplete::Three);
+    }
+    debug_assert!(built!("kin.wasm").starts_with(b"\0asm"));
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// The CI builds the whole page: the wasm target and `npm ci` come from install-deps.
+    #[test]
+    fn the_page_is_complete() {
+        super::check().unwrap();
+        let wasm = super::get("/kin.wasm").unwrap();
+        assert!(wasm.bytes.starts_with(b"\0asm"), "kin.wasm is WebAssembly");
+        let three = super::get("/vendor/three.module.js").unwrap();
+        assert!(three.bytes.len() > 10_000, "three.js bundled");
+    }
+}

@@ -34,12 +34,17 @@ every answer passes stream's readback check. When the controlling page goes away
 applies the device's link-loss rule (hold, or outputs off).
 
 --listen sets the address (default 127.0.0.1:8080; port 0 picks a free one). Binding to
-another interface exposes the robot to that network: there is no authentication.";
+another interface exposes the robot to that network: there is no authentication.
+
+--check does everything but serve: opens the device, binds the address, checks that this build
+embeds the whole page (kin-core in WebAssembly, three.js), then stops; exit status 2 when the
+page is incomplete (scripts/install-deps.sh installs what the build needs).";
 
 const EXAMPLES: &str = "\
 Examples (from the repository root):
   quadctl serve --emulator
-  quadctl serve --sim --listen 127.0.0.1:0";
+  quadctl serve --sim --listen 127.0.0.1:0
+  quadctl serve --sim --listen 127.0.0.1:0 --check";
 
 /// Arguments of `quadctl serve`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -61,6 +66,9 @@ pub struct Args {
     /// How often the device's state is read between commands, ms.
     #[arg(long, value_name = "MS", default_value_t = 50, value_parser = clap::value_parser!(u64).range(5..=10_000))]
     pub poll_ms: u64,
+    /// Check the device, the address and the embedded page, then stop instead of serving.
+    #[arg(long)]
+    pub check: bool,
 }
 
 /// Runs `quadctl serve` and returns its exit status.
@@ -92,7 +100,29 @@ pub fn main(args: &Args) -> ExitCode {
         Ok(r) => r,
         Err(e) => return args::fail("quadctl", &e),
     };
+    let page = quad_web::assets::check();
     let mut out = io::stdout().lock();
+    if args.check {
+        let _ = writeln!(
+            out,
+            "quadctl serve: device answered, http://{}/ bound, page {}; stopping (--check)",
+            running.addr,
+            if page.is_ok() {
+                "complete"
+            } else {
+                "INCOMPLETE"
+            }
+        );
+        drop(out);
+        let stopped = running.stop();
+        return match page {
+            Err(e) => args::fail("quadctl", &e),
+            Ok(()) => args::exit_status(stopped),
+        };
+    }
+    if let Err(e) = page {
+        eprintln!("quadctl serve: warning: {e}");
+    }
     let _ = writeln!(
         out,
         "quadctl serve: http://{}/ (Ctrl-C stops)",

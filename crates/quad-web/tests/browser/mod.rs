@@ -11,8 +11,11 @@ use quad_protocol::RobotPreset;
 use quad_web::device::DeviceSetup;
 use quad_web::{Running, ServeConfig};
 use serde_json::{json, Value};
+use std::io::{BufRead, BufReader};
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The headless flags that work in a root container, plus a fixed window.
@@ -71,29 +74,105 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// Longest a browser may live: past it the watchdog kills chromedriver and the browser (the
+/// test then fails on its next WebDriver call) so that a stuck test cannot keep Chromium
+/// burning CPU.
+const BROWSER_LIFETIME: Duration = Duration::from_secs(600);
+
+/// Runs chromedriver (which starts Chromium) in a process group of its own, led by a shell that
+/// waits for its stdin to close and then kills the whole group. The pipe's write end is held
+/// only by this process, so the group dies when the [`Driver`] is dropped (a test's end or its
+/// panic), when the watchdog fires, and when the test process itself dies — even by SIGKILL,
+/// where no destructor runs. chromedriver's own shutdown is not relied on: a killed
+/// chromedriver leaves its browser running.
+const DRIVER_SCRIPT: &str = "chromedriver --port=0 & read -r _; kill -KILL 0";
+
+/// The chromedriver process group; killed on drop.
+struct Driver {
+    leader: Child,
+    /// Closing it ends the group (see [`DRIVER_SCRIPT`]); shared with the watchdog.
+    hold: Arc<Mutex<Option<ChildStdin>>>,
+    /// Dropping it tells the watchdog the group is gone.
+    _alive: mpsc::Sender<()>,
+}
+
+impl Driver {
+    /// Starts chromedriver on a port of the system's choice (`--port=0`, read back from its
+    /// banner: parallel tests cannot collide) and returns it with that port.
+    fn start() -> (Driver, u16) {
+        let mut leader = Command::new("sh")
+            .args(["-c", DRIVER_SCRIPT])
+            .process_group(0)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("sh runs");
+        let hold = Arc::new(Mutex::new(leader.stdin.take()));
+        let stdout = leader.stdout.take().expect("piped");
+        let (port_tx, port_rx) = mpsc::channel();
+        // Reads the banner, then drains chromedriver's output until the group is gone.
+        std::thread::spawn(move || {
+            let mut port_tx = Some(port_tx);
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                if let Some(port) = line
+                    .split_once("started successfully on port ")
+                    .and_then(|(_, p)| p.trim_end_matches('.').parse::<u16>().ok())
+                {
+                    if let Some(tx) = port_tx.take() {
+                        let _ = tx.send(port);
+                    }
+                }
+            }
+        });
+        let (alive, watched) = mpsc::channel::<()>();
+        let watchdog_hold = Arc::clone(&hold);
+        std::thread::spawn(move || {
+            if let Err(mpsc::RecvTimeoutError::Timeout) = watched.recv_timeout(BROWSER_LIFETIME) {
+                eprintln!(
+                    "browser test still running after {} s: killing chromedriver and Chromium",
+                    BROWSER_LIFETIME.as_secs()
+                );
+                watchdog_hold.lock().unwrap().take();
+            }
+        });
+        let driver = Driver {
+            leader,
+            hold,
+            _alive: alive,
+        };
+        let port = port_rx.recv_timeout(Duration::from_secs(30)).expect(
+            "chromedriver starts (Debian: apt-get install chromium chromium-driver; \
+             scripts/install-deps.sh)",
+        );
+        (driver, port)
+    }
+}
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        self.hold.lock().unwrap_or_else(|e| e.into_inner()).take();
+        let t0 = Instant::now();
+        while t0.elapsed() < Duration::from_secs(10) {
+            if let Ok(Some(_)) | Err(_) = self.leader.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        eprintln!("the chromedriver group did not end within 10 s");
+    }
+}
+
 /// chromedriver and a browser session on it; both end on drop.
 pub struct Browser {
     pub client: Client,
-    driver: Child,
-}
-
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
+    _driver: Driver,
 }
 
 impl Browser {
+    /// A headless Chromium with its profile in `profile`.
     pub async fn start(profile: &Path) -> Browser {
-        let port = free_port();
-        let driver = Command::new("chromedriver")
-            .arg(format!("--port={port}"))
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("chromedriver runs (Debian: apt-get install chromium chromium-driver; scripts/install-deps.sh)");
+        let (driver, port) = Driver::start();
         let mut args: Vec<String> = CHROME_ARGS.iter().map(|s| (*s).to_owned()).collect();
         args.push(format!("--user-data-dir={}", profile.display()));
         let caps = json!({
@@ -120,7 +199,10 @@ impl Browser {
                 Err(e) => panic!("no browser session through chromedriver: {e}"),
             }
         };
-        Browser { client, driver }
+        Browser {
+            client,
+            _driver: driver,
+        }
     }
 
     /// Evaluates `expr` in the page.
@@ -191,16 +273,9 @@ impl Browser {
         self.client.screenshot().await.unwrap()
     }
 
-    pub async fn close(mut self) {
+    /// Ends the WebDriver session, then the browser and chromedriver.
+    pub async fn close(self) {
         let _ = self.client.clone().close().await;
-        let _ = self.driver.kill();
-        let _ = self.driver.wait();
-    }
-}
-
-impl Drop for Browser {
-    fn drop(&mut self) {
-        let _ = self.driver.kill();
     }
 }
 
