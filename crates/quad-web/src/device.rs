@@ -23,6 +23,7 @@
 //! the same rule the device applies to a silent link ([`quad_protocol::LinkLossAction`] of its
 //! configuration): `Disable` switches the outputs off, `Hold` keeps the last pose.
 
+use crate::motion;
 use crate::msg::{self, FlagsMsg, LinkMsg, PoseMsg, State};
 use kin_core::body::Pose;
 use kin_core::Robot;
@@ -111,6 +112,9 @@ pub enum Error {
     /// The link is down; the server keeps serving pages.
     #[error("the device link is down")]
     LinkDown,
+    /// A motion command the device protocol cannot carry: not sent.
+    #[error(transparent)]
+    Motion(motion::Unsupported),
 }
 
 /// A session with the device: what the server knows of it and the requests the panel makes.
@@ -398,10 +402,20 @@ impl<L: Link> Session<L> {
     /// # Errors
     /// Link failures, no answer.
     pub fn control_lost(&mut self) -> Result<(), Error> {
+        if let Some(stop) = motion::on_control_lost() {
+            self.motion(stop)?;
+        }
         match self.info.link_timeout.action {
             LinkLossAction::Disable => self.set_outputs(false),
             LinkLossAction::Hold => Ok(()),
         }
+    }
+
+    /// Sends a motion request ([`motion::request`]) and takes the device's answer: an ack or
+    /// a nack (reported to the page) for now; the answer the protocol's motion requests will
+    /// carry (the engine's state) is to be accepted here as well.
+    fn motion(&mut self, request: Request) -> Result<(), Error> {
+        self.ack(request).map(|_| ())
     }
 
     /// The state for the pages.
@@ -452,6 +466,14 @@ impl<L: Link> Session<L> {
             M::SetDirection { servo: s, reversed } => self.set_direction(servo(s)?, reversed),
             M::SaveCalibration => self.save_calibration(),
             M::ReadCalibration => self.read_calibration(),
+            M::StartMotion { .. } | M::StopMotion | M::SetVelocity { .. } => {
+                let request = cmd.motion().map(|m| motion::request(&m));
+                match request {
+                    Some(Ok(r)) => self.motion(r),
+                    Some(Err(e)) => Err(Error::Motion(e)),
+                    None => Ok(()),
+                }
+            }
             M::TakeControl | M::ReleaseControl => Ok(()),
         }
     }

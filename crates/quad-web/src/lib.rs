@@ -12,11 +12,13 @@
 //! - a calibration tab: pick a servo, jog its pulse, set its centre and direction, save.
 //!
 //! Modules: [`msg`] (the WebSocket messages and their validation), [`device`] (the thread
-//! that owns the link and the checks every command passes), [`server`] (HTTP, WebSockets, who
+//! that owns the link and the checks every command passes), [`motion`] (the Motion tab's
+//! commands and their device requests), [`server`] (HTTP, WebSockets, who
 //! controls), [`assets`] (the embedded files).
 
 pub mod assets;
 pub mod device;
+pub mod motion;
 pub mod msg;
 pub mod server;
 

@@ -9,6 +9,7 @@
 //! larger than [`MAX_JOG_US`]). A refused message reaches neither the device thread nor the
 //! device.
 
+use crate::motion::{self, MotionCommand, MotionMsg, VelocityMsg};
 use kin_core::body::Pose;
 use kin_core::Robot;
 use quad_protocol::servo::Calibration;
@@ -111,6 +112,18 @@ pub enum ClientMsg {
     SaveCalibration,
     /// Reads the twelve calibrations back from the device.
     ReadCalibration,
+    /// Starts an onboard motion (see [`crate::motion`]).
+    StartMotion {
+        /// The motion and its parameters.
+        motion: MotionMsg,
+    },
+    /// Stops the running motion cleanly.
+    StopMotion,
+    /// The running walk's velocity (the joystick).
+    SetVelocity {
+        /// The velocity.
+        velocity: VelocityMsg,
+    },
 }
 
 /// Why a page's message was refused before reaching the device thread.
@@ -141,6 +154,9 @@ pub enum Error {
     /// A stance height that is not positive.
     #[error("stance_height_m must be > 0 (got {0})")]
     StanceHeight(f32),
+    /// A motion command's field out of range.
+    #[error(transparent)]
+    Motion(#[from] motion::Invalid),
 }
 
 fn finite(name: &'static str, v: f32) -> Result<(), Error> {
@@ -211,6 +227,22 @@ impl ClientMsg {
             | ClientMsg::SetOutputs { .. }
             | ClientMsg::SaveCalibration
             | ClientMsg::ReadCalibration => Ok(()),
+            ClientMsg::StartMotion { .. }
+            | ClientMsg::StopMotion
+            | ClientMsg::SetVelocity { .. } => {
+                let cmd = self.motion().expect("a motion command");
+                cmd.validate().map_err(Error::from)
+            }
+        }
+    }
+
+    /// The Motion tab's command this message carries, if it is one.
+    pub fn motion(&self) -> Option<MotionCommand> {
+        match *self {
+            ClientMsg::StartMotion { motion } => Some(MotionCommand::Start(motion)),
+            ClientMsg::StopMotion => Some(MotionCommand::Stop),
+            ClientMsg::SetVelocity { velocity } => Some(MotionCommand::Velocity(velocity)),
+            _ => None,
         }
     }
 }
@@ -354,6 +386,9 @@ impl ClientMsg {
             ClientMsg::SetDirection { .. } => "set_direction",
             ClientMsg::SaveCalibration => "save_calibration",
             ClientMsg::ReadCalibration => "read_calibration",
+            ClientMsg::StartMotion { .. } => "start_motion",
+            ClientMsg::StopMotion => "stop_motion",
+            ClientMsg::SetVelocity { .. } => "set_velocity",
         }
     }
 }
@@ -376,6 +411,70 @@ mod tests {
                 delta_us: -10
             }
         );
+    }
+
+    #[test]
+    fn motion_commands_parse_and_are_range_checked() {
+        use crate::motion::{Invalid, MotionMsg};
+        use kin_core::motion::laws::Axis;
+        let m = ClientMsg::parse(
+            r#"{"type":"start_motion","motion":{"kind":"sway","axis":"Roll","amplitude_rad":0.1,"period_s":2,"duration_s":null}}"#,
+        )
+        .unwrap();
+        assert_eq!(
+            m,
+            ClientMsg::StartMotion {
+                motion: MotionMsg::Sway {
+                    axis: Axis::Roll,
+                    amplitude_rad: 0.1,
+                    period_s: 2.0,
+                    duration_s: None
+                }
+            }
+        );
+        assert_eq!(m.name(), "start_motion");
+        assert_eq!(
+            ClientMsg::parse(r#"{"type":"stop_motion"}"#).unwrap(),
+            ClientMsg::StopMotion
+        );
+        let v = ClientMsg::parse(
+            r#"{"type":"set_velocity","velocity":{"forward_m_s":0.1,"lateral_m_s":0,"yaw_rate_rad_s":-0.2}}"#,
+        )
+        .unwrap();
+        assert!(matches!(v, ClientMsg::SetVelocity { .. }));
+        for (text, want) in [
+            (
+                r#"{"type":"start_motion","motion":{"kind":"sway","axis":"Roll","amplitude_rad":0.1,"period_s":0,"duration_s":null}}"#,
+                Invalid::NotPositive {
+                    name: "period_s",
+                    value: 0.0,
+                },
+            ),
+            (
+                r#"{"type":"start_motion","motion":{"kind":"foot_path","path":"Bezier","leg":4,"stride_m":0.05,"step_height_m":0.03,"duty_factor":0.5,"cycle_s":1,"duration_s":null}}"#,
+                Invalid::Leg(4),
+            ),
+            (
+                r#"{"type":"start_motion","motion":{"kind":"foot_path","path":"Bezier","leg":null,"stride_m":0.05,"step_height_m":0.03,"duty_factor":1,"cycle_s":1,"duration_s":null}}"#,
+                Invalid::DutyFactor(1.0),
+            ),
+            (
+                r#"{"type":"set_velocity","velocity":{"forward_m_s":1e39,"lateral_m_s":0,"yaw_rate_rad_s":0}}"#,
+                Invalid::NonFinite("forward_m_s"),
+            ),
+            (
+                r#"{"type":"start_motion","motion":{"kind":"walk","gait":"Trot","body_height_m":0.4,"step_height_m":0.05,"cycle_s":0.8,"velocity_timeout_ms":0}}"#,
+                Invalid::Timeout,
+            ),
+        ] {
+            match ClientMsg::parse(text) {
+                Err(Error::Motion(got)) => assert_eq!(got, want, "{text}"),
+                other => panic!("{text}: {other:?}"),
+            }
+        }
+        let e =
+            ClientMsg::parse(r#"{"type":"start_motion","motion":{"kind":"dance"}}"#).unwrap_err();
+        assert!(e.to_string().contains("unknown variant `dance`"), "{e}");
     }
 
     #[test]

@@ -79,3 +79,37 @@ fn losing_the_controlling_page_applies_the_link_loss_rule() {
     s.control_lost().unwrap();
     assert!(s.state(0.0).flags.outputs_enabled);
 }
+
+#[test]
+fn a_motion_the_protocol_cannot_carry_is_not_sent() {
+    use quad_web::motion::{MotionMsg, VelocityMsg};
+    use quad_web::msg::ClientMsg;
+    let mut s = session(LinkLossAction::Hold);
+    s.set_outputs(true).unwrap();
+    let before = s.state(0.0);
+    for cmd in [
+        ClientMsg::StartMotion {
+            motion: MotionMsg::Stand,
+        },
+        ClientMsg::SetVelocity {
+            velocity: VelocityMsg {
+                forward_m_s: 0.1,
+                lateral_m_s: 0.0,
+                yaw_rate_rad_s: 0.0,
+            },
+        },
+        ClientMsg::StopMotion,
+    ] {
+        let err = s.command(&cmd).unwrap_err();
+        assert!(matches!(err, Error::Motion(_)), "{err}");
+        assert!(err.to_string().contains("not sent"), "{err}");
+    }
+    let after = s.state(0.0);
+    assert_eq!(after.link.frames_sent, before.link.frames_sent);
+    assert_eq!(after.angles_rad, before.angles_rad);
+    s.control_lost().unwrap();
+    assert!(
+        s.state(0.0).flags.outputs_enabled,
+        "hold keeps the outputs on"
+    );
+}
