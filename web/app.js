@@ -184,6 +184,8 @@ function connect() {
       case 'state': onState(msg); break;
       case 'done':
         panel.done.push(msg.command);
+        if (msg.command === 'start_motion') panel.walking = panel.lastMotion?.kind === 'walk';
+        if (msg.command === 'stop_motion') panel.walking = false;
         if (['set_pose', 'set_stance_height'].includes(msg.command)) { inFlight = false; pump(); }
         break;
       case 'error':
@@ -454,16 +456,87 @@ function showHealth(s) {
 }
 
 // ---------------------------------------------------------------- motions and teleop
-const MOTIONS = ['stand', 'sit', 'roll sway', 'pitch sway', 'yaw turn', 'foot path', 'trot', 'walk', 'stop'];
-function buildMotion() {
-  const box = $('motion-buttons');
-  for (const m of MOTIONS) {
-    const b = document.createElement('button');
-    b.textContent = m;
-    b.disabled = true;
-    b.title = 'needs the motion requests of the device protocol';
-    box.appendChild(b);
+// Each motion's parameters as the form shows them (degrees and millimetres on the page, SI on
+// the wire, as the sliders); a duration of 0 runs until Stop.
+const LEGS = ['all', 'FL', 'FR', 'RL', 'RR'];
+const MOTION_FORMS = {
+  stand: { label: 'stand', fields: [] },
+  sit: { label: 'sit', fields: [] },
+  sway: {
+    label: 'sway',
+    fields: [['axis', ['Roll', 'Pitch', 'Yaw']], ['amplitude_deg', 8], ['period_s', 2], ['duration_s', 0]],
+  },
+  yaw_turn: {
+    label: 'yaw turn',
+    fields: [['yaw_rate_deg_s', 10], ['step_period_s', 1], ['lift_height_mm', 30], ['duration_s', 0]],
+  },
+  foot_path: {
+    label: 'foot path',
+    fields: [['path', ['Bezier', 'Rectangle', 'Semicircle', 'Ellipse', 'Cycloid']], ['leg', LEGS],
+      ['stride_mm', 60], ['step_height_mm', 30], ['duty_factor', 0.5], ['cycle_s', 1], ['duration_s', 0]],
+  },
+  walk: {
+    label: 'trot / walk',
+    fields: [['gait', ['Trot', 'Walk']], ['body_height_mm', 400], ['step_height_mm', 40], ['cycle_s', 0.8],
+      ['velocity_timeout_ms', 500]],
+  },
+};
+
+// The `start_motion` message of the form's values.
+function motionMessage(kind, values) {
+  const v = values;
+  const dur = (s) => (Number(s) > 0 ? Number(s) : null);
+  const mm = (x) => Number(x) / 1000;
+  switch (kind) {
+    case 'sway':
+      return { kind, axis: v.axis, amplitude_rad: Number(v.amplitude_deg) * DEG, period_s: Number(v.period_s), duration_s: dur(v.duration_s) };
+    case 'yaw_turn':
+      return { kind, yaw_rate_rad_s: Number(v.yaw_rate_deg_s) * DEG, step_period_s: Number(v.step_period_s), lift_height_m: mm(v.lift_height_mm), duration_s: dur(v.duration_s) };
+    case 'foot_path':
+      return { kind, path: v.path, leg: v.leg === 'all' ? null : LEGS.indexOf(v.leg) - 1, stride_m: mm(v.stride_mm), step_height_m: mm(v.step_height_mm), duty_factor: Number(v.duty_factor), cycle_s: Number(v.cycle_s), duration_s: dur(v.duration_s) };
+    case 'walk':
+      return { kind, gait: v.gait, body_height_m: mm(v.body_height_mm), step_height_m: mm(v.step_height_mm), cycle_s: Number(v.cycle_s), velocity_timeout_ms: Number(v.velocity_timeout_ms) };
+    default:
+      return { kind };
   }
+}
+
+function showMotionForm() {
+  const kind = $('motion-kind').value;
+  const box = $('motion-params');
+  box.innerHTML = '';
+  for (const [name, init] of MOTION_FORMS[kind].fields) {
+    const label = document.createElement('label');
+    label.textContent = `${name} `;
+    let input;
+    if (Array.isArray(init)) {
+      input = document.createElement('select');
+      for (const o of init) input.add(new Option(o, o));
+    } else {
+      input = document.createElement('input');
+      input.type = 'number';
+      input.step = 'any';
+      input.value = init;
+    }
+    input.dataset.param = name;
+    label.appendChild(input);
+    box.appendChild(label);
+  }
+}
+
+function buildMotion() {
+  const sel = $('motion-kind');
+  for (const [kind, f] of Object.entries(MOTION_FORMS)) sel.add(new Option(f.label, kind));
+  sel.addEventListener('change', showMotionForm);
+  showMotionForm();
+  $('motion-start').addEventListener('click', () => {
+    const values = {};
+    for (const i of document.querySelectorAll('#motion-params [data-param]')) values[i.dataset.param] = i.value;
+    const motion = motionMessage(sel.value, values);
+    panel.lastMotion = motion;
+    send({ type: 'start_motion', motion });
+  });
+  $('motion-stop').addEventListener('click', () => send({ type: 'stop_motion' }));
   const pad = $('joystick');
   const setFromPointer = (ev) => {
     const r = pad.getBoundingClientRect();
@@ -482,6 +555,8 @@ const stick = { active: false, x: 0, y: 0 };
 const keys = new Set();
 const MAX_V = 0.2; // m/s
 const MAX_YAW = 0.5; // rad/s
+const VELOCITY_PERIOD_MS = 200;
+let lastVelocitySent = 0;
 
 function pollInputs() {
   let vx = -stick.y; let vy = -stick.x; let yaw = 0;
@@ -497,6 +572,13 @@ function pollInputs() {
   }
   const v = { vx: vx * MAX_V, vy: vy * MAX_V, yaw: yaw * MAX_YAW };
   panel.velocity = v;
+  // The walk's velocity goes to the device only while a walk runs (its start was done), and
+  // often enough for its velocity timeout.
+  const now = performance.now();
+  if (panel.controlling && panel.walking && now - lastVelocitySent > VELOCITY_PERIOD_MS) {
+    lastVelocitySent = now;
+    send({ type: 'set_velocity', velocity: { forward_m_s: v.vx, lateral_m_s: v.vy, yaw_rate_rad_s: v.yaw } });
+  }
   $('velocity').textContent = `vx ${v.vx.toFixed(3)} m/s · vy ${v.vy.toFixed(3)} m/s · yaw ${v.yaw.toFixed(3)} rad/s`;
   const pad = $('joystick');
   const g = pad.getContext('2d');

@@ -114,6 +114,42 @@ async fn sim_panel() {
     b.wait(&format!("panel.states > {states} + 3"), WAIT).await;
     assert_eq!(b.js("panel.state.angles_rad").await, angles_before);
 
+    // The Motion tab: Start and Stop reach the server, which answers "not sent" (the device
+    // protocol has no motion requests yet) and moves nothing.
+    b.click("tab-motion").await;
+    b.client
+        .find(fantoccini::Locator::Css(
+            "#motion-kind option[value='sway']",
+        ))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    for (button, command) in [
+        ("motion-start", "start_motion"),
+        ("motion-stop", "stop_motion"),
+    ] {
+        let n = b.js("panel.errors.length").await.as_u64().unwrap();
+        b.click(button).await;
+        let got = b
+            .wait(
+                &format!("panel.errors.length > {n} && panel.errors[{n}]"),
+                WAIT,
+            )
+            .await;
+        assert!(
+            got.as_str().unwrap().contains("no motion requests"),
+            "{command}: {got}"
+        );
+    }
+    assert_eq!(b.js("panel.lastMotion.kind").await, "sway");
+    assert_eq!(b.js("panel.lastMotion.axis").await, "Roll");
+    assert_eq!(b.js("panel.walking === true").await, false);
+    keep_screenshot(&b.screenshot().await, "panel-motion.png", &dir);
+    b.click("tab-pose").await;
+    assert_eq!(b.js("panel.state.angles_rad").await, angles_before);
+
     // A second page is refused control while this one controls.
     b.js("(panel.second = [], (() => { const ws = new WebSocket(`ws://${location.host}/ws`); \
           ws.onmessage = (e) => panel.second.push(JSON.parse(e.data)); \
