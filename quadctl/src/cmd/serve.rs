@@ -25,7 +25,8 @@ height (millimetres on the page, metres on the wire), previewed at once by kin-c
 WebAssembly; each leg is coloured by its reachability and joint-limit margin, and an unreachable
 position is drawn, never sent. Live plots of the twelve joint angles and pulses, link health
 and device state; a calibration tab jogs a servo's pulse (by moving its centre_us), sets its
-centre and direction and saves to EEPROM.
+centre and direction and saves to EEPROM. The Motion tab's forms and joystick reach the server,
+which answers \"not sent\": the device protocol has no motion requests yet.
 
 Several pages may watch; one controls at a time (`Take control` on the page). The outputs are
 switched on only by the page's `Outputs on` button. Every command passes the same checks as the
