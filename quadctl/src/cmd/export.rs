@@ -14,11 +14,17 @@ the servos as position actuators (MJCF). docs/twin.md lists the assumptions.
 Exit status: 0 written; 2 a bad robot or value, or the file could not be written (nothing is
 left at --output).";
 
+const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl export --format urdf --output robot.urdf
+  quadctl export --format mjcf --robot fernando2025 --output robot.xml";
+
 /// Arguments of `quadctl export`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Write the robot as a MuJoCo MJCF model or a URDF",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// Description format.

@@ -30,11 +30,16 @@ URDF with this project's leg chain.
 Exit status: 0 the run finished (a fall is a result, reported); 2 a bad argument, robot or
 value, or the twin could not run (no output file is left behind).";
 
+const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl sim stand";
+
 /// Arguments of `quadctl sim`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Run a motion in the physics twin (MuJoCo) and print its metrics",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// The motion.
