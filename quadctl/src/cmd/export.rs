@@ -14,10 +14,11 @@ the servos as position actuators (MJCF). docs/twin.md lists the assumptions.
 Exit status: 0 written; 2 a bad robot or value, or the file could not be written (nothing is
 left at --output).";
 
-const EXAMPLES: &str = "\
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
 Examples (from the repository root):
-  quadctl export --format urdf --output robot.urdf
-  quadctl export --format mjcf --robot fernando2025 --output robot.xml";
+  quadctl export --format mjcf --output robot.xml
+  quadctl export --format urdf --robot examples/robots/shahriar2023.toml --output shahriar2023.urdf";
 
 /// Arguments of `quadctl export`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]

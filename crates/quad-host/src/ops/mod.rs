@@ -10,4 +10,5 @@ pub mod drive;
 pub mod motion;
 pub mod play;
 pub mod plot;
+pub mod session;
 pub mod stream;
