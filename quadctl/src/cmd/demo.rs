@@ -25,7 +25,7 @@ Motion: seed 000's pose sweeps on its robot (shahriar2023) at the stance height 
 order zyx — roll +-28 deg, then pitch +-21 deg, then yaw +-21 deg, one sine period each, sampled
 at --poses-per-sweep poses and streamed as fast as the link allows.
 
-Checks: every pose is acked with the 12 angles of the host's own kin-core (within 5e-5 rad: the
+Checks: every pose is acked with the 12 angles of the host's own kin-core (within 2e-5 rad: the
 AVR's math differs) and the 12 pulses of the device calibration's mapping of those angles; on the
 emulator every pulse measured on the 12 servo pins (Timer1/3/4/5, port L included) must match
 the readback in force within one 0.5 us timer tick. Times are simulated time on the emulator.
