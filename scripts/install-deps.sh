@@ -7,8 +7,12 @@
 #     rendering (EGL, and OSMesa as the software fallback), then a virtual environment
 #     `.venv-twin` at the repository root with the pinned packages of twin/requirements.txt
 #     (recreated only when that file changes).
+#   - the browser panel (`quadctl serve`): Debian's chromium and chromium-driver (the browser
+#     tests drive the headless browser through chromedriver), Node.js and npm, then `npm ci`
+#     in web/ (three.js, pinned by web/package-lock.json; rerun only when that file changes).
 #   - rustup: the `nightly` toolchain with `rust-src` (no_std build for avr-none with
-#     `-Z build-std=core`), and clippy + rustfmt on `stable` (rust-toolchain.toml).
+#     `-Z build-std=core`), clippy + rustfmt on `stable` (rust-toolchain.toml), and the
+#     `wasm32-unknown-unknown` target on `stable` (kin-core in the browser, crates/kin-wasm).
 #
 # Does nothing (and needs no network) when everything is already present. Installing needs
 # root; without it, a missing piece is an error naming the command to run.
@@ -21,6 +25,7 @@ APT_PACKAGES=(
     libudev-dev
     fonts-dejavu-core
     python3 python3-venv libegl1 libosmesa6
+    chromium chromium-driver
 )
 NIGHTLY=nightly
 STABLE_COMPONENTS=(clippy rustfmt)
@@ -83,6 +88,32 @@ if [ "${#stable_missing[@]}" -gt 0 ]; then
     rustup component add "${stable_missing[@]}" --toolchain stable </dev/null
 else
     echo "install-deps: stable with ${STABLE_COMPONENTS[*]} present"
+fi
+
+if rustup target list --toolchain stable --installed 2>/dev/null | grep -q '^wasm32-unknown-unknown$'; then
+    echo "install-deps: stable with wasm32-unknown-unknown present"
+else
+    echo "install-deps: adding wasm32-unknown-unknown to stable"
+    rustup target add wasm32-unknown-unknown --toolchain stable </dev/null
+fi
+
+# --- Browser panel: three.js from npm (web/package-lock.json) --------------------------------
+# Node.js may come from Debian (nodejs + npm) or from NodeSource (nodejs alone, with npm inside,
+# conflicting with Debian's npm): only the command is checked.
+if ! command -v npm >/dev/null 2>&1; then
+    is_root || die "npm not found; run as root: apt-get install -y nodejs npm"
+    echo "install-deps: installing nodejs npm"
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -q nodejs npm </dev/null
+fi
+WEB="$(cd "$(dirname "$0")/.." && pwd)/web"
+web_want=$(sha256sum "$WEB/package-lock.json" | cut -d' ' -f1)
+web_have=$(cat "$WEB/node_modules/.package-lock.sha256" 2>/dev/null || true)
+if [ -d "$WEB/node_modules/three" ] && [ "$web_want" = "$web_have" ]; then
+    echo "install-deps: web/node_modules present"
+else
+    echo "install-deps: npm ci in web/"
+    (cd "$WEB" && npm ci --no-audit --no-fund --loglevel=error </dev/null)
+    echo "$web_want" >"$WEB/node_modules/.package-lock.sha256"
 fi
 
 # --- Physics twin: Python virtual environment ------------------------------------------------

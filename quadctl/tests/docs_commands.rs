@@ -46,6 +46,10 @@ enum Check {
     /// the firmware in simavr, minutes; `twin_cli` runs it. Run with `--help` appended: the
     /// arguments must be accepted.
     SimArgs,
+    /// `quadctl serve`: serves until Ctrl-C. Run with `--check` (and `--listen 127.0.0.1:0`
+    /// unless the line sets an address): the device must open, the address bind and the page
+    /// be complete, then it stops; on a board's port, as [`Check::BoardPort`].
+    Serve,
 }
 
 /// (how the command starts, how it is checked), first match wins.
@@ -63,6 +67,7 @@ const RULES: &[(&str, Check)] = &[
     ),
     ("cargo bench -p ", Check::CargoTarget),
     ("cargo run --release -p quadctl -- sim ", Check::SimArgs),
+    ("cargo run --release -p quadctl -- serve ", Check::Serve),
     ("cargo run --release -p quadctl -- ", Check::Run),
 ];
 
@@ -173,6 +178,25 @@ fn flash_dry_run(args: &str, dir: &Path) -> String {
 fn check_command(command: &str, check: Check, dir: &Path) {
     match check {
         Check::Run => assert_ok(&run_line(&as_quadctl(command), dir), "run as written"),
+        Check::Serve => {
+            let listen = if command.contains("--listen") {
+                ""
+            } else {
+                " --listen 127.0.0.1:0"
+            };
+            let line = format!("{}{listen} --check", as_quadctl(command));
+            if line.contains(BOARD_PORT) {
+                let port = dir.join("no-board");
+                let port = port.to_str().expect("utf-8 path");
+                let run = run_line(&line.replace(BOARD_PORT, port), dir);
+                assert_eq!(run.code, 2, "{}: {}", run.line, run.stderr);
+                assert!(run.stderr.contains(port), "{}: {}", run.line, run.stderr);
+            } else {
+                let run = run_line(&line, dir);
+                assert_ok(&run, "checked with --check");
+                assert!(run.stdout.contains("page complete"), "{}", run.stdout);
+            }
+        }
         Check::SimArgs => assert_ok(
             &run_line(&format!("{} --help", as_quadctl(command)), dir),
             "arguments accepted",

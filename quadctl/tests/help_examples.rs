@@ -18,6 +18,14 @@ const NOT_RUN: &[(&str, &str)] = &[
         "quadctl demo --poses-per-sweep 20 --baud 1000000",
         "emulator_cli's demo_passes_on_the_emulator runs the demo at 1000000 baud",
     ),
+    (
+        "quadctl serve --emulator",
+        "serves until Ctrl-C; crates/quad-web's browser tests run the server on the emulator",
+    ),
+    (
+        "quadctl serve --sim --listen 127.0.0.1:0",
+        "serves until Ctrl-C; crates/quad-web's browser tests run the server on the simulated device",
+    ),
 ];
 
 /// The subcommands listed by `quadctl --help`.

@@ -182,7 +182,11 @@ fn ci_steps(root: &Path) -> Vec<Step> {
             ],
         ));
     }
-    steps.push(Step::new("test", &["cargo", "test", "--workspace"]));
+    // Every test binary runs even after one fails: one failure must not hide the others.
+    steps.push(Step::new(
+        "test",
+        &["cargo", "test", "--workspace", "--no-fail-fast"],
+    ));
     steps.push(
         Step::new("doc", &["cargo", "doc", "--workspace", "--no-deps"])
             .with_env("RUSTDOCFLAGS", "-D warnings"),

@@ -833,25 +833,14 @@ impl<L: Link> PoseStream<L> {
         &mut self.client
     }
 
-    /// What the host's kin-core and calibration make of `pose`, after the range check the
-    /// device runs too (`quad_protocol::range`).
+    /// What the host's range check, kin-core and calibration make of `pose` ([`expected`]).
     pub fn expected(&self, pose: &Pose) -> Expected {
-        if let Err(reason) = quad_protocol::range::check_pose(pose, &self.setup.robot) {
-            return Expected::Nack(reason);
-        }
-        let config = BodyConfig {
-            order: self.pose_config.order,
-            pivot_m: Vec3::ZERO,
-        };
-        match body::Solver::new(&self.setup.robot).inverse_at_stance(
+        expected(
+            &self.setup.robot,
+            &self.pose_config,
+            &self.calibration,
             pose,
-            &config,
-            self.pose_config.stance_height_m,
-            ReachPolicy::Reject,
-        ) {
-            Err(e) => Expected::Nack(e.into()),
-            Ok(solution) => self.expected_angles(solution.flat()),
-        }
+        )
     }
 
     /// What the host's kin-core, joint limits and calibration make of `setpoint`: the device's
@@ -891,16 +880,7 @@ impl<L: Link> PoseStream<L> {
     /// `angles` through the device's calibration: the angles, or the first servo out of its
     /// travel.
     fn expected_angles(&self, angles: [f32; 12]) -> Expected {
-        for s in ServoId::ALL {
-            if let Err(fault) = self.calibration[s.index()].pulse_half_us(angles[s.index()]) {
-                return Expected::Nack(NackReason::ServoRange {
-                    leg: s.leg,
-                    joint: s.joint,
-                    fault,
-                });
-            }
-        }
-        Expected::Angles(angles)
+        expected_angles(&self.calibration, angles)
     }
 
     /// Compares a readback with the expected angles (see [`check_readback`]).
@@ -1047,6 +1027,49 @@ impl<L: Link> PoseStream<L> {
         s.timeouts = self.client.counters.timeouts;
         s
     }
+}
+
+/// What the host makes of `pose` on a device with `pose_config` and `calibration`: after the
+/// range check the device runs too (`quad_protocol::range`), the angles of kin-core's
+/// `inverse_at_stance` (reject policy) when every one maps to a pulse within its servo's
+/// travel, else the nack the device must answer. The check every body pose of the host passes
+/// before it is sent.
+pub fn expected(
+    robot: &Robot,
+    pose_config: &PoseConfig,
+    calibration: &[Calibration; 12],
+    pose: &Pose,
+) -> Expected {
+    if let Err(reason) = quad_protocol::range::check_pose(pose, robot) {
+        return Expected::Nack(reason);
+    }
+    let config = BodyConfig {
+        order: pose_config.order,
+        pivot_m: Vec3::ZERO,
+    };
+    match body::Solver::new(robot).inverse_at_stance(
+        pose,
+        &config,
+        pose_config.stance_height_m,
+        ReachPolicy::Reject,
+    ) {
+        Err(e) => Expected::Nack(e.into()),
+        Ok(solution) => expected_angles(calibration, solution.flat()),
+    }
+}
+
+/// `angles` through `calibration`: the angles, or the first servo out of its travel.
+fn expected_angles(calibration: &[Calibration; 12], angles: [f32; 12]) -> Expected {
+    for s in ServoId::ALL {
+        if let Err(fault) = calibration[s.index()].pulse_half_us(angles[s.index()]) {
+            return Expected::Nack(NackReason::ServoRange {
+                leg: s.leg,
+                joint: s.joint,
+                fault,
+            });
+        }
+    }
+    Expected::Angles(angles)
 }
 
 /// The readback check of one answer against the host's expectation: a nack must carry the

@@ -16,5 +16,6 @@ pub mod motion;
 pub mod play;
 pub mod plot;
 pub mod pose;
+pub mod serve;
 pub mod sim;
 pub mod stream;

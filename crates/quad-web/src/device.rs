@@ -1,0 +1,605 @@
+//! The device side of the panel: one thread owns the link ([`quad_host::link::open`]) and a
+//! [`Session`] on it, carries out the pages' commands one at a time and reads the device's
+//! state between them, so that the 3D view always shows the device's **readback**.
+//!
+//! Every command goes through the library's checks before a byte is sent, the same as the
+//! command line's:
+//! - a body pose is solved by the host's kin-core and mapped through the device's calibration
+//!   ([`quad_host::client::expected`]); a pose the host rejects is refused here and never sent;
+//!   the device's answer then passes the readback check of `quadctl stream`
+//!   ([`quad_host::client::judge`]);
+//! - a calibration is validated ([`Calibration::validate`]) and must map the joint's current
+//!   angle within the servo's travel before it is sent, and is read back after
+//!   (`quadctl calibrate`'s check).
+//!
+//! ## Calibration jog
+//! The protocol has no raw-pulse request. A jog of ±N µs moves the servo's `center_us` by N
+//! through `SetCalibration`: at the same joint angle the pulse then moves by exactly N µs, so
+//! the servo turns and the new centre is what "Save" persists. No new wire request is needed.
+//!
+//! ## Losing the controlling page
+//! While the server runs it reads the device's state several times a second, so the device's
+//! own link-loss failsafe never fires. When the controlling page goes away, the server applies
+//! the same rule the device applies to a silent link ([`quad_protocol::LinkLossAction`] of its
+//! configuration): `Disable` switches the outputs off, `Hold` keeps the last pose.
+
+use crate::motion;
+use crate::msg::{self, FlagsMsg, LinkMsg, PoseMsg, State};
+use kin_core::body::Pose;
+use kin_core::Robot;
+use quad_host::client::{
+    self, expected, judge, AngleCheck, Client, ClientConfig, Expected, Outcome,
+};
+use quad_host::link::{self, Link, Target};
+use quad_protocol::servo::Calibration;
+use quad_protocol::{
+    DeviceInfo, DeviceToHost, Flags, LinkLossAction, NackReason, PoseConfig, Readback, Request,
+    RobotPreset, ServoId,
+};
+use std::time::{Duration, Instant};
+
+/// Why a command was not carried out.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The host's kin-core and the device's calibration reject the pose: not sent.
+    #[error("not sent: the host rejects this pose ({0})")]
+    HostRejects(NackReason),
+    /// The device answered something the host's check refuses.
+    #[error("the device's answer failed the readback check: {0}")]
+    Mismatch(client::Mismatch),
+    /// The device refused the request.
+    #[error("the device refused {request}: {reason}")]
+    Refused {
+        /// The request.
+        request: &'static str,
+        /// Why.
+        reason: NackReason,
+    },
+    /// No answer after every retry.
+    #[error("no answer from the device after every retry")]
+    Lost,
+    /// A request of the session failed.
+    #[error(transparent)]
+    Client(#[from] client::Error),
+    /// The link failed.
+    #[error(transparent)]
+    Link(#[from] link::Error),
+    /// A calibration the protocol refuses: not sent.
+    #[error("not sent: {servo}: {source}")]
+    BadCalibration {
+        /// The servo.
+        servo: ServoId,
+        /// Why.
+        source: quad_protocol::servo::Error,
+    },
+    /// The new calibration would put the joint's current angle beyond the servo's travel: not
+    /// sent.
+    #[error("not sent: {servo} at its current angle would be driven beyond its travel ({source})")]
+    Travel {
+        /// The servo.
+        servo: ServoId,
+        /// Why.
+        source: quad_protocol::servo::Error,
+    },
+    /// The device holds another calibration than the one sent.
+    #[error("{0}: the device holds another calibration than the one sent")]
+    NotHeld(ServoId),
+    /// The save did not clear the device's "unsaved" flag.
+    #[error("the device still reports an unsaved calibration after the save")]
+    NotSaved,
+    /// The device runs another robot than the server was given.
+    #[error("the device runs robot {device:?}, the server was given {host:?}")]
+    Robot {
+        /// The device's.
+        device: RobotPreset,
+        /// The server's.
+        host: RobotPreset,
+    },
+    /// The stance height makes the held pose unreachable: nothing sent.
+    #[error(
+        "not sent: the held pose is unreachable at stance height {stance_height_m} m ({reason})"
+    )]
+    Stance {
+        /// The stance height asked, m.
+        stance_height_m: f32,
+        /// Why.
+        reason: NackReason,
+    },
+    /// A servo index beyond 11 (the message validation refuses it first).
+    #[error("servo index {0} out of range (0..=11)")]
+    Servo(u8),
+    /// The link is down; the server keeps serving pages.
+    #[error("the device link is down")]
+    LinkDown,
+    /// A motion command the device protocol cannot carry: not sent.
+    #[error(transparent)]
+    Motion(motion::Unsupported),
+}
+
+/// A session with the device: what the server knows of it and the requests the panel makes.
+pub struct Session<L> {
+    client: Client<L>,
+    robot: Robot,
+    info: DeviceInfo,
+    pose_config: PoseConfig,
+    calibration: [Calibration; 12],
+    check: AngleCheck,
+    readback: Readback,
+    pose: Option<(Pose, u32)>,
+    poses_sent: u64,
+    link: LinkMsg,
+}
+
+impl<L: Link> Session<L> {
+    /// Handshake, robot check, calibration read, current state. Nothing moves: the outputs
+    /// stay as they are (off at power-on).
+    ///
+    /// # Errors
+    /// The handshake's errors, or [`Error::Robot`].
+    pub fn connect(
+        mut client: Client<L>,
+        robot: Robot,
+        preset: RobotPreset,
+        check: AngleCheck,
+    ) -> Result<Session<L>, Error> {
+        let info = client.hello()?;
+        if info.robot != preset {
+            return Err(Error::Robot {
+                device: info.robot,
+                host: preset,
+            });
+        }
+        let calibration = client.calibrations()?;
+        let readback = client.ack(Request::GetState)?;
+        Ok(Session {
+            client,
+            robot,
+            info,
+            pose_config: info.pose_config,
+            calibration,
+            check,
+            readback,
+            pose: None,
+            poses_sent: 0,
+            link: LinkMsg::default(),
+        })
+    }
+
+    /// The device's `HelloAck`.
+    pub fn info(&self) -> &DeviceInfo {
+        &self.info
+    }
+
+    /// The last readback.
+    pub fn readback(&self) -> &Readback {
+        &self.readback
+    }
+
+    /// One request through [`Client::exchange`] with `check`, timed and counted.
+    fn exchange(
+        &mut self,
+        request: Request,
+        check: impl FnMut(&DeviceToHost) -> client::Verdict,
+    ) -> Result<DeviceToHost, Error> {
+        let t0 = self.client.link().now();
+        let ex = self.client.exchange(request, check)?;
+        let rtt_ms = (self.client.link().now() - t0).as_secs_f64() * 1e3;
+        self.link.rtt_ms = rtt_ms;
+        self.link.rtt_max_ms = self.link.rtt_max_ms.max(rtt_ms);
+        match ex.outcome {
+            Outcome::Accepted(DeviceToHost::Nack { reason, .. }) => {
+                self.link.nacked += 1;
+                Err(Error::Refused {
+                    request: client::request_name(&request),
+                    reason,
+                })
+            }
+            Outcome::Accepted(answer) => {
+                self.link.acked += 1;
+                if let Some(readback) = answer.readback() {
+                    self.readback = *readback;
+                }
+                Ok(answer)
+            }
+            Outcome::Rejected(answer) => Err(Error::Mismatch(client::Mismatch::Unexpected(answer))),
+            Outcome::Lost => {
+                self.link.lost += 1;
+                Err(Error::Lost)
+            }
+        }
+    }
+
+    /// A request answered by an ack, or a configuration request answered by a `Configured`
+    /// echoing exactly the setting sent (as [`Client::ack`]).
+    fn ack(&mut self, request: Request) -> Result<Readback, Error> {
+        let sent = quad_protocol::Setting::of_request(&request);
+        match self.exchange(request, |_| client::Verdict::Accept)? {
+            DeviceToHost::Ack { readback, .. } => Ok(readback),
+            DeviceToHost::Configured {
+                setting, readback, ..
+            } if Some(setting) == sent => Ok(readback),
+            other => Err(Error::Client(client::Error::Unexpected {
+                request: client::request_name(&request),
+                answer: Box::new(other),
+            })),
+        }
+    }
+
+    /// Reads the device's state.
+    ///
+    /// # Errors
+    /// Link failures, no answer.
+    pub fn poll(&mut self) -> Result<(), Error> {
+        self.ack(Request::GetState).map(|_| ())
+    }
+
+    /// Sends `pose` (page id `id`) when the host's kin-core and calibration accept it; the
+    /// answer must pass the readback check.
+    ///
+    /// # Errors
+    /// [`Error::HostRejects`] (nothing sent), [`Error::Refused`], [`Error::Mismatch`],
+    /// [`Error::Lost`], link failures.
+    pub fn set_pose(&mut self, pose: Pose, id: u32) -> Result<(), Error> {
+        let angles = match expected(&self.robot, &self.pose_config, &self.calibration, &pose) {
+            Expected::Angles(angles) => angles,
+            Expected::Nack(reason) => return Err(Error::HostRejects(reason)),
+        };
+        let (check, calibration) = (self.check, self.calibration);
+        self.poses_sent += 1;
+        let answer = self.exchange(Request::SetBodyPose(pose), |a| {
+            judge(check, &calibration, a, &Expected::Angles(angles))
+        });
+        match answer {
+            Ok(_) => {
+                self.pose = Some((pose, id));
+                Ok(())
+            }
+            Err(Error::Mismatch(client::Mismatch::Unexpected(DeviceToHost::Ack {
+                readback,
+                ..
+            }))) => Err(Error::Mismatch(
+                client::check_readback(check, &calibration, &readback, &angles)
+                    .err()
+                    .unwrap_or(client::Mismatch::Unexpected(DeviceToHost::Ack {
+                        seq: 0,
+                        readback,
+                    })),
+            )),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// A new stance height; the held pose (or the neutral one) is solved and sent again at it.
+    ///
+    /// # Errors
+    /// [`Error::Stance`] when the held pose is unreachable there (nothing sent), the device's
+    /// refusal, link failures.
+    pub fn set_stance_height(&mut self, stance_height_m: f32) -> Result<(), Error> {
+        let config = PoseConfig {
+            stance_height_m,
+            ..self.pose_config
+        };
+        quad_protocol::range::check_pose_config(&config, &self.robot).map_err(|reason| {
+            Error::Stance {
+                stance_height_m,
+                reason,
+            }
+        })?;
+        let (pose, id) = self.pose.unwrap_or((Pose::rotation(0.0, 0.0, 0.0), 0));
+        if let Expected::Nack(reason) = expected(&self.robot, &config, &self.calibration, &pose) {
+            return Err(Error::Stance {
+                stance_height_m,
+                reason,
+            });
+        }
+        self.ack(Request::SetPoseConfig(config))?;
+        self.pose_config = config;
+        self.set_pose(pose, id)
+    }
+
+    /// Switches the outputs on or off.
+    ///
+    /// # Errors
+    /// The device's refusal, link failures.
+    pub fn set_outputs(&mut self, enabled: bool) -> Result<(), Error> {
+        self.ack(Request::SetOutputs { enabled }).map(|_| ())
+    }
+
+    /// Replaces one servo's calibration in RAM after the checks of the module docs, and reads
+    /// it back.
+    ///
+    /// # Errors
+    /// [`Error::BadCalibration`], [`Error::Travel`] (nothing sent), the device's refusal,
+    /// [`Error::NotHeld`], link failures.
+    pub fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), Error> {
+        c.validate()
+            .map_err(|source| Error::BadCalibration { servo, source })?;
+        c.pulse_half_us(self.readback.angles_rad[servo.index()])
+            .map_err(|source| Error::Travel { servo, source })?;
+        self.ack(Request::SetCalibration {
+            servo,
+            calibration: c,
+        })?;
+        let held = match self.exchange(Request::GetCalibration { servo }, |_| {
+            client::Verdict::Accept
+        })? {
+            DeviceToHost::Calibration {
+                servo: s,
+                calibration,
+                ..
+            } if s == servo => calibration,
+            other => {
+                return Err(Error::Client(client::Error::Unexpected {
+                    request: "GetCalibration",
+                    answer: Box::new(other),
+                }))
+            }
+        };
+        self.calibration[servo.index()] = held;
+        if held != c {
+            return Err(Error::NotHeld(servo));
+        }
+        self.poll()
+    }
+
+    /// Moves one servo's pulse by `delta_us` at the same angle (see the module docs).
+    ///
+    /// # Errors
+    /// As [`Session::set_calibration`]; a centre beyond 0..=65535 µs is
+    /// [`Error::BadCalibration`].
+    pub fn jog(&mut self, servo: ServoId, delta_us: i32) -> Result<(), Error> {
+        let c = self.calibration[servo.index()];
+        let center_us = i32::from(c.center_us) + delta_us;
+        let center_us = u16::try_from(center_us).map_err(|_| Error::BadCalibration {
+            servo,
+            source: quad_protocol::servo::Error::CenterOutOfBounds,
+        })?;
+        self.set_calibration(servo, Calibration { center_us, ..c })
+    }
+
+    /// Sets one servo's centre pulse.
+    ///
+    /// # Errors
+    /// As [`Session::set_calibration`].
+    pub fn set_center(&mut self, servo: ServoId, center_us: u16) -> Result<(), Error> {
+        let c = self.calibration[servo.index()];
+        self.set_calibration(servo, Calibration { center_us, ..c })
+    }
+
+    /// Sets one servo's direction.
+    ///
+    /// # Errors
+    /// As [`Session::set_calibration`].
+    pub fn set_direction(&mut self, servo: ServoId, reversed: bool) -> Result<(), Error> {
+        let c = self.calibration[servo.index()];
+        self.set_calibration(servo, Calibration { reversed, ..c })
+    }
+
+    /// Persists the twelve calibrations and checks the device's "unsaved" flag cleared.
+    ///
+    /// # Errors
+    /// The device's refusal (storage), [`Error::NotSaved`], link failures.
+    pub fn save_calibration(&mut self) -> Result<(), Error> {
+        let rb = self.ack(Request::SaveCalibration)?;
+        if rb.flags.contains(Flags::CALIBRATION_UNSAVED) {
+            return Err(Error::NotSaved);
+        }
+        Ok(())
+    }
+
+    /// Reads the twelve calibrations back from the device.
+    ///
+    /// # Errors
+    /// Link failures, no answer.
+    pub fn read_calibration(&mut self) -> Result<(), Error> {
+        self.calibration = self.client.calibrations()?;
+        Ok(())
+    }
+
+    /// The controlling page went away: the device's link-loss rule (see the module docs).
+    ///
+    /// # Errors
+    /// Link failures, no answer.
+    pub fn control_lost(&mut self) -> Result<(), Error> {
+        if let Some(stop) = motion::on_control_lost() {
+            self.motion(stop)?;
+        }
+        match self.info.link_timeout.action {
+            LinkLossAction::Disable => self.set_outputs(false),
+            LinkLossAction::Hold => Ok(()),
+        }
+    }
+
+    /// Sends a motion request ([`motion::request`]) and takes the device's answer: an ack or
+    /// a nack (reported to the page) for now; the answer the protocol's motion requests will
+    /// carry (the engine's state) is to be accepted here as well.
+    fn motion(&mut self, request: Request) -> Result<(), Error> {
+        self.ack(request).map(|_| ())
+    }
+
+    /// The state for the pages.
+    pub fn state(&self, t_ms: f64) -> State {
+        let c = self.client.counters();
+        let rb = &self.readback;
+        State {
+            t_ms,
+            angles_rad: rb.angles_rad,
+            pulses_us: rb.pulses_half_us.map(|p| f32::from(p) * 0.5),
+            flags: FlagsMsg::from(rb.flags),
+            link: LinkMsg {
+                frames_sent: c.frames_sent,
+                retries: c.retries,
+                timeouts: c.timeouts,
+                bad_frames: c.bad_frames,
+                device_frames_ok: rb.frames_ok,
+                device_frames_bad: rb.frames_bad,
+                ..self.link
+            },
+            pose: self.pose.map(|(p, _)| PoseMsg::from(p)),
+            pose_id: self.pose.map_or(0, |(_, id)| id),
+            stance_height_m: self.pose_config.stance_height_m,
+            calibration: self.calibration,
+            poses_sent: self.poses_sent,
+            controller: None,
+            pages: 0,
+            link_up: true,
+        }
+    }
+
+    /// Carries out one page command (control commands are the server's, not the device's).
+    ///
+    /// # Errors
+    /// The command's.
+    pub fn command(&mut self, cmd: &msg::ClientMsg) -> Result<(), Error> {
+        use msg::ClientMsg as M;
+        let servo = |i: u8| msg::servo(i).map_err(|_| Error::Servo(i));
+        match *cmd {
+            M::SetOutputs { enabled } => self.set_outputs(enabled),
+            M::SetPose { id, pose } => self.set_pose(pose.into(), id),
+            M::SetStanceHeight { stance_height_m } => self.set_stance_height(stance_height_m),
+            M::Jog { servo: s, delta_us } => self.jog(servo(s)?, delta_us),
+            M::SetCenter {
+                servo: s,
+                center_us,
+            } => self.set_center(servo(s)?, center_us),
+            M::SetDirection { servo: s, reversed } => self.set_direction(servo(s)?, reversed),
+            M::SaveCalibration => self.save_calibration(),
+            M::ReadCalibration => self.read_calibration(),
+            M::StartMotion { .. } | M::StopMotion | M::SetVelocity { .. } => {
+                let request = cmd.motion().map(|m| motion::request(&m));
+                match request {
+                    Some(Ok(r)) => self.motion(r),
+                    Some(Err(e)) => Err(Error::Motion(e)),
+                    None => Ok(()),
+                }
+            }
+            M::TakeControl | M::ReleaseControl => Ok(()),
+        }
+    }
+}
+
+/// Where the device is and what the server expects of it.
+#[derive(Debug, Clone)]
+pub struct DeviceSetup {
+    /// The device.
+    pub target: Target,
+    /// The robot the host checks poses with.
+    pub robot: Robot,
+    /// Its preset (the device's must match).
+    pub preset: RobotPreset,
+    /// Resends per request.
+    pub retries: u32,
+    /// How often the state is read between commands.
+    pub poll: Duration,
+}
+
+/// A page command for the device thread, and where its result goes.
+pub struct Job {
+    /// The command (validated).
+    pub cmd: msg::ClientMsg,
+    /// The result.
+    pub reply: tokio::sync::oneshot::Sender<Result<(), Error>>,
+}
+
+/// What the device thread tells the server.
+pub enum Event {
+    /// A job for the device.
+    Job(Job),
+    /// The controlling page went away.
+    ControlLost,
+}
+
+/// What the server learns when the device thread is up.
+#[derive(Debug, Clone)]
+pub struct Ready {
+    /// The device's `HelloAck`.
+    pub info: DeviceInfo,
+}
+
+/// Runs the device thread: opens the link, connects, then serves `events` and publishes the
+/// state to `state` until `events` closes. The result of the connection goes to `ready` first.
+pub fn run(
+    setup: DeviceSetup,
+    events: std::sync::mpsc::Receiver<Event>,
+    state: tokio::sync::watch::Sender<State>,
+    ready: std::sync::mpsc::Sender<Result<Ready, Error>>,
+    started: Instant,
+) {
+    let connect = || -> Result<Session<Box<dyn Link>>, Error> {
+        let link = link::open(&setup.target)?;
+        let config = ClientConfig::for_target(&setup.target, setup.retries);
+        let client = Client::new(link, config);
+        Session::connect(
+            client,
+            setup.robot,
+            setup.preset,
+            AngleCheck::for_target(&setup.target),
+        )
+    };
+    let mut session = match connect() {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = ready.send(Err(e));
+            return;
+        }
+    };
+    let _ = ready.send(Ok(Ready {
+        info: *session.info(),
+    }));
+    let now_ms = || started.elapsed().as_secs_f64() * 1e3;
+    let publish = |session: &Session<Box<dyn Link>>, link_up: bool| {
+        state.send_modify(|s| {
+            let (controller, pages) = (s.controller, s.pages);
+            *s = State {
+                controller,
+                pages,
+                link_up,
+                ..session.state(now_ms())
+            };
+        });
+    };
+    publish(&session, true);
+    let mut link_up = true;
+    loop {
+        match events.recv_timeout(setup.poll) {
+            Ok(Event::Job(job)) => {
+                let result = if link_up {
+                    session.command(&job.cmd)
+                } else {
+                    Err(Error::LinkDown)
+                };
+                publish(&session, link_up);
+                let _ = job.reply.send(result);
+            }
+            Ok(Event::ControlLost) => {
+                if link_up {
+                    if let Err(e) = session.control_lost() {
+                        eprintln!("quadctl serve: link-loss action failed: {e}");
+                    }
+                }
+                publish(&session, link_up);
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                if link_up {
+                    match session.poll() {
+                        Ok(()) => {}
+                        Err(Error::Link(e)) => {
+                            eprintln!("quadctl serve: device link failed: {e}");
+                            link_up = false;
+                        }
+                        Err(e) => eprintln!("quadctl serve: state read failed: {e}"),
+                    }
+                }
+                publish(&session, link_up);
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                // The server stopped: leave the device as the link-loss rule says.
+                if link_up {
+                    let _ = session.control_lost();
+                }
+                return;
+            }
+        }
+    }
+}

@@ -1,0 +1,25 @@
+//! # quad-web — the browser control panel
+//!
+//! `quadctl serve` runs this: a local web server (axum, WebSocket on tokio) that owns the link
+//! to the device ([`quad_host::link::open`]) and serves one page, embedded in the binary:
+//!
+//! - a 3D view (three.js) of the robot from the device's **readback**, the commanded pose as a
+//!   ghost, orbit and zoom, a ground grid and the feet's traces;
+//! - sliders for the body pose and the stance height, previewed at once by kin-core compiled
+//!   to WebAssembly (`crates/kin-wasm`), each leg coloured by its reachability and joint-limit
+//!   margin; an unreachable position is drawn, not sent;
+//! - live plots of the twelve joints and pulses, link health and device state;
+//! - a calibration tab: pick a servo, jog its pulse, set its centre and direction, save.
+//!
+//! Modules: [`msg`] (the WebSocket messages and their validation), [`device`] (the thread
+//! that owns the link and the checks every command passes), [`motion`] (the Motion tab's
+//! commands and their device requests), [`server`] (HTTP, WebSockets, who
+//! controls), [`assets`] (the embedded files).
+
+pub mod assets;
+pub mod device;
+pub mod motion;
+pub mod msg;
+pub mod server;
+
+pub use server::{start, Running, ServeConfig};

@@ -1,0 +1,355 @@
+//! The control panel in a real browser: headless Debian Chromium driven through chromedriver
+//! against the server in-process — the simulated device (`--sim`) for the page's behaviour,
+//! the firmware in simavr (`--emulator`) for the end-to-end path.
+
+mod browser;
+
+use browser::{keep_screenshot, scratch, serve, Browser};
+use fantoccini::key::Key;
+use serde_json::Value;
+use std::time::Duration;
+
+/// Patience for the page; generous because the firmware in simavr on a busy machine answers a
+/// dozen requests in seconds.
+const WAIT: Duration = Duration::from_secs(60);
+
+fn f64s(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap_or_else(|| panic!("an array: {v}"))
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+/// Moves the roll slider by `steps` of 0.5° with the arrow keys and waits until the device's
+/// readback of the last pose sent is drawn; returns the readback angles.
+async fn roll_steps(b: &Browser, steps: usize) -> Vec<f64> {
+    let key = Key::Right.to_string();
+    b.keys("s-roll", &key.repeat(steps)).await;
+    b.wait(
+        "panel.lastSent && panel.state.pose_id === panel.lastSent.id && panel.renderedPoseId === panel.lastSent.id",
+        WAIT,
+    )
+    .await;
+    f64s(&b.js("panel.renderedAngles").await)
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn sim_panel() {
+    let dir = scratch("panel-sim");
+    let server = serve(browser::sim(None));
+    let b = Browser::start(&dir.join("profile")).await;
+    b.open(server.addr).await;
+    let initial = f64s(&b.js("panel.state.angles_rad").await);
+    let shot0 = b.screenshot().await;
+
+    // Watching: a slider moves the preview only.
+    b.keys("s-roll", &Key::Right.to_string().repeat(4)).await;
+    b.wait("panel.preview.pose.roll_rad > 0.03", WAIT).await;
+    assert_eq!(b.js("panel.posesSent").await, 0);
+    assert_eq!(b.js("panel.state.poses_sent").await, 0);
+
+    // In control: the pose goes to the device and its readback is drawn.
+    b.click("take-control").await;
+    b.wait("panel.controlling", WAIT).await;
+    let angles = roll_steps(&b, 20).await;
+    assert_ne!(angles, initial, "the readback changed");
+    // The device (the host's maths here) holds exactly the preview's angles.
+    let preview = f64s(&b.js("panel.preview.angles").await);
+    let roll = b.js("panel.state.pose.roll_rad").await.as_f64().unwrap();
+    assert!((roll - 12.0f64.to_radians()).abs() < 1e-6, "roll {roll}");
+    for (a, p) in angles.iter().zip(&preview) {
+        assert!((a - p).abs() < 1e-6, "readback {a} vs preview {p}");
+    }
+    let shot1 = b.screenshot().await;
+    assert_ne!(shot0, shot1, "the view changed");
+    keep_screenshot(&shot1, "panel-pose.png", &dir);
+
+    // An unreachable stance (the slider's end is beyond the stretched leg): shown, not sent.
+    let sent_before = b.js("panel.state.poses_sent").await;
+    let page_sent_before = b.js("panel.posesSent").await;
+    b.keys("s-stance", &Key::End.to_string()).await;
+    b.wait("panel.preview.reachable === false", WAIT).await;
+    let text = b
+        .js("document.getElementById('preview-status').textContent")
+        .await;
+    assert!(text.as_str().unwrap().contains("not sent"), "{text}");
+    assert_eq!(b.js("panel.preview.legs[0].status").await, "too_far");
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    assert_eq!(b.js("panel.posesSent").await, page_sent_before);
+    assert_eq!(b.js("panel.state.poses_sent").await, sent_before);
+    assert_eq!(f64s(&b.js("panel.state.angles_rad").await), angles);
+    keep_screenshot(&b.screenshot().await, "panel-unreachable.png", &dir);
+    b.keys("s-stance", &Key::Left.to_string().repeat(60)).await;
+    b.wait("panel.preview.reachable === true", WAIT).await;
+
+    // Bad input from a page: each gets a clear error, nothing moves, the server keeps serving.
+    let bad = [
+        ("'{'", "malformed message"),
+        ("JSON.stringify({type: 'fly'})", "unknown variant `fly`"),
+        ("'x'.repeat(5000)", "bytes refused"),
+        (
+            "'{\"type\":\"set_pose\",\"id\":9,\"pose\":{\"roll_rad\":1e39,\"pitch_rad\":0,\"yaw_rad\":0,\"x_m\":0,\"y_m\":0,\"z_m\":0}}'",
+            "`roll_rad` must be a finite number",
+        ),
+        ("JSON.stringify({type: 'jog', servo: 40, delta_us: 1})", "servo index 40"),
+        (
+            "JSON.stringify({type: 'set_pose', id: 10, pose: {roll_rad: 1.5, pitch_rad: 0, yaw_rad: 0, x_m: 0, y_m: 0, z_m: 0}})",
+            "not sent: the host rejects this pose",
+        ),
+    ];
+    let angles_before = b.js("panel.state.angles_rad").await;
+    for (msg, want) in bad {
+        let n = b.js("panel.errors.length").await.as_u64().unwrap();
+        b.js(&format!("(panel.sendRaw({msg}), 1)")).await;
+        let got = b
+            .wait(
+                &format!("panel.errors.length > {n} && panel.errors[{n}]"),
+                WAIT,
+            )
+            .await;
+        assert!(got.as_str().unwrap().contains(want), "{msg}: {got}");
+    }
+    let states = b.js("panel.states").await.as_u64().unwrap();
+    b.wait(&format!("panel.states > {states} + 3"), WAIT).await;
+    assert_eq!(b.js("panel.state.angles_rad").await, angles_before);
+
+    // The Motion tab: Start and Stop reach the server, which answers "not sent" (the device
+    // protocol has no motion requests yet) and moves nothing.
+    b.click("tab-motion").await;
+    b.client
+        .find(fantoccini::Locator::Css(
+            "#motion-kind option[value='sway']",
+        ))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    for (button, command) in [
+        ("motion-start", "start_motion"),
+        ("motion-stop", "stop_motion"),
+    ] {
+        let n = b.js("panel.errors.length").await.as_u64().unwrap();
+        b.click(button).await;
+        let got = b
+            .wait(
+                &format!("panel.errors.length > {n} && panel.errors[{n}]"),
+                WAIT,
+            )
+            .await;
+        assert!(
+            got.as_str().unwrap().contains("no motion requests"),
+            "{command}: {got}"
+        );
+    }
+    assert_eq!(b.js("panel.lastMotion.kind").await, "sway");
+    assert_eq!(b.js("panel.lastMotion.axis").await, "Roll");
+    assert_eq!(b.js("panel.walking === true").await, false);
+    keep_screenshot(&b.screenshot().await, "panel-motion.png", &dir);
+    b.click("tab-pose").await;
+    assert_eq!(b.js("panel.state.angles_rad").await, angles_before);
+
+    // A second page is refused control while this one controls.
+    b.js("(panel.second = [], (() => { const ws = new WebSocket(`ws://${location.host}/ws`); \
+          ws.onmessage = (e) => panel.second.push(JSON.parse(e.data)); \
+          ws.onopen = () => { ws.send(JSON.stringify({type: 'take_control'})); \
+          ws.send(JSON.stringify({type: 'set_outputs', enabled: true})); }; panel.secondWs = ws; })(), 1)")
+        .await;
+    let refusal = b
+        .wait(
+            "panel.second.filter((m) => m.type === 'error').map((m) => m.message).join(' | ')",
+            WAIT,
+        )
+        .await;
+    let refusal = refusal.as_str().unwrap();
+    assert!(refusal.contains("controls the robot"), "{refusal}");
+    b.wait(
+        "panel.second.filter((m) => m.type === 'error').length === 2",
+        WAIT,
+    )
+    .await;
+    assert_eq!(b.js("panel.state.flags.outputs_enabled").await, false);
+
+    // Outputs only on the explicit button; then losing the controlling page releases control
+    // (the device's rule is `hold`: the outputs stay on).
+    b.click("outputs-on").await;
+    b.wait("panel.state.flags.outputs_enabled", WAIT).await;
+    b.js("(panel.secondWs.send(JSON.stringify({type: 'take_control'})), 1)")
+        .await;
+    b.wait(
+        "panel.second.filter((m) => m.type === 'error').length === 3",
+        WAIT,
+    )
+    .await;
+    b.client.goto("about:blank").await.unwrap();
+    b.open(server.addr).await;
+    b.wait("panel.state.controller === null", WAIT).await;
+    assert_eq!(b.js("panel.state.flags.outputs_enabled").await, true);
+
+    // Latency of single slider steps, the page in control again.
+    b.click("take-control").await;
+    b.wait("panel.controlling", WAIT).await;
+    b.js("(panel.latencies.length = 0, panel.arrivals.length = 0, 1)")
+        .await;
+    for _ in 0..20 {
+        roll_steps(&b, 1).await;
+    }
+    let n = report_latency(&b, "sim").await;
+    assert!(n >= 20, "{n} latencies");
+
+    let ik_per_s = b.js("panel.benchIk(20000)").await.as_f64().unwrap();
+    let wasm = b.js("panel.wasmBytes").await;
+    println!("body IK in the page: {ik_per_s:.0} per s; kin.wasm {wasm} bytes");
+    assert!(ik_per_s > 1000.0);
+    server.stop().unwrap();
+
+    // Calibration: jog, save, read back, and power on again from the saved EEPROM.
+    let eeprom = dir.join("eeprom.bin");
+    jog_save_read_back(
+        &b,
+        || browser::sim(Some(eeprom.clone())),
+        &dir,
+        "panel-calibration.png",
+    )
+    .await;
+    b.close().await;
+}
+
+/// Jogs a servo, saves, and reads the calibration back — from the device and after a restart
+/// of the server (a new power-on of the device reading its EEPROM image).
+async fn jog_save_read_back(
+    b: &Browser,
+    target: impl Fn() -> quad_host::link::Target,
+    dir: &std::path::Path,
+    shot: &str,
+) {
+    let server = serve(target());
+    b.open(server.addr).await;
+    b.click("take-control").await;
+    b.wait("panel.controlling", WAIT).await;
+    b.click("outputs-on").await;
+    b.wait("panel.state.flags.outputs_enabled", WAIT).await;
+    b.click("tab-cal").await;
+    // FL_hip (servo 1).
+    b.client
+        .find(fantoccini::Locator::Css("#cal-servo option[value='1']"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    let center0 = b
+        .js("panel.state.calibration[1].center_us")
+        .await
+        .as_u64()
+        .unwrap();
+    let pulse0 = b.js("panel.state.pulses_us[1]").await.as_f64().unwrap();
+    assert!(pulse0 > 0.0);
+    b.click_jog("10").await;
+    b.wait(
+        &format!("panel.state.calibration[1].center_us === {}", center0 + 10),
+        WAIT,
+    )
+    .await;
+    b.click_jog("1").await;
+    b.wait(
+        &format!("panel.state.calibration[1].center_us === {}", center0 + 11),
+        WAIT,
+    )
+    .await;
+    let pulse1 = b.js("panel.state.pulses_us[1]").await.as_f64().unwrap();
+    assert_eq!(pulse1 - pulse0, 11.0, "the pulse moved by the jog");
+    assert_eq!(b.js("panel.state.flags.calibration_unsaved").await, true);
+    b.click("cal-save").await;
+    b.wait("panel.state.flags.calibration_unsaved === false", WAIT)
+        .await;
+    b.click("cal-read").await;
+    b.wait("panel.done.includes('read_calibration')", WAIT)
+        .await;
+    assert_eq!(
+        b.js("panel.state.calibration[1].center_us").await.as_u64(),
+        Some(center0 + 11)
+    );
+    keep_screenshot(&b.screenshot().await, shot, dir);
+    b.client.goto("about:blank").await.unwrap();
+    server.stop().unwrap();
+
+    // Power on again from the saved EEPROM.
+    let server = serve(target());
+    b.open(server.addr).await;
+    assert_eq!(
+        b.js("panel.state.calibration[1].center_us").await.as_u64(),
+        Some(center0 + 11)
+    );
+    assert_eq!(b.js("panel.state.flags.calibration_default").await, false);
+    b.client.goto("about:blank").await.unwrap();
+    server.stop().unwrap();
+}
+
+impl Browser {
+    async fn click_jog(&self, step: &str) {
+        self.client
+            .find(fantoccini::Locator::Css(&format!("[data-jog='{step}']")))
+            .await
+            .unwrap()
+            .click()
+            .await
+            .unwrap();
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn emulator_pose_and_calibration() {
+    let dir = scratch("panel-emulator");
+    let eeprom = dir.join("eeprom.bin");
+    let b = Browser::start(&dir.join("profile")).await;
+    // The pose path on the firmware: slider → device IK on the AVR → readback → view.
+    {
+        let server = serve(browser::emulator(Some(eeprom.clone())));
+        b.open(server.addr).await;
+        b.click("take-control").await;
+        b.wait("panel.controlling", WAIT).await;
+        let initial = f64s(&b.js("panel.state.angles_rad").await);
+        let angles = roll_steps(&b, 20).await;
+        assert_ne!(angles, initial);
+        let preview = f64s(&b.js("panel.preview.angles").await);
+        for (a, p) in angles.iter().zip(&preview) {
+            // The AVR's math backend: within the stream check's tolerance.
+            assert!((a - p).abs() < 5e-5, "readback {a} vs preview {p}");
+        }
+        // Latency of slider steps through the emulated firmware.
+        for _ in 0..10 {
+            roll_steps(&b, 1).await;
+        }
+        report_latency(&b, "emulator").await;
+        keep_screenshot(&b.screenshot().await, "panel-emulator.png", &dir);
+        b.client.goto("about:blank").await.unwrap();
+        server.stop().unwrap();
+    }
+    jog_save_read_back(
+        &b,
+        || browser::emulator(Some(eeprom.clone())),
+        &dir,
+        "panel-emulator-calibration.png",
+    )
+    .await;
+    b.close().await;
+}
+
+/// Prints the page's slider → readback latencies (received, and drawn); returns their count.
+async fn report_latency(b: &Browser, what: &str) -> usize {
+    let stats = |v: &[f64]| {
+        let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+        (mean, v.iter().copied().fold(0.0, f64::max))
+    };
+    let drawn = f64s(&b.js("panel.latencies").await);
+    let received = f64s(&b.js("panel.arrivals").await);
+    let (dm, dx) = stats(&drawn);
+    let (rm, rx) = stats(&received);
+    println!(
+        "{what}: slider → readback received: mean {rm:.1} ms, max {rx:.1} ms; → drawn: mean {dm:.1} ms, max {dx:.1} ms ({} poses)",
+        drawn.len()
+    );
+    drawn.len()
+}

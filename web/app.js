@@ -1,0 +1,669 @@
+// The control panel: WebSocket to `quadctl serve`, the 3D view from the device's readback,
+// the pose sliders previewed by kin-core in WebAssembly, plots, calibration.
+//
+// Units: SI on the wire (rad, m); degrees and millimetres only on the sliders.
+// `window.panel` exposes the page's state for the browser tests and for debugging.
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { loadKin } from './kin.js';
+
+const DEG = Math.PI / 180;
+const TRACE_LEN = 400;
+const PLOT_S = 10;
+
+const panel = {
+  ready: false,
+  pageId: null,
+  controller: null,
+  get controlling() { return this.pageId !== null && this.controller === this.pageId; },
+  robot: null,
+  order: 5,
+  state: null,
+  states: 0,
+  preview: null,
+  posesSent: 0,
+  lastSent: null,
+  notSent: 0,
+  errors: [],
+  done: [],
+  latencies: [], // slider input -> the device's readback of that pose drawn, ms
+  arrivals: [], // slider input -> the device's readback of that pose received, ms
+  renderedPoseId: 0,
+  renderedAngles: null,
+  velocity: { vx: 0, vy: 0, yaw: 0 },
+  wasmBytes: 0,
+  kin: null,
+};
+window.panel = panel;
+
+const $ = (id) => document.getElementById(id);
+const message = (text) => { $('message').textContent = text; };
+
+// ---------------------------------------------------------------- sliders
+const SLIDERS = [
+  { key: 'roll', label: 'roll', unit: '°', min: -30, max: 30, step: 0.5, value: 0 },
+  { key: 'pitch', label: 'pitch', unit: '°', min: -30, max: 30, step: 0.5, value: 0 },
+  { key: 'yaw', label: 'yaw', unit: '°', min: -30, max: 30, step: 0.5, value: 0 },
+  { key: 'x', label: 'x', unit: 'mm', min: -150, max: 150, step: 1, value: 0 },
+  { key: 'y', label: 'y', unit: 'mm', min: -150, max: 150, step: 1, value: 0 },
+  { key: 'z', label: 'z', unit: 'mm', min: -150, max: 150, step: 1, value: 0 },
+  { key: 'stance', label: 'stance height', unit: 'mm', min: 100, max: 600, step: 1, value: 400 },
+];
+const sliders = {};
+
+function buildSliders() {
+  const box = $('sliders');
+  for (const s of SLIDERS) {
+    const row = document.createElement('div');
+    row.className = 'slider';
+    row.innerHTML = `<label for="s-${s.key}">${s.label}</label>
+      <input id="s-${s.key}" type="range" min="${s.min}" max="${s.max}" step="${s.step}" value="${s.value}">
+      <output id="o-${s.key}"></output>`;
+    box.appendChild(row);
+    const input = row.querySelector('input');
+    sliders[s.key] = input;
+    input.addEventListener('input', () => onSlider(s.key === 'stance'));
+  }
+  $('reset-pose').addEventListener('click', () => {
+    for (const k of ['roll', 'pitch', 'yaw', 'x', 'y', 'z']) sliders[k].value = 0;
+    onSlider(false);
+  });
+}
+
+function sliderPose() {
+  const v = (k) => Number(sliders[k].value);
+  return {
+    roll_rad: v('roll') * DEG, pitch_rad: v('pitch') * DEG, yaw_rad: v('yaw') * DEG,
+    x_m: v('x') / 1000, y_m: v('y') / 1000, z_m: v('z') / 1000,
+  };
+}
+const sliderStance = () => Number(sliders.stance.value) / 1000;
+
+// ---------------------------------------------------------------- preview and sending
+let nextPoseId = 1;
+let inFlight = false;
+let pending = null; // the latest reachable target not yet sent: { kind, ... }
+const sentAt = new Map(); // pose id -> performance.now() of the slider input
+
+function legColour(leg) {
+  if (leg.status !== 'ok') return new THREE.Color(0xff3b30);
+  // Green at >= 40 mm and >= 0.35 rad of margin, through yellow to red at 0.
+  const m = Math.min(leg.workspaceMarginM / 0.04, leg.jointMarginRad / 0.35, 1);
+  const t = Math.max(0, m);
+  return new THREE.Color().setHSL(0.33 * t, 0.9, 0.5);
+}
+
+function showPreview(p) {
+  const out = SLIDERS.map((s) => {
+    const el = $(`o-${s.key}`);
+    el.textContent = `${Number(sliders[s.key].value).toFixed(s.step < 1 ? 1 : 0)} ${s.unit}`;
+    return el;
+  });
+  void out;
+  const legs = p.legs.map((l) => {
+    const c = legColour(l);
+    const margin = l.status === 'ok'
+      ? `${(l.workspaceMarginM * 1000).toFixed(0)} mm, ${(l.jointMarginRad / DEG).toFixed(1)}°`
+      : l.status;
+    return `<span class="leg" style="background:#${c.getHexString()}">${l.name}</span>${margin}`;
+  }).join('<br>');
+  $('preview-status').innerHTML = (p.reachable
+    ? 'reachable (margins: workspace, joint limit)<br>'
+    : `<span class="unreachable">unreachable: ${p.firstLeg} ${p.legs.find((l) => l.name === p.firstLeg).status} — shown, not sent</span><br>`) + legs;
+}
+
+function onSlider(stanceChanged) {
+  if (!panel.kin) return;
+  const t0 = performance.now();
+  const pose = sliderPose();
+  const h = sliderStance();
+  const p = panel.kin.preview(pose, h, panel.order);
+  panel.preview = { pose, stanceHeightM: h, ...p };
+  showPreview(p);
+  setGhost(pose, p);
+  if (!p.reachable) {
+    panel.notSent += 1;
+    pending = null;
+    return;
+  }
+  if (!panel.controlling) return;
+  if (stanceChanged) {
+    pending = { kind: 'stance', stanceHeightM: h, pose, t0 };
+  } else {
+    pending = { kind: 'pose', pose, t0 };
+  }
+  pump();
+}
+
+function pump() {
+  if (inFlight || !pending || !socket || socket.readyState !== WebSocket.OPEN) return;
+  const job = pending;
+  pending = null;
+  if (job.kind === 'stance') {
+    // The server solves the held pose again at the new stance; send the pose after it.
+    send({ type: 'set_stance_height', stance_height_m: job.stanceHeightM });
+    pending = pending ?? { kind: 'pose', pose: job.pose, t0: job.t0 };
+  } else {
+    const id = nextPoseId++;
+    sentAt.set(id, job.t0);
+    panel.posesSent += 1;
+    panel.lastSent = { id, pose: job.pose };
+    send({ type: 'set_pose', id, pose: job.pose });
+  }
+  inFlight = true;
+}
+
+// ---------------------------------------------------------------- WebSocket
+let socket = null;
+
+function send(msg) {
+  if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify(msg));
+}
+panel.send = send;
+// A raw text message, for the tests of the server's validation.
+panel.sendRaw = (text) => socket.send(text);
+
+// Leaving the page closes its socket at once (the server also drops a silent page).
+window.addEventListener('pagehide', () => { if (socket) socket.close(); });
+
+function connect() {
+  socket = new WebSocket(`ws://${location.host}/ws`);
+  socket.onopen = () => { $('conn').textContent = 'connected'; $('conn').className = 'badge ok'; };
+  socket.onclose = () => {
+    $('conn').textContent = 'disconnected';
+    $('conn').className = 'badge bad';
+    panel.controller = null;
+    updateControl();
+    setTimeout(connect, 1000);
+  };
+  socket.onmessage = (ev) => {
+    const msg = JSON.parse(ev.data);
+    switch (msg.type) {
+      case 'welcome': onWelcome(msg); break;
+      case 'state': onState(msg); break;
+      case 'done':
+        panel.done.push(msg.command);
+        if (msg.command === 'start_motion') panel.walking = panel.lastMotion?.kind === 'walk';
+        if (msg.command === 'stop_motion') panel.walking = false;
+        if (['set_pose', 'set_stance_height'].includes(msg.command)) { inFlight = false; pump(); }
+        break;
+      case 'error':
+        panel.errors.push(msg.message);
+        message(msg.message);
+        inFlight = false;
+        pump();
+        break;
+      default: break;
+    }
+  };
+}
+
+function onWelcome(msg) {
+  panel.pageId = msg.page_id;
+  panel.robot = msg.robot;
+  panel.order = msg.rotation_order;
+  panel.servos = msg.servos;
+  panel.linkLossAction = msg.link_loss_action;
+  $('robot-name').textContent = `${msg.robot_name} · ${msg.target} · link loss: ${msg.link_loss_action}`;
+  panel.kin.setRobot(msg.robot);
+  const reach = msg.robot.leg.femur_m + msg.robot.leg.tibia_m + msg.robot.leg.d_ax_m;
+  sliders.stance.min = Math.round(reach * 200);
+  sliders.stance.max = Math.round(reach * 1050);
+  buildRobotMeshes(msg.robot);
+  buildCalibration(msg.servos);
+  panel.ready = true;
+}
+
+function onState(msg) {
+  const first = panel.state === null;
+  panel.state = msg;
+  panel.states += 1;
+  panel.controller = msg.controller;
+  if (first) {
+    sliders.stance.value = Math.round(msg.stance_height_m * 1000);
+    onSlider(false);
+  }
+  if (msg.pose_id && sentAt.has(msg.pose_id)) {
+    readbackSeen = { id: msg.pose_id, t0: sentAt.get(msg.pose_id) };
+    panel.arrivals.push(performance.now() - readbackSeen.t0);
+    for (const id of sentAt.keys()) if (id <= msg.pose_id) sentAt.delete(id);
+  }
+  updateControl();
+  updateReadback(msg);
+  pushPlots(msg);
+  showHealth(msg);
+  showCalibration(msg);
+}
+
+function updateControl() {
+  const mine = panel.controlling;
+  const other = panel.controller !== null && !mine;
+  $('control-badge').textContent = mine ? 'in control' : other ? `page ${panel.controller} controls` : 'watching';
+  $('control-badge').className = `badge ${mine ? 'mine' : ''}`;
+  $('take-control').disabled = mine;
+  $('release-control').disabled = !mine;
+  for (const id of ['outputs-on', 'outputs-off', 'cal-save', 'cal-read', 'cal-set-center', 'cal-set-direction']) {
+    $(id).disabled = !mine;
+  }
+  for (const b of document.querySelectorAll('[data-jog]')) b.disabled = !mine;
+}
+
+// ---------------------------------------------------------------- 3D view
+const view = $('view');
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+view.prepend(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x14171c);
+const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 50);
+camera.up.set(0, 0, 1);
+camera.position.set(1.1, -1.3, 0.6);
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.target.set(0, 0, -0.2);
+controls.update();
+controls.addEventListener('change', () => { viewDirty = true; });
+scene.add(new THREE.HemisphereLight(0xffffff, 0x334455, 2.0));
+const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+sun.position.set(1, -1, 2);
+scene.add(sun);
+const grid = new THREE.GridHelper(3, 30, 0x556070, 0x2c3440);
+grid.rotation.x = Math.PI / 2;
+scene.add(grid);
+
+function resize() {
+  const w = view.clientWidth;
+  const h = view.clientHeight;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(h, 1);
+  camera.updateProjectionMatrix();
+  viewDirty = true;
+}
+window.addEventListener('resize', resize);
+
+// A robot drawn from joint points: a body plate through the four hip mounts, a cylinder per
+// link, a sphere per joint.
+function makeRobot(radius, opacity) {
+  const group = new THREE.Group();
+  const transparent = opacity < 1;
+  const bodyMat = new THREE.MeshStandardMaterial({ color: 0x7088a8, transparent, opacity, side: THREE.DoubleSide });
+  const bodyGeo = new THREE.BufferGeometry();
+  bodyGeo.setAttribute('position', new THREE.Float32BufferAttribute(new Array(18).fill(0), 3));
+  const body = new THREE.Mesh(bodyGeo, bodyMat);
+  group.add(body);
+  const legs = [];
+  const cyl = new THREE.CylinderGeometry(radius, radius, 1, 12);
+  const ball = new THREE.SphereGeometry(radius * 1.5, 12, 8);
+  for (let i = 0; i < 4; i++) {
+    const mat = new THREE.MeshStandardMaterial({ color: 0xc8ccd4, transparent, opacity });
+    const links = [0, 1, 2].map(() => { const m = new THREE.Mesh(cyl, mat); group.add(m); return m; });
+    const joints = [0, 1, 2, 3].map(() => { const m = new THREE.Mesh(ball, mat); group.add(m); return m; });
+    legs.push({ mat, links, joints });
+  }
+  scene.add(group);
+  return { group, body, legs };
+}
+
+const Y = new THREE.Vector3(0, 1, 0);
+function placeLink(mesh, a, b) {
+  const d = new THREE.Vector3().subVectors(b, a);
+  const len = d.length();
+  mesh.visible = len > 1e-6;
+  mesh.position.copy(a).addScaledVector(d, 0.5);
+  mesh.scale.set(1, Math.max(len, 1e-6), 1);
+  if (len > 1e-6) mesh.quaternion.setFromUnitVectors(Y, d.normalize());
+}
+
+function drawRobot(robot, pts) {
+  const p = (leg, k) => new THREE.Vector3(pts[12 * leg + 3 * k], pts[12 * leg + 3 * k + 1], pts[12 * leg + 3 * k + 2]);
+  // Body: two triangles FL, FR, RR and FL, RR, RL.
+  const [fl, fr, rl, rr] = [0, 1, 2, 3].map((i) => p(i, 0));
+  const pos = robot.body.geometry.attributes.position;
+  [fl, fr, rr, fl, rr, rl].forEach((v, i) => pos.setXYZ(i, v.x, v.y, v.z));
+  pos.needsUpdate = true;
+  robot.body.geometry.computeVertexNormals();
+  robot.body.geometry.computeBoundingSphere();
+  for (let i = 0; i < 4; i++) {
+    const j = [0, 1, 2, 3].map((k) => p(i, k));
+    robot.legs[i].links.forEach((m, k) => placeLink(m, j[k], j[k + 1]));
+    robot.legs[i].joints.forEach((m, k) => m.position.copy(j[k]));
+  }
+}
+
+let actual = null;
+let ghost = null;
+const traces = [];
+
+function buildRobotMeshes(robot) {
+  if (actual) return;
+  const scale = robot.leg.femur_m + robot.leg.tibia_m;
+  actual = makeRobot(scale * 0.018, 1);
+  ghost = makeRobot(scale * 0.012, 0.35);
+  for (let i = 0; i < 4; i++) {
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute('position', new THREE.Float32BufferAttribute(new Float32Array(TRACE_LEN * 3), 3));
+    geo.setDrawRange(0, 0);
+    const line = new THREE.Line(geo, new THREE.LineBasicMaterial({ color: [0xff9f43, 0x54a0ff, 0x1dd1a1, 0xf368e0][i] }));
+    scene.add(line);
+    traces.push({ line, n: 0 });
+  }
+  const d = scale * 2.2;
+  camera.position.set(d * 0.9, -d * 1.1, d * 0.5);
+  controls.target.set(0, 0, -scale * 0.4);
+  controls.update();
+}
+
+function setGhost(pose, p) {
+  if (!ghost) return;
+  drawRobot(ghost, panel.kin.points(pose, p.angles, panel.order));
+  p.legs.forEach((l, i) => ghost.legs[i].mat.color.copy(legColour(l)));
+  viewDirty = true;
+}
+
+const NEUTRAL = { roll_rad: 0, pitch_rad: 0, yaw_rad: 0, x_m: 0, y_m: 0, z_m: 0 };
+let readbackSeen = null;
+let dirty = false; // a new readback to draw
+let viewDirty = true; // the camera, the preview or the size changed
+
+function updateReadback(s) {
+  if (!actual) return;
+  // The body is placed by the pose the device acked; every joint comes from its readback.
+  const pts = panel.kin.points(s.pose ?? NEUTRAL, s.angles_rad, panel.order);
+  drawRobot(actual, pts);
+  panel.renderedAngles = s.angles_rad;
+  panel.renderedPoints = pts;
+  const on = s.flags.outputs_enabled;
+  actual.legs.forEach((l) => l.mat.color.set(on ? 0xe8ecf4 : 0x8a8f99));
+  grid.position.z = -s.stance_height_m;
+  for (let i = 0; i < 4; i++) {
+    const t = traces[i];
+    const pos = t.line.geometry.attributes.position;
+    const x = pts[12 * i + 9]; const y = pts[12 * i + 10]; const z = pts[12 * i + 11];
+    if (t.n === TRACE_LEN) {
+      pos.array.copyWithin(0, 3);
+      t.n -= 1;
+    }
+    pos.setXYZ(t.n, x, y, z);
+    t.n += 1;
+    t.line.geometry.setDrawRange(0, t.n);
+    pos.needsUpdate = true;
+  }
+  dirty = true;
+}
+
+// Draws only when something changed (a state, the preview, the camera): software WebGL on a
+// busy machine would otherwise keep the page's thread from reading its socket.
+function frame() {
+  controls.update();
+  if (dirty || viewDirty) {
+    viewDirty = false;
+    renderer.render(scene, camera);
+  }
+  if (dirty && panel.state) {
+    dirty = false;
+    panel.renderedPoseId = panel.state.pose_id;
+    if (readbackSeen) {
+      panel.latencies.push(performance.now() - readbackSeen.t0);
+      readbackSeen = null;
+    }
+  }
+  pollInputs();
+  requestAnimationFrame(frame);
+}
+
+// ---------------------------------------------------------------- plots
+// Twelve traces on a 2D canvas: a few lines of drawing code instead of a chart library for two
+// fixed plots.
+const history = [];
+const COLOURS = ['#ff9f43', '#ffc880', '#ffe0b0', '#54a0ff', '#8cc0ff', '#c0dcff', '#1dd1a1', '#70e6c4', '#b0f2dc', '#f368e0', '#f79ae9', '#fbc8f3'];
+
+function pushPlots(s) {
+  history.push({ t: s.t_ms / 1000, a: s.angles_rad, p: s.pulses_us });
+  while (history.length && history[0].t < s.t_ms / 1000 - PLOT_S) history.shift();
+  plot($('plot-angles'), (h) => h.a.map((v) => v / DEG), 'joint angle, °');
+  plot($('plot-pulses'), (h) => h.p, 'pulse, µs (0: off)');
+}
+
+function plot(canvas, values, title) {
+  const g = canvas.getContext('2d');
+  const { width: w, height: h } = canvas;
+  g.clearRect(0, 0, w, h);
+  if (history.length < 2) return;
+  const rows = history.map(values);
+  let lo = Infinity; let hi = -Infinity;
+  for (const r of rows) for (const v of r) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+  if (hi - lo < 1e-3) { hi += 1; lo -= 1; }
+  const t1 = history[history.length - 1].t;
+  const x = (t) => w - ((t1 - t) / PLOT_S) * w;
+  const y = (v) => h - 14 - ((v - lo) / (hi - lo)) * (h - 24);
+  for (let j = 0; j < 12; j++) {
+    g.strokeStyle = COLOURS[j];
+    g.beginPath();
+    history.forEach((s, k) => { const py = y(rows[k][j]); if (k) g.lineTo(x(s.t), py); else g.moveTo(x(s.t), py); });
+    g.stroke();
+  }
+  g.fillStyle = '#99a';
+  g.fillText(`${title}   [${lo.toFixed(1)}, ${hi.toFixed(1)}]   last ${PLOT_S} s`, 4, h - 3);
+}
+
+function showHealth(s) {
+  const l = s.link;
+  $('health').innerHTML = `link ${s.link_up ? 'up' : '<span class="unreachable">down</span>'} · acked ${l.acked} · nacked ${l.nacked} · lost ${l.lost} · retries ${l.retries} · timeouts ${l.timeouts} · bad frames ${l.bad_frames}<br>
+    round trip ${l.rtt_ms.toFixed(2)} ms (max ${l.rtt_max_ms.toFixed(2)}) · device frames ok ${l.device_frames_ok}, bad ${l.device_frames_bad}`;
+  const f = s.flags;
+  $('device').innerHTML = `outputs <b>${f.outputs_enabled ? 'ON' : 'off'}</b> · failsafe ${f.failsafe_active ? 'ACTIVE' : 'idle'} · calibration ${f.calibration_unsaved ? 'unsaved' : f.calibration_default ? 'defaults' : 'saved'} · motion: none<br>
+    stance ${(s.stance_height_m * 1000).toFixed(0)} mm · poses sent ${s.poses_sent} · pages ${s.pages}`;
+}
+
+// ---------------------------------------------------------------- motions and teleop
+// Each motion's parameters as the form shows them (degrees and millimetres on the page, SI on
+// the wire, as the sliders); a duration of 0 runs until Stop.
+const LEGS = ['all', 'FL', 'FR', 'RL', 'RR'];
+const MOTION_FORMS = {
+  stand: { label: 'stand', fields: [] },
+  sit: { label: 'sit', fields: [] },
+  sway: {
+    label: 'sway',
+    fields: [['axis', ['Roll', 'Pitch', 'Yaw']], ['amplitude_deg', 8], ['period_s', 2], ['duration_s', 0]],
+  },
+  yaw_turn: {
+    label: 'yaw turn',
+    fields: [['yaw_rate_deg_s', 10], ['step_period_s', 1], ['lift_height_mm', 30], ['duration_s', 0]],
+  },
+  foot_path: {
+    label: 'foot path',
+    fields: [['path', ['Bezier', 'Rectangle', 'Semicircle', 'Ellipse', 'Cycloid']], ['leg', LEGS],
+      ['stride_mm', 60], ['step_height_mm', 30], ['duty_factor', 0.5], ['cycle_s', 1], ['duration_s', 0]],
+  },
+  walk: {
+    label: 'trot / walk',
+    fields: [['gait', ['Trot', 'Walk']], ['body_height_mm', 400], ['step_height_mm', 40], ['cycle_s', 0.8],
+      ['velocity_timeout_ms', 500]],
+  },
+};
+
+// The `start_motion` message of the form's values.
+function motionMessage(kind, values) {
+  const v = values;
+  const dur = (s) => (Number(s) > 0 ? Number(s) : null);
+  const mm = (x) => Number(x) / 1000;
+  switch (kind) {
+    case 'sway':
+      return { kind, axis: v.axis, amplitude_rad: Number(v.amplitude_deg) * DEG, period_s: Number(v.period_s), duration_s: dur(v.duration_s) };
+    case 'yaw_turn':
+      return { kind, yaw_rate_rad_s: Number(v.yaw_rate_deg_s) * DEG, step_period_s: Number(v.step_period_s), lift_height_m: mm(v.lift_height_mm), duration_s: dur(v.duration_s) };
+    case 'foot_path':
+      return { kind, path: v.path, leg: v.leg === 'all' ? null : LEGS.indexOf(v.leg) - 1, stride_m: mm(v.stride_mm), step_height_m: mm(v.step_height_mm), duty_factor: Number(v.duty_factor), cycle_s: Number(v.cycle_s), duration_s: dur(v.duration_s) };
+    case 'walk':
+      return { kind, gait: v.gait, body_height_m: mm(v.body_height_mm), step_height_m: mm(v.step_height_mm), cycle_s: Number(v.cycle_s), velocity_timeout_ms: Number(v.velocity_timeout_ms) };
+    default:
+      return { kind };
+  }
+}
+
+function showMotionForm() {
+  const kind = $('motion-kind').value;
+  const box = $('motion-params');
+  box.innerHTML = '';
+  for (const [name, init] of MOTION_FORMS[kind].fields) {
+    const label = document.createElement('label');
+    label.textContent = `${name} `;
+    let input;
+    if (Array.isArray(init)) {
+      input = document.createElement('select');
+      for (const o of init) input.add(new Option(o, o));
+    } else {
+      input = document.createElement('input');
+      input.type = 'number';
+      input.step = 'any';
+      input.value = init;
+    }
+    input.dataset.param = name;
+    label.appendChild(input);
+    box.appendChild(label);
+  }
+}
+
+function buildMotion() {
+  const sel = $('motion-kind');
+  for (const [kind, f] of Object.entries(MOTION_FORMS)) sel.add(new Option(f.label, kind));
+  sel.addEventListener('change', showMotionForm);
+  showMotionForm();
+  $('motion-start').addEventListener('click', () => {
+    const values = {};
+    for (const i of document.querySelectorAll('#motion-params [data-param]')) values[i.dataset.param] = i.value;
+    const motion = motionMessage(sel.value, values);
+    panel.lastMotion = motion;
+    send({ type: 'start_motion', motion });
+  });
+  $('motion-stop').addEventListener('click', () => send({ type: 'stop_motion' }));
+  const pad = $('joystick');
+  const setFromPointer = (ev) => {
+    const r = pad.getBoundingClientRect();
+    const u = ((ev.clientX - r.left) / r.width) * 2 - 1;
+    const v = ((ev.clientY - r.top) / r.height) * 2 - 1;
+    stick.x = Math.max(-1, Math.min(1, u));
+    stick.y = Math.max(-1, Math.min(1, v));
+  };
+  pad.addEventListener('pointerdown', (ev) => { stick.active = true; pad.setPointerCapture(ev.pointerId); setFromPointer(ev); });
+  pad.addEventListener('pointermove', (ev) => { if (stick.active) setFromPointer(ev); });
+  pad.addEventListener('pointerup', () => { stick.active = false; stick.x = 0; stick.y = 0; });
+  window.addEventListener('keydown', (ev) => { if (!(ev.target instanceof HTMLInputElement)) keys.add(ev.key.toLowerCase()); });
+  window.addEventListener('keyup', (ev) => keys.delete(ev.key.toLowerCase()));
+}
+const stick = { active: false, x: 0, y: 0 };
+const keys = new Set();
+const MAX_V = 0.2; // m/s
+const MAX_YAW = 0.5; // rad/s
+const VELOCITY_PERIOD_MS = 200;
+let lastVelocitySent = 0;
+
+function pollInputs() {
+  let vx = -stick.y; let vy = -stick.x; let yaw = 0;
+  if (keys.has('w')) vx = 1; if (keys.has('s')) vx = -1;
+  if (keys.has('a')) vy = 1; if (keys.has('d')) vy = -1;
+  if (keys.has('q')) yaw = 1; if (keys.has('e')) yaw = -1;
+  for (const gp of navigator.getGamepads ? navigator.getGamepads() : []) {
+    if (!gp) continue;
+    const dz = (v) => (Math.abs(v) < 0.1 ? 0 : v);
+    if (dz(gp.axes[1]) || dz(gp.axes[0]) || dz(gp.axes[2] ?? 0)) {
+      vx = -dz(gp.axes[1]); vy = -dz(gp.axes[0]); yaw = -dz(gp.axes[2] ?? 0);
+    }
+  }
+  const v = { vx: vx * MAX_V, vy: vy * MAX_V, yaw: yaw * MAX_YAW };
+  panel.velocity = v;
+  // The walk's velocity goes to the device only while a walk runs (its start was done), and
+  // often enough for its velocity timeout.
+  const now = performance.now();
+  if (panel.controlling && panel.walking && now - lastVelocitySent > VELOCITY_PERIOD_MS) {
+    lastVelocitySent = now;
+    send({ type: 'set_velocity', velocity: { forward_m_s: v.vx, lateral_m_s: v.vy, yaw_rate_rad_s: v.yaw } });
+  }
+  $('velocity').textContent = `vx ${v.vx.toFixed(3)} m/s · vy ${v.vy.toFixed(3)} m/s · yaw ${v.yaw.toFixed(3)} rad/s`;
+  const pad = $('joystick');
+  const g = pad.getContext('2d');
+  g.clearRect(0, 0, pad.width, pad.height);
+  g.fillStyle = '#54a0ff';
+  g.beginPath();
+  g.arc(pad.width / 2 - (v.vy / MAX_V) * 60, pad.height / 2 - (v.vx / MAX_V) * 60, 12, 0, 2 * Math.PI);
+  g.fill();
+}
+
+// ---------------------------------------------------------------- calibration
+let calServo = 0;
+function buildCalibration(servos) {
+  const sel = $('cal-servo');
+  if (sel.options.length) return;
+  servos.forEach((name, i) => sel.add(new Option(name, i)));
+  sel.addEventListener('change', () => { calServo = Number(sel.value); showCalibration(panel.state, true); });
+  for (const b of document.querySelectorAll('[data-jog]')) {
+    b.addEventListener('click', () => send({ type: 'jog', servo: calServo, delta_us: Number(b.dataset.jog) }));
+  }
+  $('cal-set-center').addEventListener('click', () => send({ type: 'set_center', servo: calServo, center_us: Number($('cal-center').value) }));
+  $('cal-set-direction').addEventListener('click', () => send({ type: 'set_direction', servo: calServo, reversed: $('cal-reversed').checked }));
+  $('cal-save').addEventListener('click', () => send({ type: 'save_calibration' }));
+  $('cal-read').addEventListener('click', () => send({ type: 'read_calibration' }));
+}
+
+let shownCal = null;
+function showCalibration(s, force) {
+  if (!s || !panel.servos) return;
+  const c = s.calibration[calServo];
+  $('cal-live').innerHTML = `${panel.servos[calServo]}: angle ${(s.angles_rad[calServo] / DEG).toFixed(2)}° · pulse ${s.pulses_us[calServo].toFixed(1)} µs
+    · centre ${c.center_us} µs · ${c.reversed ? 'reversed' : 'normal'} · travel [${c.min_us}, ${c.max_us}] µs`;
+  const key = JSON.stringify(s.calibration);
+  if (key !== shownCal || force) {
+    shownCal = key;
+    $('cal-center').value = c.center_us;
+    $('cal-reversed').checked = c.reversed;
+    const rows = s.calibration.map((k, i) => `<tr class="${i === calServo ? 'sel' : ''}"><td>${panel.servos[i]}</td><td>${k.center_us}</td><td>${k.reversed ? 'rev' : ''}</td><td>${(k.zero_rad / DEG).toFixed(1)}°</td><td>${k.us_per_rad.toFixed(0)}</td><td>${k.min_us}–${k.max_us}</td></tr>`);
+    $('cal-table').innerHTML = `<tr><th>servo</th><th>centre µs</th><th>dir</th><th>zero</th><th>µs/rad</th><th>travel µs</th></tr>${rows.join('')}`;
+  }
+}
+
+// ---------------------------------------------------------------- tabs, buttons, start
+function tabs() {
+  const panes = { 'tab-pose': 'pane-pose', 'tab-motion': 'pane-motion', 'tab-cal': 'pane-cal' };
+  for (const [tab, pane] of Object.entries(panes)) {
+    $(tab).addEventListener('click', () => {
+      for (const [t, p] of Object.entries(panes)) {
+        $(t).classList.toggle('active', t === tab);
+        $(p).classList.toggle('hidden', p !== pane);
+      }
+    });
+  }
+  $('take-control').addEventListener('click', () => send({ type: 'take_control' }));
+  $('release-control').addEventListener('click', () => send({ type: 'release_control' }));
+  $('outputs-on').addEventListener('click', () => send({ type: 'set_outputs', enabled: true }));
+  $('outputs-off').addEventListener('click', () => send({ type: 'set_outputs', enabled: false }));
+}
+
+// Body IK per second in the page: `n` previews through the WebAssembly module.
+panel.benchIk = (n) => {
+  const t0 = performance.now();
+  for (let i = 0; i < n; i++) {
+    const a = (i % 200) * 0.001;
+    panel.kin.preview({ roll_rad: a, pitch_rad: -a, yaw_rad: a, x_m: 0, y_m: 0, z_m: 0 }, sliderStance(), panel.order);
+  }
+  return n / ((performance.now() - t0) / 1000);
+};
+
+async function main() {
+  buildSliders();
+  buildMotion();
+  tabs();
+  updateControl();
+  resize();
+  try {
+    panel.kin = await loadKin('/kin.wasm');
+    panel.wasmBytes = panel.kin.wasmBytes;
+  } catch (e) {
+    message(`kin-core (WebAssembly) failed to load: ${e.message}`);
+    panel.errors.push(String(e));
+    return;
+  }
+  connect();
+  requestAnimationFrame(frame);
+}
+
+main();
