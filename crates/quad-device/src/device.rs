@@ -6,7 +6,6 @@ use crate::config::{
 };
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
-use core::marker::PhantomData;
 use kin_core::body::{self, BodySolution, Pose};
 use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
@@ -69,11 +68,14 @@ struct Held {
 /// - Unreadable frames are answered with a nack without a sequence number (`BadCrc`,
 ///   `BadFrame`, `Oversize`), at most one per [`FRAMING_NACK_INTERVAL_MS`], and change nothing
 ///   but the frame counters.
-pub struct Device<O, C, S, M = DefaultMath> {
+pub struct Device<O, C, S, M: Math = DefaultMath> {
     outputs: O,
     clock: C,
     storage: S,
     config: Config,
+    /// The body solver of `config.robot`, built once: its per-leg constants (square roots and
+    /// products of the link lengths) would otherwise be computed again for every request.
+    solver: body::Solver<M>,
     calibration: Table,
     store: Store,
     acc: Accumulator<RX_LEN>,
@@ -89,7 +91,6 @@ pub struct Device<O, C, S, M = DefaultMath> {
     last_valid_ms: u32,
     /// When the last nack of an unreadable frame was sent (`None`: never).
     last_framing_nack_ms: Option<u32>,
-    _math: PhantomData<fn() -> M>,
 }
 
 // The request handlers are `#[inline(never)]` on purpose: inlined into one function (as LTO
@@ -141,6 +142,7 @@ where
             storage,
             calibration: UNBOOTED_CALIBRATION,
             store: Store::new(config.storage_base),
+            solver: body::Solver::<M>::with_math(&config.robot),
             config,
             acc: Accumulator::new(),
             held: None,
@@ -154,7 +156,6 @@ where
             calibration_default: true,
             last_valid_ms: now,
             last_framing_nack_ms: None,
-            _math: PhantomData,
         })
     }
 
@@ -422,7 +423,7 @@ where
     #[inline(never)]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
         let c = &self.config.pose_config;
-        let solution = body::Solver::<M>::with_math(&self.config.robot).inverse_at_stance(
+        let solution = self.solver.inverse_at_stance(
             pose,
             &BodyConfig::about_centre(c.order),
             c.stance_height_m,
@@ -435,7 +436,8 @@ where
     #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
-        let solution = body::Solver::<M>::with_math(&self.config.robot)
+        let solution = self
+            .solver
             .inverse_feet_in_body(&feet, self.config.pose_config.policy);
         self.apply_solution(solution)
     }
