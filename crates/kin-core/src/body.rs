@@ -13,9 +13,11 @@ use crate::robot::{JointAngles, LegId, Robot};
 use crate::rotation::{self, RotationOrder};
 use crate::vec::{Mat3, Vec3};
 
-/// Body pose relative to the world frame.
+/// Body pose relative to the world frame. In self-describing formats (JSON) a field it does not
+/// have is an error, not ignored.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Pose {
     /// Rotation about x, rad.
     pub roll_rad: f32,

@@ -24,7 +24,7 @@
 //! configuration): `Disable` switches the outputs off, `Hold` keeps the last pose.
 
 use crate::motion;
-use crate::msg::{self, FlagsMsg, LinkMsg, PoseMsg, State};
+use crate::msg::{self, FlagsMsg, LinkMsg, State};
 use kin_core::body::Pose;
 use kin_core::Robot;
 use quad_host::client::{
@@ -436,7 +436,7 @@ impl<L: Link> Session<L> {
                 device_frames_bad: rb.frames_bad,
                 ..self.link
             },
-            pose: self.pose.map(|(p, _)| PoseMsg::from(p)),
+            pose: self.pose.map(|(p, _)| p),
             pose_id: self.pose.map_or(0, |(_, id)| id),
             stance_height_m: self.pose_config.stance_height_m,
             calibration: self.calibration,
@@ -456,7 +456,7 @@ impl<L: Link> Session<L> {
         let servo = |i: u8| msg::servo(i).map_err(|_| Error::Servo(i));
         match *cmd {
             M::SetOutputs { enabled } => self.set_outputs(enabled),
-            M::SetPose { id, pose } => self.set_pose(pose.into(), id),
+            M::SetPose { id, pose } => self.set_pose(pose, id),
             M::SetStanceHeight { stance_height_m } => self.set_stance_height(stance_height_m),
             M::Jog { servo: s, delta_us } => self.jog(servo(s)?, delta_us),
             M::SetCenter {

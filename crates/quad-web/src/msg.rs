@@ -22,45 +22,6 @@ pub const MAX_MESSAGE_BYTES: usize = 4096;
 /// Largest pulse step of one jog, µs.
 pub const MAX_JOG_US: i32 = 100;
 
-/// A body pose in the page's terms: rotation (rad) and translation (m) of the body in the
-/// world frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PoseMsg {
-    /// Roll, rad.
-    pub roll_rad: f32,
-    /// Pitch, rad.
-    pub pitch_rad: f32,
-    /// Yaw, rad.
-    pub yaw_rad: f32,
-    /// Forward translation, m.
-    pub x_m: f32,
-    /// Leftward translation, m.
-    pub y_m: f32,
-    /// Upward translation, m.
-    pub z_m: f32,
-}
-
-impl From<PoseMsg> for Pose {
-    fn from(p: PoseMsg) -> Pose {
-        Pose::from_array([p.roll_rad, p.pitch_rad, p.yaw_rad, p.x_m, p.y_m, p.z_m])
-    }
-}
-
-impl From<Pose> for PoseMsg {
-    fn from(p: Pose) -> PoseMsg {
-        let [roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m] = p.to_array();
-        PoseMsg {
-            roll_rad,
-            pitch_rad,
-            yaw_rad,
-            x_m,
-            y_m,
-            z_m,
-        }
-    }
-}
-
 /// What a page asks.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
@@ -79,7 +40,7 @@ pub enum ClientMsg {
         /// The page's number of this pose.
         id: u32,
         /// The pose.
-        pose: PoseMsg,
+        pose: Pose,
     },
     /// A new stance height, m; the commanded pose is solved again at it.
     SetStanceHeight {
@@ -319,7 +280,7 @@ pub struct State {
     /// Link health.
     pub link: LinkMsg,
     /// The body pose the device holds (the last one it acked), if any.
-    pub pose: Option<PoseMsg>,
+    pub pose: Option<Pose>,
     /// The page's id of that pose.
     pub pose_id: u32,
     /// Stance height in force, m.
