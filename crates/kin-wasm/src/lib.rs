@@ -247,6 +247,17 @@ fn order_of(index: u32) -> Option<RotationOrder> {
     RotationOrder::ALL.get(index as usize).copied()
 }
 
+/// What a pose export starts with: the state, the robot set, the rotation order of `order` and
+/// the pose of `input[0..6]`; else the export's error code.
+fn call(order: u32) -> Result<(&'static mut State, Robot, RotationOrder, Pose), i32> {
+    let s = state();
+    let robot = s.robot.ok_or(ERR_NO_ROBOT)?;
+    let order = order_of(order).ok_or(ERR_BAD_ORDER)?;
+    let i = &s.input;
+    let pose = Pose::from_array([i[0], i[1], i[2], i[3], i[4], i[5]]);
+    Ok((s, robot, order, pose))
+}
+
 /// The input buffer ([`INPUT_LEN`] floats).
 #[no_mangle]
 pub extern "C" fn kin_input() -> *mut f32 {
@@ -277,15 +288,11 @@ pub extern "C" fn kin_set_robot() -> i32 {
 /// [`preview`] of `input[0..7]`; see the crate docs for the codes.
 #[no_mangle]
 pub extern "C" fn kin_preview(order: u32) -> i32 {
-    let s = state();
-    let Some(robot) = s.robot else {
-        return ERR_NO_ROBOT;
-    };
-    let Some(order) = order_of(order) else {
-        return ERR_BAD_ORDER;
+    let (s, robot, order, pose) = match call(order) {
+        Ok(c) => c,
+        Err(code) => return code,
     };
     let i = &s.input;
-    let pose = Pose::from_array([i[0], i[1], i[2], i[3], i[4], i[5]]);
     let p = preview(&robot, order, &pose, i[6]);
     p.write(&mut s.output);
     match p.result {
@@ -297,15 +304,11 @@ pub extern "C" fn kin_preview(order: u32) -> i32 {
 /// [`points`] of `input[0..18]`; see the crate docs.
 #[no_mangle]
 pub extern "C" fn kin_points(order: u32) -> i32 {
-    let s = state();
-    let Some(robot) = s.robot else {
-        return ERR_NO_ROBOT;
-    };
-    let Some(order) = order_of(order) else {
-        return ERR_BAD_ORDER;
+    let (s, robot, order, pose) = match call(order) {
+        Ok(c) => c,
+        Err(code) => return code,
     };
     let i = &s.input;
-    let pose = Pose::from_array([i[0], i[1], i[2], i[3], i[4], i[5]]);
     let mut angles = [0.0; 12];
     angles.copy_from_slice(&i[6..18]);
     s.output[..48].copy_from_slice(&points(&robot, order, &pose, &angles));
