@@ -48,6 +48,7 @@
 
 pub mod config;
 pub mod device;
+pub mod engine;
 pub mod hal;
 pub mod store;
 
