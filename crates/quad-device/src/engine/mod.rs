@@ -859,14 +859,8 @@ impl<M: Math> Engine<M> {
                 if out != self.ramp.to() {
                     return tick;
                 }
-                if self.stage == Stage::Leave {
-                    if self.program == (Program::Pose { kind: Kind::Rest }) {
-                        tick.disable_outputs = true;
-                    }
-                    self.cancel();
-                    return tick;
-                }
-                if let Program::Pose { .. } = self.program {
+                if self.stage == Stage::Leave || matches!(self.program, Program::Pose { .. }) {
+                    tick.disable_outputs = self.program == (Program::Pose { kind: Kind::Rest });
                     self.cancel();
                     return tick;
                 }
