@@ -11,8 +11,11 @@
 //! ```
 //!
 //! - [`Device`]: the controller ([`Device::receive`] for bytes, [`Device::poll`] for the
-//!   link-loss failsafe, [`Device::handle`] at message level). Its documentation lists the
-//!   behaviour and invariants.
+//!   link-loss failsafe and the 50 Hz servo frames, [`Device::handle`] at message level,
+//!   [`Device::start_motion`] and its siblings for the motion engine). Its documentation lists
+//!   the behaviour and invariants.
+//! - [`engine`]: the motion engine (stand-up, sit, the papers' motions, the walk) and the one
+//!   joint-speed limiter every output passes.
 //! - [`hal`]: the traits a target implements — [`ServoOutputs`] (twelve pulse widths in 0.5 µs
 //!   timer ticks, enable/disable), [`Clock`] (monotonic ms) and [`Storage`] (EEPROM-like bytes).
 //!   The kin-core [`kin_core::Math`] backend is a type parameter: the firmware passes its
@@ -34,11 +37,13 @@
 //! ```
 //!
 //! ## Memory
-//! A [`Device`] holds one receive buffer ([`device::RX_LEN`] = 128 B + 13 B of accumulator
-//! state; the answer frame, at most [`device::TX_LEN`] = 104 B, is encoded there once the
-//! request is decoded), the calibration table (12 × 15 B), the held angles and pulses (73 B),
-//! the configuration with the robot (66 B) and a few flags: 477 B on the ATmega2560 (alignment
-//! 1; a compile-time assertion in AVR builds keeps it ≤ 480 B). Saving or loading the calibration streams 15-byte records.
+//! A [`Device`] holds one receive buffer ([`device::RX_LEN`] bytes plus the accumulator's
+//! state; the answer frame, at most [`device::TX_LEN`] bytes, is encoded there once the
+//! request is decoded), the calibration table (12 × 15 B), the held target and the output
+//! angles, the configuration with the robot, the motion [`engine`] (the running motion's
+//! parameters and state, one ramp, the limiter) and a few flags; a compile-time assertion in
+//! AVR builds bounds its size (figures in `BENCHMARKS.md`). Saving or loading the calibration
+//! streams 15-byte records.
 
 #![no_std]
 // The firmware (nightly) instantiates the generic storage code with its own opt-level "s";
@@ -57,8 +62,7 @@ pub use device::Device;
 pub use hal::{Clock, ServoOutputs, Storage};
 
 /// The size of a [`Device`] on the ATmega2560 (alignment 1, 16-bit `usize`), checked when
-/// building for AVR: the whole firmware has 8 KB of SRAM and a 2 KB budget for static data and
-/// stack.
+/// building for AVR: the whole firmware has 8 KB of SRAM.
 #[cfg(target_arch = "avr")]
 pub mod avr_size {
     //! Compile-time checks of AVR builds: the controller's size, and its code generated for
@@ -86,8 +90,9 @@ pub mod avr_size {
         }
     }
 
-    /// Upper bound of `size_of::<Device>()` on the ATmega2560, bytes.
-    const DEVICE_SRAM_MAX: usize = 480;
+    /// Upper bound of `size_of::<Device>()` on the ATmega2560, bytes: the controller and its
+    /// motion engine.
+    const DEVICE_SRAM_MAX: usize = 1152;
     const _: () = assert!(core::mem::size_of::<Device<Null, Null, Null>>() <= DEVICE_SRAM_MAX);
 
     /// Runs the controller on `bytes` (instantiates its code for the target).

@@ -201,12 +201,24 @@ impl Walker {
             PathKind::Semicircle => self.p.reach_radius_m,
             _ => self.p.step_height_m,
         };
+        // (cos, sin) of the eight directions k·45°.
+        const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
+        const DIRECTIONS: [(f32, f32); 8] = [
+            (1.0, 0.0),
+            (H, H),
+            (0.0, 1.0),
+            (-H, H),
+            (-1.0, 0.0),
+            (-H, -H),
+            (0.0, -1.0),
+            (H, -H),
+        ];
         let r = self.p.reach_radius_m / COS_PI_8;
         let (dx, dy, dz) = match k {
             0..=15 => {
-                let a = (k % 8) as f32 * core::f32::consts::FRAC_PI_4;
+                let (c, s) = DIRECTIONS[k % 8];
                 let z = if k < 8 { 0.0 } else { apex };
-                (r * libm::cosf(a), r * libm::sinf(a), z)
+                (r * c, r * s, z)
             }
             16 => (0.0, 0.0, apex),
             _ => (0.0, 0.0, 0.0),

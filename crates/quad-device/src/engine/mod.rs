@@ -72,7 +72,7 @@ use crate::store::Table;
 use core::fmt;
 use core::marker::PhantomData;
 use kin_core::body::{self, BodyConfig, Pose};
-use kin_core::motion::gait::{Pattern, Velocity};
+use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
 use kin_core::motion::path::{AnyPath, PathKind, Stride};
 use kin_core::motion::walker::{Walker, WalkerParams};
@@ -275,12 +275,11 @@ impl WalkRequest {
     /// `pattern` at `body_height_m` with kin-core's default cycle and step height
     /// ([`kin_core::motion::gait::GaitParams::new`]) and [`DEFAULT_VELOCITY_TIMEOUT_MS`].
     pub fn new(pattern: Pattern, body_height_m: f32) -> WalkRequest {
-        let w = WalkerParams::new(pattern, Robot::shahriar2023(), body_height_m);
         WalkRequest {
             pattern,
             body_height_m,
-            step_height_m: w.step_height_m,
-            cycle_s: w.cycle_s,
+            step_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * body_height_m,
+            cycle_s: GaitParams::DEFAULT_CYCLE_S,
             velocity_timeout_ms: DEFAULT_VELOCITY_TIMEOUT_MS,
         }
     }
