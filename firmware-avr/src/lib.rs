@@ -44,8 +44,8 @@ pub use avr_device::atmega2560 as pac;
 pub const F_CPU_HZ: u32 = 16_000_000;
 
 /// Puts every output into its safe state and waits for the watchdog: all servo compare
-/// outputs disconnected (pins low), interrupts off. No `core::fmt` (it would cost about 7 KB
-/// of flash and 1 KB of SRAM).
+/// outputs disconnected (pins low), interrupts off. No `core::fmt`: its formatting machinery
+/// would take kilobytes of flash and SRAM for a message nobody reads on the board.
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
     avr_device::interrupt::disable();

@@ -9,6 +9,7 @@
 //! | `clippy`       | `cargo clippy --workspace --all-targets -- -D warnings`               |
 //! | `avr-kin-core` | no_std build of kin-core, quad-protocol and quad-device for `avr-none` (atmega2560), nightly + build-std=core |
 //! | `firmware`     | `cargo build --release` in `firmware-avr/` (when that directory exists) |
+//! | `budget`       | the firmware's flash ≤ 64 KB and SRAM (static + worst stack in simavr) ≤ 4 KB: figures and margins (`integration_tests::budget`) |
 //! | `test`         | `cargo test --workspace`                                              |
 //! | `doc`          | `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`     |
 //!
@@ -138,6 +139,20 @@ fn ci_steps(root: &Path) -> Vec<Step> {
                 .without_env("RUSTFLAGS")
                 .without_env("CARGO_ENCODED_RUSTFLAGS"),
         );
+        // Flash and static SRAM from the ELF, the worst stack in simavr after every request
+        // type; fails over budget. A debug build of the runner, as the test step's.
+        steps.push(Step::new(
+            "budget",
+            &[
+                "cargo",
+                "run",
+                "--quiet",
+                "--package",
+                "integration-tests",
+                "--bin",
+                "firmware-budget",
+            ],
+        ));
     }
     steps.push(Step::new("test", &["cargo", "test", "--workspace"]));
     steps.push(
@@ -311,6 +326,11 @@ mod tests {
         assert_eq!(n[0], "deps");
         let pos = |name| n.iter().position(|s| *s == name).unwrap();
         assert!(pos("firmware") < pos("test"));
+        assert_eq!(
+            pos("budget"),
+            pos("firmware") + 1,
+            "the budget follows the firmware build"
+        );
     }
 
     #[test]

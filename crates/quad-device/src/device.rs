@@ -15,9 +15,9 @@ use kin_core::{DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    decode_request_payload, encode_answer_frame, is_compatible, Accumulator, DeviceInfo,
-    DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig,
-    Readback, Request, ServoId, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice,
+    LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
+    DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -101,9 +101,7 @@ pub struct Device<O, C, S, M = DefaultMath> {
 // AVR's 63-byte frame-pointer displacement. Every access then costs about 8 instructions, which
 // doubled the firmware's flash, and the LLVM AVR backend miscompiled one such access (it saved
 // SREG in r0 while r0 still held a `mul` result: a wrong calibration index). Small frames avoid
-// both; `firmware-avr`'s emulator tests scan the ELF for that pattern. The exceptions, inlined
-// into `answer` because that saves flash (-292 B) within the stack budget: `set_body_pose`,
-// `set_feet` (both calling the one out-of-line `solve_body`), `set_joints` and `info`.
+// both; `firmware-avr`'s emulator tests scan the ELF for that pattern.
 impl<O, C, S, M> Device<O, C, S, M>
 where
     O: ServoOutputs,
@@ -187,7 +185,6 @@ where
 
     /// Loads the calibration from storage (true when a valid one was found). Out of line: the
     /// record buffers stay out of [`Device::boot`]'s frame, which the stance IK's stack adds to.
-    #[cfg_attr(target_arch = "avr", optimize(size))]
     #[inline(never)]
     fn load_calibration(&mut self) -> bool {
         self.store.load(&mut self.storage, &mut self.calibration)
@@ -205,11 +202,9 @@ where
     }
 
     /// Consumes `bytes` up to the end of the first frame in them, handles it and encodes the
-    /// answer into the accumulator's buffer (free between frames): its length (0 when it could not be encoded) and the
-    /// bytes left; `None` when no frame ended in `bytes`. Inlined into [`Device::receive`]
-    /// (-64 B of flash; the firmware has one instance of it, with one closure); the decoder and
-    /// the encoder it calls stay out of line (one instance each).
-    #[inline(always)]
+    /// answer into the accumulator's buffer (free between frames): its length (0 when it could
+    /// not be encoded) and the bytes left; `None` when no frame ended in `bytes`. Not generic
+    /// over the caller's closure, so that the firmware has one instance of it.
     fn receive_one<'a>(&mut self, bytes: &'a [u8]) -> Option<(usize, &'a [u8])> {
         let (answer, remaining) = match feed_request(&mut self.acc, bytes) {
             Feed::NeedMore => return None,
@@ -446,7 +441,6 @@ where
     }
 
     /// What `HelloAck` reports.
-    #[inline(always)]
     pub fn info(&self) -> DeviceInfo {
         DeviceInfo {
             version: PROTOCOL_VERSION,
@@ -521,12 +515,10 @@ where
         (self.outputs, self.clock, self.storage)
     }
 
-    #[inline]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
         self.solve_body(pose, BodyFeet::Stance)
     }
 
-    #[inline(always)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
         self.solve_body(&Pose::default(), BodyFeet::World(&feet))
@@ -545,7 +537,6 @@ where
         self.apply_solution(solution)
     }
 
-    #[inline]
     fn apply_solution(
         &mut self,
         solution: Result<BodySolution, IkError>,
@@ -564,7 +555,6 @@ where
         self.apply(angles, clamped, limited)
     }
 
-    #[inline(always)]
     fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
         for s in ServoId::ALL {
             let a = angles[s.index()];
@@ -704,7 +694,6 @@ where
         Ok(())
     }
 
-    #[cfg_attr(target_arch = "avr", optimize(size))]
     #[inline(never)]
     fn save_calibration(&mut self) -> Result<(), NackReason> {
         self.store
@@ -722,19 +711,19 @@ where
     }
 }
 
-/// The accumulator with the protocol's compact request decoder
-/// ([`quad_protocol::decode_request_payload`]: postcard's results, a fraction of its code).
+/// The device's receive path: the protocol's frame decoder (postcard) on the accumulator.
+/// Out of line, as is [`encode_answer`]: one instance each, and the message's temporaries stay
+/// out of the caller's stack frame.
 #[inline(never)]
-fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<'a, HostToDevice> {
-    acc.feed_with(bytes, decode_request_payload)
+pub fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<'a, HostToDevice> {
+    acc.feed::<HostToDevice>(bytes)
 }
 
-/// Encodes `answer` into `out` with the protocol's compact encoder
-/// ([`quad_protocol::encode_answer_frame`]: `encode_frame`'s bytes, a fraction of its code):
-/// the frame's length, 0 when it does not fit.
+/// The device's answer encoder: [`encode_frame`] (postcard) of `answer` into `out`; the
+/// frame's length, 0 when it does not fit.
 #[inline(never)]
-fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
-    encode_answer_frame(answer, out).map_or(0, <[u8]>::len)
+pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
+    encode_frame(answer, out).map_or(0, <[u8]>::len)
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {

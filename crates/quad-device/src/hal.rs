@@ -1,5 +1,5 @@
 //! The three small traits a target implements: servo outputs, a millisecond clock and
-//! calibration storage. The ATmega2560 firmware implements them on Timer1/3/4/5, a Timer0
+//! calibration storage. The ATmega2560 firmware implements them on Timer1/3/4/5, a Timer2
 //! tick and the EEPROM; the host simulator on plain memory.
 
 /// Twelve servo outputs in kin-core's canonical order

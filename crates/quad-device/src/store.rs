@@ -143,7 +143,6 @@ impl Store {
     }
 
     /// The generation of `bank` when it holds a valid table.
-    #[cfg_attr(target_arch = "avr", optimize(size))]
     fn verify<S: Storage>(&self, storage: &mut S, bank: Bank) -> Option<u32> {
         let addr = self.bank_addr(bank);
         let mut header = [0u8; HEADER_LEN];
@@ -174,7 +173,6 @@ impl Store {
 
     /// Reads the newest valid table into `table` and makes its bank the active one. Returns
     /// `false`, leaving `table` as it was, when neither bank holds a valid table.
-    #[cfg_attr(target_arch = "avr", optimize(size))]
     pub fn load<S: Storage>(&mut self, storage: &mut S, table: &mut Table) -> bool {
         let a = self.verify(storage, Bank::A);
         let b = self.verify(storage, Bank::B);
@@ -211,7 +209,6 @@ impl Store {
     ///
     /// # Errors
     /// The storage's error; the active bank is untouched and stays active.
-    #[cfg_attr(target_arch = "avr", optimize(size))]
     pub fn save<S: Storage>(&mut self, storage: &mut S, table: &Table) -> Result<(), S::Error> {
         let (bank, generation) = match self.active {
             Some((bank, generation)) => (bank.other(), generation.wrapping_add(1)),

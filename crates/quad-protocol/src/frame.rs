@@ -110,7 +110,7 @@ impl From<postcard::Error> for Error {
 }
 
 /// A postcard flavor that updates the CRC and COBS-encodes each byte straight into a slice.
-pub(crate) struct CobsCrcSlice<'b> {
+struct CobsCrcSlice<'b> {
     out: &'b mut [u8],
     /// Next free position.
     pos: usize,
@@ -122,7 +122,7 @@ pub(crate) struct CobsCrcSlice<'b> {
 }
 
 impl<'b> CobsCrcSlice<'b> {
-    pub(crate) fn new(out: &'b mut [u8]) -> Result<Self, postcard::Error> {
+    fn new(out: &'b mut [u8]) -> Result<Self, postcard::Error> {
         if out.len() < 2 {
             return Err(postcard::Error::SerializeBufferFull);
         }
@@ -221,7 +221,7 @@ pub fn decode_payload<T: DeserializeOwned>(decoded: &[u8]) -> Result<T, Error> {
 ///
 /// # Errors
 /// [`Error::TooShort`], [`Error::BadCrc`].
-pub(crate) fn check_crc(decoded: &[u8]) -> Result<&[u8], Error> {
+fn check_crc(decoded: &[u8]) -> Result<&[u8], Error> {
     if decoded.len() < CRC_LEN + 1 {
         return Err(Error::TooShort);
     }
@@ -387,23 +387,13 @@ impl<const N: usize> Accumulator<N> {
     /// Consumes `input` up to and including the first delimiter that ends a non-empty frame,
     /// and reports that frame; or consumes everything and returns [`Feed::NeedMore`].
     pub fn feed<'a, T: DeserializeOwned>(&mut self, input: &'a [u8]) -> Feed<'a, T> {
-        self.feed_with(input, decode_payload::<T>)
-    }
-
-    /// [`Accumulator::feed`] with another decoder of the frame (postcard bytes ‖ CRC) in place
-    /// of [`decode_payload`], e.g. [`crate::decode_request_payload`].
-    pub fn feed_with<'a, T>(
-        &mut self,
-        input: &'a [u8],
-        decode: fn(&[u8]) -> Result<T, Error>,
-    ) -> Feed<'a, T> {
         for (i, &byte) in input.iter().enumerate() {
             if byte == DELIMITER {
                 if self.code == 0 {
                     continue; // empty frame
                 }
                 let remaining = &input[i + 1..];
-                let result = self.finish(decode);
+                let result = self.finish::<T>();
                 self.reset();
                 return match result {
                     Ok(msg) => {
@@ -439,13 +429,13 @@ impl<const N: usize> Accumulator<N> {
         Feed::NeedMore
     }
 
-    fn finish<T>(&self, decode: fn(&[u8]) -> Result<T, Error>) -> Result<T, Error> {
+    fn finish<T: DeserializeOwned>(&self) -> Result<T, Error> {
         if self.overflow {
             return Err(Error::Oversize);
         }
         if self.block_left != 0 {
             return Err(Error::Cobs);
         }
-        decode(&self.buf[..self.len])
+        decode_payload(&self.buf[..self.len])
     }
 }

@@ -10,6 +10,8 @@
 //!   bounded [`Accumulator`] for split, concatenated, oversize and garbled input.
 //! - [`crc`]: CRC-16/IBM-3740 (CCITT-FALSE), bitwise, no table.
 //! - [`servo`]: per-joint [`servo::Calibration`] and the angle ↔ pulse mapping.
+//! - [`wire`]: the explicit wire index of every enum variant, and the tables of the kin-core
+//!   types the messages carry.
 //!
 //! The byte-level specification with an example frame per message is `docs/protocol.md`.
 //!
@@ -26,13 +28,12 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
-mod compact;
 pub mod crc;
 pub mod frame;
 pub mod msg;
 pub mod servo;
+pub mod wire;
 
-pub use compact::{decode_request_payload, encode_answer_frame};
 pub use frame::{
     decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };

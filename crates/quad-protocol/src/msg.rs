@@ -1,18 +1,21 @@
 //! The messages, named by direction: [`HostToDevice`] (requests) and [`DeviceToHost`]
 //! (answers).
 //!
-//! Every type here is serialized with postcard; the declaration order of fields and enum
-//! variants **is** the wire format (variant index = discriminant varint). Append new variants
-//! and fields only at the end, and only in a new minor version (see `docs/protocol.md`).
-//! Leg, joint, rotation-order and reach-policy enums and the body pose are kin-core's own
-//! types ([`LegId`], [`Joint`], [`RotationOrder`], [`ReachPolicy`], [`Pose`]); the golden tests
-//! pin their encoding.
+//! Every type here is serialized with postcard. The declarations below are the wire format: a
+//! struct's fields in declaration order, an enum's variants by the index written beside each
+//! (`0 => Hello { .. }`; see [`crate::wire`]), their fields in declaration order. Add variants
+//! with new indices and fields only at the end, and only in a new minor version (see
+//! `docs/protocol.md`). Leg, joint, rotation-order and reach-policy enums and the body pose are
+//! kin-core's own types ([`LegId`], [`Joint`], [`RotationOrder`], [`ReachPolicy`], [`Pose`]),
+//! carried through the index tables and field order of [`crate::wire`]; the golden tests pin
+//! their encoding.
 //!
 //! Arrays of twelve joint values are in kin-core's canonical order
 //! `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`; arrays of four feet in leg order
 //! FL, FR, RL, RR.
 
 use crate::servo;
+use crate::wire::{self, wire_enum};
 use core::fmt;
 use kin_core::{IkError, Joint, LegId, Pose, ReachPolicy, RotationOrder, Unreachable};
 use serde::{Deserialize, Serialize};
@@ -28,66 +31,70 @@ pub struct HostToDevice {
     pub request: Request,
 }
 
-/// What the host asks. The comment on each variant names the answer.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Request {
-    /// Handshake: the host's [`crate::PROTOCOL_VERSION`]. → [`DeviceToHost::HelloAck`], or
-    /// [`NackReason::UnknownVersion`] when the major versions differ. Variant index 0 and its
-    /// layout are frozen across all versions.
-    Hello {
-        /// The host's protocol version.
-        version: u16,
-    },
-    /// Report the current state without moving anything. → [`DeviceToHost::Ack`].
-    GetState,
-    /// Body pose in the world frame; the device solves full-body IK with the feet held at the
-    /// stance of its [`PoseConfig`]. → [`DeviceToHost::Ack`] or a nack (nothing moves).
-    SetBodyPose(Pose),
-    /// Feet positions in the body frame, m, leg order FL, FR, RL, RR; `[x, y, z]` each.
-    /// → [`DeviceToHost::Ack`] or a nack.
-    SetFeet {
-        /// The four feet in the body frame, m.
-        feet_in_body_m: [[f32; 3]; 4],
-    },
-    /// Twelve joint angles, rad, canonical order; bypasses the IK (joint limits and servo
-    /// calibration still apply). → [`DeviceToHost::Ack`] or a nack.
-    SetJoints {
-        /// The twelve joint angles, rad.
-        angles_rad: [f32; 12],
-    },
-    /// Switch the servo outputs on or off (off at power-on). → [`DeviceToHost::Ack`].
-    SetOutputs {
-        /// True to drive the outputs.
-        enabled: bool,
-    },
-    /// Configure the link-loss failsafe. → [`DeviceToHost::Ack`].
-    SetLinkTimeout(LinkTimeout),
-    /// Replace one servo's calibration in RAM (not yet persisted). → [`DeviceToHost::Ack`] or
-    /// [`NackReason::BadCalibration`].
-    SetCalibration {
-        /// Which servo.
-        servo: ServoId,
-        /// The new calibration.
-        calibration: servo::Calibration,
-    },
-    /// Read one servo's calibration. → [`DeviceToHost::Calibration`].
-    GetCalibration {
-        /// Which servo.
-        servo: ServoId,
-    },
-    /// Persist all twelve calibrations. → [`DeviceToHost::Ack`] or [`NackReason::Storage`].
-    SaveCalibration,
-    /// Set how [`Request::SetBodyPose`] is interpreted. → [`DeviceToHost::Ack`] or
-    /// [`NackReason::InvalidArgument`].
-    SetPoseConfig(PoseConfig),
+wire_enum! {
+    /// What the host asks. The comment on each variant names the answer.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub enum Request {
+        /// Handshake: the host's [`crate::PROTOCOL_VERSION`]. → [`DeviceToHost::HelloAck`], or
+        /// [`NackReason::UnknownVersion`] when the major versions differ. Variant index 0 and its
+        /// layout are frozen across all versions.
+        0 => Hello {
+            /// The host's protocol version.
+            version: u16,
+        },
+        /// Report the current state without moving anything. → [`DeviceToHost::Ack`].
+        1 => GetState,
+        /// Body pose in the world frame; the device solves full-body IK with the feet held at the
+        /// stance of its [`PoseConfig`]. → [`DeviceToHost::Ack`] or a nack (nothing moves).
+        2 => SetBodyPose(Pose as wire::pose),
+        /// Feet positions in the body frame, m, leg order FL, FR, RL, RR; `[x, y, z]` each.
+        /// → [`DeviceToHost::Ack`] or a nack.
+        3 => SetFeet {
+            /// The four feet in the body frame, m.
+            feet_in_body_m: [[f32; 3]; 4],
+        },
+        /// Twelve joint angles, rad, canonical order; bypasses the IK (joint limits and servo
+        /// calibration still apply). → [`DeviceToHost::Ack`] or a nack.
+        4 => SetJoints {
+            /// The twelve joint angles, rad.
+            angles_rad: [f32; 12],
+        },
+        /// Switch the servo outputs on or off (off at power-on). → [`DeviceToHost::Ack`].
+        5 => SetOutputs {
+            /// True to drive the outputs.
+            enabled: bool,
+        },
+        /// Configure the link-loss failsafe. → [`DeviceToHost::Ack`].
+        6 => SetLinkTimeout(LinkTimeout),
+        /// Replace one servo's calibration in RAM (not yet persisted). → [`DeviceToHost::Ack`] or
+        /// [`NackReason::BadCalibration`].
+        7 => SetCalibration {
+            /// Which servo.
+            servo: ServoId,
+            /// The new calibration.
+            calibration: servo::Calibration,
+        },
+        /// Read one servo's calibration. → [`DeviceToHost::Calibration`].
+        8 => GetCalibration {
+            /// Which servo.
+            servo: ServoId,
+        },
+        /// Persist all twelve calibrations. → [`DeviceToHost::Ack`] or [`NackReason::Storage`].
+        9 => SaveCalibration,
+        /// Set how [`Request::SetBodyPose`] is interpreted. → [`DeviceToHost::Ack`] or
+        /// [`NackReason::InvalidArgument`].
+        10 => SetPoseConfig(PoseConfig),
+    }
 }
 
 /// One servo: a leg and one of its joints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct ServoId {
     /// The leg.
+    #[serde(with = "wire::leg_id")]
     pub leg: LegId,
     /// The joint of that leg.
+    #[serde(with = "wire::joint")]
     pub joint: Joint,
 }
 
@@ -132,14 +139,16 @@ impl fmt::Display for ServoId {
     }
 }
 
-/// What the device does when no valid frame arrived for `timeout_ms`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum LinkLossAction {
-    /// Keep the last pulses on the outputs (the default).
-    #[default]
-    Hold,
-    /// Stop the pulses (hobby servos then go limp).
-    Disable,
+wire_enum! {
+    /// What the device does when no valid frame arrived for `timeout_ms`.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+    pub enum LinkLossAction {
+        /// Keep the last pulses on the outputs (the default).
+        #[default]
+        0 => Hold,
+        /// Stop the pulses (hobby servos then go limp).
+        1 => Disable,
+    }
 }
 
 /// Link-loss failsafe settings.
@@ -157,20 +166,24 @@ pub struct PoseConfig {
     /// Stance height `H`: the feet are held at `hip_in_body + (0, s·d_lat, −H)`, m (> 0).
     pub stance_height_m: f32,
     /// Rotation order of roll, pitch and yaw.
+    #[serde(with = "wire::rotation_order")]
     pub order: RotationOrder,
     /// Reject unreachable targets, or clamp them and report [`Flags::CLAMPED`].
+    #[serde(with = "wire::reach_policy")]
     pub policy: ReachPolicy,
 }
 
-/// Robot geometry the firmware was built for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum RobotPreset {
-    /// [`kin_core::Robot::shahriar2023`] (seed 000).
-    Shahriar2023,
-    /// [`kin_core::Robot::fernando2025`] (seed 001).
-    Fernando2025,
-    /// A geometry that is none of the presets.
-    Custom,
+wire_enum! {
+    /// Robot geometry the firmware was built for.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum RobotPreset {
+        /// [`kin_core::Robot::shahriar2023`] (seed 000).
+        0 => Shahriar2023,
+        /// [`kin_core::Robot::fernando2025`] (seed 001).
+        1 => Fernando2025,
+        /// A geometry that is none of the presets.
+        2 => Custom,
+    }
 }
 
 impl RobotPreset {
@@ -296,40 +309,42 @@ pub struct Readback {
     pub frames_bad: u32,
 }
 
-/// One answer from the device.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum DeviceToHost {
-    /// The request was refused; nothing moved. Variant index 0 and its layout are frozen.
-    Nack {
-        /// The request's sequence number; `None` when the frame could not be read
-        /// ([`NackReason::BadCrc`], [`NackReason::BadFrame`], [`NackReason::Oversize`]).
-        seq: Option<u16>,
-        /// Why.
-        reason: NackReason,
-    },
-    /// Answer to [`Request::Hello`] with a compatible version.
-    HelloAck {
-        /// The request's sequence number.
-        seq: u16,
-        /// The device.
-        info: DeviceInfo,
-    },
-    /// The request was carried out (or, for [`Request::GetState`], the state is reported).
-    Ack {
-        /// The request's sequence number.
-        seq: u16,
-        /// The state after the request.
-        readback: Readback,
-    },
-    /// Answer to [`Request::GetCalibration`].
-    Calibration {
-        /// The request's sequence number.
-        seq: u16,
-        /// Which servo.
-        servo: ServoId,
-        /// Its calibration in RAM.
-        calibration: servo::Calibration,
-    },
+wire_enum! {
+    /// One answer from the device.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub enum DeviceToHost {
+        /// The request was refused; nothing moved. Variant index 0 and its layout are frozen.
+        0 => Nack {
+            /// The request's sequence number; `None` when the frame could not be read
+            /// ([`NackReason::BadCrc`], [`NackReason::BadFrame`], [`NackReason::Oversize`]).
+            seq: Option<u16>,
+            /// Why.
+            reason: NackReason,
+        },
+        /// Answer to [`Request::Hello`] with a compatible version.
+        1 => HelloAck {
+            /// The request's sequence number.
+            seq: u16,
+            /// The device.
+            info: DeviceInfo,
+        },
+        /// The request was carried out (or, for [`Request::GetState`], the state is reported).
+        2 => Ack {
+            /// The request's sequence number.
+            seq: u16,
+            /// The state after the request.
+            readback: Readback,
+        },
+        /// Answer to [`Request::GetCalibration`].
+        3 => Calibration {
+            /// The request's sequence number.
+            seq: u16,
+            /// Which servo.
+            servo: ServoId,
+            /// Its calibration in RAM.
+            calibration: servo::Calibration,
+        },
+    }
 }
 
 impl DeviceToHost {
@@ -344,72 +359,76 @@ impl DeviceToHost {
     }
 }
 
-/// Why a foot target cannot be reached (kin-core's [`Unreachable`] without the joint-limit and
-/// non-finite cases, which have their own [`NackReason`]s).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ReachFault {
-    /// Farther than femur + tibia.
-    TooFar,
-    /// Closer than |femur − tibia|.
-    TooClose,
-    /// Within `d_lat` of the abduction axis.
-    InsideOffset,
-    /// A reason this protocol version has no code for.
-    Other,
+wire_enum! {
+    /// Why a foot target cannot be reached (kin-core's [`Unreachable`] without the joint-limit and
+    /// non-finite cases, which have their own [`NackReason`]s).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum ReachFault {
+        /// Farther than femur + tibia.
+        0 => TooFar,
+        /// Closer than |femur − tibia|.
+        1 => TooClose,
+        /// Within `d_lat` of the abduction axis.
+        2 => InsideOffset,
+        /// A reason this protocol version has no code for.
+        3 => Other,
+    }
 }
 
-/// Why a request was refused.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[non_exhaustive]
-pub enum NackReason {
-    /// The host's major version differs from the device's. Variant index 0 is frozen.
-    UnknownVersion {
-        /// The device's own [`crate::PROTOCOL_VERSION`].
-        supported: u16,
-    },
-    /// A frame arrived whose CRC did not match.
-    BadCrc,
-    /// A frame arrived that is not valid COBS or not a valid message.
-    BadFrame,
-    /// A frame arrived that exceeds the device's buffer.
-    Oversize,
-    /// A motion or configuration request arrived before a successful [`Request::Hello`].
-    HelloRequired,
-    /// A foot cannot reach its target.
-    Unreachable {
-        /// The first leg (in order FL, FR, RL, RR) that cannot reach.
-        leg: LegId,
-        /// Why.
-        fault: ReachFault,
-    },
-    /// A joint angle would leave the robot's joint limits.
-    JointLimit {
-        /// The leg.
-        leg: LegId,
-        /// The joint.
-        joint: Joint,
-    },
-    /// A joint angle maps to a pulse outside that servo's calibrated `[min_us, max_us]`.
-    ServoRange {
-        /// The leg.
-        leg: LegId,
-        /// The joint.
-        joint: Joint,
-        /// Below min or above max.
-        fault: servo::Error,
-    },
-    /// A value in the request is NaN or infinite.
-    NonFinite,
-    /// A calibration was refused.
-    BadCalibration(servo::Error),
-    /// The device cannot take the request now (e.g. a save is in progress).
-    Busy,
-    /// A motion request arrived while the outputs are disabled.
-    OutputsDisabled,
-    /// The calibration storage failed.
-    Storage,
-    /// A configuration value is out of its admissible range.
-    InvalidArgument,
+wire_enum! {
+    /// Why a request was refused.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    #[non_exhaustive]
+    pub enum NackReason {
+        /// The host's major version differs from the device's. Variant index 0 is frozen.
+        0 => UnknownVersion {
+            /// The device's own [`crate::PROTOCOL_VERSION`].
+            supported: u16,
+        },
+        /// A frame arrived whose CRC did not match.
+        1 => BadCrc,
+        /// A frame arrived that is not valid COBS or not a valid message.
+        2 => BadFrame,
+        /// A frame arrived that exceeds the device's buffer.
+        3 => Oversize,
+        /// A motion or configuration request arrived before a successful [`Request::Hello`].
+        4 => HelloRequired,
+        /// A foot cannot reach its target.
+        5 => Unreachable {
+            /// The first leg (in order FL, FR, RL, RR) that cannot reach.
+            leg: LegId as wire::leg_id,
+            /// Why.
+            fault: ReachFault,
+        },
+        /// A joint angle would leave the robot's joint limits.
+        6 => JointLimit {
+            /// The leg.
+            leg: LegId as wire::leg_id,
+            /// The joint.
+            joint: Joint as wire::joint,
+        },
+        /// A joint angle maps to a pulse outside that servo's calibrated `[min_us, max_us]`.
+        7 => ServoRange {
+            /// The leg.
+            leg: LegId as wire::leg_id,
+            /// The joint.
+            joint: Joint as wire::joint,
+            /// Below min or above max.
+            fault: servo::Error,
+        },
+        /// A value in the request is NaN or infinite.
+        8 => NonFinite,
+        /// A calibration was refused.
+        9 => BadCalibration(servo::Error),
+        /// The device cannot take the request now (e.g. a save is in progress).
+        10 => Busy,
+        /// A motion request arrived while the outputs are disabled.
+        11 => OutputsDisabled,
+        /// The calibration storage failed.
+        12 => Storage,
+        /// A configuration value is out of its admissible range.
+        13 => InvalidArgument,
+    }
 }
 
 impl From<IkError> for NackReason {

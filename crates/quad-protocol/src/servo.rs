@@ -15,6 +15,7 @@
 //! `half = 2 · (center_us + s · (us_per_rad · (angle_rad − zero_rad)))`, then rounded half-up to
 //! an integer (`floor(half + 0.5)`), then checked against `[2·min_us, 2·max_us]`.
 
+use crate::wire::wire_enum;
 use core::fmt;
 use serde::{Deserialize, Serialize};
 
@@ -32,24 +33,26 @@ pub const ZERO_RAD_LIMIT: f32 = core::f32::consts::TAU;
 /// Gain of a standard hobby servo: 1000 µs per 90° (and 2000 µs per 180°), µs per rad.
 pub const STANDARD_US_PER_RAD: f32 = 2000.0 / core::f32::consts::PI;
 
-/// Why an angle or a pulse cannot be mapped, or why a calibration is refused.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[non_exhaustive]
-pub enum Error {
-    /// The angle is NaN or infinite.
-    NonFiniteAngle,
-    /// The pulse would be shorter than `min_us`.
-    BelowMin,
-    /// The pulse would be longer than `max_us`.
-    AboveMax,
-    /// `zero_rad` is not finite or |zero_rad| > [`ZERO_RAD_LIMIT`].
-    BadZero,
-    /// `us_per_rad` is not finite or lies outside [[`US_PER_RAD_MIN`], [`US_PER_RAD_MAX`]].
-    BadGain,
-    /// `min_us < max_us` within [[`PULSE_MIN_US`], [`PULSE_MAX_US`]] does not hold.
-    BadBounds,
-    /// `center_us` lies outside `[min_us, max_us]`.
-    CenterOutOfBounds,
+wire_enum! {
+    /// Why an angle or a pulse cannot be mapped, or why a calibration is refused.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    #[non_exhaustive]
+    pub enum Error {
+        /// The angle is NaN or infinite.
+        0 => NonFiniteAngle,
+        /// The pulse would be shorter than `min_us`.
+        1 => BelowMin,
+        /// The pulse would be longer than `max_us`.
+        2 => AboveMax,
+        /// `zero_rad` is not finite or |zero_rad| > [`ZERO_RAD_LIMIT`].
+        3 => BadZero,
+        /// `us_per_rad` is not finite or lies outside [[`US_PER_RAD_MIN`], [`US_PER_RAD_MAX`]].
+        4 => BadGain,
+        /// `min_us < max_us` within [[`PULSE_MIN_US`], [`PULSE_MAX_US`]] does not hold.
+        5 => BadBounds,
+        /// `center_us` lies outside `[min_us, max_us]`.
+        6 => CenterOutOfBounds,
+    }
 }
 
 impl fmt::Display for Error {

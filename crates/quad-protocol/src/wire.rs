@@ -1,0 +1,699 @@
+//! The wire indices, written once: the macros that declare the protocol's enums with an
+//! explicit index per variant, and the index tables of the kin-core types the messages carry.
+//!
+//! postcard writes an enum as its variant index (a varint) followed by the variant's fields in
+//! order. serde's derive takes that index from the declaration order, and kin-core's own derive
+//! from kin-core's declaration order; here every index is written beside its variant instead:
+//!
+//! - `wire_enum!` declares an enum of this crate, `0 => Hello { version: u16 }`, and emits it
+//!   with its `Serialize`/`Deserialize` using those indices. A field of a foreign type names its
+//!   table with `as`: `leg: LegId as wire::leg_id`.
+//! - `wire_index!` writes the table of a foreign field-less enum as a module with `index`,
+//!   `from_index` and serde's `with` functions ([`leg_id`], [`joint`], [`rotation_order`],
+//!   [`reach_policy`]); `wire_fields!` fixes the field order of a foreign struct ([`pose`]).
+//!
+//! Every table is an exhaustive `match`: a variant or field added to kin-core does not compile
+//! until it has its place on the wire. The implementations follow serde's data model as the
+//! derive does (enum → variant index and name, struct variant → its fields in sequence), so any
+//! index-based format reads them; the protocol uses postcard only.
+
+use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
+
+/// Serializes the field `$value` (a reference) of type `$ty`, through the table `$with` when one
+/// is named.
+macro_rules! wire_ser_field {
+    ($value:expr, $ty:ty) => {
+        $value
+    };
+    ($value:expr, $ty:ty, $($with:ident)::+) => {
+        &{
+            struct With<'a>(&'a $ty);
+            impl ::serde::Serialize for With<'_> {
+                fn serialize<S: ::serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                    $($with)::+::serialize(self.0, s)
+                }
+            }
+            With($value)
+        }
+    };
+}
+
+/// Reads the next field (of type `$ty`, through the table `$with` when one is named) from the
+/// sequence `$seq`; `$n` counts the fields read, `$exp` is the visitor (for the error).
+macro_rules! wire_next_field {
+    ($seq:ident, $n:ident, $exp:expr, $ty:ty $(, $($with:ident)::+)?) => {{
+        let value = $crate::wire::wire_next_field!(@read $seq, $ty $(, $($with)::+)?);
+        match value {
+            Some(v) => {
+                $n += 1;
+                v
+            }
+            None => return Err(::serde::de::Error::invalid_length($n, $exp)),
+        }
+    }};
+    (@read $seq:ident, $ty:ty) => {
+        ::serde::de::SeqAccess::next_element::<$ty>(&mut $seq)?
+    };
+    (@read $seq:ident, $ty:ty, $($with:ident)::+) => {{
+        struct With($ty);
+        impl<'de> ::serde::Deserialize<'de> for With {
+            fn deserialize<D: ::serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                $($with)::+::deserialize(d).map(With)
+            }
+        }
+        ::serde::de::SeqAccess::next_element::<With>(&mut $seq)?.map(|w| w.0)
+    }};
+}
+
+/// Declares an enum of the protocol with an explicit wire index per variant and emits its serde
+/// `Serialize`/`Deserialize` with those indices (see the module docs). Variants are unit,
+/// one-field tuple or struct variants; each field may name a table (`as path::to::table`).
+macro_rules! wire_enum {
+    (
+        $(#[$attr:meta])*
+        $vis:vis enum $name:ident {
+            $($body:tt)*
+        }
+    ) => {
+        $crate::wire::wire_enum!(@munch
+            [$(#[$attr])* $vis $name]
+            [serializer variant]
+            [] [] []
+            $($body)*
+        );
+    };
+
+    // A unit variant.
+    (@munch $head:tt [$ser:ident $var_access:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+        $(#[$vattr:meta])* $idx:literal => $var:ident
+        $(, $($rest:tt)*)?
+    ) => {
+        $crate::wire::wire_enum!(@munch $head [$ser $var_access]
+            [$($decl)* $(#[$vattr])* $var,]
+            [$($ser_arms)* Self::$var => ::serde::Serializer::serialize_unit_variant(
+                $ser, NAME, $idx, stringify!($var)),]
+            [$($de_arms)* $idx => {
+                ::serde::de::VariantAccess::unit_variant($var_access)?;
+                Ok(Target::$var)
+            }]
+            $($($rest)*)?
+        );
+    };
+
+    // A one-field tuple variant.
+    (@munch $head:tt [$ser:ident $var_access:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+        $(#[$vattr:meta])* $idx:literal => $var:ident ( $ty:ty $(as $($with:ident)::+)? )
+        $(, $($rest:tt)*)?
+    ) => {
+        $crate::wire::wire_enum!(@munch $head [$ser $var_access]
+            [$($decl)* $(#[$vattr])* $var($ty),]
+            [$($ser_arms)* Self::$var(value) => ::serde::Serializer::serialize_newtype_variant(
+                $ser, NAME, $idx, stringify!($var),
+                $crate::wire::wire_ser_field!(value, $ty $(, $($with)::+)?)),]
+            [$($de_arms)* $idx => $crate::wire::wire_de_newtype!(
+                $var_access, Target::$var, $ty $(, $($with)::+)?),]
+            $($($rest)*)?
+        );
+    };
+
+    // A struct variant.
+    (@munch $head:tt [$ser:ident $var_access:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+        $(#[$vattr:meta])* $idx:literal => $var:ident {
+            $( $(#[$fattr:meta])* $field:ident : $fty:ty $(as $($with:ident)::+)? ),* $(,)?
+        }
+        $(, $($rest:tt)*)?
+    ) => {
+        $crate::wire::wire_enum!(@munch $head [$ser $var_access]
+            [$($decl)* $(#[$vattr])* $var { $( $(#[$fattr])* $field: $fty, )* },]
+            [$($ser_arms)* Self::$var { $($field),* } => {
+                let mut fields = ::serde::Serializer::serialize_struct_variant(
+                    $ser, NAME, $idx, stringify!($var), <[&str]>::len(&[$(stringify!($field)),*]))?;
+                $(
+                    ::serde::ser::SerializeStructVariant::serialize_field(
+                        &mut fields,
+                        stringify!($field),
+                        $crate::wire::wire_ser_field!($field, $fty $(, $($with)::+)?),
+                    )?;
+                )*
+                ::serde::ser::SerializeStructVariant::end(fields)
+            }]
+            [$($de_arms)* $idx => {
+                struct Fields;
+                impl<'de> ::serde::de::Visitor<'de> for Fields {
+                    type Value = Target;
+                    fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                        f.write_str(concat!("the fields of ", stringify!($var)))
+                    }
+                    // The count after the last field is not read.
+                    #[allow(unused_assignments)]
+                    fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
+                        self,
+                        mut seq: A,
+                    ) -> Result<Target, A::Error> {
+                        let mut n = 0usize;
+                        $( let $field = $crate::wire::wire_next_field!(seq, n, &self, $fty $(, $($with)::+)?); )*
+                        Ok(Target::$var { $($field),* })
+                    }
+                }
+                ::serde::de::VariantAccess::struct_variant(
+                    $var_access,
+                    &[$(stringify!($field)),*],
+                    Fields,
+                )
+            }]
+            $($($rest)*)?
+        );
+    };
+
+    // All variants read: the enum and its serde implementations.
+    (@munch [$(#[$attr:meta])* $vis:vis $name:ident] [$ser:ident $var_access:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+    ) => {
+        $(#[$attr])*
+        $vis enum $name {
+            $($decl)*
+        }
+
+        const _: () = {
+            const NAME: &str = stringify!($name);
+            type Target = $name;
+
+            impl ::serde::Serialize for $name {
+                fn serialize<S: ::serde::Serializer>(&self, $ser: S) -> Result<S::Ok, S::Error> {
+                    match self {
+                        $($ser_arms)*
+                    }
+                }
+            }
+
+            impl<'de> ::serde::Deserialize<'de> for $name {
+                fn deserialize<D: ::serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                    struct Variants;
+                    impl<'de> ::serde::de::Visitor<'de> for Variants {
+                        type Value = $name;
+                        fn expecting(
+                            &self,
+                            f: &mut ::core::fmt::Formatter<'_>,
+                        ) -> ::core::fmt::Result {
+                            f.write_str(concat!("enum ", stringify!($name)))
+                        }
+                        fn visit_enum<A: ::serde::de::EnumAccess<'de>>(
+                            self,
+                            data: A,
+                        ) -> Result<$name, A::Error> {
+                            let (index, $var_access) =
+                                ::serde::de::EnumAccess::variant::<u32>(data)?;
+                            match index {
+                                $($de_arms)*
+                                other => Err(::serde::de::Error::invalid_value(
+                                    ::serde::de::Unexpected::Unsigned(u64::from(other)),
+                                    &self,
+                                )),
+                            }
+                        }
+                    }
+                    // postcard does not read the names; they serve self-describing formats'
+                    // error messages only.
+                    ::serde::Deserializer::deserialize_enum(d, NAME, &[], Variants)
+                }
+            }
+        };
+    };
+}
+
+/// Writes the wire table of a foreign field-less enum as a module: `index`, `from_index`, and
+/// `serialize`/`deserialize` for serde's `with` and `wire_enum!`'s `as`.
+macro_rules! wire_index {
+    (
+        $(#[$attr:meta])*
+        $vis:vis mod $module:ident for $ty:ident {
+            $($idx:literal => $var:ident),+ $(,)?
+        }
+    ) => {
+        $(#[$attr])*
+        $vis mod $module {
+            use super::$ty;
+
+            /// The wire index of `value`.
+            pub const fn index(value: &$ty) -> u32 {
+                match value {
+                    $($ty::$var => $idx,)+
+                }
+            }
+
+            /// The value of wire index `index`; `None` when no variant has it.
+            pub const fn from_index(index: u32) -> Option<$ty> {
+                match index {
+                    $($idx => Some($ty::$var),)+
+                    _ => None,
+                }
+            }
+
+            /// Serializes `value` as its wire index (serde's `with`).
+            ///
+            /// # Errors
+            /// The serializer's.
+            pub fn serialize<S: ::serde::Serializer>(value: &$ty, s: S) -> Result<S::Ok, S::Error> {
+                let name = match value {
+                    $($ty::$var => stringify!($var),)+
+                };
+                s.serialize_unit_variant(stringify!($ty), index(value), name)
+            }
+
+            /// Deserializes a value from its wire index (serde's `with`).
+            ///
+            /// # Errors
+            /// The deserializer's, or an invalid value for an index no variant has.
+            pub fn deserialize<'de, D: ::serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+                struct Variants;
+                impl<'de> ::serde::de::Visitor<'de> for Variants {
+                    type Value = $ty;
+                    fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                        f.write_str(concat!("enum ", stringify!($ty)))
+                    }
+                    fn visit_enum<A: ::serde::de::EnumAccess<'de>>(
+                        self,
+                        data: A,
+                    ) -> Result<$ty, A::Error> {
+                        let (i, variant) = ::serde::de::EnumAccess::variant::<u32>(data)?;
+                        ::serde::de::VariantAccess::unit_variant(variant)?;
+                        from_index(i).ok_or_else(|| {
+                            ::serde::de::Error::invalid_value(
+                                ::serde::de::Unexpected::Unsigned(u64::from(i)),
+                                &self,
+                            )
+                        })
+                    }
+                }
+                d.deserialize_enum(stringify!($ty), &[], Variants)
+            }
+        }
+    };
+}
+
+/// Writes the field order of a foreign struct as a module with `serialize`/`deserialize` for
+/// serde's `with` and `wire_enum!`'s `as`: the fields in the listed order.
+macro_rules! wire_fields {
+    (
+        $(#[$attr:meta])*
+        $vis:vis mod $module:ident for $ty:ident {
+            $($field:ident : $fty:ty),+ $(,)?
+        }
+    ) => {
+        $(#[$attr])*
+        $vis mod $module {
+            use super::$ty;
+
+            const FIELDS: &[&str] = &[$(stringify!($field)),+];
+
+            /// Serializes `value`'s fields in the wire order (serde's `with`).
+            ///
+            /// # Errors
+            /// The serializer's.
+            pub fn serialize<S: ::serde::Serializer>(value: &$ty, s: S) -> Result<S::Ok, S::Error> {
+                use ::serde::ser::SerializeStruct;
+                // Exhaustive: a field added to the type does not compile here.
+                let $ty { $($field),+ } = value;
+                let mut out = s.serialize_struct(stringify!($ty), FIELDS.len())?;
+                $(out.serialize_field(stringify!($field), $field)?;)+
+                out.end()
+            }
+
+            /// Deserializes the fields in the wire order (serde's `with`).
+            ///
+            /// # Errors
+            /// The deserializer's.
+            pub fn deserialize<'de, D: ::serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+                struct Fields;
+                impl<'de> ::serde::de::Visitor<'de> for Fields {
+                    type Value = $ty;
+                    fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                        f.write_str(concat!("struct ", stringify!($ty)))
+                    }
+                    // The count after the last field is not read.
+                    #[allow(unused_assignments)]
+                    fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
+                        self,
+                        mut seq: A,
+                    ) -> Result<$ty, A::Error> {
+                        let mut n = 0usize;
+                        $(let $field = $crate::wire::wire_next_field!(seq, n, &self, $fty);)+
+                        Ok($ty { $($field),+ })
+                    }
+                }
+                d.deserialize_struct(stringify!($ty), FIELDS, Fields)
+            }
+        }
+    };
+}
+
+/// Reads the field of a one-field tuple variant (of type `$ty`, through the table `$with` when
+/// one is named) from the variant access `$access` and wraps it in `$ctor`.
+macro_rules! wire_de_newtype {
+    ($access:ident, $ctor:path, $ty:ty) => {
+        ::serde::de::VariantAccess::newtype_variant::<$ty>($access).map($ctor)
+    };
+    ($access:ident, $ctor:path, $ty:ty, $($with:ident)::+) => {{
+        struct With($ty);
+        impl<'de> ::serde::Deserialize<'de> for With {
+            fn deserialize<D: ::serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                $($with)::+::deserialize(d).map(With)
+            }
+        }
+        ::serde::de::VariantAccess::newtype_variant::<With>($access).map(|w| $ctor(w.0))
+    }};
+}
+
+pub(crate) use {wire_de_newtype, wire_enum, wire_next_field, wire_ser_field};
+
+wire_index! {
+    /// [`LegId`] on the wire.
+    pub mod leg_id for LegId { 0 => FL, 1 => FR, 2 => RL, 3 => RR }
+}
+
+wire_index! {
+    /// [`Joint`] on the wire.
+    pub mod joint for Joint { 0 => Abduction, 1 => Hip, 2 => Knee }
+}
+
+wire_index! {
+    /// [`RotationOrder`] on the wire.
+    pub mod rotation_order for RotationOrder {
+        0 => Xyz, 1 => Xzy, 2 => Yxz, 3 => Yzx, 4 => Zxy, 5 => Zyx,
+    }
+}
+
+wire_index! {
+    /// [`ReachPolicy`] on the wire.
+    pub mod reach_policy for ReachPolicy { 0 => Reject, 1 => Clamp }
+}
+
+wire_fields! {
+    /// [`Pose`] on the wire: roll, pitch, yaw (rad), then x, y, z (m).
+    pub mod pose for Pose {
+        roll_rad: f32,
+        pitch_rad: f32,
+        yaw_rad: f32,
+        x_m: f32,
+        y_m: f32,
+        z_m: f32,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Every variant of every enum nested in the messages, by an exhaustive `match` per enum
+    //! (here, inside the crate, the `#[non_exhaustive]` ones too: a variant added without a
+    //! case does not compile), has the index written here at its place in the postcard bytes,
+    //! round-trips through the frame encoder and the accumulator the device uses, and the
+    //! index after the last is refused.
+    extern crate std;
+    use super::*;
+    use crate::frame::{encode_frame, Accumulator, Feed, MAX_DECODED_LEN, MAX_FRAME_LEN};
+    use crate::msg::{
+        DeviceInfo, DeviceToHost, FirmwareVersion, HostToDevice, LinkLossAction, LinkTimeout,
+        NackReason, PoseConfig, ReachFault, Request, RobotPreset, ServoId,
+    };
+    use crate::servo;
+    use serde::de::DeserializeOwned;
+    use serde::Serialize;
+    use std::vec::Vec;
+
+    fn nack_index(n: &NackReason) -> u8 {
+        match n {
+            NackReason::UnknownVersion { .. } => 0,
+            NackReason::BadCrc => 1,
+            NackReason::BadFrame => 2,
+            NackReason::Oversize => 3,
+            NackReason::HelloRequired => 4,
+            NackReason::Unreachable { .. } => 5,
+            NackReason::JointLimit { .. } => 6,
+            NackReason::ServoRange { .. } => 7,
+            NackReason::NonFinite => 8,
+            NackReason::BadCalibration(_) => 9,
+            NackReason::Busy => 10,
+            NackReason::OutputsDisabled => 11,
+            NackReason::Storage => 12,
+            NackReason::InvalidArgument => 13,
+        }
+    }
+
+    fn servo_error_index(e: &servo::Error) -> u8 {
+        match e {
+            servo::Error::NonFiniteAngle => 0,
+            servo::Error::BelowMin => 1,
+            servo::Error::AboveMax => 2,
+            servo::Error::BadZero => 3,
+            servo::Error::BadGain => 4,
+            servo::Error::BadBounds => 5,
+            servo::Error::CenterOutOfBounds => 6,
+        }
+    }
+
+    fn reach_fault_index(f: &ReachFault) -> u8 {
+        match f {
+            ReachFault::TooFar => 0,
+            ReachFault::TooClose => 1,
+            ReachFault::InsideOffset => 2,
+            ReachFault::Other => 3,
+        }
+    }
+
+    fn link_loss_index(a: &LinkLossAction) -> u8 {
+        match a {
+            LinkLossAction::Hold => 0,
+            LinkLossAction::Disable => 1,
+        }
+    }
+
+    fn preset_index(p: &RobotPreset) -> u8 {
+        match p {
+            RobotPreset::Shahriar2023 => 0,
+            RobotPreset::Fernando2025 => 1,
+            RobotPreset::Custom => 2,
+        }
+    }
+
+    fn leg_index(l: &LegId) -> u8 {
+        match l {
+            LegId::FL => 0,
+            LegId::FR => 1,
+            LegId::RL => 2,
+            LegId::RR => 3,
+        }
+    }
+
+    fn joint_index(j: &Joint) -> u8 {
+        match j {
+            Joint::Abduction => 0,
+            Joint::Hip => 1,
+            Joint::Knee => 2,
+        }
+    }
+
+    fn order_index(o: &RotationOrder) -> u8 {
+        match o {
+            RotationOrder::Xyz => 0,
+            RotationOrder::Xzy => 1,
+            RotationOrder::Yxz => 2,
+            RotationOrder::Yzx => 3,
+            RotationOrder::Zxy => 4,
+            RotationOrder::Zyx => 5,
+        }
+    }
+
+    fn policy_index(p: &ReachPolicy) -> u8 {
+        match p {
+            ReachPolicy::Reject => 0,
+            ReachPolicy::Clamp => 1,
+        }
+    }
+
+    /// `msg` has `index` at byte `at` of its postcard bytes and round-trips through a frame;
+    /// with `past` in its place it does not decode (an unknown variant).
+    fn check<T: Serialize + DeserializeOwned + PartialEq + core::fmt::Debug>(
+        msg: T,
+        at: usize,
+        index: u8,
+        past: u8,
+    ) {
+        let mut buf = [0u8; MAX_DECODED_LEN];
+        let mut bytes = postcard::to_slice(&msg, &mut buf).unwrap().to_vec();
+        assert_eq!(bytes[at], index, "index of {msg:?} in {bytes:02x?}");
+        let mut out = [0u8; MAX_FRAME_LEN];
+        let frame = encode_frame(&msg, &mut out).unwrap();
+        match Accumulator::<MAX_DECODED_LEN>::new().feed::<T>(frame) {
+            Feed::Frame { msg: back, .. } => assert_eq!(back, msg),
+            other => panic!("{msg:?}: {other:?}"),
+        }
+        bytes[at] = past;
+        assert_eq!(
+            postcard::from_bytes::<T>(&bytes).err(),
+            Some(postcard::Error::SerdeDeCustom),
+            "index {past} after the last of {msg:?}"
+        );
+    }
+
+    fn nack(reason: NackReason) -> DeviceToHost {
+        DeviceToHost::Nack { seq: None, reason }
+    }
+
+    #[test]
+    fn every_nested_variant_has_its_index_and_round_trips() {
+        let errors = [
+            servo::Error::NonFiniteAngle,
+            servo::Error::BelowMin,
+            servo::Error::AboveMax,
+            servo::Error::BadZero,
+            servo::Error::BadGain,
+            servo::Error::BadBounds,
+            servo::Error::CenterOutOfBounds,
+        ];
+        let faults = [
+            ReachFault::TooFar,
+            ReachFault::TooClose,
+            ReachFault::InsideOffset,
+            ReachFault::Other,
+        ];
+        let reasons: Vec<NackReason> = [
+            NackReason::UnknownVersion { supported: 0x0102 },
+            NackReason::BadCrc,
+            NackReason::BadFrame,
+            NackReason::Oversize,
+            NackReason::HelloRequired,
+            NackReason::Unreachable {
+                leg: LegId::FR,
+                fault: ReachFault::TooClose,
+            },
+            NackReason::JointLimit {
+                leg: LegId::RR,
+                joint: Joint::Knee,
+            },
+            NackReason::ServoRange {
+                leg: LegId::RL,
+                joint: Joint::Hip,
+                fault: servo::Error::AboveMax,
+            },
+            NackReason::NonFinite,
+            NackReason::BadCalibration(servo::Error::BadGain),
+            NackReason::Busy,
+            NackReason::OutputsDisabled,
+            NackReason::Storage,
+            NackReason::InvalidArgument,
+        ]
+        .into();
+        // Nack | seq None (00) | reason ...
+        for (i, r) in reasons.iter().enumerate() {
+            assert_eq!(usize::from(nack_index(r)), i);
+            check(nack(*r), 2, i as u8, reasons.len() as u8);
+        }
+        for (i, e) in errors.iter().enumerate() {
+            assert_eq!(usize::from(servo_error_index(e)), i);
+            check(nack(NackReason::BadCalibration(*e)), 3, i as u8, 7);
+        }
+        for (i, fault) in faults.iter().enumerate() {
+            assert_eq!(usize::from(reach_fault_index(fault)), i);
+            let leg = LegId::FL;
+            check(
+                nack(NackReason::Unreachable { leg, fault: *fault }),
+                4,
+                i as u8,
+                4,
+            );
+        }
+        for (i, leg) in LegId::ALL.iter().enumerate() {
+            assert_eq!(usize::from(leg_index(leg)), i);
+            let r = NackReason::JointLimit {
+                leg: *leg,
+                joint: Joint::Hip,
+            };
+            check(nack(r), 3, i as u8, 4);
+        }
+        for (i, joint) in Joint::ALL.iter().enumerate() {
+            assert_eq!(usize::from(joint_index(joint)), i);
+            let r = NackReason::JointLimit {
+                leg: LegId::RR,
+                joint: *joint,
+            };
+            check(nack(r), 4, i as u8, 3);
+        }
+        for (i, preset) in [
+            RobotPreset::Shahriar2023,
+            RobotPreset::Fernando2025,
+            RobotPreset::Custom,
+        ]
+        .iter()
+        .enumerate()
+        {
+            assert_eq!(usize::from(preset_index(preset)), i);
+            // HelloAck | seq | version (80 02) | firmware (3 bytes) | robot
+            let info = DeviceInfo {
+                version: 0x0100,
+                firmware: FirmwareVersion::default(),
+                robot: *preset,
+                max_frame_len: 128,
+                pose_config: PoseConfig {
+                    stance_height_m: 0.25,
+                    order: RotationOrder::Zyx,
+                    policy: ReachPolicy::Reject,
+                },
+                link_timeout: LinkTimeout::default(),
+            };
+            check(DeviceToHost::HelloAck { seq: 1, info }, 7, i as u8, 3);
+        }
+        let h2d = |request| HostToDevice { seq: 5, request };
+        for (i, action) in [LinkLossAction::Hold, LinkLossAction::Disable]
+            .iter()
+            .enumerate()
+        {
+            assert_eq!(usize::from(link_loss_index(action)), i);
+            // seq | SetLinkTimeout (06) | timeout 5 | action
+            let t = LinkTimeout {
+                timeout_ms: 5,
+                action: *action,
+            };
+            check(h2d(Request::SetLinkTimeout(t)), 3, i as u8, 2);
+        }
+        let orders = [
+            RotationOrder::Xyz,
+            RotationOrder::Xzy,
+            RotationOrder::Yxz,
+            RotationOrder::Yzx,
+            RotationOrder::Zxy,
+            RotationOrder::Zyx,
+        ];
+        for (i, order) in orders.iter().enumerate() {
+            assert_eq!(usize::from(order_index(order)), i);
+            // seq | SetPoseConfig (0a) | height f32 | order | policy
+            let p = PoseConfig {
+                stance_height_m: 0.25,
+                order: *order,
+                policy: ReachPolicy::Clamp,
+            };
+            check(h2d(Request::SetPoseConfig(p)), 6, i as u8, 6);
+        }
+        for (i, policy) in [ReachPolicy::Reject, ReachPolicy::Clamp].iter().enumerate() {
+            assert_eq!(usize::from(policy_index(policy)), i);
+            let p = PoseConfig {
+                stance_height_m: 0.25,
+                order: RotationOrder::Zyx,
+                policy: *policy,
+            };
+            check(h2d(Request::SetPoseConfig(p)), 7, i as u8, 2);
+        }
+        // The tables agree with the tests' indices.
+        for leg in LegId::ALL {
+            assert_eq!(leg_id::index(&leg), u32::from(leg_index(&leg)));
+            assert_eq!(leg_id::from_index(leg_id::index(&leg)), Some(leg));
+        }
+        assert_eq!(leg_id::from_index(4), None);
+        let servo = ServoId {
+            leg: LegId::RL,
+            joint: Joint::Knee,
+        };
+        check(h2d(Request::GetCalibration { servo }), 2, 2, 4);
+    }
+}
