@@ -20,11 +20,12 @@
 use crate::body::{self, BodyConfig};
 use crate::jacobian::{self, SINGULARITY_THRESHOLD};
 use crate::leg::{self, Unreachable};
-use crate::math::{wrap_pi, DefaultMath};
+use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::motion::{finite, positive, Error, Frame, Motion};
 use crate::robot::{Joint, JointAngles, JointLimits, LegId, Robot};
 use crate::vec::Vec3;
 use crate::ReachPolicy;
+use core::marker::PhantomData;
 
 /// Default per-joint speed limit, rad/s (about a standard hobby servo's no-load speed, 60° in
 /// 0.17 s).
@@ -122,17 +123,22 @@ impl Boundary {
 /// `r_yz = √(y² + z²)`, `w = −√(r_yz² − d_lat²)` and `r = √(x² + (w + d_ax)²)`. Negative outside.
 /// `None` for a non-finite foot.
 pub fn workspace_margin(robot: &Robot, foot_in_hip: Vec3) -> Option<(f32, Boundary)> {
+    workspace_margin_by::<DefaultMath>(robot, foot_in_hip)
+}
+
+/// [`workspace_margin`] on math backend `M`.
+fn workspace_margin_by<M: Math>(robot: &Robot, foot_in_hip: Vec3) -> Option<(f32, Boundary)> {
     if !foot_in_hip.is_finite() {
         return None;
     }
     let g = &robot.leg;
     let Vec3 { x, y, z } = foot_in_hip;
     let r_yz2 = y * y + z * z;
-    let r_yz = libm::sqrtf(r_yz2);
+    let r_yz = M::sqrt(r_yz2);
     let w2 = r_yz2 - g.d_lat_m * g.d_lat_m;
-    let w = -libm::sqrtf(if w2 > 0.0 { w2 } else { 0.0 });
+    let w = -M::sqrt(if w2 > 0.0 { w2 } else { 0.0 });
     let v = w + g.d_ax_m;
-    let r = libm::sqrtf(x * x + v * v);
+    let r = M::sqrt(x * x + v * v);
     let far = g.femur_m + g.tibia_m - r;
     let near = r - libm::fabsf(g.femur_m - g.tibia_m);
     let offset = r_yz - g.d_lat_m;
@@ -334,25 +340,38 @@ impl Report {
     }
 }
 
-/// Incremental preflight: push samples in time order, then [`Checker::finish`].
+/// Incremental preflight on math backend `M`: push samples in time order, then
+/// [`Checker::finish`].
 #[derive(Debug, Clone, Copy)]
-pub struct Checker {
+pub struct Checker<M = DefaultMath> {
     robot: Robot,
     geometric: Robot,
     config: BodyConfig,
     max_speed: [f32; 3],
     prev: [Option<(f32, JointAngles)>; 4],
     report: Report,
+    _math: PhantomData<fn() -> M>,
 }
 
 impl Checker {
     /// A checker for `robot` with poses read in `config`, and per-joint speed limits
-    /// `max_joint_speed_rad_s` (each > 0).
+    /// `max_joint_speed_rad_s` (each > 0), on the [`DefaultMath`] backend.
     pub fn new(
         robot: &Robot,
         config: BodyConfig,
         max_joint_speed_rad_s: [f32; 3],
     ) -> Result<Checker, Error> {
+        Checker::with_math(robot, config, max_joint_speed_rad_s)
+    }
+}
+
+impl<M: Math> Checker<M> {
+    /// [`Checker::new`] on math backend `M` (a device's own).
+    pub fn with_math(
+        robot: &Robot,
+        config: BodyConfig,
+        max_joint_speed_rad_s: [f32; 3],
+    ) -> Result<Checker<M>, Error> {
         robot.validate()?;
         for v in max_joint_speed_rad_s {
             positive(v, "max_joint_speed_rad_s")?;
@@ -373,6 +392,7 @@ impl Checker {
                 max_joint_speed_limit_rad_s: max_joint_speed_rad_s,
                 singularity_threshold: SINGULARITY_THRESHOLD,
             },
+            _math: PhantomData,
         })
     }
 
@@ -384,7 +404,7 @@ impl Checker {
         self.report.samples = sample.saturating_add(1);
         let mut out = [Err(Unreachable::NonFinite); 4];
         let finite_input = t_s.is_finite() && frame.pose.is_finite();
-        let local = body::feet_in_hips_with::<DefaultMath>(
+        let local = body::feet_in_hips_with::<M>(
             &self.robot,
             &frame.pose,
             &self.config,
@@ -393,14 +413,16 @@ impl Checker {
         for leg in LegId::ALL {
             let i = leg.index();
             let mut failure: Option<FailureKind> = None;
-            if let Some((m, b)) = workspace_margin(&self.robot, local[i]).filter(|_| finite_input) {
+            if let Some((m, b)) =
+                workspace_margin_by::<M>(&self.robot, local[i]).filter(|_| finite_input)
+            {
                 let l = &mut self.report.legs[i];
                 if update(&mut l.workspace_margin_m, m, t_s, true) {
                     l.workspace_boundary = Some(b);
                 }
             }
             let solved = if finite_input {
-                leg::inverse(&self.geometric, leg, local[i], ReachPolicy::Reject)
+                leg::inverse_with::<M>(&self.geometric, leg, local[i], ReachPolicy::Reject)
                     .map(|s| s.angles)
                     .map_err(|e| e.kind)
             } else {
@@ -445,8 +467,8 @@ impl Checker {
                 );
                 continue;
             }
-            let foot = leg::forward(&self.robot.leg, leg, q);
-            if let Some((m, b)) = workspace_margin(&self.robot, foot) {
+            let foot = leg::forward_with::<M>(&self.robot.leg, leg, q);
+            if let Some((m, b)) = workspace_margin_by::<M>(&self.robot, foot) {
                 let l = &mut self.report.legs[i];
                 if update(&mut l.workspace_margin_m, m, t_s, true) {
                     l.workspace_boundary = Some(b);
@@ -488,7 +510,8 @@ impl Checker {
         if tight.0 < 0.0 {
             failure = Some(FailureKind::Unreachable(Unreachable::JointLimit(tight.1)));
         }
-        let ic = jacobian::inverse_condition(&jacobian::leg_jacobian(&self.robot.leg, leg, q));
+        let j = jacobian::leg_jacobian_with::<M>(&self.robot.leg, leg, q);
+        let ic = jacobian::inverse_condition_by::<M>(&j);
         let ic = if ic.is_finite() { ic } else { 0.0 };
         update(&mut l.inverse_condition, ic, t_s, true);
         if ic < SINGULARITY_THRESHOLD {

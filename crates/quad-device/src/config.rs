@@ -217,8 +217,8 @@ fn stance_angles<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> [f32; 12] 
 pub(crate) enum BodyFeet<'a> {
     /// At the nominal stance of the pose configuration's height.
     Stance,
-    /// At these points of the world frame, m, with the body at the zero pose (the pose
-    /// argument is not read).
+    /// At these points of the world frame, m (`SetFeet` gives the zero pose, a motion frame
+    /// its own).
     World(&'a [kin_core::Vec3; 4]),
 }
 
@@ -286,7 +286,8 @@ fn body_feet_in_hips<M: Math>(
             solver.stance_feet_in_hips_with::<M>(pose, &config, pose_config.stance_height_m)
         }
         BodyFeet::World(feet) => {
-            solver.feet_in_hips_with::<M>(&body::Pose::default(), &config, feet)
+            body::check_finite(pose, &config)?;
+            solver.feet_in_hips_with::<M>(pose, &config, feet)
         }
     })
 }

@@ -249,6 +249,7 @@ where
 
     /// One servo frame, when a frame boundary has passed: the engine's new target, then one
     /// limiter step of the outputs toward the held target.
+    #[inline(never)]
     fn frame_tick(&mut self) {
         if !self.outputs_enabled {
             return;

@@ -24,7 +24,7 @@ use super::{
     check_reach, finite, fract01, non_negative, positive, Contact, Error, Frame, Motion, Phase,
 };
 use crate::body::{BodyConfig, Pose};
-use crate::math::{wrap_pi, Math};
+use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::robot::{LegId, Robot};
 use crate::rotation::RotationOrder;
 use crate::vec::Vec3;
@@ -165,7 +165,7 @@ pub fn swing_foot_with<M: Math>(
     phase: Phase,
 ) -> Vec3 {
     let chord = touch_down - lift_off;
-    let length = libm::sqrtf(chord.x * chord.x + chord.y * chord.y);
+    let length = M::sqrt(chord.x * chord.x + chord.y * chord.y);
     let (ux, uy) = if length > 0.0 {
         (chord.x / length, chord.y / length)
     } else {
@@ -189,8 +189,13 @@ impl Gait {
     /// height ≥ 0 and below the hips; then checks that every foot reaches its neutral foothold
     /// (`stance_height_m`), its lift-off and touch-down points (the velocity command sets the
     /// stride: `velocity`) and its swing apex (`step_height_m`). [`crate::preflight`] sweeps the
-    /// whole motion.
+    /// whole motion. The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: GaitParams) -> Result<Gait, Error> {
+        Self::with_math::<DefaultMath>(p)
+    }
+
+    /// [`Gait::new`] with the reach checks on math backend `M` (a device's own).
+    pub fn with_math<M: Math>(p: GaitParams) -> Result<Gait, Error> {
         p.robot.validate()?;
         positive(p.stance_height_m, "stance_height_m")?;
         positive(p.cycle_s, "cycle_s")?;
@@ -220,13 +225,11 @@ impl Gait {
         };
         let cfg = gait.body_config();
         let zero = Pose::default();
-        check_reach(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
-        let at = |phase: f32| {
-            LegId::ALL.map(|leg| gait.foot_in_body_with::<crate::DefaultMath>(leg, phase).0)
-        };
-        check_reach(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
-        check_reach(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
-        check_reach(&p.robot, &zero, &cfg, &at(0.5 * (1.0 - d)), "step_height_m")?;
+        check_reach::<M>(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
+        let at = |phase: f32| LegId::ALL.map(|leg| gait.foot_in_body_with::<M>(leg, phase).0);
+        check_reach::<M>(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
+        check_reach::<M>(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
+        check_reach::<M>(&p.robot, &zero, &cfg, &at(0.5 * (1.0 - d)), "step_height_m")?;
         Ok(gait)
     }
 
@@ -282,9 +285,7 @@ impl Gait {
     pub fn step_length_m(&self, leg: LegId) -> f32 {
         let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
         let n = self.neutral[leg.index()];
-        (self.displaced::<crate::DefaultMath>(half, n)
-            - self.displaced::<crate::DefaultMath>(-half, n))
-        .norm()
+        (self.displaced::<DefaultMath>(half, n) - self.displaced::<DefaultMath>(-half, n)).norm()
     }
 }
 

@@ -308,24 +308,23 @@ impl Motion for AnyMotion {
     }
 }
 
-/// Checks that the four feet are reachable at `pose` (used by the constructors' quick checks);
-/// a failure is blamed on `parameter`.
-pub(crate) fn check_reach(
+/// Checks that the four feet are reachable at `pose` on backend `M` (used by the constructors'
+/// quick checks); a failure is blamed on `parameter`.
+pub(crate) fn check_reach<M: Math>(
     robot: &Robot,
     pose: &Pose,
     config: &BodyConfig,
     feet_in_world: &[Vec3; 4],
     parameter: &'static str,
 ) -> Result<(), Error> {
-    let local = body::feet_in_hips_with::<DefaultMath>(robot, pose, config, feet_in_world);
+    let local = body::feet_in_hips_with::<M>(robot, pose, config, feet_in_world);
     for leg in LegId::ALL {
-        crate::leg::inverse(robot, leg, local[leg.index()], ReachPolicy::Reject).map_err(|e| {
-            Error::BeyondReach {
+        crate::leg::inverse_with::<M>(robot, leg, local[leg.index()], ReachPolicy::Reject)
+            .map_err(|e| Error::BeyondReach {
                 parameter,
                 leg,
                 kind: e.kind,
-            }
-        })?;
+            })?;
     }
     Ok(())
 }

@@ -44,7 +44,7 @@ use super::gait::{displace_with, swing_foot_with, Gait, GaitParams, Pattern, Vel
 use super::path::PathKind;
 use super::{check_reach, finite, fract01, positive, Contact, Error, Frame, Phase};
 use crate::body::{BodyConfig, Pose};
-use crate::math::Math;
+use crate::math::{DefaultMath, Math};
 use crate::robot::{LegId, Robot};
 use crate::rotation::RotationOrder;
 use crate::vec::Vec3;
@@ -140,9 +140,15 @@ impl Walker {
 
     /// Validates the parameters (those of [`Gait::new`] at zero velocity, and `R > 0`) and the
     /// reach of the stride cylinder (module docs; a failure names `reach_radius_m`), and starts
-    /// at phase 0 standing on the neutral footholds with a zero command.
+    /// at phase 0 standing on the neutral footholds with a zero command. The reach checks run
+    /// on the [`DefaultMath`] backend.
     pub fn new(p: WalkerParams) -> Result<Walker, Error> {
-        let gait = Gait::new(p.gait_params(Velocity::default()))?;
+        Self::with_math::<DefaultMath>(p)
+    }
+
+    /// [`Walker::new`] with the reach checks on math backend `M` (a device's own).
+    pub fn with_math<M: Math>(p: WalkerParams) -> Result<Walker, Error> {
+        let gait = Gait::with_math::<M>(p.gait_params(Velocity::default()))?;
         positive(p.reach_radius_m, "reach_radius_m")?;
         let neutral = gait.neutral_feet();
         let leg = |n: Vec3| Leg {
@@ -162,7 +168,7 @@ impl Walker {
         };
         let cfg = walker.body_config();
         for k in 0..Self::ENVELOPE_SAMPLES {
-            check_reach(
+            check_reach::<M>(
                 &p.robot,
                 &Pose::default(),
                 &cfg,
@@ -243,7 +249,7 @@ impl Walker {
         for n in self.neutral {
             for s in [half, -half] {
                 let q = displace_with::<M>(v, s, n) - n;
-                e = e.max(libm::sqrtf(q.x * q.x + q.y * q.y));
+                e = e.max(M::sqrt(q.x * q.x + q.y * q.y));
             }
         }
         e
@@ -415,6 +421,10 @@ impl Walker {
 
     /// Leg `i` after a step from global phase `old` to `new` (`dt_s` long), the body moving by
     /// `scale` times the command.
+    ///
+    /// Out of line: one copy in the step's retry loop, and a small stack frame on targets
+    /// where large frames are costly (the ATmega2560).
+    #[inline(never)]
     fn advance_leg<M: Math>(&self, i: usize, old: f32, new: f32, dt_s: f32, scale: f32) -> Leg {
         let mut l = self.legs[i];
         if l.parked {

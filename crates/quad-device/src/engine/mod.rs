@@ -68,10 +68,11 @@ pub mod limiter;
 
 pub use limiter::{Limiter, Ramp, DEFAULT_JOINT_SPEED_LIMIT_RAD_S};
 
+use crate::config::{body_inverse, BodyFeet};
 use crate::store::Table;
 use core::fmt;
 use core::marker::PhantomData;
-use kin_core::body::{self, BodyConfig, Pose};
+use kin_core::body::{BodyConfig, Pose};
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
 use kin_core::motion::path::{AnyPath, PathKind, Stride};
@@ -80,7 +81,7 @@ use kin_core::motion::{self, AnyMotion, Frame, Motion};
 use kin_core::preflight::{self, Failure};
 use kin_core::{IkError, Joint, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo;
-use quad_protocol::ServoId;
+use quad_protocol::{PoseConfig, ServoId};
 
 /// One servo frame, ms.
 pub const FRAME_MS: u32 = 20;
@@ -370,7 +371,7 @@ struct Law {
     end_frame: Option<u32>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 enum Program {
     Idle,
     /// Stand-up, sit or rest: one ramp.
@@ -428,17 +429,25 @@ pub fn rest_angles(robot: &Robot) -> Result<[f32; 12], Error> {
     Ok(out)
 }
 
-/// The device's body IK of one motion frame: kin-core's [`body::inverse_with`].
+/// The body IK of one motion frame (poses in rotation order `order`, about the body centre):
+/// the device's one body IK ([`crate::config`]'s, which `SetBodyPose` and `SetFeet` use), so
+/// the firmware holds one copy of it.
 pub fn solve_frame<M: Math>(
     robot: &Robot,
-    config: &BodyConfig,
+    order: RotationOrder,
     frame: &Frame,
 ) -> Result<[f32; 12], IkError> {
-    body::inverse_with::<M>(
+    let pose_config = PoseConfig {
+        // Not read: the feet are given.
+        stance_height_m: 0.0,
+        order,
+        policy: ReachPolicy::Reject,
+    };
+    body_inverse::<M>(
         robot,
         &frame.pose,
-        config,
-        &frame.feet_in_world,
+        &pose_config,
+        BodyFeet::World(&frame.feet_in_world),
         ReachPolicy::Reject,
     )
     .map(|s| s.flat())
@@ -460,24 +469,21 @@ fn stance_angles<M: Math>(s: &Setup<'_>) -> Result<[f32; 12], Error> {
         feet_in_world: s.robot.stance_feet(s.stance_height_m),
         contact: [motion::Contact::Stance; 4],
     };
-    let config = BodyConfig {
-        order: s.order,
-        pivot_m: Vec3::ZERO,
-    };
-    let q = solve_frame::<M>(s.robot, &config, &frame).map_err(Error::Ik)?;
+    let q = solve_frame::<M>(s.robot, s.order, &frame).map_err(Error::Ik)?;
     check_travel(s.calibration, &q)?;
     Ok(q)
 }
 
-/// Sparse preflight of `frames` (module docs): kin-core's checker and the servo travel.
-fn preflight_frames(
+/// Sparse preflight of `frames` (module docs): kin-core's checker on backend `M` and the servo
+/// travel.
+fn preflight_frames<M: Math>(
     s: &Setup<'_>,
     config: BodyConfig,
     mut frame_at: impl FnMut(u16) -> Result<(f32, Frame), Error>,
     count: u16,
 ) -> Result<(), Error> {
     // Joint speeds are the limiter's business, not a reason to refuse.
-    let mut checker = preflight::Checker::new(s.robot, config, [f32::MAX; 3])?;
+    let mut checker = preflight::Checker::<M>::with_math(s.robot, config, [f32::MAX; 3])?;
     for k in 0..count {
         let (t, frame) = frame_at(k)?;
         let legs = checker.push_frame(t, &frame);
@@ -549,7 +555,8 @@ impl<M: Math> Engine<M> {
 
     /// True while a motion runs.
     pub fn is_active(&self) -> bool {
-        self.program != Program::Idle
+        // A pattern, not `!=`: comparing whole programs would compare every walker field.
+        !matches!(self.program, Program::Idle)
     }
 
     /// Validates and preflights `request` against `setup` and, when it passes, starts it: the
@@ -614,7 +621,7 @@ impl<M: Math> Engine<M> {
                 duration_s,
             } => {
                 let d = duration(duration_s)?;
-                let sway = laws::Sway::new(laws::SwayParams {
+                let sway = laws::Sway::with_math::<M>(laws::SwayParams {
                     robot,
                     axis,
                     amplitude_rad,
@@ -637,7 +644,7 @@ impl<M: Math> Engine<M> {
                 if !yaw_rate_rad_s.is_finite() {
                     return Err(motion::Error::NonFinite("yaw_rate_rad_s").into());
                 }
-                let turn = laws::YawTurn::new(laws::YawTurnParams {
+                let turn = laws::YawTurn::with_math::<M>(laws::YawTurnParams {
                     robot,
                     // Seed 001's ω_z turns clockwise (eq. 9).
                     omega_rad_s: -yaw_rate_rad_s,
@@ -662,7 +669,7 @@ impl<M: Math> Engine<M> {
             } => {
                 let d = duration(duration_s)?;
                 let stride = Stride::new(stride_m, step_height_m, duty_factor)?;
-                let paths = laws::LegPaths::new(laws::LegPathsParams {
+                let paths = laws::LegPaths::with_math::<M>(laws::LegPathsParams {
                     robot,
                     path: AnyPath::new(path, stride),
                     cycle_s,
@@ -686,7 +693,7 @@ impl<M: Math> Engine<M> {
             end_frame: d.map(|d| frames_to_boundary(d, period_s)),
         };
         let n = PREFLIGHT_SAMPLES;
-        preflight_frames(
+        preflight_frames::<M>(
             s,
             motion.body_config(),
             |k| {
@@ -708,8 +715,8 @@ impl<M: Math> Engine<M> {
         p.step_height_m = w.step_height_m;
         p.cycle_s = w.cycle_s;
         p.order = s.order;
-        let walker = Walker::new(p)?;
-        preflight_frames(
+        let walker = Walker::with_math::<M>(p)?;
+        preflight_frames::<M>(
             s,
             walker.body_config(),
             |k| {
@@ -724,8 +731,7 @@ impl<M: Math> Engine<M> {
             },
             Walker::ENVELOPE_SAMPLES as u16,
         )?;
-        let first =
-            solve_frame::<M>(s.robot, &walker.body_config(), &walker.frame()).map_err(Error::Ik)?;
+        let first = solve_frame::<M>(s.robot, s.order, &walker.frame()).map_err(Error::Ik)?;
         check_travel(s.calibration, &first)?;
         Ok((
             Program::Walk {
@@ -739,8 +745,16 @@ impl<M: Math> Engine<M> {
 
     /// The law's frame at `t_s`: the motion's frame with the legs it does not move at their
     /// stance points.
+    #[inline(never)]
     fn law_frame(law: &Law, t_s: f32) -> Result<Frame, Error> {
-        let mut f = law.motion.frame_with::<M>(t_s)?;
+        // The engine's law motions only: matching them keeps the gait's frame code out of the
+        // firmware.
+        let mut f = match &law.motion {
+            AnyMotion::Sway(m) => m.frame_with::<M>(t_s),
+            AnyMotion::YawTurn(m) => m.frame_with::<M>(t_s),
+            AnyMotion::LegPaths(m) => m.frame_with::<M>(t_s),
+            _ => Err(motion::Error::NonFinite("t_s")),
+        }?;
         for (i, moves) in law.legs.iter().enumerate() {
             if !moves {
                 f.feet_in_world[i] = law.stance_feet[i];
@@ -751,12 +765,13 @@ impl<M: Math> Engine<M> {
     }
 
     /// The law's joint setpoint at `t_s`.
+    #[inline(never)]
     fn law_setpoint(law: &Law, t_s: f32) -> Result<[f32; 12], IkError> {
         let frame = Self::law_frame(law, t_s).map_err(|_| IkError {
             leg: LegId::FL,
             kind: kin_core::Unreachable::NonFinite,
         })?;
-        solve_frame::<M>(law.motion.robot(), &law.motion.body_config(), &frame)
+        solve_frame::<M>(law.motion.robot(), law.motion.body_config().order, &frame)
     }
 
     /// Sets a walk's velocity command at `now_ms`.
@@ -843,6 +858,10 @@ impl<M: Math> Engine<M> {
 
     /// One tick after `frames` (≥ 1) frame boundaries, at `now_ms`, with the outputs at `out`:
     /// the new target, if any.
+    ///
+    /// Out of line, as are the law's frame and setpoint and the walker's steps: each keeps its
+    /// own small stack frame (see `Device`'s notes on AVR stack frames).
+    #[inline(never)]
     pub fn tick(&mut self, frames: u32, now_ms: u32, out: &[f32; 12]) -> Tick {
         let mut tick = Tick {
             target: None,
@@ -859,7 +878,8 @@ impl<M: Math> Engine<M> {
                     return tick;
                 }
                 if self.stage == Stage::Leave || matches!(self.program, Program::Pose { .. }) {
-                    tick.disable_outputs = self.program == (Program::Pose { kind: Kind::Rest });
+                    tick.disable_outputs =
+                        matches!(self.program, Program::Pose { kind: Kind::Rest });
                     self.cancel();
                     return tick;
                 }
@@ -874,7 +894,8 @@ impl<M: Math> Engine<M> {
                 tick
             }
             Stage::Run | Stage::Stopping => {
-                let result = match &mut self.program {
+                // Borrowed, not copied: a walker is a few hundred bytes of stack.
+                let (result, ended) = match &mut self.program {
                     Program::Law(law) => {
                         let mut frame = self.frame.saturating_add(frames);
                         let end = law.end_frame.filter(|&e| frame >= e);
@@ -882,14 +903,8 @@ impl<M: Math> Engine<M> {
                             frame = e;
                         }
                         self.frame = frame;
-                        let law = *law;
-                        let q = Self::law_setpoint(&law, frame as f32 * FRAME_S);
-                        if end.is_some() {
-                            if let Ok(q) = q {
-                                self.leave(q);
-                            }
-                        }
-                        q
+                        let q = Self::law_setpoint(law, frame as f32 * FRAME_S);
+                        (q, end.is_some())
                     }
                     Program::Walk {
                         walker,
@@ -905,24 +920,21 @@ impl<M: Math> Engine<M> {
                             let _ = walker.step::<M>(FRAME_S);
                         }
                         self.frame = self.frame.saturating_add(frames);
-                        let walker = *walker;
                         let q = solve_frame::<M>(
                             &walker.params().robot,
-                            &walker.body_config(),
+                            walker.params().order,
                             &walker.frame(),
                         );
-                        if walker.is_stopped() {
-                            if let Ok(q) = q {
-                                self.leave(q);
-                            }
-                        }
-                        q
+                        (q, walker.is_stopped())
                     }
                     _ => {
                         self.cancel();
                         return tick;
                     }
                 };
+                if let (true, Ok(q)) = (ended, result) {
+                    self.leave(q);
+                }
                 match result {
                     Ok(q) => tick.target = Some(q),
                     Err(e) => self.fail(Error::Ik(e), *out),
