@@ -431,6 +431,32 @@ where
             }
             Request::SaveCalibration => self.save_calibration(),
             Request::SetPoseConfig(p) => self.set_pose_config(p),
+            Request::SetJointSpeedLimit {
+                joint_speed_limit_rad_s,
+            } => self
+                .set_joint_speed_limit(joint_speed_limit_rad_s)
+                .map_err(NackReason::from),
+            Request::StartMotion(m) => {
+                let r = self.start_motion(&engine::Request::from(m));
+                return self.motion_answer(seq, r);
+            }
+            Request::StopMotion => {
+                self.stop_motion();
+                return self.motion_answer(seq, Ok(()));
+            }
+            Request::GetMotion => return self.motion_answer(seq, Ok(())),
+            Request::SetVelocity {
+                forward_m_s,
+                lateral_m_s,
+                yaw_rate_rad_s,
+            } => {
+                let r = self.set_velocity(Velocity {
+                    forward_m_s,
+                    lateral_m_s,
+                    yaw_rad_s: yaw_rate_rad_s,
+                });
+                return self.motion_answer(seq, r);
+            }
         };
         match result {
             Ok(()) => DeviceToHost::Ack {
@@ -438,6 +464,20 @@ where
                 readback: self.readback(),
             },
             Err(reason) => nack(Some(seq), reason),
+        }
+    }
+
+    /// The answer to a motion request: `MotionAck` with the engine's status and the readback,
+    /// or the nack of `result`'s error. Out of line: one instance for the four requests.
+    #[inline(never)]
+    fn motion_answer(&self, seq: u16, result: Result<(), engine::Error>) -> DeviceToHost {
+        match result {
+            Ok(()) => DeviceToHost::MotionAck {
+                seq,
+                status: self.engine.status().into(),
+                readback: self.readback(),
+            },
+            Err(e) => nack(Some(seq), e.into()),
         }
     }
 

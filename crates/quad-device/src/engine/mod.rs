@@ -65,6 +65,7 @@
 //! and [`Status::fault`] tells why.
 
 pub mod limiter;
+pub mod protocol;
 
 pub use limiter::{Limiter, Ramp, DEFAULT_JOINT_SPEED_LIMIT_RAD_S};
 
