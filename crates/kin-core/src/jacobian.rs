@@ -73,6 +73,7 @@ pub fn inverse_condition(j: &Mat3) -> f32 {
 }
 
 /// [`inverse_condition`] on math backend `M` (the preflight of a device runs on its own).
+#[inline(never)]
 pub(crate) fn inverse_condition_by<M: Math>(j: &Mat3) -> f32 {
     let jt = j.transpose();
     let a = jt.mul_mat(j); // symmetric positive semi-definite
@@ -85,6 +86,7 @@ pub(crate) fn inverse_condition_by<M: Math>(j: &Mat3) -> f32 {
 }
 
 /// Eigenvalues of a symmetric 3×3 matrix, ascending (trigonometric closed form).
+#[inline(never)]
 fn symmetric_eigenvalues<M: Math>(a: &[[f32; 3]; 3]) -> [f32; 3] {
     let p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
     let tr = a[0][0] + a[1][1] + a[2][2];

@@ -127,6 +127,7 @@ pub fn workspace_margin(robot: &Robot, foot_in_hip: Vec3) -> Option<(f32, Bounda
 }
 
 /// [`workspace_margin`] on math backend `M`.
+#[inline(never)]
 fn workspace_margin_by<M: Math>(robot: &Robot, foot_in_hip: Vec3) -> Option<(f32, Boundary)> {
     if !foot_in_hip.is_finite() {
         return None;
@@ -342,6 +343,10 @@ impl Report {
 
 /// Incremental preflight on math backend `M`: push samples in time order, then
 /// [`Checker::finish`].
+///
+/// A device preflights motions with it; its pieces (workspace margin, joint metrics, the
+/// Jacobian's eigenvalues) stay out of line so that each keeps a small stack frame, which on
+/// the ATmega2560 saves the frame-pointer adjustments of every access beyond 63 bytes.
 #[derive(Debug, Clone, Copy)]
 pub struct Checker<M = DefaultMath> {
     robot: Robot,
@@ -492,6 +497,7 @@ impl<M: Math> Checker<M> {
     }
 
     /// Joint margin, singularity and speed of one leg; the first failure among them.
+    #[inline(never)]
     fn angles_metrics(&mut self, leg: LegId, t_s: f32, q: JointAngles) -> Option<FailureKind> {
         let i = leg.index();
         let mut failure = None;
@@ -538,6 +544,7 @@ impl<M: Math> Checker<M> {
         failure
     }
 
+    #[inline(never)]
     fn record(&mut self, sample: u32, t_s: f32, leg: LegId, kind: FailureKind) {
         let f = Failure {
             sample,

@@ -406,6 +406,7 @@ pub struct Engine<M> {
 /// knee [`REST_KNEE_MARGIN_RAD`] short of the folded end of its range, hip at minus half the
 /// knee, which puts each foot below its hip joint. The body then rests low, on the ground or on
 /// its folded legs. Refused when a joint limit excludes it.
+#[inline(never)]
 pub fn rest_angles(robot: &Robot) -> Result<[f32; 12], Error> {
     let l = &robot.limits;
     let knee = match robot.knee_bend {
@@ -455,6 +456,7 @@ pub fn solve_frame<M: Math>(
 }
 
 /// Checks that `angles` map within every servo's calibrated travel.
+#[inline(never)]
 pub fn check_travel(calibration: &Table, angles: &[f32; 12]) -> Result<(), Error> {
     for (s, (c, &a)) in ServoId::ALL.iter().zip(calibration.iter().zip(angles)) {
         c.pulse_half_us(a)
@@ -464,6 +466,7 @@ pub fn check_travel(calibration: &Table, angles: &[f32; 12]) -> Result<(), Error
 }
 
 /// The stance angles of a setup: the nominal stance at its height, zero pose.
+#[inline(never)]
 fn stance_angles<M: Math>(s: &Setup<'_>) -> Result<[f32; 12], Error> {
     let frame = Frame {
         pose: Pose::default(),
@@ -477,6 +480,7 @@ fn stance_angles<M: Math>(s: &Setup<'_>) -> Result<[f32; 12], Error> {
 
 /// Sparse preflight of `frames` (module docs): kin-core's checker on backend `M` and the servo
 /// travel.
+#[inline(never)]
 fn preflight_frames<M: Math>(
     s: &Setup<'_>,
     config: BodyConfig,
@@ -611,6 +615,7 @@ impl<M: Math> Engine<M> {
     }
 
     /// Builds and preflights a law motion.
+    #[inline(never)]
     fn law(request: &Request, s: &Setup<'_>) -> Result<Law, Error> {
         let robot = *s.robot;
         let stance = robot.stance_feet(s.stance_height_m);
@@ -708,6 +713,7 @@ impl<M: Math> Engine<M> {
     }
 
     /// Builds and preflights a walk; its first setpoint.
+    #[inline(never)]
     fn walk(w: &WalkRequest, s: &Setup<'_>) -> Result<(Program, [f32; 12]), Error> {
         if w.velocity_timeout_ms == 0 {
             return Err(motion::Error::NotPositive("velocity_timeout_ms").into());
