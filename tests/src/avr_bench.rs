@@ -639,8 +639,7 @@ pub fn run() -> Report {
             sram_static_bytes: sizes.sram_static_bytes,
             max_stack_bytes: stack as u64,
             trot_frame_cycles: motions[0].max_cycles,
-            trot_frame_share_pct: 100.0 * motions[0].max_cycles as f64
-                / SERVO_FRAME_CYCLES as f64,
+            trot_frame_share_pct: 100.0 * motions[0].max_cycles as f64 / SERVO_FRAME_CYCLES as f64,
         },
         motions,
         backends,
