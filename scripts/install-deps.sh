@@ -3,6 +3,10 @@
 #
 #   - Debian packages: the AVR toolchain (firmware link), simavr and the libraries its Rust
 #     bindings build against (emulator tests), libudev (serial ports / flashing).
+#   - the physics twin: Python's venv module and the libraries of MuJoCo's offscreen
+#     rendering (EGL, and OSMesa as the software fallback), then a virtual environment
+#     `.venv-twin` at the repository root with the pinned packages of twin/requirements.txt
+#     (recreated only when that file changes).
 #   - rustup: the `nightly` toolchain with `rust-src` (no_std build for avr-none with
 #     `-Z build-std=core`), and clippy + rustfmt on `stable` (rust-toolchain.toml).
 #
@@ -16,6 +20,7 @@ APT_PACKAGES=(
     simavr
     libudev-dev
     fonts-dejavu-core
+    python3 python3-venv libegl1 libosmesa6
 )
 NIGHTLY=nightly
 STABLE_COMPONENTS=(clippy rustfmt)
@@ -78,4 +83,21 @@ if [ "${#stable_missing[@]}" -gt 0 ]; then
     rustup component add "${stable_missing[@]}" --toolchain stable </dev/null
 else
     echo "install-deps: stable with ${STABLE_COMPONENTS[*]} present"
+fi
+
+# --- Physics twin: Python virtual environment ------------------------------------------------
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+VENV="$ROOT/.venv-twin"
+REQUIREMENTS="$ROOT/twin/requirements.txt"
+STAMP="$VENV/.requirements.sha256"
+want=$(sha256sum "$REQUIREMENTS" | cut -d' ' -f1)
+have=$(cat "$STAMP" 2>/dev/null || true)
+if [ -x "$VENV/bin/python" ] && [ "$want" = "$have" ]; then
+    echo "install-deps: twin environment .venv-twin present"
+else
+    echo "install-deps: creating .venv-twin from twin/requirements.txt"
+    rm -rf "$VENV"
+    python3 -m venv "$VENV"
+    "$VENV/bin/pip" install --quiet --disable-pip-version-check -r "$REQUIREMENTS" </dev/null
+    echo "$want" >"$STAMP"
 fi

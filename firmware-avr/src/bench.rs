@@ -73,21 +73,22 @@ pub fn leg_with<M: Math>(
     leg_id: LegId,
     foot_in_hip: Vec3,
 ) -> Result<[f32; 3], IkError> {
-    leg::inverse_with::<M>(robot, leg_id, foot_in_hip, ReachPolicy::Reject)
+    leg::Solver::<M>::with_math(robot)
+        .inverse(leg_id, foot_in_hip, ReachPolicy::Reject)
         .map(|s| s.angles.to_array())
 }
 
 /// kin-core's body IK at the stance on backend `M`.
 #[inline(never)]
 pub fn body_with<M: Math>(robot: &Robot, pose: &Pose) -> Result<[f32; 12], IkError> {
-    body::inverse_at_stance_with::<M>(
-        robot,
-        pose,
-        &BodyConfig::default(),
-        STANCE_HEIGHT_M,
-        ReachPolicy::Reject,
-    )
-    .map(|s| s.flat())
+    body::Solver::<M>::with_math(robot)
+        .inverse_at_stance(
+            pose,
+            &BodyConfig::default(),
+            STANCE_HEIGHT_M,
+            ReachPolicy::Reject,
+        )
+        .map(|s| s.flat())
 }
 
 const STATUS_OK: u8 = 0;

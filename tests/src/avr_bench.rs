@@ -13,12 +13,12 @@
 //!   forward kinematics (written from the chain formula in kin-core's crate docs), started
 //!   from the host's f32 solution, to a residual below [`REFERENCE_RESIDUAL_M`].
 
-use host_tools::client::{Client, ClientConfig};
-use host_tools::emu::{build, elf, Mega2560, MARKER_PIN};
-use host_tools::link::emulator::{EmulatorConfig, EmulatorLink};
 use kin_core::math::Libm;
 use kin_core::{body, BodyConfig, LegId, Pose, ReachPolicy, Robot, Vec3};
 use nalgebra::{Matrix3, Rotation3, Vector3};
+use quad_host::client::{Client, ClientConfig};
+use quad_host::emu::{build, elf, Mega2560, MARKER_PIN};
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::{DeviceToHost, PoseConfig, Request};
 use seeded_rng::SplitMix64;
 use serde::Serialize;
@@ -108,14 +108,9 @@ pub fn targets() -> Targets {
             y_m: ty,
             z_m: tz,
         };
-        if body::inverse_at_stance_with::<Libm>(
-            &robot,
-            &pose,
-            &config,
-            STANCE_HEIGHT_M,
-            ReachPolicy::Reject,
-        )
-        .is_ok()
+        if body::Solver::<Libm>::with_math(&robot)
+            .inverse_at_stance(&pose, &config, STANCE_HEIGHT_M, ReachPolicy::Reject)
+            .is_ok()
         {
             poses.push(pose);
         }
@@ -125,8 +120,7 @@ pub fn targets() -> Targets {
         .enumerate()
         .map(|(i, pose)| {
             let leg = LegId::ALL[i % 4];
-            let local = body::feet_in_hips_with::<Libm>(
-                &robot,
+            let local = body::Solver::<Libm>::with_math(&robot).feet_in_hips(
                 pose,
                 &config,
                 &robot.stance_feet(STANCE_HEIGHT_M),
@@ -392,7 +386,8 @@ pub fn measure_backend(
     for &(leg, foot) in &targets.legs {
         let (c, angles) = fw.leg(backend, leg, foot);
         let angles = angles.unwrap_or_else(|| panic!("{elf_name}: leg target unreachable"));
-        let host = kin_core::leg::inverse_with::<Libm>(&robot, leg, foot, ReachPolicy::Reject)
+        let host = kin_core::leg::Solver::<Libm>::with_math(&robot)
+            .inverse(leg, foot, ReachPolicy::Reject)
             .expect("host solves the leg target")
             .angles
             .to_array();
@@ -406,15 +401,10 @@ pub fn measure_backend(
     for pose in &targets.poses {
         let (c, angles) = fw.body(backend, pose);
         let angles = angles.unwrap_or_else(|| panic!("{elf_name}: pose unreachable"));
-        let host = body::inverse_at_stance_with::<Libm>(
-            &robot,
-            pose,
-            &config,
-            STANCE_HEIGHT_M,
-            ReachPolicy::Reject,
-        )
-        .expect("host solves the pose")
-        .flat();
+        let host = body::Solver::<Libm>::with_math(&robot)
+            .inverse_at_stance(pose, &config, STANCE_HEIGHT_M, ReachPolicy::Reject)
+            .expect("host solves the pose")
+            .flat();
         let reference = reference_body(&robot, pose, &host);
         err = err.max(max_abs_diff(&angles, &reference));
         host_diff = host_diff.max(max_abs_diff(&angles, &host.map(|v| v as f64)));
@@ -432,9 +422,9 @@ pub fn measure_backend(
     }
 }
 
-pub use host_tools::emu::elf::ElfSizes;
+pub use quad_host::emu::elf::ElfSizes;
 
-/// Flash and static SRAM of an ELF (`host_tools::emu::elf`).
+/// Flash and static SRAM of an ELF (`quad_host::emu::elf`).
 pub fn elf_sizes(path: &Path) -> ElfSizes {
     elf::sizes(path).unwrap_or_else(|e| panic!("{e}"))
 }

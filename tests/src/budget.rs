@@ -7,10 +7,10 @@
 //! for what comes next, and keeps an eye on growth: flash ≤ [`FLASH_BUDGET_BYTES`], static SRAM
 //! plus the worst stack ≤ [`SRAM_BUDGET_BYTES`].
 
-use host_tools::client::{Client, ClientConfig};
-use host_tools::emu::elf;
-use host_tools::link::emulator::{EmulatorConfig, EmulatorLink};
 use kin_core::{LegId, Pose, ReachPolicy, RotationOrder};
+use quad_host::client::{Client, ClientConfig};
+use quad_host::emu::elf;
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::{
     DeviceToHost, LinkLossAction, LinkTimeout, PoseConfig, Request, ServoId, PROTOCOL_VERSION,
 };

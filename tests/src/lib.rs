@@ -3,7 +3,7 @@
 //! - [`avr_bench`]: the firmware's IK cycle benchmark (`cargo xtask avr-bench`).
 //! - [`budget`]: the firmware's flash and SRAM against its budget (`cargo xtask ci budget`).
 //!
-//! Building the firmware and running it in simavr is `host_tools::emu` (one implementation
+//! Building the firmware and running it in simavr is `quad_host::emu` (one implementation
 //! for these tests and `quadctl`).
 
 pub mod avr_bench;

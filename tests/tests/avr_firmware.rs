@@ -3,25 +3,25 @@
 //! and calibration, refusals, unreadable frames, the link-loss failsafe, a soak with line
 //! corruption, and the watchdog.
 //!
-//! The firmware is built once per test process (`host_tools::emu::build`, nightly toolchain
+//! The firmware is built once per test process (`quad_host::emu::build`, nightly toolchain
 //! via `firmware-avr/rust-toolchain.toml`); a test fails — never skips — when it cannot be
 //! built. All times are simulated.
 
-use host_tools::client::{
-    AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
-};
-use host_tools::emu::{build, elf, Pulse, CYCLES_PER_TICK, PERIOD_CYCLES, SERVO_PINS};
-use host_tools::link::emulator::{EmulatorConfig, EmulatorLink};
-use host_tools::link::sim::Rng;
-use host_tools::link::{Faults, Link};
 use integration_tests::avr_bench::{self, STACK_PAINT, STANCE_HEIGHT_M};
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, ReachPolicy, RotationOrder};
+use kin_core::{BodyConfig, ReachPolicy, RotationOrder};
+use quad_host::client::{
+    AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
+};
+use quad_host::emu::{build, elf, Pulse, CYCLES_PER_TICK, PERIOD_CYCLES, SERVO_PINS};
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
+use quad_host::link::{Faults, Link};
 use quad_protocol::{
     encode_frame, Accumulator, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction,
     LinkTimeout, NackReason, Request, RobotPreset, MAX_DECODED_LEN, MAX_FRAME_LEN,
     PROTOCOL_VERSION,
 };
+use seeded_rng::SplitMix64 as Rng;
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::Duration;
@@ -77,15 +77,15 @@ fn connect(link: EmulatorLink) -> PoseStream<EmulatorLink> {
 /// The twelve pulse widths the host expects for `pose`: its own kin-core IK mapped through the
 /// device's calibration, in timer ticks.
 fn host_pulses(stream: &PoseStream<EmulatorLink>, pose: &Pose) -> [u16; 12] {
-    let angles = body::inverse_at_stance_with::<DefaultMath>(
-        &avr_bench::robot(),
-        pose,
-        &BodyConfig::default(),
-        STANCE_HEIGHT_M,
-        ReachPolicy::Reject,
-    )
-    .expect("the host solves the pose")
-    .flat();
+    let angles = body::Solver::new(&avr_bench::robot())
+        .inverse_at_stance(
+            pose,
+            &BodyConfig::default(),
+            STANCE_HEIGHT_M,
+            ReachPolicy::Reject,
+        )
+        .expect("the host solves the pose")
+        .flat();
     std::array::from_fn(|i| {
         stream.calibration()[i]
             .pulse_half_us(angles[i])
@@ -455,8 +455,8 @@ fn link_loss_stops_the_outputs_within_the_timeout() {
     let timeout = Duration::from_millis(TIMEOUT_MS);
     for (ch, p) in link.last_pulses().iter().enumerate() {
         let p = p.unwrap_or_else(|| panic!("channel {ch} pulsed before the link loss"));
-        let rise = host_tools::emu::cycles_to_duration(p.rise_cycle);
-        let period = host_tools::emu::cycles_to_duration(PERIOD_CYCLES);
+        let rise = quad_host::emu::cycles_to_duration(p.rise_cycle);
+        let period = quad_host::emu::cycles_to_duration(PERIOD_CYCLES);
         assert!(
             rise + period >= sent + timeout,
             "channel {ch}: pulses stopped at {rise:?}, before the timeout"
@@ -496,14 +496,14 @@ fn soak_poses(n: usize) -> Vec<Pose> {
             y_m: rng.range(-0.02, 0.02) as f32,
             z_m: rng.range(-0.02, 0.02) as f32,
         };
-        if body::inverse_at_stance_with::<DefaultMath>(
-            &robot,
-            &pose,
-            &BodyConfig::default(),
-            STANCE_HEIGHT_M,
-            ReachPolicy::Reject,
-        )
-        .is_ok()
+        if body::Solver::new(&robot)
+            .inverse_at_stance(
+                &pose,
+                &BodyConfig::default(),
+                STANCE_HEIGHT_M,
+                ReachPolicy::Reject,
+            )
+            .is_ok()
         {
             out.push(pose);
         }
@@ -599,7 +599,7 @@ fn watchdog_is_on_survives_a_long_eeprom_save_and_resets_a_hung_cpu() {
         MCUSR_WDRF,
         "by the watchdog"
     );
-    let after = host_tools::emu::cycles_to_duration(resets.last_cycle.expect("reset"));
+    let after = quad_host::emu::cycles_to_duration(resets.last_cycle.expect("reset"));
     let hung = after - hang_at;
     // The watchdog's own oscillator in simavr is exact; the last feed was shortly before.
     assert!(

@@ -22,7 +22,8 @@ fn body_ik(c: &mut Criterion) {
     let poses = common::body_poses();
     let n = poses.len();
     for p in &poses {
-        body::inverse_at_stance(&robot, p, &config, height_m, ReachPolicy::Reject)
+        body::Solver::new(&robot)
+            .inverse_at_stance(p, &config, height_m, ReachPolicy::Reject)
             .expect("seed 000 pose ranges are reachable at the nominal stance");
     }
 
@@ -34,8 +35,7 @@ fn body_ik(c: &mut Criterion) {
         b.iter(|| {
             let p = &poses[i];
             i = if i + 1 == n { 0 } else { i + 1 };
-            black_box(body::inverse_at_stance(
-                black_box(&robot),
+            black_box(body::Solver::new(black_box(&robot)).inverse_at_stance(
                 black_box(p),
                 black_box(&config),
                 black_box(height_m),
@@ -62,13 +62,14 @@ fn body_ik(c: &mut Criterion) {
         b.iter(|| {
             let p = &poses[i];
             i = if i + 1 == n { 0 } else { i + 1 };
-            black_box(body::inverse_at_stance_with::<Libm>(
-                black_box(&robot),
-                black_box(p),
-                black_box(&config),
-                black_box(height_m),
-                ReachPolicy::Reject,
-            ))
+            black_box(
+                body::Solver::<Libm>::with_math(black_box(&robot)).inverse_at_stance(
+                    black_box(p),
+                    black_box(&config),
+                    black_box(height_m),
+                    ReachPolicy::Reject,
+                ),
+            )
         });
     });
     group.finish();

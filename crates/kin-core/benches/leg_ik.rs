@@ -133,7 +133,8 @@ fn leg_ik(c: &mut Criterion) {
     let n = targets.len();
     // Every target must be solved by kin-core (the set is reachable by construction).
     for t in &targets {
-        leg::inverse(&robots[t.robot], t.leg, t.foot_in_hip, ReachPolicy::Reject)
+        leg::Solver::new(&robots[t.robot])
+            .inverse(t.leg, t.foot_in_hip, ReachPolicy::Reject)
             .expect("generated target is reachable");
     }
     let inputs: Vec<(usize, LegId, kin_core::Vec3)> = targets
@@ -149,12 +150,7 @@ fn leg_ik(c: &mut Criterion) {
         b.iter(|| {
             let (r, leg, p) = *black_box(&inputs[i]);
             i = if i + 1 == n { 0 } else { i + 1 };
-            black_box(leg::inverse(
-                black_box(&robots[r]),
-                leg,
-                p,
-                ReachPolicy::Reject,
-            ))
+            black_box(leg::Solver::new(black_box(&robots[r])).inverse(leg, p, ReachPolicy::Reject))
         });
     });
     let solvers = robots.map(|r| leg::Solver::new(&r));
@@ -171,12 +167,13 @@ fn leg_ik(c: &mut Criterion) {
         b.iter(|| {
             let (r, leg, p) = *black_box(&inputs[i]);
             i = if i + 1 == n { 0 } else { i + 1 };
-            black_box(leg::inverse_with::<Libm>(
-                black_box(&robots[r]),
-                leg,
-                p,
-                ReachPolicy::Reject,
-            ))
+            black_box(
+                leg::Solver::<Libm>::with_math(black_box(&robots[r])).inverse(
+                    leg,
+                    p,
+                    ReachPolicy::Reject,
+                ),
+            )
         });
     });
 

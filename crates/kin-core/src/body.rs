@@ -8,7 +8,7 @@
 //! - `foot_in_world = R·(hip_in_body + foot_in_hip − c) + c + t` (forward)
 
 use crate::leg::{self, IkError, LegSolution, ReachPolicy};
-use crate::math::{cmp, DefaultMath, Math};
+use crate::math::{finite, DefaultMath, Math};
 use crate::robot::{JointAngles, LegId, Robot};
 use crate::rotation::{self, RotationOrder};
 use crate::vec::{Mat3, Vec3};
@@ -90,6 +90,16 @@ pub struct BodyConfig {
     pub pivot_m: Vec3,
 }
 
+impl BodyConfig {
+    /// Rotations in `order` about the body centre (no pivot).
+    pub const fn about_centre(order: RotationOrder) -> BodyConfig {
+        BodyConfig {
+            order,
+            pivot_m: Vec3::ZERO,
+        }
+    }
+}
+
 /// Twelve joint angles, in leg order FL, FR, RL, RR.
 pub type BodyAngles = [JointAngles; 4];
 
@@ -136,9 +146,8 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
     core::array::from_fn(|i| JointAngles::new(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]))
 }
 
-/// Full-body IK with the robot's constants prepared once (the leg IK's [`leg::Solver`], the
-/// hip mounts). The free functions ([`inverse_with`], [`inverse_at_stance_with`], …) build
-/// one per call; a caller that solves many poses of one robot keeps one:
+/// Full-body IK on math backend `M` with the robot's constants prepared once (the leg IK's
+/// [`leg::Solver`], the hip mounts). A caller that solves many poses of one robot keeps one:
 ///
 /// ```
 /// use kin_core::{body, BodyConfig, Pose, ReachPolicy, Robot};
@@ -148,21 +157,40 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
 /// # Ok::<(), kin_core::IkError>(())
 /// ```
 ///
-/// Results are bit for bit those of the free functions. [`Solver::new`] is a `const fn`, so a
-/// firmware can build its solver at compile time:
+/// [`Solver::new`] takes the [`DefaultMath`] backend, [`Solver::with_math`] any other; both
+/// are `const fn`, so a firmware can build its solver at compile time:
 ///
 /// ```
-/// use kin_core::{body, Robot};
-/// const SOLVER: body::Solver = body::Solver::new(&Robot::shahriar2023());
+/// use kin_core::{body, math::SoftFloat, Robot};
+/// const SOLVER: body::Solver<SoftFloat> = body::Solver::with_math(&Robot::shahriar2023());
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Solver {
-    leg: leg::Solver,
-    /// `length/2` and `width/2`: the hip mounts are `(±length/2, ±width/2, 0)`.
-    half_length_m: f32,
-    half_width_m: f32,
+pub struct Solver<M: Math = DefaultMath> {
+    leg: leg::Solver<M>,
+    /// The front left hip mount `(length/2, width/2, 0)`; the others by [`LegId::at_corner`].
+    hip_fl_m: Vec3,
     /// `width/2 + d_lat`: the stance foot's lateral distance from the body's centre line.
     stance_lateral_m: f32,
+}
+
+// By hand: derives would ask the backend type (never a value here) for the same traits.
+impl<M: Math> Clone for Solver<M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<M: Math> Copy for Solver<M> {}
+impl<M: Math> PartialEq for Solver<M> {
+    fn eq(&self, other: &Self) -> bool {
+        (self.leg, self.hip_fl_m) == (other.leg, other.hip_fl_m)
+    }
+}
+impl<M: Math> core::fmt::Debug for Solver<M> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Solver")
+            .field("leg", &self.leg)
+            .field("hip_fl_m", &self.hip_fl_m)
+            .finish()
+    }
 }
 
 /// True when `v` is (±0, ±0, ±0), from the bits (no float comparison).
@@ -172,52 +200,43 @@ fn is_zero(v: Vec3) -> bool {
     (v.x.to_bits() | v.y.to_bits() | v.z.to_bits()) & ABS == 0
 }
 
-impl Solver {
-    /// The constants of `robot`.
+impl Solver<DefaultMath> {
+    /// The body IK of `robot` on the [`DefaultMath`] backend.
     #[inline]
     pub const fn new(robot: &Robot) -> Solver {
-        let half_width_m = 0.5 * robot.body_width_m;
+        Solver::with_math(robot)
+    }
+}
+
+impl<M: Math> Solver<M> {
+    /// The body IK of `robot` on backend `M`.
+    #[inline]
+    pub const fn with_math(robot: &Robot) -> Solver<M> {
+        let hip_fl_m = robot.hip_in_body(LegId::FL);
         Solver {
-            leg: leg::Solver::new(robot),
-            half_length_m: 0.5 * robot.body_length_m,
-            half_width_m,
-            stance_lateral_m: half_width_m + robot.leg.d_lat_m,
+            leg: leg::Solver::with_math(robot),
+            hip_fl_m,
+            stance_lateral_m: hip_fl_m.y + robot.leg.d_lat_m,
         }
     }
 
     /// The leg IK of this robot.
     #[inline]
-    pub fn leg(&self) -> &leg::Solver {
+    pub fn leg(&self) -> &leg::Solver<M> {
         &self.leg
-    }
-
-    /// Hip mount of `leg` in the body frame, as [`Robot::hip_in_body`].
-    #[inline(always)]
-    fn hip_in_body(&self, leg: LegId) -> Vec3 {
-        let x = if leg.is_front() {
-            self.half_length_m
-        } else {
-            -self.half_length_m
-        };
-        let y = if leg.is_left() {
-            self.half_width_m
-        } else {
-            -self.half_width_m
-        };
-        Vec3::new(x, y, 0.0)
     }
 
     /// Feet in the world frame → feet in each leg's hip frame:
     /// `Rᵀ·(foot_in_world − t − c) + c − hip_in_body`.
     #[inline]
-    pub fn feet_in_hips_with<M: Math>(
+    pub fn feet_in_hips(
         &self,
         pose: &Pose,
         config: &BodyConfig,
         feet_in_world: &[Vec3; 4],
     ) -> [Vec3; 4] {
         let r: Mat3 =
-            rotation::matrix_with::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+            rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
         let c = config.pivot_m;
         let pivot = !is_zero(c);
         let offset = if pivot {
@@ -233,7 +252,7 @@ impl Solver {
             if pivot {
                 p = p + c;
             }
-            let hip = self.hip_in_body(leg);
+            let hip = leg.at_corner(self.hip_fl_m);
             out[i] = Vec3::new(p.x - hip.x, p.y - hip.y, p.z);
         }
         out
@@ -241,28 +260,25 @@ impl Solver {
 
     /// The feet of the nominal stance of height `stance_height_m`
     /// (`foot_in_world = hip_in_body + (0, s·d_lat, −H)`) in each leg's hip frame: the
-    /// transform of [`Solver::feet_in_hips_with`] in closed form. With `R`'s rows `r₀, r₁, r₂`,
+    /// transform of [`Solver::feet_in_hips`] in closed form. With `R`'s rows `r₀, r₁, r₂`,
     /// `foot_in_hip = sx·(L/2·r₀ − (L/2, 0, 0)) + s·((W/2 + d_lat)·r₁ − (0, W/2, 0)) − K` for the
-    /// front/rear sign `sx`, the side sign `s` and `K = Rᵀ·(t + c + (0, 0, H)) − c`: 15
-    /// multiplications and 27 additions for the four feet (9 and 20 without translation and
-    /// pivot) instead of 36 and 60.
+    /// front/rear sign `sx`, the side sign `s` and `K = Rᵀ·(t + c + (0, 0, H)) − c`: fewer
+    /// operations than the general transform (counted in `BENCHMARKS.md`).
     #[inline]
-    pub fn stance_feet_in_hips_with<M: Math>(
+    fn stance_feet_in_hips(
         &self,
         pose: &Pose,
         config: &BodyConfig,
         stance_height_m: f32,
     ) -> [Vec3; 4] {
         let r: Mat3 =
-            rotation::matrix_with::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+            rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
         let [r0, r1, r2] = r.rows.map(Vec3::from_array);
         let c = config.pivot_m;
         let pivot = !is_zero(c);
         let t = pose.translation();
         // K = Rᵀ·(t + c) + H·r₂ − c.
-        // The ATmega2560 keeps only the general arm (-168 B of flash): the same feet, but for
-        // the sign of a component that is zero in both.
-        let k = if !cfg!(target_arch = "avr") && !pivot && is_zero(t) {
+        let k = if !pivot && is_zero(t) {
             r2 * stance_height_m
         } else {
             let g = if pivot { t + c } else { t };
@@ -273,11 +289,11 @@ impl Solver {
                 k
             }
         };
-        let hl = self.half_length_m;
+        let hl = self.hip_fl_m.x;
         let a = r0 * hl;
         let a = Vec3::new(a.x - hl, a.y, a.z);
         let b = r1 * self.stance_lateral_m;
-        let b = Vec3::new(b.x, b.y - self.half_width_m, b.z);
+        let b = Vec3::new(b.x, b.y - self.hip_fl_m.y, b.z);
         // Front: a − K ± b; rear: −(a + K) ± b (left +, right −).
         let front = a - k;
         let rear = -(a + k);
@@ -285,21 +301,8 @@ impl Solver {
     }
 
     /// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
-    /// rejects the pose and is named in the error.
-    #[inline]
-    pub fn inverse_with<M: Math>(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        feet_in_world: &[Vec3; 4],
-        policy: ReachPolicy,
-    ) -> Result<BodySolution, IkError> {
-        check_finite(pose, config)?;
-        let local = self.feet_in_hips_with::<M>(pose, config, feet_in_world);
-        self.legs::<M>(&local, policy)
-    }
-
-    /// [`Solver::inverse_with`] on the [`DefaultMath`] backend.
+    /// rejects the pose and is named in the error; a non-finite pose or pivot is
+    /// [`leg::Unreachable::NonFinite`] named on FL.
     #[inline]
     pub fn inverse(
         &self,
@@ -308,25 +311,15 @@ impl Solver {
         feet_in_world: &[Vec3; 4],
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
-        self.inverse_with::<DefaultMath>(pose, config, feet_in_world, policy)
+        check_finite(pose, config)?;
+        let local = self.feet_in_hips(pose, config, feet_in_world);
+        self.legs(&local, policy)
     }
 
     /// Body pose with the feet held at the nominal stance of height `stance_height_m`
-    /// (through [`Solver::stance_feet_in_hips_with`]).
-    #[inline]
-    pub fn inverse_at_stance_with<M: Math>(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        stance_height_m: f32,
-        policy: ReachPolicy,
-    ) -> Result<BodySolution, IkError> {
-        check_finite(pose, config)?;
-        let local = self.stance_feet_in_hips_with::<M>(pose, config, stance_height_m);
-        self.legs::<M>(&local, policy)
-    }
-
-    /// [`Solver::inverse_at_stance_with`] on the [`DefaultMath`] backend.
+    /// ([`Robot::stance_feet`]), through the closed-form transform of the stance feet (the
+    /// same angles as [`Solver::inverse`] with those feet up to f32 rounding). Errors as
+    /// [`Solver::inverse`].
     #[inline]
     pub fn inverse_at_stance(
         &self,
@@ -335,35 +328,34 @@ impl Solver {
         stance_height_m: f32,
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
-        self.inverse_at_stance_with::<DefaultMath>(pose, config, stance_height_m, policy)
+        check_finite(pose, config)?;
+        let local = self.stance_feet_in_hips(pose, config, stance_height_m);
+        self.legs(&local, policy)
     }
 
-    /// The four leg solves of feet already in their hips' frames (from
-    /// [`Solver::feet_in_hips_with`] or [`Solver::stance_feet_in_hips_with`]):
-    /// [`Solver::inverse_with`] is [`check_finite`], [`Solver::feet_in_hips_with`] and this.
+    /// The body at the zero pose with its feet at `feet_in_body` (body frame, m): each foot
+    /// less its hip mount, then the leg solves, all-or-nothing as [`Solver::inverse`] (a
+    /// non-finite foot is [`leg::Unreachable::NonFinite`] of its leg).
     #[inline]
-    pub fn inverse_in_hips_with<M: Math>(
+    pub fn inverse_feet_in_body(
         &self,
-        feet_in_hips: &[Vec3; 4],
+        feet_in_body: &[Vec3; 4],
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
-        self.legs::<M>(feet_in_hips, policy)
+        let mut local = *feet_in_body;
+        for (p, leg) in local.iter_mut().zip(LegId::ALL) {
+            *p = *p - leg.at_corner(self.hip_fl_m);
+        }
+        self.legs(&local, policy)
     }
 
-    /// The four leg solves of a body pose.
+    /// The four leg solves of feet in their hips' frames: staged across the legs when the
+    /// backend asks for it ([`Math::STAGE_LEGS`]), else (and to name the first failure) one
+    /// after the other through one out-of-line leg solve; the same results either way.
     #[inline(always)]
-    fn legs<M: Math>(
-        &self,
-        local: &[Vec3; 4],
-        policy: ReachPolicy,
-    ) -> Result<BodySolution, IkError> {
-        // Hosts run the four legs interleaved (out-of-order CPUs overlap their dependency
-        // chains); the in-order AVR would gain nothing and carry a second copy of the leg
-        // solver (≈ 4 KB of flash), so it solves them one by one (the same results, bit for
-        // bit).
-        #[cfg(not(target_arch = "avr"))]
-        if policy == ReachPolicy::Reject {
-            if let Some(angles) = self.leg.inverse_all_reject::<M>(local) {
+    fn legs(&self, local: &[Vec3; 4], policy: ReachPolicy) -> Result<BodySolution, IkError> {
+        if M::STAGE_LEGS && policy == ReachPolicy::Reject {
+            if let Some(angles) = self.leg.inverse_all_reject(local) {
                 return Ok(BodySolution {
                     legs: angles.map(|angles| LegSolution {
                         angles,
@@ -372,44 +364,27 @@ impl Solver {
                 });
             }
         }
-        self.legs_one_by_one::<M>(local, policy)
-    }
-
-    /// The four leg solves in order FL, FR, RL, RR, stopping at the first failure (on hosts,
-    /// the fallback of the interleaved path that names the failing leg).
-    #[inline]
-    fn legs_one_by_one<M: Math>(
-        &self,
-        local: &[Vec3; 4],
-        policy: ReachPolicy,
-    ) -> Result<BodySolution, IkError> {
-        // One expression, so that each leg's solution is written in place (no copies of the
-        // 64-byte result through memory).
-        let solve = |leg: LegId| self.leg.inverse_with::<M>(leg, local[leg.index()], policy);
-        Ok(BodySolution {
-            legs: [
-                solve(LegId::FL)?,
-                solve(LegId::FR)?,
-                solve(LegId::RL)?,
-                solve(LegId::RR)?,
-            ],
-        })
+        let mut out = BodySolution {
+            legs: [LegSolution {
+                angles: JointAngles::default(),
+                clamped: None,
+            }; 4],
+        };
+        for (i, leg) in LegId::ALL.into_iter().enumerate() {
+            out.legs[i] = self.leg.inverse_out_of_line(leg, local[i], policy)?;
+        }
+        Ok(out)
     }
 }
 
 /// `NonFinite` (named on FL) when the pose or the pivot is not finite: the first check of
-/// [`Solver::inverse_with`] and [`Solver::inverse_at_stance_with`].
-///
-/// # Errors
-/// `NonFinite` on [`LegId::FL`].
+/// [`Solver::inverse`] and [`Solver::inverse_at_stance`].
 #[inline(always)]
-pub fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
+fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = config.pivot_m;
-    let finite = pose.to_array().iter().all(|&v| cmp::finite(v))
-        && cmp::finite(p.x)
-        && cmp::finite(p.y)
-        && cmp::finite(p.z);
-    if finite {
+    let ok =
+        pose.to_array().iter().all(|&v| finite(v)) && finite(p.x) && finite(p.y) && finite(p.z);
+    if ok {
         Ok(())
     } else {
         Err(IkError {
@@ -419,73 +394,10 @@ pub fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     }
 }
 
-/// Feet in the world frame → feet in each leg's hip frame ([`Solver::feet_in_hips_with`]).
-#[inline]
-pub fn feet_in_hips_with<M: Math>(
-    robot: &Robot,
-    pose: &Pose,
-    config: &BodyConfig,
-    feet_in_world: &[Vec3; 4],
-) -> [Vec3; 4] {
-    Solver::new(robot).feet_in_hips_with::<M>(pose, config, feet_in_world)
-}
-
-/// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
-/// rejects the pose and is named in the error. Computes the robot's constants each call;
-/// [`Solver`] keeps them.
-#[inline]
-pub fn inverse_with<M: Math>(
-    robot: &Robot,
-    pose: &Pose,
-    config: &BodyConfig,
-    feet_in_world: &[Vec3; 4],
-    policy: ReachPolicy,
-) -> Result<BodySolution, IkError> {
-    Solver::new(robot).inverse_with::<M>(pose, config, feet_in_world, policy)
-}
-
-/// [`inverse_with`] on the [`DefaultMath`] backend.
-#[inline]
-pub fn inverse(
-    robot: &Robot,
-    pose: &Pose,
-    config: &BodyConfig,
-    feet_in_world: &[Vec3; 4],
-    policy: ReachPolicy,
-) -> Result<BodySolution, IkError> {
-    inverse_with::<DefaultMath>(robot, pose, config, feet_in_world, policy)
-}
-
-/// Body pose with the feet held at the nominal stance of height `stance_height_m`
-/// ([`Robot::stance_feet`]), through the closed-form transform of
-/// [`Solver::stance_feet_in_hips_with`] (the same angles as [`inverse_with`] with those feet
-/// up to f32 rounding).
-#[inline]
-pub fn inverse_at_stance_with<M: Math>(
-    robot: &Robot,
-    pose: &Pose,
-    config: &BodyConfig,
-    stance_height_m: f32,
-    policy: ReachPolicy,
-) -> Result<BodySolution, IkError> {
-    Solver::new(robot).inverse_at_stance_with::<M>(pose, config, stance_height_m, policy)
-}
-
-/// [`inverse_at_stance_with`] on the [`DefaultMath`] backend.
-#[inline]
-pub fn inverse_at_stance(
-    robot: &Robot,
-    pose: &Pose,
-    config: &BodyConfig,
-    stance_height_m: f32,
-    policy: ReachPolicy,
-) -> Result<BodySolution, IkError> {
-    inverse_at_stance_with::<DefaultMath>(robot, pose, config, stance_height_m, policy)
-}
-
 /// Full-body FK: pose + twelve angles → the four feet in the world frame.
 pub fn forward(robot: &Robot, pose: &Pose, config: &BodyConfig, angles: &BodyAngles) -> [Vec3; 4] {
-    let r = rotation::matrix(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+    let r =
+        rotation::matrix::<DefaultMath>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
     LegId::ALL.map(|leg| {
         let foot_in_hip = leg::forward(&robot.leg, leg, angles[leg.index()]);
         r.mul_vec(robot.hip_in_body(leg) + foot_in_hip - config.pivot_m)
@@ -497,18 +409,34 @@ pub fn forward(robot: &Robot, pose: &Pose, config: &BodyConfig, angles: &BodyAng
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{Fast, SoftFloat};
     use crate::robot::KneeBend;
+    use seeded_rng::SplitMix64;
 
-    /// A tiny seeded generator for test inputs (SplitMix64), uniform in `[lo, hi)`.
-    struct Rng(u64);
+    /// Seeded test inputs, uniform in `[lo, hi)`.
+    struct Rng(SplitMix64);
     impl Rng {
+        fn new(seed: u64) -> Rng {
+            Rng(SplitMix64::new(seed))
+        }
         fn uniform(&mut self, lo: f32, hi: f32) -> f32 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            lo + (hi - lo) * ((z >> 40) as f32 / (1u64 << 24) as f32)
+            self.0.range(lo as f64, hi as f64) as f32
+        }
+    }
+
+    /// [`Fast`]'s kernels with the legs solved one after the other: the other arm of
+    /// [`Math::STAGE_LEGS`].
+    struct Unstaged;
+    impl Math for Unstaged {
+        const STAGE_LEGS: bool = false;
+        fn sqrt(x: f32) -> f32 {
+            Fast::sqrt(x)
+        }
+        fn atan2(y: f32, x: f32) -> f32 {
+            Fast::atan2(y, x)
+        }
+        fn sin_cos(x: f32) -> (f32, f32) {
+            Fast::sin_cos(x)
         }
     }
 
@@ -518,7 +446,7 @@ mod tests {
     fn stance_transform_equals_general_transform() {
         /// Largest difference, m: a few f32 ulp of half-metre coordinates.
         const TOL_M: f32 = 2e-7;
-        let mut rng = Rng(11);
+        let mut rng = Rng::new(11);
         for robot in [Robot::shahriar2023(), Robot::fernando2025()] {
             let solver = Solver::new(&robot);
             let height_m = 0.75 * (robot.leg.femur_m + robot.leg.tibia_m);
@@ -545,9 +473,8 @@ mod tests {
                         config.pivot_m =
                             Vec3::new(rng.uniform(-0.1, 0.1), 0.0, rng.uniform(-0.1, 0.1));
                     }
-                    let fast =
-                        solver.stance_feet_in_hips_with::<DefaultMath>(&pose, &config, height_m);
-                    let general = solver.feet_in_hips_with::<DefaultMath>(&pose, &config, &feet);
+                    let fast = solver.stance_feet_in_hips(&pose, &config, height_m);
+                    let general = solver.feet_in_hips(&pose, &config, &feet);
                     for (a, b) in fast.iter().zip(&general) {
                         let d = *a - *b;
                         let worst = d.x.abs().max(d.y.abs()).max(d.z.abs());
@@ -558,10 +485,10 @@ mod tests {
         }
     }
 
-    /// A kept [`Solver`] gives exactly the free functions' results.
+    /// A kept [`Solver`] gives exactly the results of one built per call.
     #[test]
-    fn solver_equals_free_functions() {
-        let mut rng = Rng(5);
+    fn kept_solver_equals_solver_per_call() {
+        let mut rng = Rng::new(5);
         for robot in [Robot::shahriar2023(), Robot::fernando2025()] {
             let solver = Solver::new(&robot);
             let height_m = 0.75 * (robot.leg.femur_m + robot.leg.tibia_m);
@@ -578,12 +505,12 @@ mod tests {
                     let config = BodyConfig::default();
                     assert_eq!(
                         solver.inverse_at_stance(&pose, &config, height_m, policy),
-                        inverse_at_stance(&robot, &pose, &config, height_m, policy)
+                        Solver::new(&robot).inverse_at_stance(&pose, &config, height_m, policy)
                     );
                     let feet = robot.stance_feet(height_m);
                     assert_eq!(
                         solver.inverse(&pose, &config, &feet, policy),
-                        inverse(&robot, &pose, &config, &feet, policy)
+                        Solver::new(&robot).inverse(&pose, &config, &feet, policy)
                     );
                     let foot = Vec3::new(
                         rng.uniform(-0.6, 0.6),
@@ -593,7 +520,7 @@ mod tests {
                     for leg in LegId::ALL {
                         assert_eq!(
                             solver.leg().inverse(leg, foot, policy),
-                            leg::inverse(&robot, leg, foot, policy)
+                            leg::Solver::new(&robot).inverse(leg, foot, policy)
                         );
                     }
                 }
@@ -605,7 +532,7 @@ mod tests {
     /// the same first error when a leg cannot reach.
     #[test]
     fn body_ik_equals_leg_by_leg_ik_bit_for_bit() {
-        let mut rng = Rng(7);
+        let mut rng = Rng::new(7);
         let (mut solved, mut rejected) = (0, 0);
         for robot in [Robot::shahriar2023(), Robot::fernando2025()] {
             for bend in [KneeBend::Backward, KneeBend::Forward] {
@@ -626,15 +553,14 @@ mod tests {
                             pivot_m: Vec3::new(rng.uniform(-0.1, 0.1), 0.0, rng.uniform(-0.1, 0.1)),
                         };
                         let feet = robot.stance_feet(height_m);
-                        let local = feet_in_hips_with::<DefaultMath>(&robot, &pose, &config, &feet);
+                        let local = Solver::new(&robot).feet_in_hips(&pose, &config, &feet);
                         let one_by_one: Result<[LegSolution; 4], IkError> = (|| {
                             let mut legs = [LegSolution {
                                 angles: JointAngles::default(),
                                 clamped: None,
                             }; 4];
                             for leg in LegId::ALL {
-                                legs[leg.index()] = leg::inverse(
-                                    &robot,
+                                legs[leg.index()] = leg::Solver::new(&robot).inverse(
                                     leg,
                                     local[leg.index()],
                                     ReachPolicy::Reject,
@@ -643,7 +569,21 @@ mod tests {
                             Ok(legs)
                         })(
                         );
-                        let body = inverse(&robot, &pose, &config, &feet, ReachPolicy::Reject);
+                        let body =
+                            Solver::new(&robot).inverse(&pose, &config, &feet, ReachPolicy::Reject);
+                        // The legs one after the other (the other arm of `Math::STAGE_LEGS`).
+                        let unstaged = Solver::<Unstaged>::with_math(&robot).inverse(
+                            &pose,
+                            &config,
+                            &feet,
+                            ReachPolicy::Reject,
+                        );
+                        match (&body, &unstaged) {
+                            (Ok(b), Ok(u)) => {
+                                assert_eq!(b.flat().map(f32::to_bits), u.flat().map(f32::to_bits))
+                            }
+                            (b, u) => assert_eq!(b, u),
+                        }
                         match (body, one_by_one) {
                             (Ok(b), Ok(l)) => {
                                 solved += 1;
@@ -666,6 +606,50 @@ mod tests {
         }
         assert!(
             solved > 1000 && rejected > 100,
+            "solved {solved}, rejected {rejected}"
+        );
+    }
+
+    /// The body at the zero pose with feet given in the body frame equals the general body IK
+    /// of those feet at the zero pose, on the default and the soft-float backend.
+    #[test]
+    fn feet_in_body_equals_the_general_inverse_at_the_zero_pose() {
+        let mut rng = Rng::new(13);
+        let (mut solved, mut rejected) = (0, 0);
+        for robot in [Robot::shahriar2023(), Robot::fernando2025()] {
+            let height_m = 0.75 * (robot.leg.femur_m + robot.leg.tibia_m);
+            for policy in [ReachPolicy::Reject, ReachPolicy::Clamp] {
+                for _ in 0..200 {
+                    let feet = robot.stance_feet(height_m).map(|f| {
+                        f + Vec3::new(
+                            rng.uniform(-0.3, 0.3),
+                            rng.uniform(-0.3, 0.3),
+                            rng.uniform(-0.3, 0.3),
+                        )
+                    });
+                    let zero = (Pose::default(), BodyConfig::default());
+                    let a = Solver::new(&robot).inverse_feet_in_body(&feet, policy);
+                    let b = Solver::new(&robot).inverse(&zero.0, &zero.1, &feet, policy);
+                    let c =
+                        Solver::<SoftFloat>::with_math(&robot).inverse_feet_in_body(&feet, policy);
+                    match (&a, &b, &c) {
+                        (Ok(a), Ok(b), Ok(c)) => {
+                            solved += 1;
+                            for ((x, y), z) in a.flat().iter().zip(b.flat()).zip(c.flat()) {
+                                assert!((x - y).abs() < 1e-5 && (x - z).abs() < 5e-5);
+                            }
+                        }
+                        (Err(a), Err(b), Err(c)) => {
+                            rejected += 1;
+                            assert_eq!((a, a), (b, c));
+                        }
+                        _ => panic!("{a:?} vs {b:?} vs {c:?}"),
+                    }
+                }
+            }
+        }
+        assert!(
+            solved > 100 && rejected > 10,
             "solved {solved}, rejected {rejected}"
         );
     }

@@ -40,10 +40,10 @@ impl fmt::Display for Singular {
 impl core::error::Error for Singular {}
 
 /// Analytic leg Jacobian `∂foot_in_hip/∂(abduction, hip, knee)`, m/rad.
-pub fn leg_jacobian_with<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
-    let (sa, ca) = M::sin_cos(q.abduction_rad);
-    let (sh, ch) = M::sin_cos(q.hip_rad);
-    let (shk, chk) = M::sin_cos(q.hip_rad + q.knee_rad);
+pub fn leg_jacobian(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
+    let (sa, ca) = DefaultMath::sin_cos(q.abduction_rad);
+    let (sh, ch) = DefaultMath::sin_cos(q.hip_rad);
+    let (shk, chk) = DefaultMath::sin_cos(q.hip_rad + q.knee_rad);
     let (l1, l2) = (g.femur_m, g.tibia_m);
     let u = -l1 * sh - l2 * shk;
     let w = -g.d_ax_m - l1 * ch - l2 * chk;
@@ -54,11 +54,6 @@ pub fn leg_jacobian_with<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -
     let d_h = rx(Vec3::new(-l1 * ch - l2 * chk, 0.0, l1 * sh + l2 * shk));
     let d_k = rx(Vec3::new(-l2 * chk, 0.0, l2 * shk));
     Mat3::from_columns(d_a, d_h, d_k)
-}
-
-/// [`leg_jacobian_with`] on the [`DefaultMath`] backend.
-pub fn leg_jacobian(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
-    leg_jacobian_with::<DefaultMath>(g, leg, q)
 }
 
 /// Manipulability `√det(J·Jᵀ) = |det J|`, m³/rad³.

@@ -3,11 +3,37 @@
 //!
 //! All positions are in the **hip frame** of the leg: origin at the hip (abduction-axis) mount,
 //! axes parallel to the body frame (x forward, y left, z up), metres.
+//!
+//! ## Seed 000's IK (eq. 4.1–4.21) in this module
+//!
+//! [`Solver::inverse`] solves seed 000's geometry (`La` = `d_lat`, `Lb` = femur, `Lc` = tibia)
+//! and seed 001's (`l0` = `d_ax`) in one chain, with the errata of `docs/papers.md` applied.
+//! Every angle is one four-quadrant `atan2` of unnormalised arguments, so the paper's
+//! quadrant cases, `sin⁻¹` and `cos⁻¹` collapse into the functions below (`s = ±1` the side
+//! sign, `sd = s·d_lat`, `(x, y, z)` the foot in the hip frame):
+//!
+//! | paper step | equation (seed 000) | here |
+//! |---|---|---|
+//! | distance of the foot from the abduction axis, `A = √(y² + z²)` | 4.1 | [`Solver::inverse`]'s `r_sq` (`A²`), checked `A² ≥ La²` ([`Unreachable::InsideOffset`]) |
+//! | α1, the direction of `A` (erratum 6a: measured from +y, one `atan2`) | 4.2–4.5 | `abduction_yx` |
+//! | α2, α3 of the right triangle with legs `La`, `ℓ = √(A² − La²)` | 4.6–4.7 | `depth`: `w = −ℓ` |
+//! | θ1 = α1 + (90° − α2) per quadrant (erratum 6c: wrapped on both sides) | 4.8–4.11 | `abduction_yx`: `atan2(sd·z − w·y, sd·y + w·z)` |
+//! | `R = √(x² + z²)` in the tilted leg plane (its z is `w`, plus `d_ax`) | 4.12 | `Consts::leg_plane`: `R² = u² + v²`, checked against `(L1 ± L2)²` ([`Unreachable::TooFar`], [`Unreachable::TooClose`]) |
+//! | R1, the direction of `R` (erratum 6b: by the sign of x, one `atan2`) | 4.13–4.14 | `hip_yx`: `angle(−v, −u)` |
+//! | R2 by the law of cosines (erratum 1: `Lc²`) | 4.15 | `hip_yx`: `angle(L1 + L2·cos k, L2·sin k)` |
+//! | R3 by the law of cosines | 4.16 | `Consts::knee_yx`: `cos k = (R² − L1² − L2²)/(2·L1·L2)` |
+//! | θ2 = R1 − R2 | 4.17–4.20 | `hip_yx`: one `atan2` of the difference angle |
+//! | θ3 = π − R3 | 4.21 | `Consts::knee_yx`: `atan2(sin k, cos k)`, `sin k` by the knee bend |
+//! | `math_error_handler`, `angle_range_limiter` | Algorithm 1 | [`ReachPolicy`], [`JointLimits`] |
+//!
+//! The paper's angles θ1, θ2, θ3 relate to the crate's abduction, hip and knee as
+//! [`crate::paper::to_seed000`] says (θ2 = 3π/2 − hip, θ3 = −knee).
 
-use crate::math::{cmp, DefaultMath, Math};
+use crate::math::{finite, DefaultMath, Math};
 use crate::robot::{Joint, JointAngles, JointLimits, KneeBend, LegGeometry, LegId, Robot};
 use crate::vec::Vec3;
 use core::fmt;
+use core::marker::PhantomData;
 
 /// Why a foot target cannot be reached.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -134,19 +160,19 @@ fn abduct(s_a: f32, c_a: f32, v: Vec3) -> Vec3 {
     Vec3::new(v.x, c_a * v.y - s_a * v.z, s_a * v.y + c_a * v.z)
 }
 
-/// Forward kinematics, closed form:
-/// `foot_in_hip = Rx(a)·([0, s·d_lat, −d_ax] + Ry(h)·[0,0,−L_femur] + Ry(h+k)·[0,0,−L_tibia])`.
+/// Forward kinematics on backend `M`, closed form.
 #[inline]
-pub fn forward_with<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
+fn forward_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
     let (_, _, u, w) = planar::<M>(g, q.hip_rad, q.knee_rad);
     let (sa, ca) = M::sin_cos(q.abduction_rad);
     abduct(sa, ca, Vec3::new(u, leg.side() * g.d_lat_m, w))
 }
 
-/// [`forward_with`] on the [`DefaultMath`] backend.
+/// Forward kinematics, closed form:
+/// `foot_in_hip = Rx(a)·([0, s·d_lat, −d_ax] + Ry(h)·[0,0,−L_femur] + Ry(h+k)·[0,0,−L_tibia])`.
 #[inline]
 pub fn forward(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
-    forward_with::<DefaultMath>(g, leg, q)
+    forward_on::<DefaultMath>(g, leg, q)
 }
 
 /// Every joint position of the leg in its hip frame.
@@ -233,10 +259,9 @@ pub fn forward_dh(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
     pos
 }
 
-/// The leg IK with the per-robot constants computed once: squared link lengths and reach
-/// limits, `d_lat²`, the joint-limit interval. The free functions [`inverse_with`] and
-/// [`inverse`] build one per call; a caller that solves many targets of one robot (a device's
-/// control loop, the body IK) keeps one:
+/// The leg IK of one robot on math backend `M`, with the per-robot constants computed once:
+/// squared link lengths and reach limits, `d_lat²`. A caller that solves many targets of one
+/// robot (a device's control loop, the body IK) keeps one:
 ///
 /// ```
 /// use kin_core::{leg, LegId, ReachPolicy, Robot, Vec3};
@@ -245,19 +270,44 @@ pub fn forward_dh(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
 /// # Ok::<(), kin_core::IkError>(())
 /// ```
 ///
-/// Results are bit for bit those of the free functions. [`Solver::new`] is a `const fn`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Solver {
+/// [`Solver::new`] takes the [`DefaultMath`] backend, [`Solver::with_math`] any other
+/// (`leg::Solver::<kin_core::math::Libm>::with_math(&robot)`); both are `const fn`.
+pub struct Solver<M: Math = DefaultMath> {
     geometry: LegGeometry,
     limits: JointLimits,
     knee_bend: KneeBend,
-    consts: Consts,
+    c: Consts,
+    math: PhantomData<M>,
+}
+
+// By hand: derives would ask the backend type (never a value here) for the same traits.
+impl<M: Math> Clone for Solver<M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<M: Math> Copy for Solver<M> {}
+impl<M: Math> PartialEq for Solver<M> {
+    fn eq(&self, other: &Self) -> bool {
+        (self.geometry, self.limits, self.knee_bend)
+            == (other.geometry, other.limits, other.knee_bend)
+    }
+}
+impl<M: Math> fmt::Debug for Solver<M> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Solver")
+            .field("geometry", &self.geometry)
+            .field("limits", &self.limits)
+            .field("knee_bend", &self.knee_bend)
+            .field("math", &core::any::type_name::<M>())
+            .finish()
+    }
 }
 
 /// Constants of the leg IK derived from the link lengths.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Consts {
-    /// `d_lat²`.
+    /// `d_lat²` (seed 000's `La²`).
     d_lat_sq: f32,
     /// `(L1 + L2)²` and `(L1 − L2)²`: the squared reach limits of the leg plane.
     far_sq: f32,
@@ -285,31 +335,34 @@ impl Consts {
     }
 }
 
-/// What a solve reads: borrowed from a [`Solver`], or from a [`Robot`] with the constants
-/// computed on the spot (the free functions), so that neither copies the robot.
-#[derive(Clone, Copy)]
-struct View<'a> {
-    geometry: &'a LegGeometry,
-    limits: &'a JointLimits,
-    knee_bend: KneeBend,
-    c: Consts,
-}
-
-/// Un-abducted depth of the foot: `w = −√(y² + z² − d_lat²)`, the branch with the foot below
-/// the hip (0 when the foot lies on the offset circle), from `r² = y² + z²`; with `w²`.
+/// Seed 000 eq. 4.6–4.7: the right triangle of the coxa `La` (= `d_lat`) and the leg plane's
+/// line `ℓ` to the foot at distance `A` from the abduction axis, `ℓ = √(A² − La²)`. Returns
+/// the un-abducted depth of the foot `w = −ℓ` (the branch with the foot below the hip; 0 when
+/// the foot lies on the offset circle) and `w²`, from `r_sq = A² = y² + z²` (eq. 4.1).
 #[inline(always)]
 fn depth<M: Math>(d_lat_sq: f32, r_sq: f32) -> (f32, f32) {
     let w_sq = r_sq - d_lat_sq;
-    let w_sq = if cmp::gt_zero(w_sq) { w_sq } else { 0.0 };
+    // max(w², 0) without a float comparison on the backends that avoid them.
+    let w_sq = if M::gt_zero(w_sq) { w_sq } else { 0.0 };
     (-M::sqrt(w_sq), w_sq)
 }
 
+/// Seed 000 eq. 4.2–4.11 (errata 6a, 6c): the abduction θ1 = α1 + α3, the direction of the
+/// foot's `(y, z)` less that of the leg's own `(s·d_lat, w)` (`sd = s·d_lat`, `w` from
+/// [`depth`]), as the arguments `(y, x)` of one `atan2` of their cross and dot products: every
+/// quadrant of the abduction circle in one formula, in `(−π, π]`.
+#[inline(always)]
+fn abduction_yx(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
+    (sd * z - w * y, sd * y + w * z)
+}
+
 impl Consts {
-    /// `(v, v²)` of the in-plane foot height `v = w + d_ax` below the hip-flexion joint, from
-    /// [`depth`]'s `(w, w²)`: `(w, w²)` itself when `d_ax = 0` (a multiplication and an addition
-    /// fewer).
+    /// Seed 000 eq. 4.12 in the tilted leg plane (`docs/papers.md`): the foot's height
+    /// `v = w + d_ax` below the hip-flexion joint and `v²`, from [`depth`]'s `(w, w²)`;
+    /// `(w, w²)` itself when `d_ax = 0` (a multiplication and an addition fewer). The planar
+    /// distance is then `R² = x² + v²`.
     #[inline(always)]
-    fn height(&self, d_ax_m: f32, (w, w_sq): (f32, f32)) -> (f32, f32) {
+    fn leg_plane(&self, d_ax_m: f32, (w, w_sq): (f32, f32)) -> (f32, f32) {
         if self.d_ax_zero {
             (w, w_sq)
         } else {
@@ -317,17 +370,68 @@ impl Consts {
             (v, v * v)
         }
     }
+
+    /// Seed 000 eq. 4.16 and 4.21: the knee `k = −θ3 = R3 − π` as the arguments `(sin k, cos k)`
+    /// of one `atan2`, both scaled by `2·L1·L2` (no division; `atan2` is scale-invariant), for
+    /// the planar distance `dist2 = R²` within the reach up to rounding (`moved`: after a
+    /// projection). `cos k = (R² − L1² − L2²)/(2·L1·L2)` (eq. 4.16's `−cos R3`), and
+    /// `sin² k` in the factored form `(R² − (L1−L2)²)·((L1+L2)² − R²)`, which stays accurate
+    /// near a folded or straight knee, where `(2·L1·L2)² − cos²` loses the digits that set the
+    /// foot's distance; the sign of `sin k` is the knee bend.
+    #[inline(always)]
+    fn knee_yx<M: Math>(
+        &self,
+        g: &LegGeometry,
+        bend: KneeBend,
+        dist2: f32,
+        moved: bool,
+    ) -> (f32, f32) {
+        let mut c = dist2 - self.sum_sq;
+        // Only rounding can push a projected point past ±2·L1·L2 here.
+        if moved {
+            let two_l1l2 = 2.0 * g.femur_m * g.tibia_m;
+            c = c.clamp(-two_l1l2, two_l1l2);
+        }
+        let s_sq = (dist2 - self.near_sq) * (self.far_sq - dist2);
+        let s_abs = M::sqrt(if M::gt_zero(s_sq) { s_sq } else { 0.0 });
+        let s = match bend {
+            KneeBend::Backward => -s_abs,
+            KneeBend::Forward => s_abs,
+        };
+        (s, c)
+    }
 }
 
-impl Solver {
-    /// The constants of `robot`'s legs (all legs are alike).
+/// Seed 000 eq. 4.13–4.15 and 4.17–4.20 (errata 1, 6b): the hip θ2 = R1 − R2 as the arguments
+/// of one `atan2`: R1 = `angle(−v, −u)`, the direction of the line R to the foot at `(u, v)`
+/// in the leg plane, less R2 = `angle(L1 + L2·cos k, L2·sin k)`, the femur's angle from R by
+/// the law of cosines; the second vector scaled by `2·L1` is `(R² + L1² − L2², 2·L1·L2·sin k)`
+/// (`diff_sq` = `L1² − L2²`, `s` from [`Consts::knee_yx`]).
+#[inline(always)]
+fn hip_yx(u: f32, v: f32, dist2: f32, diff_sq: f32, s: f32) -> (f32, f32) {
+    let (bx, by) = (dist2 + diff_sq, s);
+    let (ax, ay) = (-v, -u);
+    (bx * ay - by * ax, bx * ax + by * ay)
+}
+
+impl Solver<DefaultMath> {
+    /// The leg IK of `robot` (all legs are alike) on the [`DefaultMath`] backend.
     #[inline]
     pub const fn new(robot: &Robot) -> Solver {
+        Solver::with_math(robot)
+    }
+}
+
+impl<M: Math> Solver<M> {
+    /// The leg IK of `robot` (all legs are alike) on backend `M`.
+    #[inline]
+    pub const fn with_math(robot: &Robot) -> Solver<M> {
         Solver {
             geometry: robot.leg,
             limits: robot.limits,
             knee_bend: robot.knee_bend,
-            consts: Consts::of(&robot.leg),
+            c: Consts::of(&robot.leg),
+            math: PhantomData,
         }
     }
 
@@ -337,29 +441,27 @@ impl Solver {
         &self.geometry
     }
 
+    /// `s·d_lat`: the leg plane's offset with the side sign of `leg`.
     #[inline(always)]
-    fn view(&self) -> View<'_> {
-        View {
-            geometry: &self.geometry,
-            limits: &self.limits,
-            knee_bend: self.knee_bend,
-            c: self.consts,
+    fn side_d_lat(&self, leg: LegId) -> f32 {
+        if leg.is_left() {
+            self.geometry.d_lat_m
+        } else {
+            -self.geometry.d_lat_m
         }
     }
 
-    /// Analytic leg IK: the foot target in the hip frame → joint angles; see
-    /// [`inverse_with`](fn@inverse_with), which this is with the constants prepared.
-    #[inline]
-    pub fn inverse_with<M: Math>(
-        &self,
-        leg: LegId,
-        foot_in_hip: Vec3,
-        policy: ReachPolicy,
-    ) -> Result<LegSolution, IkError> {
-        self.view().inverse_with::<M>(leg, foot_in_hip, policy)
-    }
-
-    /// [`Solver::inverse_with`] on the [`DefaultMath`] backend.
+    /// Analytic leg IK: the foot target in the hip frame → joint angles (the steps of seed 000
+    /// eq. 4.1–4.21 in the [module docs](self)).
+    ///
+    /// Branches: the knee bend of the robot's `knee_bend`, and the abduction whose un-abducted
+    /// foot lies below the hip (`w ≤ 0`). Every quadrant of the abduction circle is covered
+    /// (seed 000 §2.2, Algorithm 1): the abduction angle is one four-quadrant `atan2` in
+    /// `(−π, π]`.
+    ///
+    /// Never returns NaN: non-finite input gives [`Unreachable::NonFinite`]; out-of-workspace
+    /// targets give a typed error under [`ReachPolicy::Reject`] or a reported clamp under
+    /// [`ReachPolicy::Clamp`].
     #[inline]
     pub fn inverse(
         &self,
@@ -367,204 +469,8 @@ impl Solver {
         foot_in_hip: Vec3,
         policy: ReachPolicy,
     ) -> Result<LegSolution, IkError> {
-        self.inverse_with::<DefaultMath>(leg, foot_in_hip, policy)
-    }
-
-    /// The four legs of [`LegId::ALL`] at once under [`ReachPolicy::Reject`], for the
-    /// full-body IK: the arithmetic of [`Solver::inverse_with`] leg by leg (bit-identical
-    /// results), written stage by stage across the legs so that the four independent solves
-    /// interleave instead of running one after the other. `None` when any leg is not cleanly
-    /// solvable (non-finite input, outside the workspace, beyond a joint limit): the caller
-    /// then solves the legs in order to name the first failure.
-    #[cfg(not(target_arch = "avr"))]
-    #[inline]
-    pub(crate) fn inverse_all_reject<M: Math>(
-        &self,
-        feet_in_hip: &[Vec3; 4],
-    ) -> Option<[JointAngles; 4]> {
-        self.view().inverse_all_reject::<M>(feet_in_hip)
-    }
-}
-
-/// `lo <= x && x <= hi` by integer keys (no software-float comparison).
-#[cfg(target_arch = "avr")]
-#[inline(always)]
-fn within_limit(x: f32, lo: f32, hi: f32) -> bool {
-    cmp::bits::within(x, cmp::bits::interval(lo, hi))
-}
-
-impl View<'_> {
-    /// True when all three angles lie within the joint limits (false for any NaN).
-    #[inline(always)]
-    fn admits(&self, q: JointAngles) -> bool {
-        #[cfg(target_arch = "avr")]
-        {
-            let (lo, hi) = (&self.limits.min_rad, &self.limits.max_rad);
-            within_limit(q.abduction_rad, lo[0], hi[0])
-                && within_limit(q.hip_rad, lo[1], hi[1])
-                && within_limit(q.knee_rad, lo[2], hi[2])
-        }
-        #[cfg(not(target_arch = "avr"))]
-        {
-            let (lo, hi) = (&self.limits.min_rad, &self.limits.max_rad);
-            let a = q.to_array();
-            (a[0] >= lo[0])
-                & (a[0] <= hi[0])
-                & (a[1] >= lo[1])
-                & (a[1] <= hi[1])
-                & (a[2] >= lo[2])
-                & (a[2] <= hi[2])
-        }
-    }
-
-    /// The arguments of the abduction's `atan2`: a = angle(y, z) − angle(s·d_lat, w), as one
-    /// atan2 of cross and dot (the foot's `(y, z)` lies at least `d_lat` from the abduction
-    /// axis, `w` is its depth from [`depth`], `sd = s·d_lat`).
-    #[inline(always)]
-    fn abduction_yx(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
-        (sd * z - w * y, sd * y + w * z)
-    }
-
-    /// The arguments of the knee's and the hip's `atan2`, `([knee_y, hip_y], [knee_x, hip_x])`,
-    /// for the foot at `(u, v)` in the leg plane (`dist2 = u² + v²`) within the reach up to
-    /// rounding (`moved`: after a projection).
-    #[inline(always)]
-    fn planar_yx<M: Math>(&self, u: f32, v: f32, dist2: f32, moved: bool) -> ([f32; 2], [f32; 2]) {
-        // The law of cosines, scaled by 2·L1·L2 (no division; atan2 is scale-invariant):
-        // c = D² − L1² − L2², and s² = (D² − (L1−L2)²)·((L1+L2)² − D²), the factored form that
-        // stays accurate near a folded or straight knee, where (2·L1·L2)² − c² loses the digits
-        // that set the foot's distance.
-        let mut c = dist2 - self.c.sum_sq;
-        // Only rounding can push a projected point past ±2·L1·L2 here.
-        if moved {
-            let two_l1l2 = 2.0 * self.geometry.femur_m * self.geometry.tibia_m;
-            c = c.clamp(-two_l1l2, two_l1l2);
-        }
-        let s_sq = (dist2 - self.c.near_sq) * (self.c.far_sq - dist2);
-        let s_abs = M::sqrt(if cmp::gt_zero(s_sq) { s_sq } else { 0.0 });
-        let s = match self.knee_bend {
-            KneeBend::Backward => -s_abs,
-            KneeBend::Forward => s_abs,
-        };
-        // hip = angle(−v, −u) − angle(L1 + L2·cos k, L2·sin k), the second vector scaled by
-        // 2·L1: (D² + L1² − L2², s).
-        let (bx, by) = (dist2 + self.c.diff_sq, s);
-        let (ax, ay) = (-v, -u);
-        ([s, bx * ay - by * ax], [c, bx * ax + by * ay])
-    }
-
-    /// Solves the abduction and planar problem exactly for a point known to be reachable
-    /// (after optional projection), for the leg with `sd = s·d_lat`. Returns the angles and,
-    /// when projecting, the first reason and the foot actually reached.
-    #[inline(always)]
-    fn solve<M: Math>(
-        &self,
-        sd: f32,
-        target: Vec3,
-        policy: ReachPolicy,
-    ) -> Result<(JointAngles, Option<(Unreachable, Vec3)>), Unreachable> {
-        let g = &self.geometry;
-        let (mut y, mut z) = (target.y, target.z);
-        let mut first: Option<Unreachable> = None;
-
-        // Abduction: the foot's (y, z) must lie at distance ≥ d_lat from the abduction axis.
-        let mut r_sq = y * y + z * z;
-        if cmp::lt_nonneg(r_sq, self.c.d_lat_sq) {
-            if policy == ReachPolicy::Reject {
-                return Err(Unreachable::InsideOffset);
-            }
-            first = Some(Unreachable::InsideOffset);
-            let r = M::sqrt(r_sq);
-            if cmp::gt_zero(r) {
-                let k = g.d_lat_m / r;
-                y *= k;
-                z *= k;
-            } else {
-                y = sd;
-                z = 0.0;
-            }
-            r_sq = y * y + z * z;
-        }
-        let depth = depth::<M>(self.c.d_lat_sq, r_sq);
-        let w = depth.0;
-
-        // Planar two-link problem from the hip-flexion joint: (u, v) = (x, w + d_ax).
-        let mut u = target.x;
-        let (mut v, v_sq) = self.c.height(g.d_ax_m, depth);
-        let mut dist2 = u * u + v_sq;
-        let (l1, l2) = (g.femur_m, g.tibia_m);
-        let planar_fault = if cmp::lt_nonneg(self.c.far_sq, dist2) {
-            Some((Unreachable::TooFar, l1 + l2))
-        } else if cmp::lt_nonneg(dist2, self.c.near_sq) {
-            Some((Unreachable::TooClose, libm::fabsf(l1 - l2)))
-        } else {
-            None
-        };
-        let mut moved = first.is_some();
-        if let Some((kind, radius)) = planar_fault {
-            if policy == ReachPolicy::Reject {
-                return Err(kind);
-            }
-            first.get_or_insert(kind);
-            moved = true;
-            let dist = M::sqrt(dist2);
-            if cmp::gt_zero(dist) {
-                let k = radius / dist;
-                u *= k;
-                v *= k;
-            } else {
-                u = 0.0;
-                v = -radius;
-            }
-            dist2 = u * u + v * v;
-        }
-        let (abd_y, abd_x) = Self::abduction_yx(sd, y, z, w);
-        let ([knee_y, hip_y], [knee_x, hip_x]) = self.planar_yx::<M>(u, v, dist2, moved);
-        let [abduction, knee, hip] = M::atan2_3([abd_y, knee_y, hip_y], [abd_x, knee_x, hip_x]);
-        let angles = JointAngles::new(abduction, hip, knee);
-        let reached = if moved {
-            let (sa, ca) = M::sin_cos(abduction);
-            Some((
-                first.unwrap_or(Unreachable::TooFar),
-                abduct(sa, ca, Vec3::new(u, sd, v - g.d_ax_m)),
-            ))
-        } else {
-            None
-        };
-        Ok((angles, reached))
-    }
-
-    /// The first joint of `q` outside its limits (any joint for a NaN angle).
-    #[inline(always)]
-    fn first_violation(&self, q: JointAngles) -> Option<Joint> {
-        if self.admits(q) {
-            return None;
-        }
-        Joint::ALL.into_iter().find(|&j| {
-            #[cfg(target_arch = "avr")]
-            let ok = within_limit(
-                q.get(j),
-                self.limits.min_rad[j as usize],
-                self.limits.max_rad[j as usize],
-            );
-            #[cfg(not(target_arch = "avr"))]
-            let ok = self.limits.admits(j, q.get(j));
-            !ok
-        })
-    }
-
-    /// [`Solver::inverse_with`].
-    #[cfg_attr(not(target_arch = "avr"), inline(always))]
-    #[cfg_attr(target_arch = "avr", inline(never))]
-    fn inverse_with<M: Math>(
-        &self,
-        leg: LegId,
-        foot_in_hip: Vec3,
-        policy: ReachPolicy,
-    ) -> Result<LegSolution, IkError> {
         let err = |kind| IkError { leg, kind };
-        if !(cmp::finite(foot_in_hip.x) && cmp::finite(foot_in_hip.y) && cmp::finite(foot_in_hip.z))
-        {
+        if !(finite(foot_in_hip.x) && finite(foot_in_hip.y) && finite(foot_in_hip.z)) {
             return Err(err(Unreachable::NonFinite));
         }
         // Far outside the workspace a clamped answer depends only on the target's direction;
@@ -585,13 +491,10 @@ impl View<'_> {
             }
             ReachPolicy::Reject => foot_in_hip,
         };
-        let side_d_lat = if leg.is_left() {
-            self.geometry.d_lat_m
-        } else {
-            -self.geometry.d_lat_m
-        };
-        let (mut angles, reached) = self.solve::<M>(side_d_lat, target, policy).map_err(err)?;
-        let Some(joint) = self.first_violation(angles) else {
+        let (mut angles, reached) = self
+            .solve(self.side_d_lat(leg), target, policy)
+            .map_err(err)?;
+        if self.limits.admits_all::<M>(angles) {
             // Within the limits also means finite: a NaN fails every comparison.
             return Ok(LegSolution {
                 angles,
@@ -600,16 +503,17 @@ impl View<'_> {
                     distance_m: distance::<M>(p, foot_in_hip),
                 }),
             });
-        };
+        }
+        // Some joint is outside (any for a NaN angle).
+        let joint = self
+            .limits
+            .first_violation(angles)
+            .unwrap_or(Joint::Abduction);
         if policy == ReachPolicy::Reject {
             return Err(err(Unreachable::JointLimit(joint)));
         }
-        let mut a = angles.to_array();
-        for (i, v) in a.iter_mut().enumerate() {
-            *v = v.clamp(self.limits.min_rad[i], self.limits.max_rad[i]);
-        }
-        angles = JointAngles::from_array(a);
-        let foot = forward_with::<M>(self.geometry, leg, angles);
+        angles = self.limits.clamp(angles);
+        let foot = forward_on::<M>(&self.geometry, leg, angles);
         let clamped = Some(Clamp {
             kind: reached.map_or(Unreachable::JointLimit(joint), |(kind, _)| kind),
             distance_m: distance::<M>(foot, foot_in_hip),
@@ -621,10 +525,110 @@ impl View<'_> {
         Ok(LegSolution { angles, clamped })
     }
 
-    /// [`Solver::inverse_all_reject`].
-    #[cfg(not(target_arch = "avr"))]
+    /// [`Solver::inverse`] kept out of line: the body IK's legs one after the other through
+    /// one copy of the leg solve ([`Math::STAGE_LEGS`] false, and the fallback that names the
+    /// first failing leg).
+    #[inline(never)]
+    pub(crate) fn inverse_out_of_line(
+        &self,
+        leg: LegId,
+        foot_in_hip: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<LegSolution, IkError> {
+        self.inverse(leg, foot_in_hip, policy)
+    }
+
+    /// Solves the abduction and planar problem exactly for a point known to be reachable
+    /// (after optional projection), for the leg with `sd = s·d_lat`. Returns the angles and,
+    /// when projecting, the first reason and the foot actually reached.
+    #[inline(always)]
+    fn solve(
+        &self,
+        sd: f32,
+        target: Vec3,
+        policy: ReachPolicy,
+    ) -> Result<(JointAngles, Option<(Unreachable, Vec3)>), Unreachable> {
+        let g = &self.geometry;
+        let (mut y, mut z) = (target.y, target.z);
+        let mut first: Option<Unreachable> = None;
+
+        // Eq. 4.1: the foot must lie at A ≥ La from the abduction axis (A² < La²: inside).
+        let mut r_sq = y * y + z * z;
+        if M::lt_nonneg(r_sq, self.c.d_lat_sq) {
+            if policy == ReachPolicy::Reject {
+                return Err(Unreachable::InsideOffset);
+            }
+            first = Some(Unreachable::InsideOffset);
+            let r = M::sqrt(r_sq);
+            if M::gt_zero(r) {
+                let k = g.d_lat_m / r;
+                y *= k;
+                z *= k;
+            } else {
+                y = sd;
+                z = 0.0;
+            }
+            r_sq = y * y + z * z;
+        }
+        let depth = depth::<M>(self.c.d_lat_sq, r_sq);
+        let w = depth.0;
+
+        // Eq. 4.12: the planar two-link problem from the hip-flexion joint, (u, v) = (x, w + d_ax),
+        // R² = u² + v² within [(L1 − L2)², (L1 + L2)²].
+        let mut u = target.x;
+        let (mut v, v_sq) = self.c.leg_plane(g.d_ax_m, depth);
+        let mut dist2 = u * u + v_sq;
+        let (l1, l2) = (g.femur_m, g.tibia_m);
+        let planar_fault = if M::lt_nonneg(self.c.far_sq, dist2) {
+            Some((Unreachable::TooFar, l1 + l2))
+        } else if M::lt_nonneg(dist2, self.c.near_sq) {
+            Some((Unreachable::TooClose, libm::fabsf(l1 - l2)))
+        } else {
+            None
+        };
+        let mut moved = first.is_some();
+        if let Some((kind, radius)) = planar_fault {
+            if policy == ReachPolicy::Reject {
+                return Err(kind);
+            }
+            first.get_or_insert(kind);
+            moved = true;
+            let dist = M::sqrt(dist2);
+            if M::gt_zero(dist) {
+                let k = radius / dist;
+                u *= k;
+                v *= k;
+            } else {
+                u = 0.0;
+                v = -radius;
+            }
+            dist2 = u * u + v * v;
+        }
+        let (abd_y, abd_x) = abduction_yx(sd, y, z, w);
+        let (knee_y, knee_x) = self.c.knee_yx::<M>(g, self.knee_bend, dist2, moved);
+        let (hip_y, hip_x) = hip_yx(u, v, dist2, self.c.diff_sq, knee_y);
+        let [abduction, knee, hip] = M::atan2_3([abd_y, knee_y, hip_y], [abd_x, knee_x, hip_x]);
+        let angles = JointAngles::new(abduction, hip, knee);
+        let reached = if moved {
+            let (sa, ca) = M::sin_cos(abduction);
+            Some((
+                first.unwrap_or(Unreachable::TooFar),
+                abduct(sa, ca, Vec3::new(u, sd, v - g.d_ax_m)),
+            ))
+        } else {
+            None
+        };
+        Ok((angles, reached))
+    }
+
+    /// The four legs of [`LegId::ALL`] at once under [`ReachPolicy::Reject`], for the
+    /// full-body IK when [`Math::STAGE_LEGS`]: the arithmetic of [`Solver::inverse`] leg by leg
+    /// (bit-identical results), written stage by stage across the legs so that the four
+    /// independent solves interleave instead of running one after the other. `None` when any
+    /// leg is not cleanly solvable (non-finite input, outside the workspace, beyond a joint
+    /// limit): the caller then solves the legs in order to name the first failure.
     #[inline]
-    fn inverse_all_reject<M: Math>(&self, feet_in_hip: &[Vec3; 4]) -> Option<[JointAngles; 4]> {
+    pub(crate) fn inverse_all_reject(&self, feet_in_hip: &[Vec3; 4]) -> Option<[JointAngles; 4]> {
         let g = &self.geometry;
         let mut ok = true;
         // One plain array per quantity (not arrays of structs), which the compiler keeps in
@@ -639,32 +643,30 @@ impl View<'_> {
             // finite q and NaN otherwise.
             let finite = p.x * 0.0 + p.y * 0.0 + p.z * 0.0 == 0.0;
             let r_sq = p.y * p.y + p.z * p.z;
-            ok &= finite & !(r_sq < self.c.d_lat_sq);
+            ok &= finite & !M::lt_nonneg(r_sq, self.c.d_lat_sq);
             (w[i], w_sq[i]) = depth::<M>(self.c.d_lat_sq, r_sq);
         }
         for (i, p) in feet_in_hip.iter().enumerate() {
-            let sd = if LegId::ALL[i].is_left() {
-                g.d_lat_m
-            } else {
-                -g.d_lat_m
-            };
-            let (abd_y, abd_x) = Self::abduction_yx(sd, p.y, p.z, w[i]);
+            let sd = self.side_d_lat(LegId::ALL[i]);
+            let (abd_y, abd_x) = abduction_yx(sd, p.y, p.z, w[i]);
             abduction[i] = M::atan2(abd_y, abd_x);
             let v_sq;
-            (v[i], v_sq) = self.c.height(g.d_ax_m, (w[i], w_sq[i]));
+            (v[i], v_sq) = self.c.leg_plane(g.d_ax_m, (w[i], w_sq[i]));
             dist2[i] = p.x * p.x + v_sq;
-            ok &= !(dist2[i] > self.c.far_sq) & !(dist2[i] < self.c.near_sq);
+            ok &= !M::lt_nonneg(self.c.far_sq, dist2[i]) & !M::lt_nonneg(dist2[i], self.c.near_sq);
         }
         // Stage by stage across the legs (square roots, then angles), so that the independent
         // dependency chains sit next to each other in the instruction stream; the abductions
         // above start as soon as their depths are known. (The same `atan2` calls as
         // `Math::atan2_3` makes: bit for bit the leg-by-leg results.)
-        let mut planar = [([0.0f32; 2], [0.0f32; 2]); 4];
+        let mut planar = [(0.0f32, 0.0f32, 0.0f32, 0.0f32); 4];
         for (i, p) in feet_in_hip.iter().enumerate() {
-            planar[i] = self.planar_yx::<M>(p.x, v[i], dist2[i], false);
+            let (knee_y, knee_x) = self.c.knee_yx::<M>(g, self.knee_bend, dist2[i], false);
+            let (hip_y, hip_x) = hip_yx(p.x, v[i], dist2[i], self.c.diff_sq, knee_y);
+            planar[i] = (knee_y, knee_x, hip_y, hip_x);
         }
         let mut out = [JointAngles::default(); 4];
-        for (i, ([knee_y, hip_y], [knee_x, hip_x])) in planar.iter().enumerate() {
+        for (i, (knee_y, knee_x, hip_y, hip_x)) in planar.iter().enumerate() {
             let knee = M::atan2(*knee_y, *knee_x);
             let hip = M::atan2(*hip_y, *hip_x);
             out[i] = JointAngles::new(abduction[i], hip, knee);
@@ -672,7 +674,7 @@ impl View<'_> {
         // Within the limits (a NaN fails every comparison, so this also rejects non-finite
         // angles).
         for a in &out {
-            ok &= self.admits(*a);
+            ok &= self.limits.admits_all::<M>(*a);
         }
         if ok {
             Some(out)
@@ -687,7 +689,7 @@ impl View<'_> {
 const FAR_M: f32 = 1.0e6;
 
 /// `|a − b|` without overflowing the squares of far targets, with the backend's square root
-/// (on the ATmega2560 that keeps a second one, libm's, out of the firmware).
+/// (a firmware then links one square root, its backend's).
 #[inline]
 fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     let d = a - b;
@@ -700,40 +702,4 @@ fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     } else {
         M::sqrt(d.norm_squared())
     }
-}
-
-/// Analytic leg IK: the foot target in the hip frame → joint angles.
-///
-/// Branches: the knee bend of `robot.knee_bend`, and the abduction whose un-abducted foot lies
-/// below the hip (`w ≤ 0`). Every quadrant of the abduction circle is covered (seed 000 §2.2,
-/// Algorithm 1): the abduction angle is one four-quadrant `atan2` in `(−π, π]`.
-///
-/// Never returns NaN: non-finite input gives [`Unreachable::NonFinite`]; out-of-workspace
-/// targets give a typed error under [`ReachPolicy::Reject`] or a reported clamp under
-/// [`ReachPolicy::Clamp`]. Computes the robot's constants each call; [`Solver`] keeps them.
-#[inline]
-pub fn inverse_with<M: Math>(
-    robot: &Robot,
-    leg: LegId,
-    foot_in_hip: Vec3,
-    policy: ReachPolicy,
-) -> Result<LegSolution, IkError> {
-    let view = View {
-        geometry: &robot.leg,
-        limits: &robot.limits,
-        knee_bend: robot.knee_bend,
-        c: Consts::of(&robot.leg),
-    };
-    view.inverse_with::<M>(leg, foot_in_hip, policy)
-}
-
-/// [`inverse_with`] on the [`DefaultMath`] backend.
-#[inline]
-pub fn inverse(
-    robot: &Robot,
-    leg: LegId,
-    foot_in_hip: Vec3,
-    policy: ReachPolicy,
-) -> Result<LegSolution, IkError> {
-    inverse_with::<DefaultMath>(robot, leg, foot_in_hip, policy)
 }

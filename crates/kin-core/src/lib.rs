@@ -41,19 +41,19 @@
 //! - [`rotation`], [`body`]: body rotation in six orders, full-body IK/FK.
 //! - [`jacobian`]: velocity kinematics and the singularity measure.
 //! - [`paper`]: seed 000 (θ1, θ2, θ3) and seed 001 (β, α, φ) angle adapters.
-//! - [`math`]: the [`Math`] backend trait (`libm`, fast polynomials, or a firmware's own).
+//! - [`math`]: the [`Math`] backend trait (`libm`, fast polynomials, the soft-float choices of
+//!   CPUs without floating-point hardware, or a firmware's own).
 //! - [`motion`]: foot paths, seed 001's body-motion laws, trot / walk gaits.
 //! - [`preflight`]: sweep a motion and report reach, margins, singularity, joint speeds.
 //!
 //! ## Why not nalgebra inside
-//! Measured on the ATmega2560 (avr-none, opt-level "s", LTO; see `BENCHMARKS.md`): a program
-//! that builds the zyx body rotation and rotates four vectors links to 30,052 B of flash with
-//! nalgebra's `Rotation3::from_euler_angles` and to 9,550 B with this crate's
-//! [`rotation::matrix`]. The gap is nalgebra's sine/cosine, which goes through libm's f64
-//! `sincosf` and cannot be swapped for a cheaper backend; the matrix code itself is the same
-//! size either way (9,734 B for nalgebra matrices on this crate's sin/cos). So the hand-written
-//! [`Vec3`]/[`Mat3`] stay — they also keep every operation visible and every backend
-//! swappable — and nalgebra (f64) is the independent oracle of the tests.
+//! On the ATmega2560, a program that builds the zyx body rotation and rotates four vectors
+//! links to about three times the flash with nalgebra's `Rotation3::from_euler_angles` than
+//! with this crate's [`rotation::matrix`] (measured in `BENCHMARKS.md`, "nalgebra on the
+//! ATmega2560"). The gap is nalgebra's sine/cosine, which goes through libm's f64 `sincosf` and
+//! cannot be swapped for a cheaper backend; the matrix code itself is the same size either way.
+//! So the hand-written [`Vec3`]/[`Mat3`] stay — they also keep every operation visible and
+//! every backend swappable — and nalgebra (f64) is the independent oracle of the tests.
 
 #![no_std]
 #![forbid(unsafe_code)]

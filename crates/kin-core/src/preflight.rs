@@ -20,12 +20,11 @@
 use crate::body::{self, BodyConfig};
 use crate::jacobian::{self, SINGULARITY_THRESHOLD};
 use crate::leg::{self, Unreachable};
-use crate::math::{wrap_pi, DefaultMath, Math};
+use crate::math::wrap_pi;
 use crate::motion::{finite, positive, Error, Frame, Motion};
 use crate::robot::{Joint, JointAngles, JointLimits, LegId, Robot};
 use crate::vec::Vec3;
 use crate::ReachPolicy;
-use core::marker::PhantomData;
 
 /// Default per-joint speed limit, rad/s (about a standard hobby servo's no-load speed, 60° in
 /// 0.17 s).
@@ -123,23 +122,17 @@ impl Boundary {
 /// `r_yz = √(y² + z²)`, `w = −√(r_yz² − d_lat²)` and `r = √(x² + (w + d_ax)²)`. Negative outside.
 /// `None` for a non-finite foot.
 pub fn workspace_margin(robot: &Robot, foot_in_hip: Vec3) -> Option<(f32, Boundary)> {
-    workspace_margin_by::<DefaultMath>(robot, foot_in_hip)
-}
-
-/// [`workspace_margin`] on math backend `M`.
-#[inline(never)]
-fn workspace_margin_by<M: Math>(robot: &Robot, foot_in_hip: Vec3) -> Option<(f32, Boundary)> {
     if !foot_in_hip.is_finite() {
         return None;
     }
     let g = &robot.leg;
     let Vec3 { x, y, z } = foot_in_hip;
     let r_yz2 = y * y + z * z;
-    let r_yz = M::sqrt(r_yz2);
+    let r_yz = libm::sqrtf(r_yz2);
     let w2 = r_yz2 - g.d_lat_m * g.d_lat_m;
-    let w = -M::sqrt(if w2 > 0.0 { w2 } else { 0.0 });
+    let w = -libm::sqrtf(if w2 > 0.0 { w2 } else { 0.0 });
     let v = w + g.d_ax_m;
-    let r = M::sqrt(x * x + v * v);
+    let r = libm::sqrtf(x * x + v * v);
     let far = g.femur_m + g.tibia_m - r;
     let near = r - libm::fabsf(g.femur_m - g.tibia_m);
     let offset = r_yz - g.d_lat_m;
@@ -341,42 +334,25 @@ impl Report {
     }
 }
 
-/// Incremental preflight on math backend `M`: push samples in time order, then
-/// [`Checker::finish`].
-///
-/// A device preflights motions with it; its pieces (workspace margin, joint metrics, the
-/// Jacobian's eigenvalues) stay out of line so that each keeps a small stack frame, which on
-/// the ATmega2560 saves the frame-pointer adjustments of every access beyond 63 bytes.
+/// Incremental preflight: push samples in time order, then [`Checker::finish`].
 #[derive(Debug, Clone, Copy)]
-pub struct Checker<M = DefaultMath> {
+pub struct Checker {
     robot: Robot,
     geometric: Robot,
     config: BodyConfig,
     max_speed: [f32; 3],
     prev: [Option<(f32, JointAngles)>; 4],
     report: Report,
-    _math: PhantomData<fn() -> M>,
 }
 
 impl Checker {
     /// A checker for `robot` with poses read in `config`, and per-joint speed limits
-    /// `max_joint_speed_rad_s` (each > 0), on the [`DefaultMath`] backend.
+    /// `max_joint_speed_rad_s` (each > 0).
     pub fn new(
         robot: &Robot,
         config: BodyConfig,
         max_joint_speed_rad_s: [f32; 3],
     ) -> Result<Checker, Error> {
-        Checker::with_math(robot, config, max_joint_speed_rad_s)
-    }
-}
-
-impl<M: Math> Checker<M> {
-    /// [`Checker::new`] on math backend `M` (a device's own).
-    pub fn with_math(
-        robot: &Robot,
-        config: BodyConfig,
-        max_joint_speed_rad_s: [f32; 3],
-    ) -> Result<Checker<M>, Error> {
         robot.validate()?;
         for v in max_joint_speed_rad_s {
             positive(v, "max_joint_speed_rad_s")?;
@@ -397,7 +373,6 @@ impl<M: Math> Checker<M> {
                 max_joint_speed_limit_rad_s: max_joint_speed_rad_s,
                 singularity_threshold: SINGULARITY_THRESHOLD,
             },
-            _math: PhantomData,
         })
     }
 
@@ -409,8 +384,7 @@ impl<M: Math> Checker<M> {
         self.report.samples = sample.saturating_add(1);
         let mut out = [Err(Unreachable::NonFinite); 4];
         let finite_input = t_s.is_finite() && frame.pose.is_finite();
-        let local = body::feet_in_hips_with::<M>(
-            &self.robot,
+        let local = body::Solver::new(&self.robot).feet_in_hips(
             &frame.pose,
             &self.config,
             &frame.feet_in_world,
@@ -418,16 +392,15 @@ impl<M: Math> Checker<M> {
         for leg in LegId::ALL {
             let i = leg.index();
             let mut failure: Option<FailureKind> = None;
-            if let Some((m, b)) =
-                workspace_margin_by::<M>(&self.robot, local[i]).filter(|_| finite_input)
-            {
+            if let Some((m, b)) = workspace_margin(&self.robot, local[i]).filter(|_| finite_input) {
                 let l = &mut self.report.legs[i];
                 if update(&mut l.workspace_margin_m, m, t_s, true) {
                     l.workspace_boundary = Some(b);
                 }
             }
             let solved = if finite_input {
-                leg::inverse_with::<M>(&self.geometric, leg, local[i], ReachPolicy::Reject)
+                leg::Solver::new(&self.geometric)
+                    .inverse(leg, local[i], ReachPolicy::Reject)
                     .map(|s| s.angles)
                     .map_err(|e| e.kind)
             } else {
@@ -472,8 +445,8 @@ impl<M: Math> Checker<M> {
                 );
                 continue;
             }
-            let foot = leg::forward_with::<M>(&self.robot.leg, leg, q);
-            if let Some((m, b)) = workspace_margin_by::<M>(&self.robot, foot) {
+            let foot = leg::forward(&self.robot.leg, leg, q);
+            if let Some((m, b)) = workspace_margin(&self.robot, foot) {
                 let l = &mut self.report.legs[i];
                 if update(&mut l.workspace_margin_m, m, t_s, true) {
                     l.workspace_boundary = Some(b);
@@ -497,7 +470,6 @@ impl<M: Math> Checker<M> {
     }
 
     /// Joint margin, singularity and speed of one leg; the first failure among them.
-    #[inline(never)]
     fn angles_metrics(&mut self, leg: LegId, t_s: f32, q: JointAngles) -> Option<FailureKind> {
         let i = leg.index();
         let mut failure = None;
@@ -516,8 +488,7 @@ impl<M: Math> Checker<M> {
         if tight.0 < 0.0 {
             failure = Some(FailureKind::Unreachable(Unreachable::JointLimit(tight.1)));
         }
-        let j = jacobian::leg_jacobian_with::<M>(&self.robot.leg, leg, q);
-        let ic = jacobian::inverse_condition_by::<M>(&j);
+        let ic = jacobian::inverse_condition(&jacobian::leg_jacobian(&self.robot.leg, leg, q));
         let ic = if ic.is_finite() { ic } else { 0.0 };
         update(&mut l.inverse_condition, ic, t_s, true);
         if ic < SINGULARITY_THRESHOLD {
@@ -544,7 +515,6 @@ impl<M: Math> Checker<M> {
         failure
     }
 
-    #[inline(never)]
     fn record(&mut self, sample: u32, t_s: f32, leg: LegId, kind: FailureKind) {
         let f = Failure {
             sample,

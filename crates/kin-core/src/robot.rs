@@ -1,6 +1,7 @@
 //! Robot description: leg identities, leg geometry, hip mounts, joint limits, knee bend, and the
 //! two presets taken from the papers.
 
+use crate::math::Math;
 use crate::vec::Vec3;
 use core::fmt;
 
@@ -59,6 +60,17 @@ impl LegId {
     #[inline]
     pub const fn is_left(self) -> bool {
         matches!(self, LegId::FL | LegId::RL)
+    }
+
+    /// `v` (given for the front left corner, `x, y ≥ 0`) moved to this leg's corner of the
+    /// body: `x` negated for rear legs, `y` for right legs.
+    #[inline(always)]
+    pub const fn at_corner(self, v: Vec3) -> Vec3 {
+        Vec3::new(
+            if self.is_front() { v.x } else { -v.x },
+            if self.is_left() { v.y } else { -v.y },
+            v.z,
+        )
     }
 
     /// Short name: `FL`, `FR`, `RL`, `RR`.
@@ -215,6 +227,26 @@ impl JointLimits {
     pub fn admits(&self, joint: Joint, angle_rad: f32) -> bool {
         let j = joint as usize;
         angle_rad >= self.min_rad[j] && angle_rad <= self.max_rad[j]
+    }
+
+    /// True when all three angles lie within their limits (false for any NaN), compared by
+    /// backend `M` (all backends agree with the float operators; some compare faster).
+    #[inline(always)]
+    pub(crate) fn admits_all<M: Math>(&self, q: JointAngles) -> bool {
+        let (lo, hi) = (&self.min_rad, &self.max_rad);
+        M::within(q.abduction_rad, lo[0], hi[0])
+            & M::within(q.hip_rad, lo[1], hi[1])
+            & M::within(q.knee_rad, lo[2], hi[2])
+    }
+
+    /// `angles` with each angle clamped into its joint's interval.
+    #[inline]
+    pub fn clamp(&self, angles: JointAngles) -> JointAngles {
+        let mut a = angles.to_array();
+        for (i, v) in a.iter_mut().enumerate() {
+            *v = v.clamp(self.min_rad[i], self.max_rad[i]);
+        }
+        JointAngles::from_array(a)
     }
 
     /// The first joint of `angles` outside its limits, if any.
@@ -396,9 +428,12 @@ impl Robot {
 
     /// Hip (abduction-axis) mount of `leg` in the body frame: `(±length/2, ±width/2, 0)`.
     #[inline]
-    pub fn hip_in_body(&self, leg: LegId) -> Vec3 {
-        let x = if leg.is_front() { 0.5 } else { -0.5 } * self.body_length_m;
-        Vec3::new(x, leg.side() * 0.5 * self.body_width_m, 0.0)
+    pub const fn hip_in_body(&self, leg: LegId) -> Vec3 {
+        leg.at_corner(Vec3::new(
+            0.5 * self.body_length_m,
+            0.5 * self.body_width_m,
+            0.0,
+        ))
     }
 
     /// Nominal stance for stance height `height_m`: each foot straight below its hip, in the

@@ -112,52 +112,143 @@ pub fn rot_z(angle_rad: f32) -> Mat3 {
     elementary(2, s, c)
 }
 
-/// Body rotation matrix for `roll`, `pitch`, `yaw` (rad) in `order`, on backend `M`: three
-/// `sin_cos`, then the closed form of the order (14 multiplications, 4 additions).
-#[inline]
-pub fn matrix_with<M: Math>(
-    order: RotationOrder,
-    roll_rad: f32,
-    pitch_rad: f32,
-    yaw_rad: f32,
-) -> Mat3 {
-    let sc = [
+/// `(sin, cos)` of roll, pitch and yaw on backend `M`.
+#[inline(always)]
+fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32); 3] {
+    [
         M::sin_cos(roll_rad),
         M::sin_cos(pitch_rad),
         M::sin_cos(yaw_rad),
-    ];
-    // Hosts: one arm per order with the axes as constants, so that each compiles to its own
-    // closed form without index arithmetic. The ATmega2560: one copy with the axes at run
-    // time (a sixth of the flash; the indexing costs little next to software floats).
-    #[cfg(not(target_arch = "avr"))]
+    ]
+}
+
+/// Body rotation matrix for `roll`, `pitch`, `yaw` (rad) in `order`, on backend `M`
+/// (`rotation::matrix::<kin_core::DefaultMath>(…)` on a host): three `sin_cos`, then the
+/// closed form of the order — written out entry by entry for the papers' orders ([`zyx`],
+/// [`zxy`]), from the general Tait–Bryan closed form for the other four.
+///
+/// ```
+/// use kin_core::{rotation::{self, RotationOrder}, DefaultMath, Mat3};
+/// let (roll, pitch, yaw) = (0.3, -0.2, 0.7);
+/// let product = rotation::rot_z(yaw).mul_mat(&rotation::rot_x(roll)).mul_mat(&rotation::rot_y(pitch));
+/// let m = rotation::matrix::<DefaultMath>(RotationOrder::Zxy, roll, pitch, yaw);
+/// for (a, b) in m.rows.iter().flatten().zip(product.rows.iter().flatten()) {
+///     assert!((a - b).abs() < 1e-6);
+/// }
+/// ```
+#[inline]
+pub fn matrix<M: Math>(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
+    // One arm per order with the axes as constants, so that each compiles to its own closed
+    // form without index arithmetic.
     match order {
-        RotationOrder::Xyz => closed_form(0, 1, 2, true, &sc),
-        RotationOrder::Xzy => closed_form(0, 2, 1, false, &sc),
-        RotationOrder::Yxz => closed_form(1, 0, 2, false, &sc),
-        RotationOrder::Yzx => closed_form(1, 2, 0, true, &sc),
-        RotationOrder::Zxy => closed_form(2, 0, 1, true, &sc),
-        RotationOrder::Zyx => closed_form(2, 1, 0, false, &sc),
-    }
-    #[cfg(target_arch = "avr")]
-    {
-        closed_form_at_run_time(order, &sc)
+        RotationOrder::Zyx => zyx::<M>(roll_rad, pitch_rad, yaw_rad),
+        RotationOrder::Zxy => zxy::<M>(roll_rad, pitch_rad, yaw_rad),
+        RotationOrder::Xyz => {
+            closed_form(0, 1, 2, true, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
+        }
+        RotationOrder::Xzy => {
+            closed_form(0, 2, 1, false, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
+        }
+        RotationOrder::Yxz => {
+            closed_form(1, 0, 2, false, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
+        }
+        RotationOrder::Yzx => {
+            closed_form(1, 2, 0, true, &sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
+        }
     }
 }
 
-/// [`closed_form`] with the axes of `order` as run-time values.
-#[cfg_attr(not(any(test, target_arch = "avr")), allow(dead_code))]
+/// Seed 000's default order ([`RotationOrder::Zyx`], seed 000 eq. 5.1–5.3 and Algorithm 2 with
+/// erratum 3): `R = Rz(ψ)·Ry(θ)·Rx(φ)` for roll φ, pitch θ, yaw ψ, entry by entry
+/// (`c`, `s`: cosine, sine), on backend `M`:
+///
+/// ```text
+/// ⎡ cψ·cθ   cψ·sθ·sφ − sψ·cφ   cψ·sθ·cφ + sψ·sφ ⎤
+/// ⎢ sψ·cθ   sψ·sθ·sφ + cψ·cφ   sψ·sθ·cφ − cψ·sφ ⎥
+/// ⎣ −sθ     cθ·sφ              cθ·cφ            ⎦
+/// ```
+///
+/// ```
+/// use kin_core::{rotation::{self, RotationOrder}, DefaultMath};
+/// let (roll, pitch, yaw) = (0.3, -0.2, 0.7);
+/// let product = rotation::rot_z(yaw).mul_mat(&rotation::rot_y(pitch)).mul_mat(&rotation::rot_x(roll));
+/// let m = rotation::zyx::<DefaultMath>(roll, pitch, yaw);
+/// for (a, b) in m.rows.iter().flatten().zip(product.rows.iter().flatten()) {
+///     assert!((a - b).abs() < 1e-6);
+/// }
+/// // The general closed form of the order gives the same matrix.
+/// assert_eq!(m, rotation::matrix::<DefaultMath>(RotationOrder::Zyx, roll, pitch, yaw));
+/// ```
 #[inline(always)]
-fn closed_form_at_run_time(order: RotationOrder, sc: &[(f32, f32); 3]) -> Mat3 {
-    let [i, j, k] = order.axes();
-    // Cyclic orders (xyz, yzx, zxy) are the even permutations.
-    let even = (j + 3 - i) % 3 == 1;
-    closed_form(i as usize, j as usize, k as usize, even, sc)
+pub fn zyx<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
+    let [(s_phi, c_phi), (s_theta, c_theta), (s_psi, c_psi)] =
+        sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
+    // The shared products first (the same roundings as the general closed form).
+    let (s_psi_s_theta, c_psi_s_theta) = (s_psi * s_theta, c_psi * s_theta);
+    Mat3 {
+        rows: [
+            [
+                c_psi * c_theta,
+                c_psi_s_theta * s_phi - s_psi * c_phi,
+                c_psi_s_theta * c_phi + s_psi * s_phi,
+            ],
+            [
+                s_psi * c_theta,
+                s_psi_s_theta * s_phi + c_psi * c_phi,
+                s_psi_s_theta * c_phi - c_psi * s_phi,
+            ],
+            [-s_theta, c_theta * s_phi, c_theta * c_phi],
+        ],
+    }
+}
+
+/// Seed 001's order ([`RotationOrder::Zxy`], seed 001 eq. 1–2 with erratum 6g):
+/// `Γψθγ = Γψ·Γθ·Γγ` for course ψ (yaw, about z), roll θ (about x) and pitch γ (about y), entry
+/// by entry, on backend `M`:
+///
+/// ```text
+/// ⎡ cψ·cγ − sψ·sθ·sγ   −sψ·cθ   cψ·sγ + sψ·sθ·cγ ⎤
+/// ⎢ sψ·cγ + cψ·sθ·sγ    cψ·cθ   sψ·sγ − cψ·sθ·cγ ⎥
+/// ⎣ −cθ·sγ              sθ      cθ·cγ            ⎦
+/// ```
+///
+/// ```
+/// use kin_core::{rotation::{self, RotationOrder}, DefaultMath};
+/// let (roll, pitch, yaw) = (0.3, -0.2, 0.7);
+/// let product = rotation::rot_z(yaw).mul_mat(&rotation::rot_x(roll)).mul_mat(&rotation::rot_y(pitch));
+/// let m = rotation::zxy::<DefaultMath>(roll, pitch, yaw);
+/// for (a, b) in m.rows.iter().flatten().zip(product.rows.iter().flatten()) {
+///     assert!((a - b).abs() < 1e-6);
+/// }
+/// assert_eq!(m, rotation::matrix::<DefaultMath>(RotationOrder::Zxy, roll, pitch, yaw));
+/// ```
+#[inline(always)]
+pub fn zxy<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
+    let [(s_theta, c_theta), (s_gamma, c_gamma), (s_psi, c_psi)] =
+        sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
+    let (s_psi_s_theta, c_psi_s_theta) = (s_psi * s_theta, c_psi * s_theta);
+    Mat3 {
+        rows: [
+            [
+                c_psi * c_gamma - s_psi_s_theta * s_gamma,
+                -(s_psi * c_theta),
+                c_psi * s_gamma + s_psi_s_theta * c_gamma,
+            ],
+            [
+                s_psi * c_gamma + c_psi_s_theta * s_gamma,
+                c_psi * c_theta,
+                s_psi * s_gamma - c_psi_s_theta * c_gamma,
+            ],
+            [-(c_theta * s_gamma), s_theta, c_theta * c_gamma],
+        ],
+    }
 }
 
 /// `E_i(a)·E_j(b)·E_k(c)` for the elementary rotations about the distinct axes `i`, `j`, `k`
 /// (0 = x, 1 = y, 2 = z; `even`: `(i, j, k)` is a cyclic permutation of `(x, y, z)`), with
 /// `(sin, cos)` of the roll, pitch and yaw angles in `sc` (`a`, `b`, `c` are the angles of axes
-/// `i`, `j`, `k`). The Tait–Bryan closed form, with `ε = ±1` by the parity of the order:
+/// `i`, `j`, `k`). The general Tait–Bryan closed form, with `ε = ±1` by the parity of the
+/// order (for zyx and zxy it is [`zyx`] and [`zxy`], bit for bit):
 ///
 /// | | column i | column j | column k |
 /// |---|---|---|---|
@@ -180,12 +271,6 @@ fn closed_form(i: usize, j: usize, k: usize, even: bool, sc: &[(f32, f32); 3]) -
     rows[k][j] = e(sa * c_c) + ca_sb * s_c;
     rows[k][k] = ca * cb;
     Mat3 { rows }
-}
-
-/// [`matrix_with`] on the [`DefaultMath`] backend.
-#[inline]
-pub fn matrix(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
-    matrix_with::<DefaultMath>(order, roll_rad, pitch_rad, yaw_rad)
 }
 
 /// Angular velocity of the body, in the world frame, for Euler-angle rates in `order`:
@@ -211,37 +296,44 @@ pub fn angular_velocity(order: RotationOrder, angles_rad: [f32; 3], rates_rad_s:
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Fast;
+    use crate::math::{Fast, SoftFloat};
 
-    /// The ATmega2560's form (axes at run time) gives the hosts' matrices bit for bit, and
-    /// both equal the product of the elementary rotations.
+    /// [`closed_form`] with the axes of `order` as run-time values.
+    fn closed_form_at_run_time(order: RotationOrder, sc: &[(f32, f32); 3]) -> Mat3 {
+        let [i, j, k] = order.axes();
+        // Cyclic orders (xyz, yzx, zxy) are the even permutations.
+        let even = (j + 3 - i) % 3 == 1;
+        closed_form(i as usize, j as usize, k as usize, even, sc)
+    }
+
+    /// Every order's matrix (the written-out [`zyx`] and [`zxy`] included) equals the general
+    /// closed form with the order's axes found at run time, bit for bit, on the default and the
+    /// soft-float kernels, and the product of the elementary rotations.
     #[test]
-    fn run_time_axes_equal_constant_axes() {
-        for order in RotationOrder::ALL {
-            for (r, p, y) in [
-                (0.3f32, -0.2f32, 0.7f32),
-                (-2.0, 1.1, -0.4),
-                (0.0, 0.0, 0.0),
-            ] {
-                let sc = [Fast::sin_cos(r), Fast::sin_cos(p), Fast::sin_cos(y)];
-                let host = matrix_with::<Fast>(order, r, p, y);
-                let avr = closed_form_at_run_time(order, &sc);
-                assert_eq!(host, avr, "{order}");
-                let angles = [r, p, y];
-                let mut product = Mat3::IDENTITY;
-                for axis in order.axes() {
-                    let (s, c) = sc[axis as usize];
-                    product = product.mul_mat(&elementary(axis, s, c));
-                }
-                for (a, b) in host
-                    .rows
-                    .iter()
-                    .flatten()
-                    .zip(product.rows.iter().flatten())
-                {
-                    assert!((a - b).abs() < 1e-6, "{order} {angles:?}");
+    fn every_order_equals_the_general_closed_form_and_the_product() {
+        fn check<M: Math>() {
+            for order in RotationOrder::ALL {
+                for (r, p, y) in [
+                    (0.3f32, -0.2f32, 0.7f32),
+                    (-2.0, 1.1, -0.4),
+                    (0.0, 0.0, 0.0),
+                ] {
+                    let sc = [M::sin_cos(r), M::sin_cos(p), M::sin_cos(y)];
+                    let m = matrix::<M>(order, r, p, y);
+                    assert_eq!(m, closed_form_at_run_time(order, &sc), "{order}");
+                    let angles = [r, p, y];
+                    let mut product = Mat3::IDENTITY;
+                    for axis in order.axes() {
+                        let (s, c) = sc[axis as usize];
+                        product = product.mul_mat(&elementary(axis, s, c));
+                    }
+                    for (a, b) in m.rows.iter().flatten().zip(product.rows.iter().flatten()) {
+                        assert!((a - b).abs() < 1e-6, "{order} {angles:?}");
+                    }
                 }
             }
         }
+        check::<Fast>();
+        check::<SoftFloat>();
     }
 }

@@ -1,6 +1,8 @@
-//! The ATmega2560 firmware's math on the host: `avr_libc_math::AvrFast` is avr-libc's `sqrt`
-//! (correctly rounded, as libm's `sqrtf` here), [`poly::atan2_fixed`] and
-//! [`poly::sin_cos_deg5`]. The same kernels run here on the same benchmark inputs as
+//! The ATmega2560 firmware's math on the host: the firmware's backend `avr_libc_math::AvrFast`
+//! is `kin_core::math::SoftFloat` over avr-libc's `sqrt` (correctly rounded, as libm's `sqrtf`
+//! of `SoftFloat`'s default here): the kernels `poly::atan2_fixed` and `poly::sin_cos_deg5`,
+//! the bit-pattern comparisons and the legs one after the other, as on the board. The same
+//! backend runs here on the same benchmark inputs as
 //! `bench_accuracy.rs`, against the generating f64 angles (the hard limit of the firmware:
 //! 0.01°) and against the host's default backend (the readback bound between device and host,
 //! which the emulator test `tests/tests/avr_firmware.rs` checks on the real firmware).
@@ -8,23 +10,11 @@
 #[path = "../benches/common/mod.rs"]
 mod common;
 
-use kin_core::math::{poly, Fast};
-use kin_core::{body, leg, BodyConfig, Math, ReachPolicy, Robot};
+use kin_core::math::{Fast, SoftFloat};
+use kin_core::{body, leg, BodyConfig, ReachPolicy, Robot};
 
-/// The firmware's kernels, with libm's square root for avr-libc's.
-struct AvrKernels;
-
-impl Math for AvrKernels {
-    fn sqrt(x: f32) -> f32 {
-        libm::sqrtf(x)
-    }
-    fn atan2(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed(y, x)
-    }
-    fn sin_cos(x: f32) -> (f32, f32) {
-        poly::sin_cos_deg5(x)
-    }
-}
+/// The firmware's backend, with libm's square root for avr-libc's.
+type AvrKernels = SoftFloat;
 
 /// The firmware's hard limit on the angle error against an f64 reference, rad (0.01°).
 const HARD_LIMIT_RAD: f64 = 0.01 * std::f64::consts::PI / 180.0;
@@ -39,11 +29,13 @@ fn firmware_kernels_on_every_benchmark_leg_target() {
     let (mut worst_f64, mut worst_host) = (0.0f64, 0.0f64);
     for t in common::leg_targets() {
         let robot = &robots[t.robot];
-        let avr = leg::inverse_with::<AvrKernels>(robot, t.leg, t.foot_in_hip, ReachPolicy::Reject)
+        let avr = leg::Solver::<AvrKernels>::with_math(robot)
+            .inverse(t.leg, t.foot_in_hip, ReachPolicy::Reject)
             .unwrap_or_else(|e| panic!("{t:?}: {e}"))
             .angles
             .to_array();
-        let host = leg::inverse_with::<Fast>(robot, t.leg, t.foot_in_hip, ReachPolicy::Reject)
+        let host = leg::Solver::<Fast>::with_math(robot)
+            .inverse(t.leg, t.foot_in_hip, ReachPolicy::Reject)
             .expect("the host solves every benchmark target")
             .angles
             .to_array();
@@ -73,16 +65,14 @@ fn firmware_kernels_on_every_benchmark_pose() {
     for pose in common::body_poses() {
         let solve = |avr: bool| {
             if avr {
-                body::inverse_at_stance_with::<AvrKernels>(
-                    &robot,
+                body::Solver::<AvrKernels>::with_math(&robot).inverse_at_stance(
                     &pose,
                     &config,
                     height_m,
                     ReachPolicy::Reject,
                 )
             } else {
-                body::inverse_at_stance_with::<Fast>(
-                    &robot,
+                body::Solver::<Fast>::with_math(&robot).inverse_at_stance(
                     &pose,
                     &config,
                     height_m,

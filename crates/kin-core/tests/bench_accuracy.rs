@@ -52,7 +52,8 @@ fn worst_leg_error<M: Math>() -> f64 {
     let mut worst = 0.0f64;
     for t in common::leg_targets() {
         let robot = &robots[t.robot];
-        let q = leg::inverse_with::<M>(robot, t.leg, t.foot_in_hip, ReachPolicy::Reject)
+        let q = leg::Solver::<M>::with_math(robot)
+            .inverse(t.leg, t.foot_in_hip, ReachPolicy::Reject)
             .unwrap_or_else(|e| panic!("{} target {:?}: {e}", common::ROBOT_NAMES[t.robot], t));
         let err =
             (foot_in_hip_f64(robot, t.leg, angles_f64(q.angles)) - to_f64(t.foot_in_hip)).norm();
@@ -100,7 +101,8 @@ fn body_ik_then_f64_fk_within_1_um_on_every_benchmark_pose() {
     let config = BodyConfig::default();
     let mut worst = 0.0f64;
     for pose in common::body_poses() {
-        let sol = body::inverse_at_stance(&robot, &pose, &config, height_m, ReachPolicy::Reject)
+        let sol = body::Solver::new(&robot)
+            .inverse_at_stance(&pose, &config, height_m, ReachPolicy::Reject)
             .unwrap_or_else(|e| panic!("{pose:?}: {e}"));
         // zyx: R = Rz(yaw)·Ry(pitch)·Rx(roll), nalgebra's from_euler_angles(roll, pitch, yaw).
         let r = Rotation3::from_euler_angles(

@@ -87,7 +87,7 @@ proptest! {
     ) {
         let rpy = [roll as f32, pitch as f32, yaw as f32];
         for order in RotationOrder::ALL {
-            let m = rotation::matrix(order, rpy[0], rpy[1], rpy[2]);
+            let m = rotation::matrix::<kin_core::DefaultMath>(order, rpy[0], rpy[1], rpy[2]);
             let want = nalgebra_matrix(order, rpy.map(|a| a as f64));
             prop_assert!(max_abs(to64(&m) - want) <= ROTATION_TOL, "{order}");
             let m64 = to64(&m);
@@ -95,7 +95,7 @@ proptest! {
             prop_assert!((m64.determinant() - 1.0).abs() <= ROTATION_TOL);
         }
         // zyx is nalgebra's roll-pitch-yaw (roll first, then pitch, then yaw).
-        let zyx = rotation::matrix(RotationOrder::Zyx, rpy[0], rpy[1], rpy[2]);
+        let zyx = rotation::matrix::<kin_core::DefaultMath>(RotationOrder::Zyx, rpy[0], rpy[1], rpy[2]);
         let euler = Rotation3::from_euler_angles(rpy[0] as f64, rpy[1] as f64, rpy[2] as f64);
         prop_assert!(max_abs(to64(&zyx) - euler.into_inner()) <= ROTATION_TOL);
     }
@@ -120,7 +120,7 @@ proptest! {
             (pose.x_m, pose.y_m, pose.z_m) = (shift[0], shift[1], shift[2]);
         }
         let feet = robot.stance_feet(SEED000_STANCE_HEIGHT_M);
-        let res = body::inverse(&robot, &pose, &config, &feet, ReachPolicy::Reject);
+        let res = body::Solver::new(&robot).inverse(&pose, &config, &feet, ReachPolicy::Reject);
         if !with_offsets {
             prop_assert!(res.is_ok(), "pure rotation {pose:?} {}: {res:?}", config.order);
         }
@@ -144,7 +144,7 @@ proptest! {
         let mut rng = SplitMix64::new(seed);
         let angles = LegId::ALL.map(|_| random_angles(&mut rng, &robot, 0.05));
         let feet = body::forward(&robot, &pose, &config, &angles);
-        let res = body::inverse(&robot, &pose, &config, &feet, ReachPolicy::Reject);
+        let res = body::Solver::new(&robot).inverse(&pose, &config, &feet, ReachPolicy::Reject);
         check_body(&robot, &pose, &config, &feet, res)?;
     }
 }
@@ -159,7 +159,8 @@ fn check_body(
     feet: &[Vec3; 4],
     res: Result<body::BodySolution, kin_core::IkError>,
 ) -> Result<(), TestCaseError> {
-    let local = body::feet_in_hips_with::<kin_core::math::Libm>(robot, pose, config, feet);
+    let local =
+        body::Solver::<kin_core::math::Libm>::with_math(robot).feet_in_hips(pose, config, feet);
     let verdicts = LegId::ALL.map(|l| {
         let p = v64(local[l.index()]);
         ik64(robot, l, [p.x, p.y, p.z])
@@ -217,7 +218,8 @@ fn seed000_extreme_poses_solve_at_stance_height() {
                         order,
                         pivot_m: Vec3::ZERO,
                     };
-                    let sol = body::inverse(&robot, &pose, &config, &feet, ReachPolicy::Reject)
+                    let sol = body::Solver::new(&robot)
+                        .inverse(&pose, &config, &feet, ReachPolicy::Reject)
                         .unwrap_or_else(|e| panic!("{order} {pose:?}: {e}"));
                     let back = body::forward(&robot, &pose, &config, &sol.angles());
                     for l in LegId::ALL {
@@ -254,7 +256,8 @@ fn seed001_roll_and_pitch_laws_round_trip() {
             } else {
                 Pose::rotation(0.0, angle, 0.0)
             };
-            let sol = body::inverse(&robot, &pose, &config, &feet, ReachPolicy::Reject)
+            let sol = body::Solver::new(&robot)
+                .inverse(&pose, &config, &feet, ReachPolicy::Reject)
                 .unwrap_or_else(|e| panic!("law {law} t = {t}: {e}"));
             let angles = sol.angles();
             let back = body::forward(&robot, &pose, &config, &angles);
@@ -292,14 +295,14 @@ fn seed001_roll_and_pitch_laws_round_trip() {
 #[test]
 fn nominal_stance_is_zero_abduction() {
     for ((_, robot), h) in presets().into_iter().zip([0.3f32, 0.8]) {
-        let sol = body::inverse_at_stance(
-            &robot,
-            &Pose::default(),
-            &BodyConfig::default(),
-            h,
-            ReachPolicy::Reject,
-        )
-        .unwrap();
+        let sol = body::Solver::new(&robot)
+            .inverse_at_stance(
+                &Pose::default(),
+                &BodyConfig::default(),
+                h,
+                ReachPolicy::Reject,
+            )
+            .unwrap();
         for (l, s) in LegId::ALL.iter().zip(sol.legs) {
             assert!(s.angles.abduction_rad.abs() < 1e-6, "{l}: {s:?}");
             let foot = leg::forward(&robot.leg, *l, s.angles);

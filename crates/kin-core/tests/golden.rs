@@ -58,7 +58,7 @@ fn golden_ik() {
         let leg_id = LegId::parse(&r[2]).expect("leg");
         let p: [f32; 3] = [3, 4, 5].map(|c| r[c].parse().expect("f32 coordinate"));
         let target = Vec3::from_array(p);
-        let res = leg::inverse(&robot, leg_id, target, ReachPolicy::Reject);
+        let res = leg::Solver::new(&robot).inverse(leg_id, target, ReachPolicy::Reject);
         assert_eq!(status_of(&res), r[6], "line {line}: {res:?}");
         kinds.insert(r[6].clone());
         *per_robot.entry(r[0].clone()).or_default() += 1;

@@ -232,7 +232,12 @@ fn foot_velocity_in_hip_matches_differentiated_pose() {
             };
             let dt = 1e-6;
             let want = (local(dt) - local(-dt)) / (2.0 * dt);
-            let r = rotation::matrix(order, q[0] as f32, q[1] as f32, q[2] as f32);
+            let r = rotation::matrix::<kin_core::DefaultMath>(
+                order,
+                q[0] as f32,
+                q[1] as f32,
+                q[2] as f32,
+            );
             let omega =
                 rotation::angular_velocity(order, q.map(|v| v as f32), qd.map(|v| v as f32));
             let f32v = |v: Vector3<f64>| Vec3::new(v.x as f32, v.y as f32, v.z as f32);

@@ -32,7 +32,7 @@ fn robot_of(index: usize, forward: bool) -> Robot {
 fn check_against_oracle(robot: &Robot, leg_id: LegId, target: Vec3) -> Option<JointAngles> {
     let p = v64(target);
     let verdict = ik64(robot, leg_id, [p.x, p.y, p.z]);
-    let got = leg::inverse(robot, leg_id, target, ReachPolicy::Reject);
+    let got = leg::Solver::new(robot).inverse(leg_id, target, ReachPolicy::Reject);
     if let Ok(sol) = &got {
         assert!(sol.angles.is_finite(), "non-finite angles {sol:?}");
         assert!(sol.clamped.is_none(), "Reject policy reported a clamp");
@@ -234,7 +234,8 @@ fn seed000_quadrants_theta1_matches_algorithm1_done_right() {
                 }
                 let target = Vec3::new(x as f32, y as f32, z as f32);
                 let p = v64(target);
-                let sol = leg::inverse(&robot, leg_id, target, ReachPolicy::Reject)
+                let sol = leg::Solver::new(&robot)
+                    .inverse(leg_id, target, ReachPolicy::Reject)
                     .unwrap_or_else(|e| panic!("{leg_id} {target:?}: {e}"));
                 let err = (fk64(&g, leg_id, q64(sol.angles)) - p).norm();
                 assert!(err <= FOOT_TOL_M, "{leg_id} {target:?}: foot error {err:e}");
@@ -272,7 +273,9 @@ fn theta1_wraps_at_two_pi() {
             let a = wrap_pi64(centre + i as f64 * 1.0e-3);
             let q = JointAngles::new(a as f32, 0.3, -0.9);
             let target = leg::forward(&robot.leg, leg_id, q);
-            let sol = leg::inverse(&robot, leg_id, target, ReachPolicy::Reject).unwrap();
+            let sol = leg::Solver::new(&robot)
+                .inverse(leg_id, target, ReachPolicy::Reject)
+                .unwrap();
             let s = paper::to_seed000(leg_id, sol.angles);
             let theta1 = s.theta1_rad as f64;
             assert!((0.0..2.0 * PI).contains(&theta1), "θ1 = {theta1}");
@@ -412,7 +415,8 @@ fn seed000_fifty_random_points_all_solve() {
             if verdict.result.is_err() || verdict.margin < 1e-3 {
                 continue;
             }
-            let sol = leg::inverse(&robot, leg_id, target, ReachPolicy::Reject)
+            let sol = leg::Solver::new(&robot)
+                .inverse(leg_id, target, ReachPolicy::Reject)
                 .unwrap_or_else(|e| panic!("point {solved}: {target:?} -> {e}"));
             let err = (fk64(&g, leg_id, q64(sol.angles)) - p).norm();
             assert!(err <= FOOT_TOL_M, "point {solved}: error {err:e}");
@@ -432,8 +436,12 @@ fn knee_bend_forward_mirrors_the_knee() {
         for leg_id in LegId::ALL {
             let q = JointAngles::new(0.1, 0.2, -1.0);
             let target = leg::forward(&robot.leg, leg_id, q);
-            let back = leg::inverse(&robot, leg_id, target, ReachPolicy::Reject).unwrap();
-            let front = leg::inverse(&fwd, leg_id, target, ReachPolicy::Reject).unwrap();
+            let back = leg::Solver::new(&robot)
+                .inverse(leg_id, target, ReachPolicy::Reject)
+                .unwrap();
+            let front = leg::Solver::new(&fwd)
+                .inverse(leg_id, target, ReachPolicy::Reject)
+                .unwrap();
             assert!((back.angles.knee_rad + 1.0).abs() < 1e-5);
             assert!((front.angles.knee_rad - 1.0).abs() < 1e-5);
             assert!((front.angles.abduction_rad - back.angles.abduction_rad).abs() < 1e-6);

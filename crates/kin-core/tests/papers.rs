@@ -45,7 +45,9 @@ fn seed001_initial_pose_is_hip_30_knee_minus_60() {
         );
         // And back: IK of that foot is the initial pose.
         let target = Vec3::new(0.0, 0.0, -depth as f32);
-        let sol = leg::inverse(&robot, leg_id, target, ReachPolicy::Reject).unwrap();
+        let sol = leg::Solver::new(&robot)
+            .inverse(leg_id, target, ReachPolicy::Reject)
+            .unwrap();
         let s = paper::to_seed001(sol.angles);
         assert!((s.phi_rad as f64 - 120f64.to_radians()).abs() < 1e-5);
         assert!((s.alpha_rad as f64 - 60f64.to_radians()).abs() < 1e-5);
@@ -418,7 +420,7 @@ fn erratum_seed000_alg2_rotation_order_keys() {
         _ => rotation::rot_z(yaw),
     };
     let product = |m: [char; 3]| axis(m[0]).mul_mat(&axis(m[1])).mul_mat(&axis(m[2]));
-    let ours = |o: RotationOrder| rotation::matrix(o, roll, pitch, yaw);
+    let ours = |o: RotationOrder| rotation::matrix::<kin_core::DefaultMath>(o, roll, pitch, yaw);
     let close = |a: &kin_core::Mat3, b: &kin_core::Mat3| {
         (0..3).all(|i| (0..3).all(|j| (a.rows[i][j] - b.rows[i][j]).abs() < 1e-6))
     };
@@ -606,7 +608,9 @@ fn erratum_seed000_alg1_right_leg_theta1_not_wrapped() {
         for a in [1.7f32, 2.2, 3.0] {
             let q = JointAngles::new(a, 0.3, -1.0);
             let target = leg::forward(&robot.leg, leg_id, q);
-            let sol = leg::inverse(&robot, leg_id, target, ReachPolicy::Reject).unwrap();
+            let sol = leg::Solver::new(&robot)
+                .inverse(leg_id, target, ReachPolicy::Reject)
+                .unwrap();
             let p = v64(target);
             let alpha1 = wrap_2pi64(p.z.atan2(p.y));
             let alpha3 = FRAC_PI_2 - (la / p.y.hypot(p.z)).asin();
@@ -742,7 +746,14 @@ fn erratum_seed001_eq1_gamma_subscripts() {
         gamma.cos(),
     );
     let to64 = |m: kin_core::Mat3| Matrix3::from_fn(|i, j| m.rows[i][j] as f64);
-    let ours = |o| to64(rotation::matrix(o, theta as f32, gamma as f32, psi as f32));
+    let ours = |o| {
+        to64(rotation::matrix::<kin_core::DefaultMath>(
+            o,
+            theta as f32,
+            gamma as f32,
+            psi as f32,
+        ))
+    };
     let written = g_psi * g_theta * g_gamma;
     assert!((ours(RotationOrder::Zxy) - written).abs().max() <= F32_TOL);
     assert!((g_psi * g_gamma * g_theta - written).abs().max() > WRONG_BY);

@@ -193,7 +193,7 @@ proptest! {
         let leg_id = LegId::ALL[leg_i];
         let foot = Vec3::new(x, y, z);
         let (m, _) = workspace_margin(&robot, foot).unwrap();
-        let ok = leg::inverse(&robot, leg_id, foot, ReachPolicy::Reject).is_ok();
+        let ok = leg::Solver::new(&robot).inverse(leg_id, foot, ReachPolicy::Reject).is_ok();
         if m > BOUNDARY_BAND_M {
             prop_assert!(ok, "margin {m} but refused");
         } else if m < -BOUNDARY_BAND_M {

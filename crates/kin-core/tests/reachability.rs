@@ -21,10 +21,12 @@ const BITS_CASES: u32 = 3000;
 const BODY_BITS_CASES: u32 = 800;
 
 fn reject(robot: &Robot, leg_id: LegId, p: Vec3) -> Result<JointAngles, IkError> {
-    leg::inverse(robot, leg_id, p, ReachPolicy::Reject).map(|s| {
-        assert!(s.angles.is_finite());
-        s.angles
-    })
+    leg::Solver::new(robot)
+        .inverse(leg_id, p, ReachPolicy::Reject)
+        .map(|s| {
+            assert!(s.angles.is_finite());
+            s.angles
+        })
 }
 
 fn kind(robot: &Robot, leg_id: LegId, p: Vec3) -> Unreachable {
@@ -36,14 +38,14 @@ fn kind(robot: &Robot, leg_id: LegId, p: Vec3) -> Unreachable {
 /// The error of body IK on `feet` at the zero pose and default configuration, rejecting
 /// unreachable targets (the pose must be refused).
 fn rejected_at_rest(robot: &Robot, feet: &[Vec3; 4]) -> IkError {
-    body::inverse(
-        robot,
-        &Pose::default(),
-        &BodyConfig::default(),
-        feet,
-        ReachPolicy::Reject,
-    )
-    .unwrap_err()
+    body::Solver::new(robot)
+        .inverse(
+            &Pose::default(),
+            &BodyConfig::default(),
+            feet,
+            ReachPolicy::Reject,
+        )
+        .unwrap_err()
 }
 
 /// Foot in the hip frame of the zero-abduction leg plane at height `z` and forward offset `x`.
@@ -143,7 +145,9 @@ fn non_finite_in_each_coordinate() {
                     a[i] = bad;
                     let p = Vec3::from_array(a);
                     for policy in [ReachPolicy::Reject, ReachPolicy::Clamp] {
-                        let e = leg::inverse(&robot, leg_id, p, policy).unwrap_err();
+                        let e = leg::Solver::new(&robot)
+                            .inverse(leg_id, p, policy)
+                            .unwrap_err();
                         assert_eq!(
                             e,
                             IkError {
@@ -169,14 +173,9 @@ fn body_non_finite_in_each_input() {
             let mut a = [0.0; 6];
             a[i] = bad;
             let pose = Pose::from_array(a);
-            let e = body::inverse(
-                &robot,
-                &pose,
-                &BodyConfig::default(),
-                &feet,
-                ReachPolicy::Clamp,
-            )
-            .unwrap_err();
+            let e = body::Solver::new(&robot)
+                .inverse(&pose, &BodyConfig::default(), &feet, ReachPolicy::Clamp)
+                .unwrap_err();
             assert_eq!(e.kind, Unreachable::NonFinite, "pose field {i}");
         }
         for i in 0..3 {
@@ -186,14 +185,9 @@ fn body_non_finite_in_each_input() {
                 order: RotationOrder::Zyx,
                 pivot_m: Vec3::from_array(c),
             };
-            let e = body::inverse(
-                &robot,
-                &Pose::default(),
-                &config,
-                &feet,
-                ReachPolicy::Reject,
-            )
-            .unwrap_err();
+            let e = body::Solver::new(&robot)
+                .inverse(&Pose::default(), &config, &feet, ReachPolicy::Reject)
+                .unwrap_err();
             assert_eq!(e.kind, Unreachable::NonFinite, "pivot {i}");
         }
         for leg_id in LegId::ALL {
@@ -234,14 +228,14 @@ fn body_rejects_pose_and_names_the_leg() {
     let e = rejected_at_rest(&robot, &feet);
     assert_eq!(e.leg, LegId::FR);
     // Under Clamp the same pose solves, reporting the clamped legs.
-    let sol = body::inverse(
-        &robot,
-        &Pose::default(),
-        &BodyConfig::default(),
-        &feet,
-        ReachPolicy::Clamp,
-    )
-    .unwrap();
+    let sol = body::Solver::new(&robot)
+        .inverse(
+            &Pose::default(),
+            &BodyConfig::default(),
+            &feet,
+            ReachPolicy::Clamp,
+        )
+        .unwrap();
     assert!(sol.any_clamped());
     assert!(sol.legs[LegId::FL.index()].clamped.is_none());
     assert!(sol.legs[LegId::RL.index()].clamped.is_some());
@@ -257,7 +251,9 @@ fn planar_and_radial(robot: &Robot, foot: nalgebra::Vector3<f64>) -> (f64, f64) 
 }
 
 fn clamp_solve(robot: &Robot, leg_id: LegId, p: Vec3) -> (JointAngles, leg::Clamp) {
-    let sol = leg::inverse(robot, leg_id, p, ReachPolicy::Clamp).expect("clamp solves");
+    let sol = leg::Solver::new(robot)
+        .inverse(leg_id, p, ReachPolicy::Clamp)
+        .expect("clamp solves");
     assert!(sol.angles.is_finite());
     let c = sol.clamped.expect("clamp reported");
     // The reported distance is |target − FK(angles)|.
@@ -341,7 +337,8 @@ fn clamp_with_preset_limits() {
                 let mut q = JointAngles::new(0.1, 0.3, -1.0).to_array();
                 q[joint as usize] = robot.limits.max_rad[joint as usize] + 0.3;
                 let target = leg::forward(&g, leg_id, JointAngles::from_array(q));
-                let Ok(sol) = leg::inverse(&robot, leg_id, target, ReachPolicy::Clamp) else {
+                let Ok(sol) = leg::Solver::new(&robot).inverse(leg_id, target, ReachPolicy::Clamp)
+                else {
                     panic!("clamp must solve");
                 };
                 if let Some(c) = sol.clamped {
@@ -410,7 +407,7 @@ proptest! {
         let leg_id = LegId::ALL[l];
         let p = Vec3::new(x, y, z);
         for policy in [ReachPolicy::Reject, ReachPolicy::Clamp] {
-            let res = leg::inverse(&robot, leg_id, p, policy);
+            let res = leg::Solver::new(&robot).inverse(leg_id, p, policy);
             check_leg_result(&res, &robot, leg_id, p);
             if !p.is_finite() {
                 prop_assert_eq!(res.unwrap_err().kind, Unreachable::NonFinite);
@@ -436,7 +433,7 @@ proptest! {
         let pose = Pose::from_array(pose);
         let feet: [Vec3; 4] = std::array::from_fn(|i| Vec3::new(feet[3*i], feet[3*i+1], feet[3*i+2]));
         for policy in [ReachPolicy::Reject, ReachPolicy::Clamp] {
-            if let Ok(sol) = body::inverse(&robot, &pose, &config, &feet, policy) {
+            if let Ok(sol) = body::Solver::new(&robot).inverse(&pose, &config, &feet, policy) {
                 for l in sol.legs {
                     prop_assert!(l.angles.is_finite());
                 }
@@ -445,7 +442,7 @@ proptest! {
         // The same with sane feet and a random pose: the stance is only moved by the pose.
         let stance = robot.stance_feet(0.3);
         for policy in [ReachPolicy::Reject, ReachPolicy::Clamp] {
-            if let Ok(sol) = body::inverse(&robot, &pose, &config, &stance, policy) {
+            if let Ok(sol) = body::Solver::new(&robot).inverse(&pose, &config, &stance, policy) {
                 for l in sol.legs {
                     prop_assert!(l.angles.is_finite());
                 }

@@ -33,7 +33,8 @@ fn round_trip_grid_both_presets() {
                                 t(2, 5.0, k),
                             );
                             let foot = leg::forward(&robot.leg, leg, q);
-                            let sol = leg::inverse(&robot, leg, foot, ReachPolicy::Reject);
+                            let sol =
+                                leg::Solver::new(&robot).inverse(leg, foot, ReachPolicy::Reject);
                             let Ok(sol) = sol else { continue };
                             let back = leg::forward(&robot.leg, leg, sol.angles);
                             assert!((back - foot).norm() < 2e-6, "{leg} {q:?} {:?}", sol.angles);

@@ -197,99 +197,17 @@ pub(crate) fn write_default_calibration<M: Math>(
 }
 
 /// The twelve joint angles of the nominal stance of `pose_config` (zeros when unreachable).
-/// Inlined into its caller (-128 B of flash): the body solution stays in the frame of the
-/// out-of-line [`body_inverse`].
 #[inline(always)]
 fn stance_angles<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> [f32; 12] {
-    body_inverse::<M>(
-        robot,
-        &body::Pose::default(),
-        pose_config,
-        BodyFeet::Stance,
-        ReachPolicy::Reject,
-    )
-    .map(|s| s.flat())
-    .unwrap_or([0.0; 12])
-}
-
-/// Where [`body_inverse`] holds the feet.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum BodyFeet<'a> {
-    /// At the nominal stance of the pose configuration's height.
-    Stance,
-    /// At these points of the world frame, m (`SetFeet` gives the zero pose, a motion frame
-    /// its own).
-    World(&'a [kin_core::Vec3; 4]),
-}
-
-/// The device's one body IK (kin-core's [`body::Solver`]) for the boot stance, `SetBodyPose`
-/// and `SetFeet`, about the body centre in `pose_config`'s rotation order: one instance of the
-/// solver's constants and leg solves in the firmware instead of one per request.
-#[inline(never)]
-pub(crate) fn body_inverse<M: Math>(
-    robot: &Robot,
-    pose: &body::Pose,
-    pose_config: &PoseConfig,
-    feet: BodyFeet<'_>,
-    policy: ReachPolicy,
-) -> Result<body::BodySolution, kin_core::IkError> {
-    let solver = body::Solver::new(robot);
-    let local = body_feet_in_hips::<M>(&solver, pose, pose_config, feet)?;
-    body_legs::<M>(&solver, &local, policy)
-}
-
-/// The second half of [`body_inverse`], out of line (a small stack frame): the leg solves.
-#[inline(never)]
-fn body_legs<M: Math>(
-    solver: &body::Solver,
-    feet_in_hips: &[kin_core::Vec3; 4],
-    policy: ReachPolicy,
-) -> Result<body::BodySolution, kin_core::IkError> {
-    // The ATmega2560: the legs in a loop around kin-core's out-of-line leg solve (-148 B of
-    // flash against its four unrolled calls); hosts keep the solver's own path (the same
-    // results).
-    #[cfg(target_arch = "avr")]
-    {
-        let mut out = body::BodySolution {
-            legs: [kin_core::LegSolution {
-                angles: kin_core::JointAngles::default(),
-                clamped: None,
-            }; 4],
-        };
-        for (i, leg) in LegId::ALL.into_iter().enumerate() {
-            out.legs[i] = solver
-                .leg()
-                .inverse_with::<M>(leg, feet_in_hips[i], policy)?;
-        }
-        Ok(out)
-    }
-    #[cfg(not(target_arch = "avr"))]
-    solver.inverse_in_hips_with::<M>(feet_in_hips, policy)
-}
-
-/// The first half of [`body_inverse`], out of line so that each half keeps a small stack
-/// frame: the feet in each leg's hip frame.
-#[inline(never)]
-fn body_feet_in_hips<M: Math>(
-    solver: &body::Solver,
-    pose: &body::Pose,
-    pose_config: &PoseConfig,
-    feet: BodyFeet<'_>,
-) -> Result<[kin_core::Vec3; 4], kin_core::IkError> {
-    let config = BodyConfig {
-        order: pose_config.order,
-        pivot_m: kin_core::Vec3::ZERO,
-    };
-    Ok(match feet {
-        BodyFeet::Stance => {
-            body::check_finite(pose, &config)?;
-            solver.stance_feet_in_hips_with::<M>(pose, &config, pose_config.stance_height_m)
-        }
-        BodyFeet::World(feet) => {
-            body::check_finite(pose, &config)?;
-            solver.feet_in_hips_with::<M>(pose, &config, feet)
-        }
-    })
+    body::Solver::<M>::with_math(robot)
+        .inverse_at_stance(
+            &body::Pose::default(),
+            &BodyConfig::about_centre(pose_config.order),
+            pose_config.stance_height_m,
+            ReachPolicy::Reject,
+        )
+        .map(|s| s.flat())
+        .unwrap_or([0.0; 12])
 }
 
 #[cfg(test)]

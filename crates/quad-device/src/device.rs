@@ -2,16 +2,15 @@
 //! answer bytes out.
 
 use crate::config::{
-    body_inverse, validate_pose_config, write_default_calibration, BodyFeet, Config, ConfigError,
-    UNBOOTED_CALIBRATION,
+    validate_pose_config, write_default_calibration, Config, ConfigError, UNBOOTED_CALIBRATION,
 };
 use crate::engine::{self, Engine, Limiter, Setup, FRAME_MS};
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use core::marker::PhantomData;
-use kin_core::body::{BodySolution, Pose};
+use kin_core::body::{self, BodySolution, Pose};
 use kin_core::motion::gait::Velocity;
-use kin_core::{DefaultMath, IkError, Math, Vec3};
+use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
@@ -556,25 +555,27 @@ where
         (self.outputs, self.clock, self.storage)
     }
 
+    /// `SetBodyPose`: the pose at the stance of the pose configuration's height, about the body
+    /// centre in its rotation order. Out of line (as `set_feet`), so that the body
+    /// solve's locals stay out of the dispatcher's stack frame.
+    #[inline(never)]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
-        self.solve_body(pose, BodyFeet::Stance)
+        let c = &self.config.pose_config;
+        let solution = body::Solver::<M>::with_math(&self.config.robot).inverse_at_stance(
+            pose,
+            &BodyConfig::about_centre(c.order),
+            c.stance_height_m,
+            c.policy,
+        );
+        self.apply_solution(solution)
     }
 
+    /// `SetFeet`: the feet in the body frame at the zero pose.
+    #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
-        self.solve_body(&Pose::default(), BodyFeet::World(&feet))
-    }
-
-    #[inline(never)]
-    fn solve_body(&mut self, pose: &Pose, feet: BodyFeet<'_>) -> Result<(), NackReason> {
-        let pose_config = &self.config.pose_config;
-        let solution = body_inverse::<M>(
-            &self.config.robot,
-            pose,
-            pose_config,
-            feet,
-            pose_config.policy,
-        );
+        let solution = body::Solver::<M>::with_math(&self.config.robot)
+            .inverse_feet_in_body(&feet, self.config.pose_config.policy);
         self.apply_solution(solution)
     }
 

@@ -4,7 +4,7 @@ mod common;
 
 use common::*;
 use kin_core::body::{self, Pose};
-use kin_core::{BodyConfig, DefaultMath, Joint, LegId, ReachPolicy, Vec3};
+use kin_core::{BodyConfig, Joint, LegId, ReachPolicy, Vec3};
 use quad_device::config::DEFAULT_CENTER_US;
 use quad_device::{Config, Device};
 use quad_protocol::servo::{self, Calibration};
@@ -29,18 +29,18 @@ fn nack_reason(answer: DeviceToHost) -> NackReason {
 
 /// Host-side expectation for a body pose with the device's configuration.
 fn expected_angles(config: &Config, pose: &Pose) -> [f32; 12] {
-    body::inverse_at_stance_with::<DefaultMath>(
-        &config.robot,
-        pose,
-        &BodyConfig {
-            order: config.pose_config.order,
-            pivot_m: Vec3::ZERO,
-        },
-        config.pose_config.stance_height_m,
-        config.pose_config.policy,
-    )
-    .unwrap()
-    .flat()
+    body::Solver::new(&config.robot)
+        .inverse_at_stance(
+            pose,
+            &BodyConfig {
+                order: config.pose_config.order,
+                pivot_m: Vec3::ZERO,
+            },
+            config.pose_config.stance_height_m,
+            config.pose_config.policy,
+        )
+        .unwrap()
+        .flat()
 }
 
 const POSE: Pose = Pose {
@@ -166,18 +166,18 @@ fn set_feet_runs_the_body_ik_at_the_zero_pose() {
             feet_in_body_m: feet.map(|v| [v.x + 0.03, v.y, v.z]),
         },
     ));
-    let want = body::inverse_with::<DefaultMath>(
-        &config.robot,
-        &Pose::default(),
-        &BodyConfig {
-            order: config.pose_config.order,
-            pivot_m: Vec3::ZERO,
-        },
-        &feet.map(|v| Vec3::new(v.x + 0.03, v.y, v.z)),
-        ReachPolicy::Reject,
-    )
-    .unwrap()
-    .flat();
+    let want = body::Solver::new(&config.robot)
+        .inverse(
+            &Pose::default(),
+            &BodyConfig {
+                order: config.pose_config.order,
+                pivot_m: Vec3::ZERO,
+            },
+            &feet.map(|v| Vec3::new(v.x + 0.03, v.y, v.z)),
+            ReachPolicy::Reject,
+        )
+        .unwrap()
+        .flat();
     assert_eq!(rb.angles_rad, want);
 }
 
@@ -249,8 +249,7 @@ fn invalid_or_unreachable_requests_move_nothing() {
         ),
     ];
     for (i, (pose, reason)) in cases.into_iter().enumerate() {
-        let host = body::inverse_at_stance(
-            &config.robot,
+        let host = body::Solver::new(&config.robot).inverse_at_stance(
             &pose,
             &BodyConfig {
                 order: config.pose_config.order,

@@ -95,15 +95,15 @@ impl Rig {
 }
 
 fn stance(config: &Config) -> [f32; 12] {
-    kin_core::body::inverse_at_stance_with::<DefaultMath>(
-        &config.robot,
-        &Pose::default(),
-        &body_config(config),
-        config.pose_config.stance_height_m,
-        ReachPolicy::Reject,
-    )
-    .unwrap()
-    .flat()
+    kin_core::body::Solver::<DefaultMath>::with_math(&config.robot)
+        .inverse_at_stance(
+            &Pose::default(),
+            &body_config(config),
+            config.pose_config.stance_height_m,
+            ReachPolicy::Reject,
+        )
+        .unwrap()
+        .flat()
 }
 
 fn body_config(config: &Config) -> BodyConfig {
@@ -316,15 +316,15 @@ fn seed000_foot_paths_run_on_one_leg_or_all_four() {
                         f.feet_in_world[l.index()] = stance_feet[l.index()];
                     }
                 }
-                kin_core::body::inverse_with::<DefaultMath>(
-                    &config.robot,
-                    &f.pose,
-                    &paths.body_config(),
-                    &f.feet_in_world,
-                    ReachPolicy::Reject,
-                )
-                .unwrap()
-                .flat()
+                kin_core::body::Solver::<DefaultMath>::with_math(&config.robot)
+                    .inverse(
+                        &f.pose,
+                        &paths.body_config(),
+                        &f.feet_in_world,
+                        ReachPolicy::Reject,
+                    )
+                    .unwrap()
+                    .flat()
             });
         }
     }

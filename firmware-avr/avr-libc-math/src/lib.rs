@@ -21,7 +21,7 @@
 #![no_std]
 #![cfg(target_arch = "avr")]
 
-use kin_core::math::poly;
+use kin_core::math::SoftFloat;
 use kin_core::Math;
 
 /// Links avr-libc's `libm.a` (and `libc.a`, for its `memcpy`/`memset`) ahead of
@@ -71,32 +71,12 @@ impl Math for AvrLibm {
     }
 }
 
-/// The fastest mix measured in simavr (see `BENCHMARKS.md`), the firmware's backend:
-/// avr-libc's `sqrt` (327 cycles), kin-core's [`poly::atan2_fixed`] (about 1,400 cycles
-/// against 3,000 for avr-libc's `atan2`: one float division, the polynomial in 16-bit fixed
-/// point on the hardware multiplier; error ≤ 3.5e-5 rad) and [`poly::sin_cos_deg5`] (about
-/// 2,000 cycles for both within ±π/4, 3,300 beyond, against 7,200 for avr-libc's `sin` plus
-/// `cos`; error ≤ 7e-7). All float arithmetic on avr-libc's primitives.
+/// The firmware's backend: kin-core's [`SoftFloat`] (the kernels, comparisons and leg staging
+/// for CPUs without floating-point hardware; the host tests run the same choices) over
+/// avr-libc's `sqrt`, with all float arithmetic on avr-libc's primitives. The fastest mix
+/// measured in simavr (see `BENCHMARKS.md`).
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by
 /// at most about 4e-5 rad (the fixed-point arctangent's error plus rounding); see the readback
 /// bound in `BENCHMARKS.md`.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct AvrFast;
-
-impl Math for AvrFast {
-    #[inline]
-    fn sqrt(x: f32) -> f32 {
-        AvrLibm::sqrt(x)
-    }
-
-    #[inline]
-    fn atan2(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed(y, x)
-    }
-
-    #[inline]
-    fn sin_cos(x: f32) -> (f32, f32) {
-        poly::sin_cos_deg5(x)
-    }
-}
+pub type AvrFast = SoftFloat<AvrLibm>;

@@ -59,13 +59,12 @@ static PRIMS: [bench::PrimFn; 15] = [
         s + c
     },
     |a, b| {
-        let m = kin_core::rotation::matrix_with::<AvrLibm>(RotationOrder::Zyx, a, b, a);
+        let m = kin_core::rotation::matrix::<AvrLibm>(RotationOrder::Zyx, a, b, a);
         core::hint::black_box(m).rows[0][0]
     },
     |a, b| {
         let robot = core::hint::black_box(bench::ROBOT);
-        let feet = kin_core::body::feet_in_hips_with::<AvrLibm>(
-            &robot,
+        let feet = kin_core::body::Solver::<AvrLibm>::with_math(&robot).feet_in_hips(
             &Pose::rotation(a, b, a),
             &BodyConfig::default(),
             &robot.stance_feet(bench::STANCE_HEIGHT_M),

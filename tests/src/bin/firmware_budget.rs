@@ -2,8 +2,8 @@
 //! worst stack in simavr (see `integration_tests::budget`), prints them with the margins and
 //! fails when a figure is over budget. `firmware-budget ELF` measures another firmware ELF.
 
-use host_tools::emu::build;
 use integration_tests::{avr_bench, budget};
+use quad_host::emu::build;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {

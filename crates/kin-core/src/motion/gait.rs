@@ -295,10 +295,7 @@ impl Motion for Gait {
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig {
-            order: self.p.order,
-            pivot_m: Vec3::ZERO,
-        }
+        BodyConfig::about_centre(self.p.order)
     }
 
     fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {

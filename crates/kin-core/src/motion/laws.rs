@@ -203,10 +203,7 @@ impl Motion for Sway {
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig {
-            order: self.p.order,
-            pivot_m: Vec3::ZERO,
-        }
+        BodyConfig::about_centre(self.p.order)
     }
 
     fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
@@ -397,10 +394,7 @@ impl Motion for YawTurn {
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig {
-            order: self.p.order,
-            pivot_m: Vec3::ZERO,
-        }
+        BodyConfig::about_centre(self.p.order)
     }
 
     fn frame_with<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {

@@ -3,7 +3,7 @@
 //! Every motion is a pure function of time and its (validated) parameters — no hidden state —
 //! so the same code runs on the host and on the device. A [`Motion`] yields a [`Frame`] at time
 //! `t`: the body [`Pose`] and the four feet in the world frame; [`solve`] turns a frame into the
-//! twelve joint angles through [`crate::body::inverse_with`].
+//! twelve joint angles through [`crate::body::Solver::inverse`].
 //!
 //! - [`path`]: foot paths with one interface, [`path::FootPath`] (phase → foot offset + contact):
 //!   seed 000's rectangle, semicircle, ellipse, cycloid, Bézier swing.
@@ -229,21 +229,21 @@ pub trait Motion {
 }
 
 /// Frame and joint angles of `motion` at `t_s` on backend `M`: the motion's frame solved by
-/// [`crate::body::inverse_with`] under `policy`.
+/// [`crate::body::Solver::inverse`] under `policy`.
 pub fn solve_with<M: Math, T: Motion>(
     motion: &T,
     t_s: f32,
     policy: ReachPolicy,
 ) -> Result<(Frame, BodySolution), Error> {
     let frame = motion.frame_with::<M>(t_s)?;
-    let sol = body::inverse_with::<M>(
-        motion.robot(),
-        &frame.pose,
-        &motion.body_config(),
-        &frame.feet_in_world,
-        policy,
-    )
-    .map_err(Error::Ik)?;
+    let sol = body::Solver::<M>::with_math(motion.robot())
+        .inverse(
+            &frame.pose,
+            &motion.body_config(),
+            &frame.feet_in_world,
+            policy,
+        )
+        .map_err(Error::Ik)?;
     Ok((frame, sol))
 }
 
@@ -317,14 +317,17 @@ pub(crate) fn check_reach<M: Math>(
     feet_in_world: &[Vec3; 4],
     parameter: &'static str,
 ) -> Result<(), Error> {
-    let local = body::feet_in_hips_with::<M>(robot, pose, config, feet_in_world);
+    let solver = body::Solver::<M>::with_math(robot);
+    let local = solver.feet_in_hips(pose, config, feet_in_world);
     for leg in LegId::ALL {
-        crate::leg::inverse_with::<M>(robot, leg, local[leg.index()], ReachPolicy::Reject)
-            .map_err(|e| Error::BeyondReach {
-                parameter,
-                leg,
-                kind: e.kind,
-            })?;
+        let solution = solver
+            .leg()
+            .inverse(leg, local[leg.index()], ReachPolicy::Reject);
+        solution.map_err(|e| Error::BeyondReach {
+            parameter,
+            leg,
+            kind: e.kind,
+        })?;
     }
     Ok(())
 }

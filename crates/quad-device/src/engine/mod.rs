@@ -69,7 +69,6 @@ pub mod protocol;
 
 pub use limiter::{Limiter, Ramp, DEFAULT_JOINT_SPEED_LIMIT_RAD_S};
 
-use crate::config::{body_inverse, BodyFeet};
 use crate::store::Table;
 use core::fmt;
 use core::marker::PhantomData;
@@ -82,7 +81,7 @@ use kin_core::motion::{self, AnyMotion, Frame, Motion};
 use kin_core::preflight::{self, Failure};
 use kin_core::{IkError, Joint, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo;
-use quad_protocol::{PoseConfig, ServoId};
+use quad_protocol::ServoId;
 
 /// One servo frame, ms.
 pub const FRAME_MS: u32 = 20;
@@ -439,20 +438,14 @@ pub fn solve_frame<M: Math>(
     order: RotationOrder,
     frame: &Frame,
 ) -> Result<[f32; 12], IkError> {
-    let pose_config = PoseConfig {
-        // Not read: the feet are given.
-        stance_height_m: 0.0,
-        order,
-        policy: ReachPolicy::Reject,
-    };
-    body_inverse::<M>(
-        robot,
-        &frame.pose,
-        &pose_config,
-        BodyFeet::World(&frame.feet_in_world),
-        ReachPolicy::Reject,
-    )
-    .map(|s| s.flat())
+    kin_core::body::Solver::<M>::with_math(robot)
+        .inverse(
+            &frame.pose,
+            &BodyConfig::about_centre(order),
+            &frame.feet_in_world,
+            ReachPolicy::Reject,
+        )
+        .map(|s| s.flat())
 }
 
 /// Checks that `angles` map within every servo's calibrated travel.
@@ -488,7 +481,7 @@ fn preflight_frames<M: Math>(
     count: u16,
 ) -> Result<(), Error> {
     // Joint speeds are the limiter's business, not a reason to refuse.
-    let mut checker = preflight::Checker::<M>::with_math(s.robot, config, [f32::MAX; 3])?;
+    let mut checker = preflight::Checker::new(s.robot, config, [f32::MAX; 3])?;
     for k in 0..count {
         let (t, frame) = frame_at(k)?;
         let legs = checker.push_frame(t, &frame);

@@ -1,0 +1,739 @@
+//! [`Mega2560`]: simavr driven directly through its C API (`simavr-ffi`).
+//!
+//! Direct access (rather than through a higher-level wrapper) gives what the tests and the
+//! emulator link need: every servo pin sampled after each instruction from the port registers
+//! (cheap: no ioctl per pin), UART bytes time-stamped in cycles by an IRQ hook, SRAM and I/O
+//! registers, the EEPROM, reset detection and setting the program counter.
+//!
+//! Simulator facts that matter (simavr as vendored by `simavr-ffi` 1.2):
+//! - USART: received bytes are delivered at the rate the firmware configured (UBRR, U2X, frame
+//!   format), one per byte time; simavr holds them in a 64-byte FIFO with XON/XOFF towards the
+//!   host instead of overrunning (a real USART would drop bytes that the firmware does not read
+//!   in time). A transmitted byte is reported when the firmware writes it to UDR; it has
+//!   crossed the line one byte time later.
+//! - Output-compare pins are driven through the port registers, so the PORT bits show the pin
+//!   levels; a pin whose DDR bit is clear is not driven (reads as low here).
+//! - The watchdog resets the MCU (MCUSR.WDRF set) and simavr restarts its cycle counter at 0;
+//!   [`Mega2560::cycle`] keeps counting.
+//! - The EEPROM completes a write at once but raises the EEPROM-ready interrupt 3.4 ms later
+//!   (the firmware waits for that interrupt, so saves take their real time here too).
+//! - A 16-bit output-compare register (OCRnx) takes effect in simavr when its low byte is
+//!   written, and only if the value changed — judged with the high byte already written, so a
+//!   change of the high byte alone is missed (the pin keeps the old width). [`Mega2560`]
+//!   corrects this: after each instruction it compares the twelve servo OCRs with their last
+//!   values; when only the high byte changed, it re-issues the low-byte write one instruction
+//!   later (after the program's own low-byte write, which follows the high byte), unless that
+//!   write changed the low byte and simavr took the value itself.
+//! - simavr applies a compare register at once, not at the next period as the chip does (the
+//!   firmware writes them between pulses, where both agree).
+
+use super::{CYCLES_PER_US, F_CPU_HZ, SERVO_PINS};
+use simavr_ffi as ffi;
+use std::collections::VecDeque;
+use std::ffi::{c_char, c_int, c_void, CString};
+use std::path::{Path, PathBuf};
+use std::ptr::NonNull;
+use std::sync::{Arc, Mutex};
+
+extern "C" {
+    fn free(ptr: *mut c_void);
+}
+
+/// An `AVR_IOCTL_DEF(a, b, c, d)` request code.
+const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
+    u32::from_be_bytes([a, b, c, d])
+}
+
+const IOCTL_UART_GET_FLAGS: u32 = ioctl(b'u', b'a', b'g', b'0');
+const IOCTL_UART_SET_FLAGS: u32 = ioctl(b'u', b'a', b's', b'0');
+const IOCTL_UART_GET_IRQ: u32 = ioctl(b'u', b'a', b'r', b'0');
+const IOCTL_EEPROM_GET: u32 = ioctl(b'e', b'e', b'g', b'p');
+const IOCTL_EEPROM_SET: u32 = ioctl(b'e', b'e', b's', b'p');
+
+/// Bytes of EEPROM.
+pub const EEPROM_LEN: usize = 4096;
+
+/// Data-space addresses of USART0's registers.
+const UCSR0A: u16 = 0xC0;
+const UCSR0B: u16 = 0xC1;
+const UBRR0L: u16 = 0xC4;
+const UBRR0H: u16 = 0xC5;
+/// Watchdog control and MCU status registers.
+const WDTCSR: u16 = 0x60;
+const MCUSR: u16 = 0x54;
+
+/// Data addresses of the low bytes of the twelve servo compare registers (OCR1A/B/C,
+/// OCR3A/B/C, OCR4A/B/C, OCR5A/B/C), in channel order.
+const OCR_LOW: [u16; 12] = [
+    0x88, 0x8A, 0x8C, 0x98, 0x9A, 0x9C, 0xA8, 0xAA, 0xAC, 0x128, 0x12A, 0x12C,
+];
+
+/// Data addresses of (DDRx, PORTx) of the ports A–L.
+fn port_regs(port: char) -> Option<(u16, u16)> {
+    let base = match port.to_ascii_uppercase() {
+        'A' => 0x20,
+        'B' => 0x23,
+        'C' => 0x26,
+        'D' => 0x29,
+        'E' => 0x2C,
+        'F' => 0x2F,
+        'G' => 0x32,
+        'H' => 0x100,
+        'J' => 0x103,
+        'K' => 0x106,
+        'L' => 0x109,
+        _ => return None,
+    };
+    Some((base + 1, base + 2))
+}
+
+/// simavr's state is per simulator, but creating simulators and its logger are not
+/// thread-safe: creation is serialised.
+static CREATE: Mutex<()> = Mutex::new(());
+
+/// Discards simavr's log messages (they would go to stdout/stderr).
+unsafe extern "C" fn quiet_logger(
+    _: *mut ffi::avr_t,
+    _: c_int,
+    _: *const c_char,
+    _: *mut ffi::__va_list_tag,
+) {
+}
+
+/// Why the simulator could not run.
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum EmuError {
+    /// The firmware file could not be read (shared: the error is cloned with the value).
+    #[error("firmware: cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: Arc<std::io::Error>,
+    },
+    /// The firmware file is not an AVR ELF.
+    #[error("firmware: {} is not an AVR ELF file", .0.display())]
+    NotAvrElf(PathBuf),
+    /// The path cannot be passed to simavr.
+    #[error("firmware: path contains a NUL byte")]
+    NulInPath,
+    /// simavr could not create or initialise the MCU.
+    #[error("simavr: {0}")]
+    Init(&'static str),
+    /// The CPU stopped (crash, or sleep with interrupts off) at this cycle.
+    #[error("the AVR stopped ({state}) at cycle {cycle}, pc {pc:#x}")]
+    Stopped {
+        /// simavr's state.
+        state: &'static str,
+        /// Cycle count ([`Mega2560::cycle`]).
+        cycle: u64,
+        /// Program counter, byte address.
+        pc: u32,
+    },
+}
+
+/// One high pulse seen on a servo pin.
+///
+/// The pins are read after every simavr step (one instruction, or an interrupt entry and its
+/// first instruction): an edge is seen at the end of the step in which it happened, up to that
+/// step's length late. [`Pulse::width_could_be`] takes this into account.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Pulse {
+    /// Channel (index into [`SERVO_PINS`]).
+    pub channel: usize,
+    /// Cycle at which the rising edge was seen.
+    pub rise_cycle: u64,
+    /// Cycles between seeing the rising and the falling edge.
+    pub high_cycles: u64,
+    /// Length of the step in which the rising edge was seen, cycles.
+    pub rise_step_cycles: u64,
+    /// Length of the step in which the falling edge was seen, cycles.
+    pub fall_step_cycles: u64,
+}
+
+impl Pulse {
+    /// High time as seen, µs.
+    pub fn high_us(&self) -> f64 {
+        self.high_cycles as f64 / CYCLES_PER_US as f64
+    }
+
+    /// True when the real width (within the steps' uncertainty) can be within `tolerance` of
+    /// `want` cycles.
+    pub fn width_could_be(&self, want: u64, tolerance: u64) -> bool {
+        let lo = self.high_cycles.saturating_sub(self.fall_step_cycles);
+        let hi = self.high_cycles + self.rise_step_cycles;
+        want + tolerance >= lo && want <= hi + tolerance
+    }
+}
+
+/// Resets seen since the simulator was created.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Resets {
+    /// How many.
+    pub count: u32,
+    /// Cycle ([`Mega2560::cycle`]) of the last one.
+    pub last_cycle: Option<u64>,
+    /// MCUSR right after the last one (its reset-cause flags; the firmware clears it at boot).
+    pub last_mcusr: u8,
+}
+
+/// State shared with simavr's IRQ hooks (reached through a raw pointer).
+struct Hooks {
+    avr: *mut ffi::avr_t,
+    /// Cycles before the current simavr epoch (simavr restarts at 0 after a reset).
+    base: u64,
+    /// Bytes written to UDR0, with the cycle.
+    out: VecDeque<(u64, u8)>,
+    /// simavr's receiver has room.
+    xon: bool,
+}
+
+unsafe extern "C" fn on_uart_output(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
+    // SAFETY: `param` is the `Hooks` allocation registered in `Mega2560::new`, alive until the
+    // simulator is dropped; simavr calls hooks only from within `avr_run`/`avr_raise_irq`,
+    // during which no Rust reference to it exists.
+    let hooks = unsafe { &mut *param.cast::<Hooks>() };
+    // SAFETY: the avr_t outlives its hooks.
+    let raw = unsafe { (*hooks.avr).cycle };
+    hooks.out.push_back((hooks.base + raw, value as u8));
+}
+
+unsafe extern "C" fn on_uart_xon(_: *mut ffi::avr_irq_t, _: u32, param: *mut c_void) {
+    // SAFETY: as in `on_uart_output`.
+    unsafe { (*param.cast::<Hooks>()).xon = true };
+}
+
+unsafe extern "C" fn on_uart_xoff(_: *mut ffi::avr_irq_t, _: u32, param: *mut c_void) {
+    // SAFETY: as in `on_uart_output`.
+    unsafe { (*param.cast::<Hooks>()).xon = false };
+}
+
+/// An ATmega2560 at 16 MHz running one ELF in simavr.
+pub struct Mega2560 {
+    avr: NonNull<ffi::avr_t>,
+    hooks: NonNull<Hooks>,
+    uart_in: NonNull<ffi::avr_irq_t>,
+    /// Bytes for USART0's receiver not yet taken by simavr (XOFF).
+    input: VecDeque<u8>,
+    /// simavr's cycle counter after the last step.
+    last_raw: u64,
+    resets: Resets,
+    /// Levels of the twelve servo pins after the last step, bit `i` = channel `i`.
+    levels: u16,
+    /// Cycle and step length of the rising edge of the pulse in progress, per channel.
+    rise: [Option<(u64, u64)>; 12],
+    capture: bool,
+    pulses: VecDeque<Pulse>,
+    /// Bytes sent by USART0 (with the cycle they were written to UDR0), not yet taken.
+    output: VecDeque<(u64, u8)>,
+    /// Lowest stack pointer seen after an instruction since the C runtime set it up.
+    min_sp: u16,
+    /// The servo compare registers after the last instruction.
+    ocr: [u16; 12],
+    /// Compare registers whose high byte alone changed in the last instruction.
+    ocr_high_only: [bool; 12],
+}
+
+impl Mega2560 {
+    /// Loads `elf` into a fresh ATmega2560 at 16 MHz (reset state; nothing runs yet).
+    ///
+    /// # Errors
+    /// When the file is not an AVR ELF or simavr cannot create the MCU.
+    pub fn new(elf: &Path) -> Result<Mega2560, EmuError> {
+        let head = std::fs::read(elf).map_err(|e| EmuError::Read {
+            path: elf.to_owned(),
+            source: Arc::new(e),
+        })?;
+        // simavr exits the process on a file it cannot load: check first (ELF, machine AVR).
+        if head.len() < 20 || &head[..4] != b"\x7fELF" || head[18] != 0x53 {
+            return Err(EmuError::NotAvrElf(elf.to_owned()));
+        }
+        let path =
+            CString::new(elf.as_os_str().as_encoded_bytes()).map_err(|_| EmuError::NulInPath)?;
+        let mcu = CString::new("atmega2560").expect("no NUL");
+        let _guard = CREATE.lock().unwrap_or_else(|e| e.into_inner());
+        // SAFETY (this block): the calls follow simavr's documented set-up sequence
+        // (`avr_make_mcu_by_name`, `avr_init`, `sim_setup_firmware` into a zeroed
+        // `elf_firmware_t`, `avr_load_firmware`); every pointer passed is valid for the call.
+        unsafe {
+            ffi::avr_global_logger_set(Some(quiet_logger));
+            let avr = NonNull::new(ffi::avr_make_mcu_by_name(mcu.as_ptr()))
+                .ok_or(EmuError::Init("unknown MCU atmega2560"))?;
+            if ffi::avr_init(avr.as_ptr()) != 0 {
+                free(avr.as_ptr().cast());
+                return Err(EmuError::Init("avr_init failed"));
+            }
+            (*avr.as_ptr()).frequency = F_CPU_HZ;
+            let mut fw: Box<ffi::elf_firmware_t> = Box::new(std::mem::zeroed());
+            for (dst, &src) in fw.mmcu.iter_mut().zip(mcu.as_bytes_with_nul()) {
+                *dst = src as c_char;
+            }
+            fw.frequency = F_CPU_HZ;
+            let name = CString::new("quadctl").expect("no NUL");
+            ffi::sim_setup_firmware(path.as_ptr(), 0, &mut *fw, name.as_ptr());
+            ffi::avr_load_firmware(avr.as_ptr(), &mut *fw);
+
+            // USART0: no stdio echo, no host-side sleeping while the firmware polls UCSR0A.
+            let mut flags: u32 = 0;
+            ffi::avr_ioctl(
+                avr.as_ptr(),
+                IOCTL_UART_GET_FLAGS,
+                (&mut flags as *mut u32).cast(),
+            );
+            flags &= !(ffi::AVR_UART_FLAG_STDIO | ffi::AVR_UART_FLAG_POLL_SLEEP);
+            ffi::avr_ioctl(
+                avr.as_ptr(),
+                IOCTL_UART_SET_FLAGS,
+                (&mut flags as *mut u32).cast(),
+            );
+            let irq = |n: u32| {
+                NonNull::new(ffi::avr_io_getirq(
+                    avr.as_ptr(),
+                    IOCTL_UART_GET_IRQ,
+                    n as c_int,
+                ))
+            };
+            let (Some(uart_in), Some(out), Some(xon), Some(xoff)) = (
+                irq(ffi::UART_IRQ_INPUT),
+                irq(ffi::UART_IRQ_OUTPUT),
+                irq(ffi::UART_IRQ_OUT_XON),
+                irq(ffi::UART_IRQ_OUT_XOFF),
+            ) else {
+                ffi::avr_terminate(avr.as_ptr());
+                free(avr.as_ptr().cast());
+                return Err(EmuError::Init("USART0 has no IRQs"));
+            };
+            let hooks = NonNull::from(Box::leak(Box::new(Hooks {
+                avr: avr.as_ptr(),
+                base: 0,
+                out: VecDeque::new(),
+                xon: true,
+            })));
+            let param: *mut c_void = hooks.as_ptr().cast();
+            ffi::avr_irq_register_notify(out.as_ptr(), Some(on_uart_output), param);
+            ffi::avr_irq_register_notify(xon.as_ptr(), Some(on_uart_xon), param);
+            ffi::avr_irq_register_notify(xoff.as_ptr(), Some(on_uart_xoff), param);
+            Ok(Mega2560 {
+                avr,
+                hooks,
+                uart_in,
+                input: VecDeque::new(),
+                last_raw: (*avr.as_ptr()).cycle,
+                resets: Resets::default(),
+                levels: 0,
+                rise: [None; 12],
+                capture: false,
+                pulses: VecDeque::new(),
+                output: VecDeque::new(),
+                min_sp: u16::MAX,
+                ocr: [0; 12],
+                ocr_high_only: [false; 12],
+            })
+        }
+    }
+
+    fn avr(&self) -> &ffi::avr_t {
+        // SAFETY: the pointer is valid for the simulator's life; simavr touches it only inside
+        // calls made through `&mut self`.
+        unsafe { self.avr.as_ref() }
+    }
+
+    /// Cycles executed since the simulator was created (resets do not restart it).
+    pub fn cycle(&self) -> u64 {
+        // SAFETY: see `avr`; no hook runs now.
+        let base = unsafe { self.hooks.as_ref().base };
+        base + self.avr().cycle
+    }
+
+    /// The resets (watchdog, or any other) since the simulator was created; the power-on
+    /// reset is not counted.
+    pub fn resets(&self) -> Resets {
+        self.resets
+    }
+
+    /// The program counter, byte address.
+    pub fn pc(&self) -> u32 {
+        self.avr().pc
+    }
+
+    /// Executes one instruction (or an interrupt entry) and the peripherals' events due by
+    /// then; returns the cycles it took.
+    ///
+    /// # Errors
+    /// When the CPU stopped: a crash, or sleep with interrupts off (the firmware never
+    /// sleeps).
+    pub fn step(&mut self) -> Result<u64, EmuError> {
+        self.feed_uart();
+        let before = self.cycle();
+        // SAFETY: a valid, initialised simulator; hooks registered with live parameters.
+        let state = unsafe { ffi::avr_run(self.avr.as_ptr()) } as u32;
+        let raw = self.avr().cycle;
+        if raw < self.last_raw {
+            // simavr reset the MCU and restarted its counter at 0.
+            // SAFETY: no hook runs now; the allocation is live.
+            let hooks = unsafe { self.hooks.as_mut() };
+            hooks.base += self.last_raw;
+            hooks.xon = true;
+            self.resets.count += 1;
+            self.resets.last_cycle = Some(hooks.base);
+            self.resets.last_mcusr = self.data(MCUSR);
+        }
+        self.last_raw = raw;
+        match state {
+            ffi::cpu_Running | ffi::cpu_Sleeping | ffi::cpu_Step | ffi::cpu_StepDone => {}
+            other => {
+                return Err(EmuError::Stopped {
+                    state: match other {
+                        ffi::cpu_Crashed => "crashed",
+                        ffi::cpu_Done => "done",
+                        ffi::cpu_Stopped => "stopped",
+                        _ => "limbo",
+                    },
+                    cycle: self.cycle(),
+                    pc: self.pc(),
+                })
+            }
+        }
+        // SAFETY: no hook runs now.
+        let hooks = unsafe { self.hooks.as_mut() };
+        self.output.extend(hooks.out.drain(..));
+        self.fix_ocr_writes();
+        let step = self.cycle().saturating_sub(before).max(1);
+        self.track_servos(step);
+        let sp = self.sp();
+        // SP starts at 0 until the C runtime loads RAMEND.
+        if sp != 0 && sp < self.min_sp {
+            self.min_sp = sp;
+        }
+        Ok(step)
+    }
+
+    /// Runs at least `cycles` cycles.
+    ///
+    /// # Errors
+    /// As [`Mega2560::step`].
+    pub fn run_cycles(&mut self, cycles: u64) -> Result<(), EmuError> {
+        let end = self.cycle() + cycles;
+        while self.cycle() < end {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Runs for `us` microseconds.
+    ///
+    /// # Errors
+    /// As [`Mega2560::step`].
+    pub fn run_us(&mut self, us: u64) -> Result<(), EmuError> {
+        self.run_cycles(us * CYCLES_PER_US)
+    }
+
+    /// Hands bytes to USART0's receiver; simavr delivers them at the firmware's line rate,
+    /// back to back, starting now.
+    pub fn uart_write(&mut self, bytes: &[u8]) {
+        self.input.extend(bytes);
+        self.feed_uart();
+    }
+
+    /// Bytes handed to [`Mega2560::uart_write`] that simavr has not taken yet.
+    pub fn uart_input_pending(&self) -> usize {
+        self.input.len()
+    }
+
+    fn feed_uart(&mut self) {
+        // SAFETY: `xon` is only written by hooks, which run inside `avr_raise_irq` below.
+        while unsafe { self.hooks.as_ref().xon } {
+            let Some(b) = self.input.pop_front() else {
+                break;
+            };
+            // SAFETY: a valid IRQ of this simulator; the hooks may run and update `xon`.
+            unsafe { ffi::avr_raise_irq(self.uart_in.as_ptr(), u32::from(b)) };
+        }
+    }
+
+    /// Bytes USART0 has sent and nobody has taken, with the cycle each was written to UDR0.
+    pub fn uart_take(&mut self) -> Vec<(u64, u8)> {
+        self.output.drain(..).collect()
+    }
+
+    /// The oldest byte USART0 has sent and nobody has taken.
+    pub fn uart_pop(&mut self) -> Option<(u64, u8)> {
+        self.output.pop_front()
+    }
+
+    /// Number of sent bytes not yet taken.
+    pub fn uart_available(&self) -> usize {
+        self.output.len()
+    }
+
+    /// Runs until USART0 has sent `n` more bytes (returned without their cycles), or
+    /// `timeout_cycles` elapsed (then `Err` with what came).
+    ///
+    /// # Errors
+    /// A timeout (the bytes so far) — a stopped CPU panics, as it is a firmware bug.
+    pub fn read_exact(&mut self, n: usize, timeout_cycles: u64) -> Result<Vec<u8>, Vec<u8>> {
+        let end = self.cycle() + timeout_cycles;
+        while self.output.len() < n {
+            if self.cycle() >= end {
+                return Err(self.uart_take().into_iter().map(|(_, b)| b).collect());
+            }
+            if let Err(e) = self.step() {
+                panic!("{e}");
+            }
+        }
+        Ok(self.output.drain(..n).map(|(_, b)| b).collect())
+    }
+
+    /// USART0's line rate as the firmware configured it (UBRR0, U2X0), bit/s; `None` while
+    /// the receiver is off.
+    pub fn uart_baud(&self) -> Option<f64> {
+        if self.data(UCSR0B) & (1 << 4) == 0 {
+            return None;
+        }
+        let ubrr = u32::from(self.data(UBRR0L)) | u32::from(self.data(UBRR0H) & 0x0F) << 8;
+        let per_bit = if self.data(UCSR0A) & (1 << 1) != 0 {
+            8
+        } else {
+            16
+        } * (ubrr + 1);
+        Some(f64::from(F_CPU_HZ) / f64::from(per_bit))
+    }
+
+    /// One byte of the data space (registers, I/O, SRAM); 0 beyond RAMEND.
+    pub fn data(&self, addr: u16) -> u8 {
+        let avr = self.avr();
+        if u32::from(addr) > u32::from(avr.ramend) {
+            return 0;
+        }
+        // SAFETY: `data` holds RAMEND + 1 bytes; the index is within.
+        unsafe { *avr.data.add(usize::from(addr)) }
+    }
+
+    /// WDTCSR, the watchdog control register.
+    pub fn wdtcsr(&self) -> u8 {
+        self.data(WDTCSR)
+    }
+
+    /// MCUSR, the reset-cause flags.
+    pub fn mcusr(&self) -> u8 {
+        self.data(MCUSR)
+    }
+
+    /// Last SRAM address (RAMEND).
+    pub fn ramend(&self) -> u16 {
+        self.avr().ramend
+    }
+
+    /// The stack pointer.
+    pub fn sp(&self) -> u16 {
+        u16::from_le_bytes([self.data(0x5D), self.data(0x5E)])
+    }
+
+    /// The deepest the stack has been since power-on, bytes below RAMEND (the stack pointer
+    /// observed after every instruction, interrupt entries included; resets do not clear it).
+    pub fn stack_peak_bytes(&self) -> u16 {
+        if self.min_sp == u16::MAX {
+            0
+        } else {
+            self.ramend() - self.min_sp
+        }
+    }
+
+    /// The stack high-water mark by the firmware's own method: SRAM from `heap_start` (the
+    /// end of the static data, symbol `__heap_start`) is painted with `paint` at boot; the
+    /// lowest byte no longer holding it shows how deep the stack went. Bytes below RAMEND.
+    pub fn painted_stack_bytes(&self, heap_start: u16, paint: u8) -> u16 {
+        let end = self.ramend();
+        let mut p = heap_start;
+        while p < end && self.data(p) == paint {
+            p += 1;
+        }
+        end + 1 - p
+    }
+
+    /// The level driven on pin `bit` of `port` ('A'..='L'): its PORT bit when DDR makes it an
+    /// output, low otherwise. Unknown ports read low.
+    pub fn pin(&self, port: char, bit: u8) -> bool {
+        port_regs(port).is_some_and(|(ddr, p)| {
+            let m = 1u8 << (bit & 7);
+            self.data(ddr) & m != 0 && self.data(p) & m != 0
+        })
+    }
+
+    /// True when pin `bit` of `port` is configured as an output.
+    pub fn is_output(&self, port: char, bit: u8) -> bool {
+        port_regs(port).is_some_and(|(ddr, _)| self.data(ddr) & (1 << (bit & 7)) != 0)
+    }
+
+    /// Levels of the twelve servo pins, bit `i` = channel `i`.
+    pub fn servo_levels(&self) -> u16 {
+        let level = |(ddr, port): (u16, u16)| self.data(ddr) & self.data(port);
+        let (b, e, h, l) = (
+            level((0x24, 0x25)),
+            level((0x2D, 0x2E)),
+            level((0x101, 0x102)),
+            level((0x10A, 0x10B)),
+        );
+        let mut out = 0u16;
+        for (i, &(port, bit)) in SERVO_PINS.iter().enumerate() {
+            let v = match port {
+                'B' => b,
+                'E' => e,
+                'H' => h,
+                _ => l,
+            };
+            if v & (1 << bit) != 0 {
+                out |= 1 << i;
+            }
+        }
+        out
+    }
+
+    /// Starts (or stops) recording the servo pulses ([`Mega2560::take_pulses`]). Edges are
+    /// tracked after every instruction either way.
+    pub fn capture_pulses(&mut self, on: bool) {
+        self.capture = on;
+        if !on {
+            self.pulses.clear();
+        }
+    }
+
+    /// The servo pulses completed since the last call (capture on), in order of their
+    /// falling edges.
+    pub fn take_pulses(&mut self) -> Vec<Pulse> {
+        self.pulses.drain(..).collect()
+    }
+
+    /// The oldest servo pulse completed and not yet taken (capture on).
+    pub fn pop_pulse(&mut self) -> Option<Pulse> {
+        self.pulses.pop_front()
+    }
+
+    /// True while a pulse is in progress on `channel`.
+    pub fn pulse_in_progress(&self, channel: usize) -> bool {
+        self.rise.get(channel).is_some_and(Option::is_some)
+    }
+
+    /// Re-issues the low-byte write of a servo compare register whose high byte alone changed
+    /// (see the module docs), so that simavr reconfigures the timer as the chip would.
+    fn fix_ocr_writes(&mut self) {
+        for (i, &lo) in OCR_LOW.iter().enumerate() {
+            let v = u16::from_le_bytes([self.data(lo), self.data(lo + 1)]);
+            let old = std::mem::replace(&mut self.ocr[i], v);
+            let high_only_before = std::mem::take(&mut self.ocr_high_only[i]);
+            if v != old && (v ^ old) & 0xFF == 0 {
+                // The high byte was written; the low byte follows in the next instruction.
+                self.ocr_high_only[i] = true;
+                continue;
+            }
+            if !high_only_before || v != old {
+                // Nothing pending, or the low byte changed: simavr took the value itself.
+                continue;
+            }
+            let avr = self.avr.as_ptr();
+            // SAFETY: `lo` is the I/O address of an OCR low byte of this MCU; its write handler
+            // is the timer's, with its parameter. Between instructions nothing else runs.
+            unsafe {
+                let slot = (*avr).io[usize::from(lo) - 0x20].w;
+                if let Some(write) = slot.c {
+                    let data = (*avr).data.add(usize::from(lo));
+                    // Make the low byte differ so that the handler sees a change.
+                    *data ^= 1;
+                    write(avr, lo, v as u8, slot.param);
+                }
+            }
+        }
+    }
+
+    fn track_servos(&mut self, step: u64) {
+        let now = self.servo_levels();
+        let changed = now ^ self.levels;
+        if changed == 0 {
+            return;
+        }
+        let cycle = self.cycle();
+        for ch in 0..12 {
+            let bit = 1u16 << ch;
+            if changed & bit == 0 {
+                continue;
+            }
+            if now & bit != 0 {
+                self.rise[ch] = Some((cycle, step));
+            } else if let Some((r, rise_step)) = self.rise[ch].take() {
+                if self.capture {
+                    self.pulses.push_back(Pulse {
+                        channel: ch,
+                        rise_cycle: r,
+                        high_cycles: cycle - r,
+                        rise_step_cycles: rise_step,
+                        fall_step_cycles: step,
+                    });
+                }
+            }
+        }
+        self.levels = now;
+    }
+
+    /// The EEPROM's bytes.
+    pub fn eeprom(&mut self) -> Vec<u8> {
+        let mut buf = vec![0xFFu8; EEPROM_LEN];
+        let mut desc = ffi::avr_eeprom_desc_t {
+            ee: buf.as_mut_ptr(),
+            offset: 0,
+            size: EEPROM_LEN as u32,
+        };
+        // SAFETY: `desc` points to a buffer of `size` bytes.
+        unsafe {
+            ffi::avr_ioctl(
+                self.avr.as_ptr(),
+                IOCTL_EEPROM_GET,
+                (&mut desc as *mut ffi::avr_eeprom_desc_t).cast(),
+            )
+        };
+        buf
+    }
+
+    /// Loads `bytes` into the EEPROM from address 0 (at most [`EEPROM_LEN`]; typically before
+    /// the firmware runs, as if it had been written by an earlier run).
+    pub fn set_eeprom(&mut self, bytes: &[u8]) {
+        let mut data = bytes[..bytes.len().min(EEPROM_LEN)].to_vec();
+        if data.is_empty() {
+            return;
+        }
+        let mut desc = ffi::avr_eeprom_desc_t {
+            ee: data.as_mut_ptr(),
+            offset: 0,
+            size: data.len() as u32,
+        };
+        // SAFETY: `desc` points to a buffer of `size` bytes, which simavr copies.
+        unsafe {
+            ffi::avr_ioctl(
+                self.avr.as_ptr(),
+                IOCTL_EEPROM_SET,
+                (&mut desc as *mut ffi::avr_eeprom_desc_t).cast(),
+            )
+        };
+    }
+
+    /// Fault injection: moves the program counter to `byte_addr`, as a corrupted return
+    /// address or a runaway jump would. The emulator tests use it to hang the CPU in the C
+    /// runtime's final `cli; rjmp .` loop (`_exit`), where nothing feeds the watchdog.
+    pub fn jump(&mut self, byte_addr: u32) {
+        // SAFETY: between instructions simavr reads `pc` only at the next `avr_run`.
+        unsafe { (*self.avr.as_ptr()).pc = byte_addr };
+    }
+}
+
+impl Drop for Mega2560 {
+    fn drop(&mut self) {
+        // SAFETY: the simulator is not running; after `avr_terminate` (which frees its I/O
+        // modules, IRQs, flash and data) the hooks are no longer referenced and the `avr_t`
+        // allocation itself (malloc'd by `avr_make_mcu_by_name`) is freed.
+        unsafe {
+            ffi::avr_terminate(self.avr.as_ptr());
+            free(self.avr.as_ptr().cast());
+            drop(Box::from_raw(self.hooks.as_ptr()));
+        }
+    }
+}

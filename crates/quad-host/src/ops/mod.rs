@@ -1,0 +1,11 @@
+//! The operations behind the `quadctl` commands, one module each, as functions that take a
+//! request and return a typed result: the command line, a server or a test call the same code.
+
+pub mod accuracy;
+pub mod batch;
+pub mod calibrate;
+pub mod check;
+pub mod demo;
+pub mod motion;
+pub mod plot;
+pub mod stream;

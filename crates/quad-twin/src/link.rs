@@ -1,0 +1,205 @@
+//! The process boundary between the device side (this crate) and the MuJoCo twin
+//! (`python -m quadtwin.runner`): JSON lines on the twin's standard input and output, in
+//! lock step — one [`ToTwin::Frame`] in, one [`FromTwin::State`] out — so that the state (an
+//! IMU's reading) can be handed to the device before its next frame.
+//!
+//! ```text
+//! → {"type":"start", "model":…, "frame_s":0.02, …}      ← {"type":"ready", "timestep_s":0.001}
+//! → {"type":"frame", "k":0, "pulses_half_us":[…], "angles_rad":[…], …}
+//!                                                        ← {"type":"state", "t_s":0.02, "quat":[…], "gyro_rad_s":[…], …}
+//! → … one frame, one state …
+//! → {"type":"end"}                                       ← {"type":"summary", …}
+//! ```
+//!
+//! A twin that fails answers `{"type":"error", "message":…}` and exits non-zero.
+
+use crate::source::DeviceFrame;
+use serde::{Deserialize, Serialize};
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, ChildStdout, Stdio};
+
+/// Messages to the twin.
+#[derive(Debug, Clone, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum ToTwin<'a> {
+    /// Load the model and prepare a run.
+    Start {
+        /// The MJCF file.
+        model: &'a Path,
+        /// Robot name (for the summary).
+        robot: &'a str,
+        /// Motion name (for the summary and the metrics it selects).
+        motion: &'a str,
+        /// Servo frame period, s.
+        frame_s: f32,
+        /// Stance height the motion keeps, m.
+        stance_height_m: f32,
+        /// Time the first frame is held before the motion's clock starts, s (the robot
+        /// settles on its feet).
+        settle_s: f32,
+        /// Directory for the summary, the plots and the pictures (none: no files).
+        out_dir: Option<&'a Path>,
+        /// Render a GIF and a strip of frames.
+        render: bool,
+    },
+    /// One servo frame, held for `frame_s`.
+    Frame {
+        /// Frame index.
+        k: u32,
+        /// Start of the frame on the motion's clock, s.
+        t_s: f32,
+        /// True while the outputs are driven.
+        enabled: bool,
+        /// The pulses, half-µs.
+        pulses_half_us: [u16; 12],
+        /// The servo targets: the pulses through the device's calibration, rad.
+        angles_rad: [f32; 12],
+        /// The commanded body pose `[roll, pitch, yaw, x, y, z]` (rad, m).
+        commanded_pose: [f32; 6],
+        /// The feet the motion has on the ground.
+        stance: [bool; 4],
+    },
+    /// The run is over: compute the metrics, write the files, answer the summary.
+    End,
+}
+
+impl<'a> ToTwin<'a> {
+    /// The message of a device frame.
+    pub fn frame(k: u32, f: &DeviceFrame) -> ToTwin<'a> {
+        ToTwin::Frame {
+            k,
+            t_s: f.t_s,
+            enabled: f.enabled,
+            pulses_half_us: f.pulses_half_us,
+            angles_rad: f.angles_rad,
+            commanded_pose: f.commanded_pose.to_array(),
+            stance: f.stance,
+        }
+    }
+}
+
+/// The body state after a frame: what an IMU on the body and contact switches would read.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct BodyState {
+    /// Simulated time at the end of the frame, s.
+    pub t_s: f64,
+    /// Body centre in the world (floor at z = 0), m.
+    pub pos_m: [f64; 3],
+    /// Body orientation, quaternion `[w, x, y, z]`.
+    pub quat: [f64; 4],
+    /// Roll, pitch, yaw of the body (`zyx` order), rad.
+    pub rpy_rad: [f64; 3],
+    /// Angular velocity in the body frame (gyroscope), rad/s.
+    pub gyro_rad_s: [f64; 3],
+    /// Specific force in the body frame (accelerometer), m/s².
+    pub accel_m_s2: [f64; 3],
+    /// Feet touching the floor.
+    pub feet_contact: [bool; 4],
+}
+
+/// Messages from the twin.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum FromTwin {
+    /// The model is loaded.
+    Ready {
+        /// The physics time step, s.
+        timestep_s: f64,
+    },
+    /// The state after a frame.
+    State(BodyState),
+    /// The run's metrics.
+    Summary(Box<crate::Summary>),
+    /// The twin failed.
+    Error {
+        /// Its message.
+        message: String,
+    },
+}
+
+/// A running twin process.
+pub struct Twin {
+    child: Child,
+    stdin: ChildStdin,
+    stdout: BufReader<ChildStdout>,
+    line: String,
+}
+
+impl Twin {
+    /// Starts `python -m quadtwin.runner` in the project's twin environment.
+    ///
+    /// # Errors
+    /// [`crate::Error::Venv`] when the environment is missing, [`crate::Error::Io`] when the
+    /// process cannot start.
+    pub fn spawn(root: &Path) -> Result<Twin, crate::Error> {
+        let mut cmd =
+            quad_model::venv::python_module(root, "runner").map_err(crate::Error::Venv)?;
+        let mut child = cmd
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .map_err(crate::Error::Io)?;
+        let stdin = child
+            .stdin
+            .take()
+            .ok_or(crate::Error::Protocol("no stdin"))?;
+        let stdout = child
+            .stdout
+            .take()
+            .ok_or(crate::Error::Protocol("no stdout"))?;
+        Ok(Twin {
+            child,
+            stdin,
+            stdout: BufReader::new(stdout),
+            line: String::new(),
+        })
+    }
+
+    /// Sends one message and reads the answer.
+    ///
+    /// # Errors
+    /// [`crate::Error`] on I/O, malformed answers, or the twin's own error.
+    pub fn exchange(&mut self, msg: &ToTwin<'_>) -> Result<FromTwin, crate::Error> {
+        let mut text = serde_json::to_string(msg).map_err(crate::Error::Json)?;
+        text.push('\n');
+        self.stdin
+            .write_all(text.as_bytes())
+            .and_then(|()| self.stdin.flush())
+            .map_err(crate::Error::Io)?;
+        self.line.clear();
+        let n = self
+            .stdout
+            .read_line(&mut self.line)
+            .map_err(crate::Error::Io)?;
+        if n == 0 {
+            return Err(crate::Error::Protocol(
+                "the twin closed its output (see its messages above)",
+            ));
+        }
+        match serde_json::from_str(&self.line).map_err(crate::Error::Json)? {
+            FromTwin::Error { message } => Err(crate::Error::Twin { message }),
+            answer => Ok(answer),
+        }
+    }
+
+    /// Waits for the process to exit.
+    ///
+    /// # Errors
+    /// [`crate::Error::Exit`] on a non-zero exit.
+    pub fn finish(mut self) -> Result<(), crate::Error> {
+        drop(self.stdin);
+        let status = self.child.wait().map_err(crate::Error::Io)?;
+        if status.success() {
+            Ok(())
+        } else {
+            Err(crate::Error::Exit(status))
+        }
+    }
+}
+
+/// Where a run writes: `out_dir` when given.
+pub(crate) fn model_path(out_dir: Option<&Path>, tmp: &Path) -> PathBuf {
+    out_dir.unwrap_or(tmp).join("model.xml")
+}

@@ -1,0 +1,262 @@
+//! The motions the twin runs, built from kin-core's motion laws for the device's robot and
+//! stance, and turned into the requests a host would send the device at every servo frame.
+//!
+//! Until the device runs motions itself, each frame's target is the kin-core motion's frame at
+//! that time, sent as `SetFeet` (the feet in the body frame): the device solves the IK and maps
+//! the angles to pulses with its own code, exactly as it would for a host.
+
+use core::fmt;
+use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
+use kin_core::motion::laws::{Axis, Sway, SwayParams, YawTurn, YawTurnParams};
+use kin_core::motion::{AnyMotion, Contact, Motion};
+use kin_core::{rotation, Pose, Robot, RotationOrder};
+use quad_device::Config;
+
+/// Rest height of the stand-up, as a fraction of the stance height: low enough to be a
+/// crouch, high enough that the body clears the floor on both presets.
+pub const REST_HEIGHT_FRACTION: f32 = 0.6;
+/// Duration of the stand-up's ramp from rest to stance, s.
+pub const STAND_RAMP_S: f32 = 2.0;
+/// Time the stance is held after the ramp, s.
+pub const STAND_HOLD_S: f32 = 2.0;
+/// Seed 001's stance height with its robot (eq. 5), m: the yaw turn's lift is scaled from
+/// seed 001's 0.3 m by the robot's stance height over this one.
+pub const SEED001_STANCE_HEIGHT_M: f32 = 0.9294;
+/// Trot speed as stance heights per second (a step of 0.1·H at the default 0.8 s cycle).
+pub const TROT_SPEED_HEIGHTS_PER_S: f32 = 0.25;
+/// Duration of the trot, s.
+pub const TROT_DURATION_S: f32 = 10.0;
+/// Yaw-turn duration, in step periods.
+pub const YAW_TURN_PERIODS: f32 = 2.0;
+/// Step period of the fast yaw turn, s: the gait's default cycle, so that each diagonal pair
+/// is in the air for 0.4 s instead of seed 001's 3 s.
+pub const FAST_YAW_TURN_PERIOD_S: f32 = 0.8;
+/// Step height of the fast yaw turn as a fraction of the stance height (the gait's default).
+pub const FAST_YAW_TURN_LIFT_FRACTION: f32 = 0.15;
+
+/// A motion of the twin's catalogue.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MotionKind {
+    /// Rest crouch → stance in [`STAND_RAMP_S`] (raised cosine), held [`STAND_HOLD_S`].
+    Stand,
+    /// Seed 001's roll sway (eq. 6: A = 0.2 rad, T = 20 s), one period.
+    Roll,
+    /// Seed 001's pitch sway (eq. 8), one period.
+    Pitch,
+    /// Seed 000's roll sweep (±28°, 10 s sine), one period.
+    SweepRoll,
+    /// Seed 000's pitch sweep (±21°), one period.
+    SweepPitch,
+    /// Seed 000's yaw sweep (±21°), one period.
+    SweepYaw,
+    /// Seed 001's crossed-pair yaw turn (eq. 9–11: ω = 0.085 rad/s, T1 = 6 s), two periods.
+    YawTurn,
+    /// Seed 001's yaw turn at the same turn rate with a step period of
+    /// [`FAST_YAW_TURN_PERIOD_S`] (dynamic, trot-like) over the same 12 s.
+    YawTurnFast,
+    /// A trot forward at [`TROT_SPEED_HEIGHTS_PER_S`], [`TROT_DURATION_S`].
+    Trot,
+}
+
+impl MotionKind {
+    /// Every motion.
+    pub const ALL: [MotionKind; 9] = [
+        MotionKind::Stand,
+        MotionKind::Roll,
+        MotionKind::Pitch,
+        MotionKind::SweepRoll,
+        MotionKind::SweepPitch,
+        MotionKind::SweepYaw,
+        MotionKind::YawTurn,
+        MotionKind::YawTurnFast,
+        MotionKind::Trot,
+    ];
+
+    /// Command-line name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            MotionKind::Stand => "stand",
+            MotionKind::Roll => "roll",
+            MotionKind::Pitch => "pitch",
+            MotionKind::SweepRoll => "sweep-roll",
+            MotionKind::SweepPitch => "sweep-pitch",
+            MotionKind::SweepYaw => "sweep-yaw",
+            MotionKind::YawTurn => "yaw-turn",
+            MotionKind::YawTurnFast => "yaw-turn-fast",
+            MotionKind::Trot => "trot",
+        }
+    }
+
+    /// Parses a [`MotionKind::name`].
+    pub fn parse(name: &str) -> Option<MotionKind> {
+        MotionKind::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
+
+impl fmt::Display for MotionKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What a motion asks at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Target {
+    /// The body pose the motion commands, world frame.
+    pub pose: Pose,
+    /// The four feet in the body frame (what `SetFeet` carries), m.
+    pub feet_in_body_m: [[f32; 3]; 4],
+    /// True for the feet the motion has on the ground.
+    pub stance: [bool; 4],
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Script {
+    StandUp { rest_m: f32, stance_m: f32 },
+    Law(AnyMotion),
+}
+
+/// A motion built for one device configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plan {
+    kind: MotionKind,
+    robot: Robot,
+    order: RotationOrder,
+    stance_height_m: f32,
+    duration_s: f32,
+    script: Script,
+}
+
+impl Plan {
+    /// Builds `kind` for the robot and stance of `config` (the device's own defaults).
+    ///
+    /// # Errors
+    /// kin-core's [`kin_core::motion::Error`] naming the parameter that puts a foot out of
+    /// reach (e.g. seed 000's sweeps on a robot they do not fit).
+    pub fn new(kind: MotionKind, config: &Config) -> Result<Plan, kin_core::motion::Error> {
+        let robot = config.robot;
+        let h = config.pose_config.stance_height_m;
+        let order = config.pose_config.order;
+        let sway = |base: SwayParams| -> Result<(Script, f32), kin_core::motion::Error> {
+            let p = SwayParams {
+                robot,
+                order,
+                feet_in_world: robot.stance_feet(h),
+                ..base
+            };
+            Ok((Script::Law(AnyMotion::Sway(Sway::new(p)?)), p.period_s))
+        };
+        let (script, duration_s) = match kind {
+            MotionKind::Stand => (
+                Script::StandUp {
+                    rest_m: REST_HEIGHT_FRACTION * h,
+                    stance_m: h,
+                },
+                STAND_RAMP_S + STAND_HOLD_S,
+            ),
+            MotionKind::Roll => sway(SwayParams::seed001(Axis::Roll))?,
+            MotionKind::Pitch => sway(SwayParams::seed001(Axis::Pitch))?,
+            MotionKind::SweepRoll => sway(SwayParams::seed000(Axis::Roll))?,
+            MotionKind::SweepPitch => sway(SwayParams::seed000(Axis::Pitch))?,
+            MotionKind::SweepYaw => sway(SwayParams::seed000(Axis::Yaw))?,
+            MotionKind::YawTurn => {
+                let base = YawTurnParams::seed001();
+                let p = YawTurnParams {
+                    robot,
+                    order,
+                    stance_feet: robot.stance_feet(h),
+                    lift_height_m: base.lift_height_m * h / SEED001_STANCE_HEIGHT_M,
+                    ..base
+                };
+                (
+                    Script::Law(AnyMotion::YawTurn(YawTurn::new(p)?)),
+                    YAW_TURN_PERIODS * p.step_period_s,
+                )
+            }
+            MotionKind::YawTurnFast => {
+                let base = YawTurnParams::seed001();
+                let p = YawTurnParams {
+                    robot,
+                    order,
+                    stance_feet: robot.stance_feet(h),
+                    lift_height_m: FAST_YAW_TURN_LIFT_FRACTION * h,
+                    step_period_s: FAST_YAW_TURN_PERIOD_S,
+                    ..base
+                };
+                (
+                    Script::Law(AnyMotion::YawTurn(YawTurn::new(p)?)),
+                    YAW_TURN_PERIODS * base.step_period_s,
+                )
+            }
+            MotionKind::Trot => {
+                let mut p = GaitParams::new(Pattern::Trot, robot, h);
+                p.order = order;
+                p.velocity = Velocity {
+                    forward_m_s: TROT_SPEED_HEIGHTS_PER_S * h,
+                    ..Velocity::default()
+                };
+                (Script::Law(AnyMotion::Gait(Gait::new(p)?)), TROT_DURATION_S)
+            }
+        };
+        Ok(Plan {
+            kind,
+            robot,
+            order,
+            stance_height_m: h,
+            duration_s,
+            script,
+        })
+    }
+
+    /// The motion.
+    pub const fn kind(&self) -> MotionKind {
+        self.kind
+    }
+
+    /// Duration, s.
+    pub const fn duration_s(&self) -> f32 {
+        self.duration_s
+    }
+
+    /// The stance height the motion keeps (the stand-up's final height), m.
+    pub const fn stance_height_m(&self) -> f32 {
+        self.stance_height_m
+    }
+
+    /// What the motion asks at `t_s`.
+    ///
+    /// # Errors
+    /// kin-core's error for a non-finite time.
+    pub fn target(&self, t_s: f32) -> Result<Target, kin_core::motion::Error> {
+        let (pose, feet_in_world, contact) = match self.script {
+            Script::StandUp { rest_m, stance_m } => {
+                let u = (t_s / STAND_RAMP_S).clamp(0.0, 1.0);
+                // Raised cosine: zero speed at both ends of the ramp.
+                let s = 0.5 - 0.5 * (core::f32::consts::PI * u).cos();
+                let h = rest_m + (stance_m - rest_m) * s;
+                // The feet stay on the ground at −stance (the world's floor); the body rises.
+                let pose = Pose {
+                    z_m: h - stance_m,
+                    ..Pose::default()
+                };
+                (pose, self.robot.stance_feet(stance_m), [Contact::Stance; 4])
+            }
+            Script::Law(m) => {
+                let f = m.frame(t_s)?;
+                (f.pose, f.feet_in_world, f.contact)
+            }
+        };
+        let r = rotation::matrix::<kin_core::DefaultMath>(
+            self.order,
+            pose.roll_rad,
+            pose.pitch_rad,
+            pose.yaw_rad,
+        );
+        let t = pose.translation();
+        Ok(Target {
+            pose,
+            feet_in_body_m: feet_in_world.map(|p| r.transpose_mul_vec(p - t).to_array()),
+            stance: contact.map(|c| c == Contact::Stance),
+        })
+    }
+}

@@ -1,0 +1,577 @@
+//! What the commands share: the exit codes, the arguments used by several commands
+//! (`--robot`, `--input`, the device target, a law's parameters), the value parsers, the
+//! batch driver and the one place where errors become exit codes.
+
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use kin_core::motion::path::PathKind;
+use kin_core::{KneeBend, LegId, ReachPolicy, Robot, RotationOrder, Vec3};
+use quad_host::client::DEFAULT_RETRIES;
+use quad_host::csv::{self, Input, Summary};
+use quad_host::link::emulator::EmulatorConfig;
+use quad_host::link::sim::{SimConfig, DEFAULT_RX_FIFO_LEN};
+use quad_host::link::{Faults, Target};
+use quad_host::names;
+use quad_host::ops::accuracy::Angles;
+use quad_host::ops::batch::PoseFormat;
+use quad_host::ops::motion::{Law, Params};
+use quad_host::robot_file;
+use quad_protocol::RobotPreset;
+use std::fmt;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+/// Exit status when every record was answered (reachable or not).
+pub const EXIT_OK: u8 = 0;
+/// Exit status when at least one record was malformed (the others were answered).
+pub const EXIT_MALFORMED: u8 = 1;
+/// Exit status when nothing or not everything could be processed: bad arguments, unreadable or
+/// invalid robot file, unreadable input, a foreign header, or an output error.
+pub const EXIT_FATAL: u8 = 2;
+/// Exit status when a readback, a nack or a pulse disagreed with the host (`stream`, `demo`).
+pub const EXIT_CHECK_FAILED: u8 = 3;
+
+/// The one place where an error becomes an exit status: reported on stderr as
+/// `<prefix>: error: <message>`, then [`EXIT_FATAL`].
+pub fn fail(prefix: &str, e: &dyn std::error::Error) -> ExitCode {
+    // Nothing useful can be done if stderr itself fails.
+    let _ = writeln!(io::stderr(), "{prefix}: error: {e}");
+    ExitCode::from(EXIT_FATAL)
+}
+
+/// [`EXIT_OK`], or [`fail`] with `quadctl`.
+pub fn exit_status<E: std::error::Error>(result: Result<(), E>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::from(EXIT_OK),
+        Err(e) => fail("quadctl", &e),
+    }
+}
+
+/// Help text shared by the batch commands: input rules and exit codes.
+pub const BATCH_RULES: &str = "\
+Input: CSV, one record per line, fields separated by commas (no quoting), spaces around fields
+ignored. Blank lines and lines starting with `#` are skipped. The header row is optional: the
+first record is taken as a header when its first field is not a value of the first column; it
+must then name exactly the expected columns, or nothing is processed. Leg names are FL, FR, RL,
+RR (any case).
+
+Output: CSV on stdout with a header row. Numbers are printed with the shortest decimal that reads
+back to the same f32.
+
+Malformed records (wrong number of fields, a field that is not a number or not a leg name) are
+reported on stderr as `<input>:<line>: <what is wrong>` and get NO output row; the other records
+are still answered, in input order.
+
+Exit status: 0 every record answered (unreachable targets are answers, see `status`); 1 at least
+one malformed record; 2 nothing processed or processing stopped (bad arguments, robot file or
+input not readable or invalid, foreign header, output error).
+
+Robot files (TOML): d_lat_m, d_ax_m, femur_m, tibia_m, body_length_m, body_width_m (metres,
+required); knee_bend = \"backward\" | \"forward\" (optional, default backward); optional
+[limits] table with abduction_rad, hip_rad, knee_rad = [min, max] (radians; a joint left out is
+limited only to the full turn [-pi, pi]). Unknown keys are refused.";
+
+/// `--robot`.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
+pub struct RobotArgs {
+    /// Robot: a preset (shahriar2023, fernando2025) or a TOML robot file.
+    #[arg(long, value_name = "PRESET|FILE.toml")]
+    pub robot: String,
+}
+
+impl RobotArgs {
+    /// Resolves the preset or file; `knee` overrides the robot's knee bend (mirroring its knee
+    /// limits with it, see [`Robot::with_knee_bend`]).
+    pub fn load(&self, knee: Option<KneeBend>) -> Result<Robot, robot_file::Error> {
+        let robot = robot_file::resolve(&self.robot)?;
+        Ok(match knee {
+            Some(k) => robot.with_knee_bend(k),
+            None => robot,
+        })
+    }
+}
+
+/// `--input`.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
+pub struct InputArgs {
+    /// CSV input file, or `-` for standard input.
+    #[arg(long, value_name = "FILE|-", default_value = "-")]
+    pub input: PathBuf,
+}
+
+/// Where the device is: `--sim`, `--emulator` or `--port`, and the line (`stream`,
+/// `calibrate`).
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct TargetArgs {
+    /// Run against the device controller behind a simulated UART.
+    #[arg(long, conflicts_with_all = ["port", "emulator"], required_unless_present_any = ["port", "emulator"])]
+    pub sim: bool,
+    /// Run the real firmware in simavr (an emulated ATmega2560; simulated time).
+    #[arg(long, conflicts_with = "port")]
+    pub emulator: bool,
+    /// Firmware ELF for --emulator; default: built from firmware-avr/ for --baud (115200:
+    /// firmware.elf, 1000000: firmware-1mbaud.elf).
+    #[arg(long, value_name = "PATH", requires = "emulator")]
+    pub elf: Option<PathBuf>,
+    /// Serial port of a real device, e.g. /dev/ttyACM0.
+    #[arg(long, value_name = "PATH")]
+    pub port: Option<String>,
+    /// Line rate, bit/s (8N1).
+    #[arg(long, value_name = "B", default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(300..))]
+    pub baud: u32,
+    /// Line faults of --sim or --emulator: drop=P,flip=P (per byte), dup=P,trunc=P,stall=P (per
+    /// frame), stall_ms=MS.
+    #[arg(
+        long,
+        value_name = "drop=P,flip=P,dup=P,trunc=P",
+        conflicts_with = "port"
+    )]
+    pub faults: Option<Faults>,
+    /// Seed of the simulated faults.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+    /// Modelled device time per answered frame in the simulation, µs (0: wire-limited).
+    #[arg(long, value_name = "US", default_value_t = 0.0, value_parser = parse_us, requires = "sim")]
+    pub sim_compute_us: f64,
+    /// EEPROM image file of the simulated or emulated device (read at power-on; written on
+    /// every change with --sim, at the end of the run with --emulator).
+    #[arg(long, value_name = "FILE", conflicts_with = "port")]
+    pub sim_storage: Option<PathBuf>,
+    /// Resends per request after the first attempt.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_RETRIES)]
+    pub retries: u32,
+}
+
+impl TargetArgs {
+    /// The library's target; `preset` is the robot of the simulated device.
+    pub fn target(&self, preset: RobotPreset) -> Target {
+        let faults = self.faults.unwrap_or(Faults::NONE);
+        if let Some(path) = &self.port {
+            Target::Serial {
+                path: path.clone(),
+                baud: self.baud,
+            }
+        } else if self.emulator {
+            Target::Emulator {
+                elf: self.elf.clone(),
+                config: EmulatorConfig {
+                    faults,
+                    seed: self.seed,
+                    ..EmulatorConfig::new(self.baud)
+                },
+                storage: self.sim_storage.clone(),
+            }
+        } else {
+            Target::Sim {
+                preset,
+                config: SimConfig {
+                    baud: self.baud,
+                    faults,
+                    seed: self.seed,
+                    compute: Duration::from_secs_f64(self.sim_compute_us * 1e-6),
+                    rx_fifo_len: DEFAULT_RX_FIFO_LEN,
+                },
+                storage: self.sim_storage.clone(),
+            }
+        }
+    }
+}
+
+/// The law and its parameters, shared by `motion` and `check --motion`. Every parameter is
+/// optional; the defaults are the papers' (see `quadctl motion --help`).
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct LawArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: RobotArgs,
+    /// Stance height H (m): feet straight below the hips, H below them. Default: seed 001's
+    /// initial pose (φ=120°, α=60°, β=0) through forward kinematics (0.9294 m for
+    /// fernando2025); rect-path: 0.2 m (seed 000 Fig. 8).
+    #[arg(long, value_name = "M")]
+    pub stance_height_m: Option<f32>,
+    /// Rotation order of the body pose [default: zxy for the sways and yaw-turn (seed 001),
+    /// zyx otherwise].
+    #[arg(long, value_parser = rotation_order())]
+    pub rotation_order: Option<RotationOrder>,
+    /// Sways: amplitude A, rad [default: 0.2].
+    #[arg(long, value_name = "RAD")]
+    pub amplitude_rad: Option<f32>,
+    /// Sways: period T, s [default: 20].
+    #[arg(long, value_name = "S")]
+    pub period_s: Option<f32>,
+    /// yaw-turn: ω_z, rad/s; positive turns clockwise seen from above [default: 0.085].
+    #[arg(long, value_name = "RAD_S")]
+    pub omega_rad_s: Option<f32>,
+    /// yaw-turn: step period T1, s [default: 6].
+    #[arg(long, value_name = "S")]
+    pub step_period_s: Option<f32>,
+    /// yaw-turn: lift height h_K, m [default: 0.3].
+    #[arg(long, value_name = "M")]
+    pub lift_height_m: Option<f32>,
+    /// rect-path: path shape [default: rectangle]; trot/walk: swing shape [default: bezier].
+    #[arg(long, value_parser = path_kind())]
+    pub path: Option<PathKind>,
+    /// rect-path: stride length, m [default: 0.1].
+    #[arg(long, value_name = "M")]
+    pub stride_m: Option<f32>,
+    /// rect-path, trot, walk: swing apex above the ground, m [default: rect-path 0.05,
+    /// gaits 0.15·H].
+    #[arg(long, value_name = "M")]
+    pub step_height_m: Option<f32>,
+    /// rect-path, trot, walk: stance fraction of the cycle, in (0, 1) [default: rectangle 1/3
+    /// (one speed round the loop), other paths 0.5; trot 0.5, walk 0.75].
+    #[arg(long, value_name = "D")]
+    pub duty_factor: Option<f32>,
+    /// rect-path, trot, walk: cycle time, s [default: rect-path 3, gaits 0.8].
+    #[arg(long, value_name = "S")]
+    pub cycle_s: Option<f32>,
+    /// trot, walk: forward speed, m/s [default: 0].
+    #[arg(long, value_name = "M_S")]
+    pub forward_m_s: Option<f32>,
+    /// trot, walk: lateral speed (left positive), m/s [default: 0].
+    #[arg(long, value_name = "M_S")]
+    pub lateral_m_s: Option<f32>,
+    /// trot, walk: yaw rate (counter-clockwise positive), rad/s [default: 0].
+    #[arg(long, value_name = "RAD_S")]
+    pub yaw_rad_s: Option<f32>,
+}
+
+impl LawArgs {
+    /// The library's parameters.
+    pub fn params(&self) -> Params {
+        Params {
+            robot: self.robot.robot.clone(),
+            stance_height_m: self.stance_height_m,
+            amplitude_rad: self.amplitude_rad,
+            period_s: self.period_s,
+            omega_rad_s: self.omega_rad_s,
+            step_period_s: self.step_period_s,
+            lift_height_m: self.lift_height_m,
+            path: self.path,
+            stride_m: self.stride_m,
+            step_height_m: self.step_height_m,
+            duty_factor: self.duty_factor,
+            cycle_s: self.cycle_s,
+            forward_m_s: self.forward_m_s,
+            lateral_m_s: self.lateral_m_s,
+            yaw_rad_s: self.yaw_rad_s,
+            rotation_order: self.rotation_order,
+        }
+    }
+}
+
+/// A value parser for one of a fixed set of named values: the names are the library's or
+/// kin-core's own (no mirror enums here), listed with `help` as the possible values in
+/// `--help`.
+pub fn choice<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+    help: fn(T) -> String,
+) -> impl TypedValueParser<Value = T> {
+    PossibleValuesParser::new(
+        all.iter()
+            .map(|&v| PossibleValue::new(name(v)).help(help(v))),
+    )
+    .map(move |s| {
+        all.iter()
+            .copied()
+            .find(|&v| name(v) == s)
+            .expect("clap accepts only the names listed")
+    })
+}
+
+/// `--rotation-order`: kin-core's six orders by name, each described by its product read
+/// left to right.
+pub fn rotation_order() -> impl TypedValueParser<Value = RotationOrder> {
+    fn help(o: RotationOrder) -> String {
+        let factor = |axis: u8| ["Rx(roll)", "Ry(pitch)", "Rz(yaw)"][usize::from(axis)];
+        let product = o.axes().map(factor).join("·");
+        match o {
+            RotationOrder::Zxy => format!("{product} (seed 001)"),
+            RotationOrder::Zyx => format!("{product} (the default)"),
+            _ => product,
+        }
+    }
+    choice(&RotationOrder::ALL, RotationOrder::name, help)
+}
+
+/// `--knee`.
+pub fn knee() -> impl TypedValueParser<Value = KneeBend> {
+    fn help(k: KneeBend) -> String {
+        match k {
+            KneeBend::Backward => "knee <= 0 (the knee joint behind the hip-foot line)",
+            KneeBend::Forward => "knee >= 0 (the knee joint in front of the hip-foot line)",
+        }
+        .to_owned()
+    }
+    choice(&names::KNEE_BEND_VALUES, names::knee_bend_name, help)
+}
+
+/// `--policy`.
+pub fn policy() -> impl TypedValueParser<Value = ReachPolicy> {
+    fn help(p: ReachPolicy) -> String {
+        match p {
+            ReachPolicy::Reject => "Report the reason in `status`, leave the angles empty",
+            ReachPolicy::Clamp => {
+                "Move the target to the nearest reachable point and report the distance moved"
+            }
+        }
+        .to_owned()
+    }
+    choice(&names::REACH_POLICY_VALUES, names::reach_policy_name, help)
+}
+
+/// `--path`: kin-core's foot path shapes by name.
+pub fn path_kind() -> impl TypedValueParser<Value = PathKind> {
+    fn help(k: PathKind) -> String {
+        match k {
+            PathKind::Rectangle => "Lift, stride, lower, return (seed 000 Fig. 8)",
+            PathKind::Semicircle => "Semicircle of diameter the stride (its height is stride/2)",
+            PathKind::Ellipse => "Half ellipse",
+            PathKind::Cycloid => "Cycloid (zero velocity at lift-off and touch-down)",
+            PathKind::Bezier => "Quintic Bézier, C1 with the stance",
+        }
+        .to_owned()
+    }
+    choice(&PathKind::ALL, PathKind::name, help)
+}
+
+/// A motion law by name.
+pub fn law() -> impl TypedValueParser<Value = Law> {
+    choice(&Law::ALL, Law::name, |l| l.summary().to_owned())
+}
+
+/// `--angles`.
+pub fn angles() -> impl TypedValueParser<Value = Angles> {
+    fn help(a: Angles) -> String {
+        match a {
+            Angles::Canonical => "The canonical angles as they are in the files",
+            Angles::Seed000 => "Seed 000's θ1, θ2, θ3 (kin_core::paper::to_seed000)",
+        }
+        .to_owned()
+    }
+    choice(&Angles::ALL, Angles::name, help)
+}
+
+/// `--format` of `pose`.
+pub fn pose_format() -> impl TypedValueParser<Value = PoseFormat> {
+    fn help(f: PoseFormat) -> String {
+        match f {
+            PoseFormat::Csv => "CSV in radians, for programs",
+            PoseFormat::Table => "A table per pose in degrees, for people",
+        }
+        .to_owned()
+    }
+    choice(&PoseFormat::ALL, PoseFormat::name, help)
+}
+
+/// Errors that stop a batch command.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// `--robot` could not be resolved.
+    #[error(transparent)]
+    Robot(#[from] robot_file::Error),
+    /// Input, output or header error.
+    #[error(transparent)]
+    Csv(#[from] csv::Error),
+}
+
+impl Error {
+    fn is_broken_pipe(&self) -> bool {
+        matches!(self, Error::Csv(csv::Error::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe)
+    }
+}
+
+/// A command-line value that could not be used.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum ArgError {
+    /// Not a number.
+    NotANumber(String),
+    /// A length that must be finite and > 0.
+    NotPositive(f32),
+    /// Not a finite number.
+    NotFinite(String),
+    /// Not three comma-separated numbers.
+    NotThree(usize),
+    /// Not a time in µs within [0, 1e7].
+    OutOfMicrosecondRange(String),
+    /// Not a leg name.
+    UnknownLeg(String),
+    /// Not one speed or three.
+    SpeedCount(String),
+}
+
+impl fmt::Display for ArgError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ArgError::NotANumber(s) => write!(f, "`{s}` is not a number"),
+            ArgError::NotPositive(v) => write!(f, "{v} must be a finite length > 0 (metres)"),
+            ArgError::NotFinite(s) => write!(f, "`{s}` is not a finite number"),
+            ArgError::NotThree(n) => {
+                write!(f, "expected three comma-separated numbers X,Y,Z, found {n}")
+            }
+            ArgError::OutOfMicrosecondRange(s) => {
+                write!(f, "`{s}` is not a time in µs within [0, 1e7]")
+            }
+            ArgError::UnknownLeg(s) => write!(f, "`{s}` is not a leg (FL, FR, RL, RR)"),
+            ArgError::SpeedCount(s) => write!(
+                f,
+                "expected one value or three (abduction,hip,knee), got `{s}`"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ArgError {}
+
+fn parse_finite(s: &str) -> Result<f32, ArgError> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| ArgError::NotANumber(s.trim().to_owned()))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ArgError::NotFinite(s.trim().to_owned()))
+    }
+}
+
+/// Value parser: a finite length > 0, metres.
+pub fn parse_positive_m(s: &str) -> Result<f32, ArgError> {
+    let v = parse_finite(s)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ArgError::NotPositive(v))
+    }
+}
+
+/// Value parser: `X,Y,Z`, three finite numbers (metres).
+pub fn parse_vec3_m(s: &str) -> Result<Vec3, ArgError> {
+    let parts: Vec<&str> = s.split(',').collect();
+    match parts.as_slice() {
+        [x, y, z] => Ok(Vec3::new(
+            parse_finite(x)?,
+            parse_finite(y)?,
+            parse_finite(z)?,
+        )),
+        other => Err(ArgError::NotThree(other.len())),
+    }
+}
+
+/// Value parser: a time in µs within [0, 1e7].
+pub fn parse_us(s: &str) -> Result<f64, ArgError> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && (0.0..=1e7).contains(&v) => Ok(v),
+        _ => Err(ArgError::OutOfMicrosecondRange(s.to_owned())),
+    }
+}
+
+/// Value parser: a leg name (any case).
+pub fn parse_leg(s: &str) -> Result<LegId, ArgError> {
+    LegId::parse(s).ok_or_else(|| ArgError::UnknownLeg(s.to_owned()))
+}
+
+/// Value parser of `--max-joint-speed-rad-s`: one speed for all joints or ABDUCTION,HIP,KNEE,
+/// rad/s.
+pub fn parse_speed_limits(s: &str) -> Result<[f32; 3], ArgError> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<f32>()
+                .map_err(|_| ArgError::NotANumber(x.trim().to_owned()))
+        })
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [a] => Ok([*a; 3]),
+        [a, b, c] => Ok([*a, *b, *c]),
+        _ => Err(ArgError::SpeedCount(s.to_owned())),
+    }
+}
+
+/// Runs a batch command on `--input` with stdout and stderr, reports its outcome on stderr and
+/// turns it into the exit status ([`EXIT_OK`], [`EXIT_MALFORMED`], [`EXIT_FATAL`]).
+pub fn run_batch(
+    input: &Path,
+    body: impl FnOnce(Input, &mut dyn Write, &mut dyn Write) -> Result<Summary, Error>,
+) -> ExitCode {
+    let stdout = io::stdout();
+    let mut out = io::BufWriter::new(stdout.lock());
+    let stderr = io::stderr();
+    let mut diag = stderr.lock();
+    let result = Input::open(input)
+        .map_err(Error::Csv)
+        .and_then(|input| body(input, &mut out, &mut diag))
+        .and_then(|summary| {
+            out.flush().map_err(|e| Error::Csv(csv::Error::Io(e)))?;
+            Ok(summary)
+        });
+    match result {
+        Ok(summary) if summary.malformed == 0 => ExitCode::from(EXIT_OK),
+        Ok(summary) => {
+            // Nothing useful can be done if stderr itself fails.
+            let _ = writeln!(
+                diag,
+                "quadctl: {} malformed record(s) skipped, {} answered",
+                summary.malformed, summary.answered
+            );
+            ExitCode::from(EXIT_MALFORMED)
+        }
+        // The reader of stdout went away (e.g. `| head`): stop quietly.
+        Err(e) if e.is_broken_pipe() => ExitCode::from(EXIT_OK),
+        Err(e) => {
+            let _ = out.flush();
+            drop(diag);
+            fail("quadctl", &e)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kin_core::preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S;
+
+    #[test]
+    fn the_default_speed_limit_is_kin_cores() {
+        let default: f32 = "6".parse().unwrap();
+        assert_eq!(default, DEFAULT_MAX_JOINT_SPEED_RAD_S);
+        assert_eq!(parse_speed_limits("1,2,3").unwrap(), [1.0, 2.0, 3.0]);
+        assert_eq!(parse_speed_limits("4").unwrap(), [4.0; 3]);
+        assert!(parse_speed_limits("1,2").is_err() && parse_speed_limits("x").is_err());
+    }
+
+    #[test]
+    fn named_values_parse_to_the_library_values() {
+        let cmd = clap::Command::new("t");
+        let order = rotation_order();
+        let ok = |s: &str| order.parse_ref(&cmd, None, std::ffi::OsStr::new(s)).ok();
+        assert_eq!(ok("zxy"), Some(RotationOrder::Zxy));
+        assert_eq!(ok("zyy"), None);
+        let knees = knee();
+        let k = knees
+            .parse_ref(&cmd, None, std::ffi::OsStr::new("forward"))
+            .ok();
+        assert_eq!(k, Some(KneeBend::Forward));
+    }
+
+    #[test]
+    fn value_parsers_refuse_what_they_cannot_use() {
+        assert_eq!(parse_positive_m("0.9294"), Ok(0.9294));
+        assert_eq!(parse_positive_m("0"), Err(ArgError::NotPositive(0.0)));
+        assert_eq!(
+            parse_positive_m("inf"),
+            Err(ArgError::NotFinite("inf".to_owned()))
+        );
+        assert_eq!(parse_vec3_m("0.1, -0.2,0"), Ok(Vec3::new(0.1, -0.2, 0.0)));
+        assert_eq!(parse_vec3_m("1,2"), Err(ArgError::NotThree(2)));
+        assert_eq!(
+            parse_vec3_m("1,x,2"),
+            Err(ArgError::NotANumber("x".to_owned()))
+        );
+    }
+}

@@ -1,0 +1,109 @@
+//! `quadctl stream`: body poses to the device, simulated (`--sim`), emulated (`--emulator`) or
+//! real (`--port`), every answer checked against the host's own kin-core; a JSON summary as the
+//! last line of stdout.
+
+use crate::args::{
+    self, InputArgs, RobotArgs, TargetArgs, EXIT_CHECK_FAILED, EXIT_MALFORMED, EXIT_OK,
+};
+use kin_core::RotationOrder;
+use quad_host::ops::stream::{self, Request};
+use quad_protocol::RobotPreset;
+use std::io::{self, Write};
+use std::process::ExitCode;
+
+const LONG_ABOUT: &str = "\
+Streams body poses to the device and checks every answer.
+
+Input: the CSV of `quadctl pose` (roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m: rotation in RADIANS,
+translation in METRES of the body relative to the world frame; feet held at the nominal stance).
+
+Target: --sim runs the device controller in-process behind a simulated UART with the timing of
+a real line at --baud (virtual time: nothing sleeps) and optional --faults; --emulator runs the
+real ATmega2560 firmware (built from firmware-avr/ if needed, or --elf PATH) in simavr
+in-process at 16 MHz, in simulated time, with the same --faults, and checks the pulses on its
+twelve servo pins; --port PATH talks to an Arduino Mega running the firmware.
+
+Each pose is sent as one SetBodyPose request and retried (same sequence number) on a timeout, on
+a nack of an unreadable frame, or when its answer fails the check: the device's 12 angles must
+equal the host's kin-core result (the same bits with --sim; within --angle-tolerance-rad with
+--emulator and --port) and its 12 pulses the device calibration's mapping of those angles; an unreachable pose
+must be nacked with the host's own leg and reason. Nacked, lost and mismatching poses are reported
+on stderr as <input>:<line>: ...
+
+Output: the last line of stdout is one JSON object:
+{\"sent\",\"acked\",\"nacked\",\"retries\",\"lost\",\"readback_mismatches\",\"max_angle_err_rad\",
+\"pulses_out_of_range\",\"poses_per_s\", then transient_mismatches (answers a retry corrected),
+timeouts, elapsed_s (link time) and reenabled}; with --emulator also pulses_checked and
+pulse_width_errors: every pulse measured on the 12 servo pins compared with the readback in
+force when it started (the last one sent before it, or the next), an error when it differs by
+more than one 0.5 us timer tick. poses_per_s counts acked + nacked poses per second of link time
+(simulated time with --sim and --emulator).
+
+Exit status: 0 all poses answered or lost, every check passed; 1 malformed input records (the
+others were streamed); 2 nothing or not everything could be streamed (arguments, robot, input,
+link, firmware build, handshake); 3 a readback mismatch, a pulse out of its travel or a pulse
+width error on the pins.";
+
+/// Arguments of `quadctl stream`.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+#[command(
+    about = "Stream body poses (rad, m) to the device (--sim or --port) and check every readback",
+    long_about = LONG_ABOUT
+)]
+pub struct Args {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub target: TargetArgs,
+    /// Stance height H set on the device, metres; default: the device's own.
+    #[arg(long, value_name = "H", value_parser = args::parse_positive_m)]
+    pub stance_height_m: Option<f32>,
+    /// Rotation order set on the device; default: the device's own.
+    #[arg(long, value_parser = args::rotation_order())]
+    pub rotation_order: Option<RotationOrder>,
+    /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
+    /// exact with --sim, 5e-5 rad with --emulator and --port (the AVR's math differs from the
+    /// host's).
+    #[arg(long, value_name = "RAD")]
+    pub angle_tolerance_rad: Option<f32>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub input: InputArgs,
+}
+
+/// Runs `quadctl stream` and returns its exit status.
+pub fn main(args: &Args) -> ExitCode {
+    // The simulated device runs the robot given; `stream::run` refuses a robot that is not a
+    // preset before the link is opened.
+    let preset = RobotPreset::from_name(args.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
+    let request = Request {
+        robot: args.robot.robot.clone(),
+        target: args.target.target(preset),
+        retries: args.target.retries,
+        stance_height_m: args.stance_height_m,
+        rotation_order: args.rotation_order,
+        angle_tolerance_rad: args.angle_tolerance_rad,
+        input: args.input.input.clone(),
+    };
+    let outcome = match stream::run(&request, &mut io::stderr().lock()) {
+        Ok(o) => o,
+        Err(e) => return args::fail("quadctl", &e),
+    };
+    let json = match serde_json::to_string(&outcome.summary) {
+        Ok(j) => j,
+        Err(e) => return args::fail("quadctl", &e),
+    };
+    let mut out = io::stdout().lock();
+    if let Err(e) = writeln!(out, "{json}").and_then(|()| out.flush()) {
+        return args::fail("quadctl", &e);
+    }
+    ExitCode::from(if outcome.summary.check_failed() {
+        EXIT_CHECK_FAILED
+    } else if outcome.malformed > 0 {
+        EXIT_MALFORMED
+    } else {
+        EXIT_OK
+    })
+}

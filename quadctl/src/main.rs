@@ -1,0 +1,56 @@
+//! `quadctl`: command-line front end of the quadruped kinematics. See `quadctl --help`.
+
+mod args;
+mod cmd;
+mod progress;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+const ABOUT: &str = "Kinematics of a 12-DoF quadruped: leg IK/FK and body poses, as CSV batches.
+
+Units: metres and radians in every CSV (degrees only in human-readable tables). Frames: body
+frame at the body centre, x forward, y left, z up; hip frame of a leg at its hip mount, axes
+parallel to the body frame. Run `quadctl <command> --help` for the columns of each command.";
+
+#[derive(Debug, Parser)]
+#[command(name = "quadctl", version, about = ABOUT)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    Ik(cmd::ik::Args),
+    Fk(cmd::fk::Args),
+    Pose(cmd::pose::Args),
+    Motion(cmd::motion::Args),
+    Check(cmd::check::Args),
+    Plot(cmd::plot::Args),
+    Accuracy(cmd::accuracy::Args),
+    Stream(cmd::stream::Args),
+    Calibrate(cmd::calibrate::Args),
+    Demo(cmd::demo::Args),
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Ik(args) => {
+            args::run_batch(&args.input.input, |i, o, d| cmd::ik::run(&args, i, o, d))
+        }
+        Command::Fk(args) => {
+            args::run_batch(&args.input.input, |i, o, d| cmd::fk::run(&args, i, o, d))
+        }
+        Command::Pose(args) => {
+            args::run_batch(&args.input.input, |i, o, d| cmd::pose::run(&args, i, o, d))
+        }
+        Command::Motion(args) => cmd::motion::run(&args),
+        Command::Check(args) => cmd::check::run(&args),
+        Command::Plot(args) => cmd::plot::run(&args),
+        Command::Accuracy(args) => cmd::accuracy::run(&args),
+        Command::Stream(args) => cmd::stream::main(&args),
+        Command::Calibrate(args) => cmd::calibrate::main(&args),
+        Command::Demo(args) => cmd::demo::main(&args),
+    }
+}

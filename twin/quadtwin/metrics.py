@@ -1,0 +1,204 @@
+"""Figures of a run: fall, yaw, travel, slip, torque, tracking.
+
+Thresholds are named constants here; docs/twin.md says why each has its value."""
+
+import math
+
+import numpy as np
+
+from .model import JOINT_NAMES
+
+#: The body fell when its centre sinks below this fraction of its commanded height.
+FALL_HEIGHT_FRACTION = 0.5
+#: ... or when |roll| or |pitch| exceeds this, rad (46°: beyond every commanded sway).
+FALL_TILT_RAD = 0.8
+#: A motion "turns" when its commanded yaw changes by more than this over the run, rad.
+TURN_MIN_RAD = 0.05
+#: A motion "travels" when its commanded displacement exceeds this, m.
+TRAVEL_MIN_M = 0.05
+#: A motion "sways" on the axis whose commanded peak-to-peak exceeds this, rad.
+SWAY_MIN_RAD = 0.05
+#: Stance frames skipped after a touchdown before the slip is measured (landing transient).
+SLIP_SKIP_FRAMES = 1
+
+
+def feet_contact(twin, d):
+    """Which feet touch the floor."""
+    touching = [False] * 4
+    for c in d.contact[: d.ncon]:
+        pair = (int(c.geom1), int(c.geom2))
+        if twin.floor_geom in pair:
+            other = pair[0] if pair[1] == twin.floor_geom else pair[1]
+            for i, g in enumerate(twin.foot_geom):
+                if other == g:
+                    touching[i] = True
+    return touching
+
+
+def body_on_floor(twin, d):
+    for c in d.contact[: d.ncon]:
+        pair = (int(c.geom1), int(c.geom2))
+        if twin.floor_geom in pair and twin.body_geom in pair:
+            return True
+    return False
+
+
+class Recorder:
+    """Samples of a run: torques every physics step, the body every frame."""
+
+    def __init__(self, twin, start):
+        self.twin = twin
+        self.start = start
+        self.torque = []
+        self.saturated = []
+        self.t = []
+        self.pos = []
+        self.rpy = []
+        self.cmd = []
+        self.stance = []
+        self.feet = []
+        self.body_touch = []
+        self.t0 = 0.0
+
+    def begin(self, d):
+        self.t0 = float(d.time)
+
+    def step(self, d, u):
+        self.torque.append(d.actuator_force[self.twin.actuator].copy())
+        self.saturated.append(bool(np.any(np.abs(u) >= 1.0)))
+
+    def frame(self, d, msg, state):
+        self.t.append(float(d.time) - self.t0)
+        self.pos.append(state["pos_m"])
+        self.rpy.append(state["rpy_rad"])
+        self.cmd.append(msg["commanded_pose"])
+        self.stance.append(msg["stance"])
+        self.feet.append([d.site_xpos[s].copy() for s in self.twin.foot_site])
+        self.body_touch.append(body_on_floor(self.twin, d))
+
+    def duration_s(self):
+        return self.t[-1] if self.t else 0.0
+
+    def arrays(self):
+        return (
+            np.array(self.t),
+            np.array(self.pos),
+            np.array(self.rpy),
+            np.array(self.cmd),
+            np.array(self.stance, dtype=bool),
+            np.array(self.feet),
+        )
+
+    def commanded_height_m(self, cmd):
+        return self.start["stance_height_m"] + cmd[:, 5] + self.twin.foot_radius_m
+
+    def summary(self):
+        t, pos, rpy, cmd, stance, feet = self.arrays()
+        out = {
+            "robot": self.start["robot"],
+            "motion": self.start["motion"],
+            "servo": self.twin.servo_name,
+            "duration_s": self.duration_s(),
+        }
+        out.update(self.fall(t, pos, rpy, cmd))
+        out["yaw"] = self.yaw(rpy, cmd)
+        out["travel"] = self.travel(pos, cmd)
+        out["slip"] = self.slip(stance, feet)
+        out["torque"] = self.torques()
+        out["tracking"] = self.tracking(rpy, cmd)
+        return out
+
+    def fall(self, t, pos, rpy, cmd):
+        h_cmd = self.commanded_height_m(cmd)
+        low = pos[:, 2] < FALL_HEIGHT_FRACTION * h_cmd
+        tilt = np.max(np.abs(rpy[:, :2]), axis=1)
+        tilted = tilt > FALL_TILT_RAD
+        touch = np.array(self.body_touch, dtype=bool)
+        reason = None
+        for i in range(len(t)):
+            if low[i]:
+                reason = f"body height {pos[i, 2]:.3f} m < {FALL_HEIGHT_FRACTION} x commanded {h_cmd[i]:.3f} m at t = {t[i]:.2f} s"
+            elif tilted[i]:
+                reason = f"tilt {tilt[i]:.2f} rad > {FALL_TILT_RAD} rad at t = {t[i]:.2f} s"
+            elif touch[i]:
+                reason = f"body touched the floor at t = {t[i]:.2f} s"
+            if reason:
+                break
+        return {
+            "fell": reason is not None,
+            "fall_reason": reason,
+            "min_height_m": float(np.min(pos[:, 2])),
+            "max_tilt_rad": float(np.max(tilt)),
+        }
+
+    def yaw(self, rpy, cmd):
+        cy = np.unwrap(cmd[:, 2])
+        commanded = float(cy[-1] - cy[0])
+        if abs(commanded) < TURN_MIN_RAD:
+            return None
+        y = np.unwrap(rpy[:, 2])
+        achieved = float(y[-1] - y[0])
+        return {"commanded_rad": commanded, "achieved_rad": achieved, "ratio": achieved / commanded}
+
+    def travel(self, pos, cmd):
+        dc = cmd[-1, 3:5] - cmd[0, 3:5]
+        commanded = float(np.linalg.norm(dc))
+        if commanded < TRAVEL_MIN_M:
+            return None
+        d = pos[-1, 0:2] - pos[0, 0:2]
+        unit = dc / commanded
+        along = float(np.dot(d, unit))
+        heading = math.atan2(float(unit[0] * d[1] - unit[1] * d[0]), float(np.dot(d, unit)))
+        return {
+            "commanded_m": commanded,
+            "achieved_m": float(np.linalg.norm(d)),
+            "ratio": along / commanded,
+            "heading_error_rad": heading,
+        }
+
+    def slip(self, stance, feet):
+        per_leg = [0.0] * 4
+        for leg in range(4):
+            run_start = None
+            for i in range(len(stance)):
+                if stance[i, leg]:
+                    if run_start is None:
+                        run_start = i
+                    if i - run_start >= SLIP_SKIP_FRAMES:
+                        ref = feet[run_start + SLIP_SKIP_FRAMES, leg, 0:2]
+                        per_leg[leg] = max(per_leg[leg], float(np.linalg.norm(feet[i, leg, 0:2] - ref)))
+                else:
+                    run_start = None
+        return {"max_stance_slip_m": max(per_leg), "per_leg_max_m": per_leg}
+
+    def torques(self):
+        tau = np.array(self.torque)
+        peak = np.max(np.abs(tau), axis=0)
+        rms = np.sqrt(np.mean(tau * tau, axis=0))
+        joints = [
+            {"name": n, "peak_nm": float(p), "rms_nm": float(r)} for n, p, r in zip(JOINT_NAMES, peak, rms)
+        ]
+        worst = int(np.argmax(peak))
+        return {
+            "stall_nm": self.twin.servo["stall_torque_nm"],
+            "joints": joints,
+            "peak_nm": float(peak[worst]),
+            "peak_joint": JOINT_NAMES[worst],
+            "saturated_fraction": float(np.mean(self.saturated)),
+        }
+
+    def tracking(self, rpy, cmd):
+        err = rpy[:, 0:2] - cmd[:, 0:2]
+        out = {
+            "roll_rms_error_rad": float(np.sqrt(np.mean(err[:, 0] ** 2))),
+            "pitch_rms_error_rad": float(np.sqrt(np.mean(err[:, 1] ** 2))),
+            "amplitude_ratio": None,
+        }
+        cmd_angles = np.column_stack([cmd[:, 0], cmd[:, 1], np.unwrap(cmd[:, 2])])
+        got = np.column_stack([rpy[:, 0], rpy[:, 1], np.unwrap(rpy[:, 2])])
+        p2p = np.ptp(cmd_angles, axis=0)
+        axis = int(np.argmax(p2p))
+        turning = abs(cmd_angles[-1, 2] - cmd_angles[0, 2]) >= TURN_MIN_RAD
+        if p2p[axis] >= SWAY_MIN_RAD and not (axis == 2 and turning):
+            out["amplitude_ratio"] = float(np.ptp(got[:, axis]) / p2p[axis])
+        return out

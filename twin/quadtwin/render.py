@@ -1,0 +1,98 @@
+"""Pictures of a run: the metric plots (matplotlib) and offscreen renders (GIF + PNG strip)."""
+
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+from PIL import Image, ImageDraw  # noqa: E402
+
+from .model import JOINT_NAMES  # noqa: E402
+
+#: Size of a rendered picture, pixels.
+WIDTH, HEIGHT = 480, 360
+#: Pictures in the strip.
+STRIP_FRAMES = 6
+
+
+def plots(rec, summary, out_dir):
+    t, pos, rpy, cmd, stance, feet = rec.arrays()
+    fig, ax = plt.subplots(2, 2, figsize=(11, 7))
+    title = f"{summary['robot']} / {summary['motion']} / {summary['servo']}" + (
+        "  — FELL" if summary["fell"] else ""
+    )
+    fig.suptitle(title)
+    a = ax[0, 0]
+    a.plot(t, pos[:, 2], label="body height")
+    a.plot(t, rec.commanded_height_m(cmd), "--", label="commanded")
+    a.set_xlabel("t (s)")
+    a.set_ylabel("m")
+    a.legend()
+    a = ax[0, 1]
+    for i, name in enumerate(("roll", "pitch")):
+        a.plot(t, np.degrees(rpy[:, i]), label=name)
+        a.plot(t, np.degrees(cmd[:, i]), "--", label=f"{name} commanded")
+    a.set_xlabel("t (s)")
+    a.set_ylabel("deg")
+    a.legend(fontsize=8)
+    a = ax[1, 0]
+    if summary["travel"] is not None:
+        a.plot(pos[:, 0], pos[:, 1], label="body")
+        a.plot(cmd[:, 3], cmd[:, 4], "--", label="commanded")
+        a.set_xlabel("x (m)")
+        a.set_ylabel("y (m)")
+        a.axis("equal")
+    else:
+        a.plot(t, np.degrees(np.unwrap(rpy[:, 2])), label="yaw")
+        a.plot(t, np.degrees(np.unwrap(cmd[:, 2])), "--", label="yaw commanded")
+        a.set_xlabel("t (s)")
+        a.set_ylabel("deg")
+    a.legend()
+    a = ax[1, 1]
+    tq = summary["torque"]
+    x = np.arange(12)
+    a.bar(x - 0.2, [j["peak_nm"] for j in tq["joints"]], 0.4, label="peak")
+    a.bar(x + 0.2, [j["rms_nm"] for j in tq["joints"]], 0.4, label="RMS")
+    a.axhline(tq["stall_nm"], color="r", ls="--", label=f"stall {tq['stall_nm']:.2f} N·m")
+    a.set_xticks(x, JOINT_NAMES, rotation=60, fontsize=7)
+    a.set_ylabel("N·m")
+    a.legend(fontsize=8)
+    fig.tight_layout()
+    path = os.path.join(out_dir, "plots.png")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return [path]
+
+
+def pictures(twin, snapshots, out_dir):
+    m = twin.model
+    d = mujoco.MjData(m)
+    renderer = mujoco.Renderer(m, HEIGHT, WIDTH)
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    extent = float(m.stat.extent)
+    cam.distance = 1.0 * extent
+    cam.azimuth = 140.0
+    cam.elevation = -18.0
+    images = []
+    for t_s, qpos in snapshots:
+        d.qpos[:] = qpos
+        mujoco.mj_forward(m, d)
+        cam.lookat[:] = [d.qpos[0], d.qpos[1], 0.5 * d.qpos[2]]
+        renderer.update_scene(d, cam)
+        img = Image.fromarray(renderer.render())
+        ImageDraw.Draw(img).text((8, 8), f"t = {t_s:5.2f} s", fill=(0, 0, 0))
+        images.append(img)
+    renderer.close()
+    gif = os.path.join(out_dir, "motion.gif")
+    images[0].save(gif, save_all=True, append_images=images[1:], duration=100, loop=0)
+    picks = np.linspace(0, len(images) - 1, min(STRIP_FRAMES, len(images))).round().astype(int)
+    strip = Image.new("RGB", (WIDTH * len(picks), HEIGHT), "white")
+    for i, k in enumerate(picks):
+        strip.paste(images[k], (i * WIDTH, 0))
+    png = os.path.join(out_dir, "strip.png")
+    strip.save(png)
+    return [gif, png]

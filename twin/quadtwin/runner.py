@@ -1,0 +1,166 @@
+"""The twin's frame loop: JSON lines in (servo frames), JSON lines out (body states).
+
+See crates/quad-twin/src/link.rs for the protocol. Each frame's servo targets are held for
+the frame; the physics steps at the model's time step; the servo boards update their duty
+cycle every physics step."""
+
+import json
+import math
+import sys
+import time
+
+import mujoco
+import numpy as np
+
+from . import metrics
+from .model import Model
+from .servo import ServoBoard
+
+#: Pictures per simulated second in the GIF.
+RENDER_FPS = 10
+
+
+def rpy_zyx(quat):
+    """Roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)) of a quaternion [w, x, y, z]."""
+    w, x, y, z = quat
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return [roll, pitch, yaw]
+
+
+def quat_zyx(roll, pitch, yaw):
+    """The quaternion [w, x, y, z] of R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    q = np.zeros(4)
+    mujoco.mju_euler2Quat(q, np.array([roll, pitch, yaw]), "XYZ")
+    return q
+
+
+class Run:
+    def __init__(self, start):
+        self.start = start
+        self.twin = Model(start["model"])
+        self.m = self.twin.model
+        self.d = self.twin.new_data()
+        self.board = ServoBoard(self.twin)
+        self.timestep_s = float(self.m.opt.timestep)
+        self.steps_per_frame = max(1, round(start["frame_s"] / self.timestep_s))
+        self.rec = metrics.Recorder(self.twin, start)
+        self.step_wall_s = 0.0
+        self.started = False
+        self.snapshots = []
+        self.frames_per_snapshot = max(1, round(1.0 / (RENDER_FPS * start["frame_s"])))
+
+    def place(self, frame):
+        """Puts the robot in the first frame's pose with its lowest foot on the floor."""
+        roll, pitch, yaw, x, y, _ = frame["commanded_pose"]
+        quat = quat_zyx(roll, pitch, yaw)
+        self.twin.set_pose(self.d, frame["angles_rad"], (x, y, 0.0), quat)
+        mujoco.mj_kinematics(self.m, self.d)
+        lowest = min(self.d.site_xpos[s][2] for s in self.twin.foot_site)
+        self.d.qpos[2] = self.twin.foot_radius_m - lowest
+        mujoco.mj_forward(self.m, self.d)
+
+    def hold(self, target, enabled, n_steps, record):
+        qpos, dofs = self.twin.qpos_adr, self.twin.dof_adr
+        m, d = self.m, self.d
+        act = self.twin.actuator
+        t0 = time.perf_counter()
+        for _ in range(n_steps):
+            if enabled:
+                u = self.board.duty(target, d.qpos[qpos], d.qvel[dofs])
+            else:
+                u = np.zeros(12)
+            d.ctrl[act] = u
+            mujoco.mj_step(m, d)
+            if record:
+                self.rec.step(d, u)
+        self.step_wall_s += time.perf_counter() - t0
+
+    def frame(self, msg):
+        target = np.array(msg["angles_rad"], dtype=float)
+        if not self.started:
+            self.place(msg)
+            settle_steps = round(self.start["settle_s"] / self.timestep_s)
+            self.hold(target, msg["enabled"], settle_steps, record=False)
+            self.rec.begin(self.d)
+            self.started = True
+        self.hold(target, msg["enabled"], self.steps_per_frame, record=True)
+        state = self.state()
+        self.rec.frame(self.d, msg, state)
+        if self.start.get("render") and msg["k"] % self.frames_per_snapshot == 0:
+            self.snapshots.append((msg["t_s"], self.d.qpos.copy()))
+        return state
+
+    def state(self):
+        d = self.d
+        quat = d.qpos[3:7].tolist()
+        return {
+            "type": "state",
+            "t_s": float(d.time),
+            "pos_m": d.qpos[0:3].tolist(),
+            "quat": quat,
+            "rpy_rad": rpy_zyx(quat),
+            "gyro_rad_s": d.sensor("gyro").data.tolist(),
+            "accel_m_s2": d.sensor("accel").data.tolist(),
+            "feet_contact": metrics.feet_contact(self.twin, d),
+        }
+
+    def end(self):
+        simulated = self.start["settle_s"] + self.rec.duration_s()
+        summary = self.rec.summary()
+        summary["physics_hz"] = 1.0 / self.timestep_s
+        summary["sim_per_wall"] = simulated / self.step_wall_s if self.step_wall_s > 0 else 0.0
+        out_dir = self.start.get("out_dir")
+        files = []
+        if out_dir:
+            from . import render
+
+            files += render.plots(self.rec, summary, out_dir)
+            if self.start.get("render") and self.snapshots:
+                files += render.pictures(self.twin, self.snapshots, out_dir)
+            summary["files"] = files
+            path = f"{out_dir}/summary.json"
+            with open(path, "w") as f:
+                json.dump(summary, f, indent=2)
+            files.append(path)
+        summary["files"] = files
+        summary["type"] = "summary"
+        return summary
+
+
+def main():
+    out = sys.stdout
+    # Anything printed by a library goes to stderr, never into the protocol.
+    sys.stdout = sys.stderr
+    run = None
+
+    def send(msg):
+        out.write(json.dumps(msg) + "\n")
+        out.flush()
+
+    for line in sys.stdin:
+        if not line.strip():
+            continue
+        try:
+            msg = json.loads(line)
+            kind = msg.get("type")
+            if kind == "start":
+                run = Run(msg)
+                send({"type": "ready", "timestep_s": run.timestep_s})
+            elif kind == "frame" and run is not None:
+                send(run.frame(msg))
+            elif kind == "end" and run is not None:
+                send(run.end())
+                return 0
+            else:
+                send({"type": "error", "message": f"unexpected message `{kind}`"})
+                return 2
+        except Exception as e:  # reported to the device side, then exit non-zero
+            send({"type": "error", "message": f"{type(e).__name__}: {e}"})
+            raise
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
