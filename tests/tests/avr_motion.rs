@@ -7,12 +7,12 @@
 //! The trot runs for `QUAD_TROT_S` seconds of emulated time (default [`TROT_S`], bounded for
 //! CI on two cores; `BENCHMARKS.md` has the 60 s figures). All times are simulated.
 
-use host_tools::emu::{build, Pulse, CYCLES_PER_US, PERIOD_CYCLES};
-use host_tools::link::emulator::{EmulatorConfig, EmulatorLink};
-use host_tools::link::Link;
 use kin_core::motion::gait::{GaitParams, Pattern};
 use kin_core::motion::laws::Axis;
 use quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S;
+use quad_host::emu::{build, Pulse, CYCLES_PER_US, PERIOD_CYCLES};
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
+use quad_host::link::Link;
 use quad_protocol::{
     encode_frame, Accumulator, DeviceToHost, Feed, HostToDevice, MotionCommand, MotionKind,
     Request, ServoId, MAX_DECODED_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,

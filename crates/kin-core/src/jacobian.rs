@@ -41,9 +41,15 @@ impl core::error::Error for Singular {}
 
 /// Analytic leg Jacobian `∂foot_in_hip/∂(abduction, hip, knee)`, m/rad.
 pub fn leg_jacobian(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
-    let (sa, ca) = DefaultMath::sin_cos(q.abduction_rad);
-    let (sh, ch) = DefaultMath::sin_cos(q.hip_rad);
-    let (shk, chk) = DefaultMath::sin_cos(q.hip_rad + q.knee_rad);
+    leg_jacobian_on::<DefaultMath>(g, leg, q)
+}
+
+/// [`leg_jacobian`] on backend `M` (reached through [`crate::leg::Solver::inverse_condition`]).
+#[inline(never)]
+pub(crate) fn leg_jacobian_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
+    let (sa, ca) = M::sin_cos(q.abduction_rad);
+    let (sh, ch) = M::sin_cos(q.hip_rad);
+    let (shk, chk) = M::sin_cos(q.hip_rad + q.knee_rad);
     let (l1, l2) = (g.femur_m, g.tibia_m);
     let u = -l1 * sh - l2 * shk;
     let w = -g.d_ax_m - l1 * ch - l2 * chk;
@@ -64,12 +70,13 @@ pub fn manipulability(j: &Mat3) -> f32 {
 /// Inverse condition number `σ_min / σ_max` of `j` ∈ [0, 1] (1 = isotropic, 0 = singular),
 /// from the closed-form eigenvalues of the symmetric `JᵀJ`, on the [`DefaultMath`] backend.
 pub fn inverse_condition(j: &Mat3) -> f32 {
-    inverse_condition_by::<DefaultMath>(j)
+    inverse_condition_on::<DefaultMath>(j)
 }
 
-/// [`inverse_condition`] on math backend `M` (the preflight of a device runs on its own).
+/// [`inverse_condition`] on backend `M` (reached through
+/// [`crate::leg::Solver::inverse_condition`]).
 #[inline(never)]
-pub(crate) fn inverse_condition_by<M: Math>(j: &Mat3) -> f32 {
+pub(crate) fn inverse_condition_on<M: Math>(j: &Mat3) -> f32 {
     let jt = j.transpose();
     let a = jt.mul_mat(j); // symmetric positive semi-definite
     let e = symmetric_eigenvalues::<M>(&a.rows);

@@ -191,11 +191,23 @@ impl Gait {
     /// stride: `velocity`) and its swing apex (`step_height_m`). [`crate::preflight`] sweeps the
     /// whole motion. The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: GaitParams) -> Result<Gait, Error> {
-        Self::with_math::<DefaultMath>(p)
+        let gait = Self::without_reach_check(p)?;
+        let cfg = gait.body_config();
+        let zero = Pose::default();
+        let d = p.duty_factor;
+        let reach = |feet: &[Vec3; 4], name| check_reach(&p.robot, &zero, &cfg, feet, name);
+        reach(&gait.neutral, "stance_height_m")?;
+        let at =
+            |phase: f32| LegId::ALL.map(|leg| gait.foot_in_body_with::<DefaultMath>(leg, phase).0);
+        reach(&at(0.0), "velocity")?;
+        reach(&at(1.0 - 0.5 * d), "velocity")?;
+        reach(&at(0.5 * (1.0 - d)), "step_height_m")?;
+        Ok(gait)
     }
 
-    /// [`Gait::new`] with the reach checks on math backend `M` (a device's own).
-    pub fn with_math<M: Math>(p: GaitParams) -> Result<Gait, Error> {
+    /// [`Gait::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself through its own IK (a device's start check).
+    pub fn without_reach_check(p: GaitParams) -> Result<Gait, Error> {
         p.robot.validate()?;
         positive(p.stance_height_m, "stance_height_m")?;
         positive(p.cycle_s, "cycle_s")?;
@@ -219,18 +231,10 @@ impl Gait {
         finite(p.velocity.forward_m_s, "forward_m_s")?;
         finite(p.velocity.lateral_m_s, "lateral_m_s")?;
         finite(p.velocity.yaw_rad_s, "yaw_rad_s")?;
-        let gait = Gait {
+        Ok(Gait {
             p,
             neutral: p.robot.stance_feet(p.stance_height_m),
-        };
-        let cfg = gait.body_config();
-        let zero = Pose::default();
-        check_reach::<M>(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
-        let at = |phase: f32| LegId::ALL.map(|leg| gait.foot_in_body_with::<M>(leg, phase).0);
-        check_reach::<M>(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
-        check_reach::<M>(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
-        check_reach::<M>(&p.robot, &zero, &cfg, &at(0.5 * (1.0 - d)), "step_height_m")?;
-        Ok(gait)
+        })
     }
 
     /// The parameters.

@@ -140,11 +140,31 @@ impl Sway {
     /// both extremes `angle0 ± A` (a quick check; [`crate::preflight`] sweeps the whole motion).
     /// The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: SwayParams) -> Result<Sway, Error> {
-        Self::with_math::<DefaultMath>(p)
+        let s = Self::without_reach_check(p)?;
+        let cfg = s.body_config();
+        check_reach(
+            &p.robot,
+            &s.pose_at(0.0),
+            &cfg,
+            &p.feet_in_world,
+            "feet_in_world",
+        )?;
+        for sign in [1.0, -1.0] {
+            check_reach(
+                &p.robot,
+                &s.pose_at(sign * p.amplitude_rad),
+                &cfg,
+                &p.feet_in_world,
+                "amplitude_rad",
+            )?;
+        }
+        Ok(s)
     }
 
-    /// [`Sway::new`] with the reach checks on math backend `M` (a device's own).
-    pub fn with_math<M: Math>(p: SwayParams) -> Result<Sway, Error> {
+    /// [`Sway::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the motion's frames through its own IK (a device's start
+    /// check).
+    pub fn without_reach_check(p: SwayParams) -> Result<Sway, Error> {
         p.robot.validate()?;
         finite(p.amplitude_rad, "amplitude_rad")?;
         positive(p.period_s, "period_s")?;
@@ -154,25 +174,7 @@ impl Sway {
         for f in p.feet_in_world {
             finite_vec(f, "feet_in_world")?;
         }
-        let s = Sway { p };
-        let cfg = s.body_config();
-        check_reach::<M>(
-            &p.robot,
-            &s.pose_at(0.0),
-            &cfg,
-            &p.feet_in_world,
-            "feet_in_world",
-        )?;
-        for sign in [1.0, -1.0] {
-            check_reach::<M>(
-                &p.robot,
-                &s.pose_at(sign * p.amplitude_rad),
-                &cfg,
-                &p.feet_in_world,
-                "amplitude_rad",
-            )?;
-        }
-        Ok(s)
+        Ok(Sway { p })
     }
 
     /// The parameters.
@@ -296,12 +298,26 @@ impl YawTurn {
     /// [`crate::preflight`] sweeps the whole motion). The checks run on the [`DefaultMath`]
     /// backend.
     pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
-        Self::with_math::<DefaultMath>(p)
+        let turn = Self::without_reach_check::<DefaultMath>(p)?;
+        let cfg = turn.body_config();
+        let t1 = p.step_period_s;
+        for (t, name) in [
+            (0.0, "stance_feet"),
+            (0.25 * t1, "lift_height_m"),
+            (0.75 * t1, "lift_height_m"),
+            (0.499 * t1, "omega_rad_s"),
+            (0.999 * t1, "omega_rad_s"),
+        ] {
+            let f = turn.frame_with::<DefaultMath>(t)?;
+            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
+        }
+        Ok(turn)
     }
 
-    /// [`YawTurn::new`] with the foot radii, angles and reach checks on math backend `M` (a
-    /// device's own).
-    pub fn with_math<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
+    /// [`YawTurn::new`]'s parameter checks without its reach checks, with the foot radii and
+    /// angles on math backend `M`, for a caller that checks the reach itself by running the
+    /// motion's frames through its own IK (a device's start check).
+    pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
         p.robot.validate()?;
         finite(p.omega_rad_s, "omega_rad_s")?;
         positive(p.step_period_s, "step_period_s")?;
@@ -318,24 +334,11 @@ impl YawTurn {
                 });
             }
         }
-        let turn = YawTurn {
+        Ok(YawTurn {
             p,
             rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
             alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
-        };
-        let cfg = turn.body_config();
-        let t1 = p.step_period_s;
-        for (t, name) in [
-            (0.0, "stance_feet"),
-            (0.25 * t1, "lift_height_m"),
-            (0.75 * t1, "lift_height_m"),
-            (0.499 * t1, "omega_rad_s"),
-            (0.999 * t1, "omega_rad_s"),
-        ] {
-            let f = turn.frame_with::<M>(t)?;
-            check_reach::<M>(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
-        }
-        Ok(turn)
+        })
     }
 
     /// The parameters.
@@ -493,11 +496,21 @@ impl LegPaths {
     /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive), on
     /// the [`DefaultMath`] backend.
     pub fn new(p: LegPathsParams) -> Result<LegPaths, Error> {
-        Self::with_math::<DefaultMath>(p)
+        let lp = Self::without_reach_check(p)?;
+        let cfg = lp.body_config();
+        for i in 0..Self::REACH_SAMPLES {
+            let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
+            let feet = LegId::ALL
+                .map(|leg| p.stance_feet[leg.index()] + p.path.offset_with::<DefaultMath>(phase));
+            check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
+        }
+        Ok(lp)
     }
 
-    /// [`LegPaths::new`] with the reach checks on math backend `M` (a device's own).
-    pub fn with_math<M: Math>(p: LegPathsParams) -> Result<LegPaths, Error> {
+    /// [`LegPaths::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the motion's frames through its own IK (a device's start
+    /// check).
+    pub fn without_reach_check(p: LegPathsParams) -> Result<LegPaths, Error> {
         p.robot.validate()?;
         positive(p.cycle_s, "cycle_s")?;
         for o in p.phase_offsets {
@@ -506,15 +519,7 @@ impl LegPaths {
         for f in p.stance_feet {
             finite_vec(f, "stance_feet")?;
         }
-        let lp = LegPaths { p };
-        let cfg = lp.body_config();
-        for i in 0..Self::REACH_SAMPLES {
-            let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
-            let feet =
-                LegId::ALL.map(|leg| p.stance_feet[leg.index()] + p.path.offset_with::<M>(phase));
-            check_reach::<M>(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
-        }
-        Ok(lp)
+        Ok(LegPaths { p })
     }
 
     /// The parameters.

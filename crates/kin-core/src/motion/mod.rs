@@ -308,16 +308,16 @@ impl Motion for AnyMotion {
     }
 }
 
-/// Checks that the four feet are reachable at `pose` on backend `M` (used by the constructors'
-/// quick checks); a failure is blamed on `parameter`.
-pub(crate) fn check_reach<M: Math>(
+/// Checks that the four feet are reachable at `pose` (used by the constructors' quick checks);
+/// a failure is blamed on `parameter`.
+pub(crate) fn check_reach(
     robot: &Robot,
     pose: &Pose,
     config: &BodyConfig,
     feet_in_world: &[Vec3; 4],
     parameter: &'static str,
 ) -> Result<(), Error> {
-    let solver = body::Solver::<M>::with_math(robot);
+    let solver = body::Solver::new(robot);
     let local = solver.feet_in_hips(pose, config, feet_in_world);
     for leg in LegId::ALL {
         let solution = solver

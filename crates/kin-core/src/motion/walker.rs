@@ -44,7 +44,7 @@ use super::gait::{displace_with, swing_foot_with, Gait, GaitParams, Pattern, Vel
 use super::path::PathKind;
 use super::{check_reach, finite, fract01, positive, Contact, Error, Frame, Phase};
 use crate::body::{BodyConfig, Pose};
-use crate::math::{DefaultMath, Math};
+use crate::math::Math;
 use crate::robot::{LegId, Robot};
 use crate::rotation::RotationOrder;
 use crate::vec::Vec3;
@@ -143,32 +143,11 @@ impl Walker {
     /// at phase 0 standing on the neutral footholds with a zero command. The reach checks run
     /// on the [`DefaultMath`] backend.
     pub fn new(p: WalkerParams) -> Result<Walker, Error> {
-        Self::with_math::<DefaultMath>(p)
-    }
-
-    /// [`Walker::new`] with the reach checks on math backend `M` (a device's own).
-    pub fn with_math<M: Math>(p: WalkerParams) -> Result<Walker, Error> {
-        let gait = Gait::with_math::<M>(p.gait_params(Velocity::default()))?;
-        positive(p.reach_radius_m, "reach_radius_m")?;
-        let neutral = gait.neutral_feet();
-        let leg = |n: Vec3| Leg {
-            foot: n,
-            lift_off: n,
-            touch_down: n,
-            parked: false,
-        };
-        let walker = Walker {
-            p,
-            neutral,
-            legs: neutral.map(leg),
-            phase: 0.0,
-            velocity: Velocity::default(),
-            stopping: false,
-            saturated: false,
-        };
+        Gait::new(p.gait_params(Velocity::default()))?;
+        let walker = Self::without_reach_check(p)?;
         let cfg = walker.body_config();
         for k in 0..Self::ENVELOPE_SAMPLES {
-            check_reach::<M>(
+            check_reach(
                 &p.robot,
                 &Pose::default(),
                 &cfg,
@@ -177,6 +156,30 @@ impl Walker {
             )?;
         }
         Ok(walker)
+    }
+
+    /// [`Walker::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the envelope's points through its own IK (a device's
+    /// start check).
+    pub fn without_reach_check(p: WalkerParams) -> Result<Walker, Error> {
+        let gait = Gait::without_reach_check(p.gait_params(Velocity::default()))?;
+        positive(p.reach_radius_m, "reach_radius_m")?;
+        let neutral = gait.neutral_feet();
+        let leg = |n: Vec3| Leg {
+            foot: n,
+            lift_off: n,
+            touch_down: n,
+            parked: false,
+        };
+        Ok(Walker {
+            p,
+            neutral,
+            legs: neutral.map(leg),
+            phase: 0.0,
+            velocity: Velocity::default(),
+            stopping: false,
+            saturated: false,
+        })
     }
 
     /// The parameters.

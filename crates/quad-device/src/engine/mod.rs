@@ -50,19 +50,27 @@
 //! running. A direct setpoint request cancels a running motion at once (the host takes over; the
 //! limiter still bounds every step), as does stopping the outputs.
 //!
-//! ## Preflight
-//! A motion's parameters are validated by kin-core's constructors, then its samples go through
-//! kin-core's [`preflight::Checker`] (reach, joint limits, singularity threshold) and the servo
-//! calibration before it starts; a refusal ([`Error`]) changes nothing. A body IK costs about
-//! 62k cycles on the ATmega2560, so the preflight is sparse: the joint angles of the sways, the
-//! yaw turn and the foot paths are periodic, so one period covers the whole motion, and it is
-//! sampled at [`PREFLIGHT_SAMPLES`] evenly spaced instants — a multiple of 4, so that the
-//! sways' extremes (T/4, 3T/4) and the yaw turn's apexes and swing ends (T1/4, T1/2, 3T1/4,
-//! T1) are among them; kin-core's constructors add their own reach checks (64 phases for the
-//! foot paths). The walk checks the [`Walker`]'s stride cylinder ([`Walker::envelope`]). Ramps
-//! need no IK: they are straight in joint space between two admitted points. Should a run-time
-//! IK still fail, the motion stops: the outputs ramp from the last valid setpoint to the stance
-//! and [`Status::fault`] tells why.
+//! ## Start check
+//! A motion's parameters are validated by kin-core's constructors (finite, positive, in range;
+//! each refusal names its parameter), without their own reach checks: the start check covers
+//! them. It runs the motion through the same per-frame code the running motion uses — the
+//! motion's frame at a sample time, its body IK (which refuses unreachable feet and joint
+//! limits), the servo travel — at a bounded set of samples, plus kin-core's singularity
+//! measure on each leg ([`kin_core::leg::Solver::inverse_condition`] against
+//! [`SINGULARITY_THRESHOLD`]). A refusal ([`Error`]) changes nothing.
+//! - The sways, the yaw turn and the foot paths are periodic in their joint angles, so one
+//!   period covers the whole motion: [`START_CHECK_SAMPLES`] evenly spaced instants, a
+//!   multiple of 4, so that the sways' extremes (T/4, 3T/4) and the yaw turn's apexes and
+//!   swing ends (T1/4, T1/2, 3T1/4, T1) are among them.
+//! - The walk checks the [`Walker`]'s stride cylinder at its [`Walker::ENVELOPE_SAMPLES`]
+//!   points ([`Walker::envelope`]), the bound every velocity command is held to.
+//!
+//! Its cost is bounded by the sample count: at most [`Walker::ENVELOPE_SAMPLES`] + 2 body IKs
+//! and 4 singularity measures per sample (`BENCHMARKS.md` has the cycles, well under the
+//! firmware's watchdog). Kin-core's full [`kin_core::preflight::Checker`] (margins, extrema,
+//! joint speeds) stays the host's tool. Ramps need no IK: they are straight in joint space
+//! between two checked points. Should a run-time IK still fail, the motion stops: the outputs
+//! ramp from the last valid setpoint to the stance and [`Status::fault`] tells why.
 
 pub mod limiter;
 pub mod protocol;
@@ -73,13 +81,16 @@ use crate::store::Table;
 use core::fmt;
 use core::marker::PhantomData;
 use kin_core::body::{BodyConfig, Pose};
+use kin_core::jacobian::SINGULARITY_THRESHOLD;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
 use kin_core::motion::path::{AnyPath, PathKind, Stride};
 use kin_core::motion::walker::{Walker, WalkerParams};
 use kin_core::motion::{self, AnyMotion, Frame, Motion};
-use kin_core::preflight::{self, Failure};
-use kin_core::{IkError, Joint, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
+use kin_core::preflight::{Failure, FailureKind};
+use kin_core::{
+    leg, IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3,
+};
 use quad_protocol::servo;
 use quad_protocol::ServoId;
 
@@ -89,8 +100,8 @@ pub const FRAME_MS: u32 = 20;
 /// One servo frame, s.
 pub const FRAME_S: f32 = 0.02;
 
-/// Samples per period of a preflight (module docs).
-pub const PREFLIGHT_SAMPLES: u16 = 16;
+/// Samples per period of a law's start check (module docs).
+pub const START_CHECK_SAMPLES: u16 = 8;
 
 /// Default timeout of a walk's velocity command, ms: five missed commands at the 10 Hz a
 /// teleoperating host sends.
@@ -108,7 +119,7 @@ const MAX_CATCH_UP_FRAMES: u32 = 50;
 pub enum Error {
     /// A parameter is invalid or out of reach; the variant names it.
     Parameter(motion::Error),
-    /// A preflight sample fails (reach, joint limit or singularity), or a run-time sample did.
+    /// A start-check sample fails (reach, joint limit or singularity; module docs).
     Preflight(Failure),
     /// A sample maps outside a servo's calibrated travel.
     ServoRange {
@@ -419,7 +430,7 @@ pub fn rest_angles(robot: &Robot) -> Result<[f32; 12], Error> {
                 sample: 0,
                 t_s: 0.0,
                 leg: LegId::FL,
-                kind: preflight::FailureKind::Unreachable(kin_core::Unreachable::JointLimit(*j)),
+                kind: FailureKind::Unreachable(kin_core::Unreachable::JointLimit(*j)),
             }));
         }
     }
@@ -471,33 +482,122 @@ fn stance_angles<M: Math>(s: &Setup<'_>) -> Result<[f32; 12], Error> {
     Ok(q)
 }
 
-/// Sparse preflight of `frames` (module docs): kin-core's checker on backend `M` and the servo
-/// travel.
+/// One sample of a start check (module docs): `solved` is what the per-frame path (the
+/// frame's body IK, [`solve_frame`]) gave at sample `sample`, time `t_s`; then the servo
+/// travel and each leg's singularity measure. The sample's setpoint when it passes.
 #[inline(never)]
-fn preflight_frames<M: Math>(
+fn check_sample<M: Math>(
     s: &Setup<'_>,
-    config: BodyConfig,
-    mut frame_at: impl FnMut(u16) -> Result<(f32, Frame), Error>,
-    count: u16,
-) -> Result<(), Error> {
-    // Joint speeds are the limiter's business, not a reason to refuse.
-    let mut checker = preflight::Checker::new(s.robot, config, [f32::MAX; 3])?;
-    for k in 0..count {
-        let (t, frame) = frame_at(k)?;
-        let legs = checker.push_frame(t, &frame);
-        if let Some(f) = checker.report().first_failure {
-            return Err(Error::Preflight(f));
+    sample: u16,
+    t_s: f32,
+    solved: Result<[f32; 12], IkError>,
+) -> Result<[f32; 12], Error> {
+    let failure = |leg, kind| {
+        Error::Preflight(Failure {
+            sample: u32::from(sample),
+            t_s,
+            leg,
+            kind,
+        })
+    };
+    let q = solved.map_err(|e| failure(e.leg, FailureKind::Unreachable(e.kind)))?;
+    check_travel(s.calibration, &q)?;
+    let solver = leg::Solver::<M>::with_math(s.robot);
+    for (&leg, a) in LegId::ALL.iter().zip(q.chunks_exact(3)) {
+        let ic = solver.inverse_condition(leg, JointAngles::new(a[0], a[1], a[2]));
+        if !(ic >= SINGULARITY_THRESHOLD) {
+            return Err(failure(
+                leg,
+                FailureKind::Singular {
+                    inverse_condition: ic,
+                },
+            ));
         }
-        let mut q = [0.0; 12];
-        for (c, leg) in q.chunks_exact_mut(3).zip(legs) {
-            // Every leg solved: the checker found no failure.
-            if let Ok(a) = leg {
-                c.copy_from_slice(&a.to_array());
-            }
-        }
-        check_travel(s.calibration, &q)?;
     }
-    Ok(())
+    Ok(q)
+}
+
+/// The kin-core motion of a law request (its parameters checked, not its reach: the start
+/// check does that), the legs it moves and its duration.
+#[inline(never)]
+fn law_motion<M: Math>(
+    request: &Request,
+    s: &Setup<'_>,
+) -> Result<(AnyMotion, [bool; 4], Option<f32>), Error> {
+    let robot = *s.robot;
+    let stance = robot.stance_feet(s.stance_height_m);
+    let (motion, legs, d) = match *request {
+        Request::Sway {
+            axis,
+            amplitude_rad,
+            period_s,
+            duration_s,
+        } => {
+            let d = duration(duration_s)?;
+            let sway = laws::Sway::without_reach_check(laws::SwayParams {
+                robot,
+                axis,
+                amplitude_rad,
+                period_s,
+                roll0_rad: 0.0,
+                pitch0_rad: 0.0,
+                yaw0_rad: 0.0,
+                order: s.order,
+                feet_in_world: stance,
+            })?;
+            (AnyMotion::Sway(sway), [true; 4], d)
+        }
+        Request::YawTurn {
+            yaw_rate_rad_s,
+            step_period_s,
+            lift_height_m,
+            duration_s,
+        } => {
+            let d = duration(duration_s)?;
+            if !yaw_rate_rad_s.is_finite() {
+                return Err(motion::Error::NonFinite("yaw_rate_rad_s").into());
+            }
+            let turn = laws::YawTurn::without_reach_check::<M>(laws::YawTurnParams {
+                robot,
+                // Seed 001's ω_z turns clockwise (eq. 9).
+                omega_rad_s: -yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                yaw0_rad: 0.0,
+                roll0_rad: 0.0,
+                pitch0_rad: 0.0,
+                order: s.order,
+                stance_feet: stance,
+            })?;
+            (AnyMotion::YawTurn(turn), [true; 4], d)
+        }
+        Request::FootPath {
+            path,
+            leg,
+            stride_m,
+            step_height_m,
+            duty_factor,
+            cycle_s,
+            duration_s,
+        } => {
+            let d = duration(duration_s)?;
+            let stride = Stride::new(stride_m, step_height_m, duty_factor)?;
+            let paths = laws::LegPaths::without_reach_check(laws::LegPathsParams {
+                robot,
+                path: AnyPath::new(path, stride),
+                cycle_s,
+                phase_offsets: [0.0; 4],
+                stance_feet: stance,
+            })?;
+            let legs = match leg {
+                None => [true; 4],
+                Some(l) => LegId::ALL.map(|x| x == l),
+            };
+            (AnyMotion::LegPaths(paths), legs, d)
+        }
+        _ => return Err(Error::Busy),
+    };
+    Ok((motion, legs, d))
 }
 
 /// Whole frames from 0 to the first period boundary at or after `t_s`.
@@ -564,41 +664,45 @@ impl<M: Math> Engine<M> {
     ///
     /// # Errors
     /// See [`Error`].
+    ///
+    /// Out of line, as are the law and walk builders, which write the program in place once
+    /// every check passed: a program is a few hundred bytes, and each copy of it on the way
+    /// would be a stack frame beyond the AVR's 63-byte displacement.
+    #[inline(never)]
     pub fn start(&mut self, request: &Request, setup: &Setup<'_>) -> Result<[f32; 12], Error> {
         if self.is_active() {
             return Err(Error::Busy);
         }
         let kind = request.kind();
-        let (program, first, home, start) = match request {
+        let (first, home, start) = match request {
             Request::StandUp => {
                 let rest = rest_angles(setup.robot)?;
                 check_travel(setup.calibration, &rest)?;
                 let stance = stance_angles::<M>(setup)?;
                 let start = setup.outputs.copied().unwrap_or(rest);
-                (Program::Pose { kind }, stance, stance, start)
+                self.program = Program::Pose { kind };
+                (stance, stance, start)
             }
             Request::Sit | Request::Rest => {
                 let out = *setup.outputs.ok_or(Error::OutputsOff)?;
                 let rest = rest_angles(setup.robot)?;
                 check_travel(setup.calibration, &rest)?;
-                (Program::Pose { kind }, rest, rest, out)
+                self.program = Program::Pose { kind };
+                (rest, rest, out)
             }
             Request::Walk(w) => {
                 let out = *setup.outputs.ok_or(Error::OutputsOff)?;
-                let (program, first) = Self::walk(w, setup)?;
                 let home = stance_angles::<M>(setup)?;
-                (program, first, home, out)
+                let first = Self::walk(w, setup, &mut self.program)?;
+                (first, home, out)
             }
             _ => {
                 let out = *setup.outputs.ok_or(Error::OutputsOff)?;
-                let law = Self::law(request, setup)?;
-                let first = Self::law_setpoint(&law, 0.0).map_err(Error::Ik)?;
-                check_travel(setup.calibration, &first)?;
                 let home = stance_angles::<M>(setup)?;
-                (Program::Law(law), first, home, out)
+                let first = Self::law(request, setup, &mut self.program)?;
+                (first, home, out)
             }
         };
-        self.program = program;
         self.stage = Stage::Approach;
         self.ramp = Ramp::new(start, first, &self.limiter);
         self.home = home;
@@ -607,107 +711,33 @@ impl<M: Math> Engine<M> {
         Ok(start)
     }
 
-    /// Builds and preflights a law motion.
+    /// Builds a law motion and runs its start check; once it passes, the law goes into
+    /// `program`. Its first setpoint.
     #[inline(never)]
-    fn law(request: &Request, s: &Setup<'_>) -> Result<Law, Error> {
-        let robot = *s.robot;
-        let stance = robot.stance_feet(s.stance_height_m);
-        let (motion, legs, d) = match *request {
-            Request::Sway {
-                axis,
-                amplitude_rad,
-                period_s,
-                duration_s,
-            } => {
-                let d = duration(duration_s)?;
-                let sway = laws::Sway::with_math::<M>(laws::SwayParams {
-                    robot,
-                    axis,
-                    amplitude_rad,
-                    period_s,
-                    roll0_rad: 0.0,
-                    pitch0_rad: 0.0,
-                    yaw0_rad: 0.0,
-                    order: s.order,
-                    feet_in_world: stance,
-                })?;
-                (AnyMotion::Sway(sway), [true; 4], d)
-            }
-            Request::YawTurn {
-                yaw_rate_rad_s,
-                step_period_s,
-                lift_height_m,
-                duration_s,
-            } => {
-                let d = duration(duration_s)?;
-                if !yaw_rate_rad_s.is_finite() {
-                    return Err(motion::Error::NonFinite("yaw_rate_rad_s").into());
-                }
-                let turn = laws::YawTurn::with_math::<M>(laws::YawTurnParams {
-                    robot,
-                    // Seed 001's ω_z turns clockwise (eq. 9).
-                    omega_rad_s: -yaw_rate_rad_s,
-                    step_period_s,
-                    lift_height_m,
-                    yaw0_rad: 0.0,
-                    roll0_rad: 0.0,
-                    pitch0_rad: 0.0,
-                    order: s.order,
-                    stance_feet: stance,
-                })?;
-                (AnyMotion::YawTurn(turn), [true; 4], d)
-            }
-            Request::FootPath {
-                path,
-                leg,
-                stride_m,
-                step_height_m,
-                duty_factor,
-                cycle_s,
-                duration_s,
-            } => {
-                let d = duration(duration_s)?;
-                let stride = Stride::new(stride_m, step_height_m, duty_factor)?;
-                let paths = laws::LegPaths::with_math::<M>(laws::LegPathsParams {
-                    robot,
-                    path: AnyPath::new(path, stride),
-                    cycle_s,
-                    phase_offsets: [0.0; 4],
-                    stance_feet: stance,
-                })?;
-                let legs = match leg {
-                    None => [true; 4],
-                    Some(l) => LegId::ALL.map(|x| x == l),
-                };
-                (AnyMotion::LegPaths(paths), legs, d)
-            }
-            _ => return Err(Error::Busy),
-        };
+    fn law(request: &Request, s: &Setup<'_>, program: &mut Program) -> Result<[f32; 12], Error> {
+        let (motion, legs, d) = law_motion::<M>(request, s)?;
         let period_s = motion.period_s().unwrap_or(1.0);
-        let mut law = Law {
+        let law = Law {
             motion,
             legs,
-            stance_feet: stance,
+            stance_feet: s.robot.stance_feet(s.stance_height_m),
             period_s,
-            end_frame: d.map(|d| frames_to_boundary(d, period_s)),
+            end_frame: d.map(|d| frames_to_boundary(d, period_s).max(1)),
         };
-        let n = PREFLIGHT_SAMPLES;
-        preflight_frames::<M>(
-            s,
-            motion.body_config(),
-            |k| {
-                let t = period_s * f32::from(k) / f32::from(n);
-                Ok((t, Self::law_frame(&law, t)?))
-            },
-            n,
-        )?;
-        law.end_frame = law.end_frame.map(|f| f.max(1));
-        Ok(law)
+        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(&law, 0.0))?;
+        let n = START_CHECK_SAMPLES;
+        for k in 1..n {
+            let t = period_s * f32::from(k) / f32::from(n);
+            check_sample::<M>(s, k, t, Self::law_setpoint(&law, t))?;
+        }
+        *program = Program::Law(law);
+        Ok(first)
     }
 
-    /// Builds and preflights a walk; its first setpoint.
+    /// Builds a walk and runs its start check; once it passes, the walk goes into `program`.
+    /// Its first setpoint.
     #[inline(never)]
-    fn walk(w: &WalkRequest, s: &Setup<'_>) -> Result<(Program, [f32; 12]), Error> {
+    fn walk(w: &WalkRequest, s: &Setup<'_>, program: &mut Program) -> Result<[f32; 12], Error> {
         if w.velocity_timeout_ms == 0 {
             return Err(motion::Error::NotPositive("velocity_timeout_ms").into());
         }
@@ -715,32 +745,24 @@ impl<M: Math> Engine<M> {
         p.step_height_m = w.step_height_m;
         p.cycle_s = w.cycle_s;
         p.order = s.order;
-        let walker = Walker::with_math::<M>(p)?;
-        preflight_frames::<M>(
-            s,
-            walker.body_config(),
-            |k| {
-                Ok((
-                    0.0,
-                    Frame {
-                        pose: Pose::default(),
-                        feet_in_world: walker.envelope(usize::from(k)),
-                        contact: [motion::Contact::Stance; 4],
-                    },
-                ))
-            },
-            Walker::ENVELOPE_SAMPLES as u16,
-        )?;
-        let first = solve_frame::<M>(s.robot, s.order, &walker.frame()).map_err(Error::Ik)?;
-        check_travel(s.calibration, &first)?;
-        Ok((
-            Program::Walk {
-                walker,
-                timeout_ms: w.velocity_timeout_ms,
-                last_command_ms: s.now_ms,
-            },
-            first,
-        ))
+        let walker = Walker::without_reach_check(p)?;
+        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(&walker))?;
+        for k in 0..Walker::ENVELOPE_SAMPLES {
+            let frame = Frame {
+                pose: Pose::default(),
+                feet_in_world: walker.envelope(k),
+                contact: [motion::Contact::Stance; 4],
+            };
+            let solved = solve_frame::<M>(s.robot, s.order, &frame);
+            // Sample 0 is the first frame; the envelope's points follow.
+            check_sample::<M>(s, k as u16 + 1, 0.0, solved)?;
+        }
+        *program = Program::Walk {
+            walker,
+            timeout_ms: w.velocity_timeout_ms,
+            last_command_ms: s.now_ms,
+        };
+        Ok(first)
     }
 
     /// The law's frame at `t_s`: the motion's frame with the legs it does not move at their
@@ -772,6 +794,13 @@ impl<M: Math> Engine<M> {
             kind: kin_core::Unreachable::NonFinite,
         })?;
         solve_frame::<M>(law.motion.robot(), law.motion.body_config().order, &frame)
+    }
+
+    /// The walk's joint setpoint at its current frame.
+    #[inline(never)]
+    fn walk_setpoint(walker: &Walker) -> Result<[f32; 12], IkError> {
+        let p = walker.params();
+        solve_frame::<M>(&p.robot, p.order, &walker.frame())
     }
 
     /// Sets a walk's velocity command at `now_ms`.
@@ -920,12 +949,7 @@ impl<M: Math> Engine<M> {
                             let _ = walker.step::<M>(FRAME_S);
                         }
                         self.frame = self.frame.saturating_add(frames);
-                        let q = solve_frame::<M>(
-                            &walker.params().robot,
-                            walker.params().order,
-                            &walker.frame(),
-                        );
-                        (q, walker.is_stopped())
+                        (Self::walk_setpoint(walker), walker.is_stopped())
                     }
                     _ => {
                         self.cancel();
