@@ -61,13 +61,17 @@
 //! - The sways, the yaw turn and the foot paths are periodic in their joint angles, so one
 //!   period covers the whole motion: [`START_CHECK_SAMPLES`] evenly spaced instants, a
 //!   multiple of 4, so that the sways' extremes (T/4, 3T/4) and the yaw turn's apexes and
-//!   swing ends (T1/4, T1/2, 3T1/4, T1) are among them.
-//! - The walk checks the [`Walker`]'s stride cylinder at its [`Walker::ENVELOPE_SAMPLES`]
-//!   points ([`Walker::envelope`]), the bound every velocity command is held to.
+//!   swing ends (T1/4, T1/2, 3T1/4, T1) are among them. Between the samples (the foot paths'
+//!   corners) the run-time IK is the last check.
+//! - The walk checks its first frame, then the [`Walker`]'s stride cylinder at its
+//!   [`Walker::ENVELOPE_SAMPLES`] points ([`Walker::envelope`], the bound every velocity
+//!   command is held to) through the IK and the servo travel; the singularity measure only at
+//!   the first frame (the envelope's points cost a body IK each already).
 //!
-//! Its cost is bounded by the sample count: at most [`Walker::ENVELOPE_SAMPLES`] + 2 body IKs
-//! and 4 singularity measures per sample (`BENCHMARKS.md` has the cycles, well under the
-//! firmware's watchdog). Kin-core's full [`kin_core::preflight::Checker`] (margins, extrema,
+//! Its cost is bounded by the sample count: a law takes [`START_CHECK_SAMPLES`] + 1 body IKs
+//! and 4 singularity measures per sample, a walk [`Walker::ENVELOPE_SAMPLES`] + 2 body IKs
+//! and 4 singularity measures (`BENCHMARKS.md` has the cycles; they must stay well under the
+//! firmware's watchdog, which resets the board). Kin-core's full [`kin_core::preflight::Checker`] (margins, extrema,
 //! joint speeds) stays the host's tool. Ramps need no IK: they are straight in joint space
 //! between two checked points. Should a run-time IK still fail, the motion stops: the outputs
 //! ramp from the last valid setpoint to the stance and [`Status::fault`] tells why.
@@ -101,7 +105,7 @@ pub const FRAME_MS: u32 = 20;
 pub const FRAME_S: f32 = 0.02;
 
 /// Samples per period of a law's start check (module docs).
-pub const START_CHECK_SAMPLES: u16 = 8;
+pub const START_CHECK_SAMPLES: u16 = 4;
 
 /// Default timeout of a walk's velocity command, ms: five missed commands at the 10 Hz a
 /// teleoperating host sends.
@@ -484,13 +488,15 @@ fn stance_angles<M: Math>(s: &Setup<'_>) -> Result<[f32; 12], Error> {
 
 /// One sample of a start check (module docs): `solved` is what the per-frame path (the
 /// frame's body IK, [`solve_frame`]) gave at sample `sample`, time `t_s`; then the servo
-/// travel and each leg's singularity measure. The sample's setpoint when it passes.
+/// travel and, when `singularity`, each leg's singularity measure. The sample's setpoint when
+/// it passes.
 #[inline(never)]
 fn check_sample<M: Math>(
     s: &Setup<'_>,
     sample: u16,
     t_s: f32,
     solved: Result<[f32; 12], IkError>,
+    singularity: bool,
 ) -> Result<[f32; 12], Error> {
     let failure = |leg, kind| {
         Error::Preflight(Failure {
@@ -502,6 +508,9 @@ fn check_sample<M: Math>(
     };
     let q = solved.map_err(|e| failure(e.leg, FailureKind::Unreachable(e.kind)))?;
     check_travel(s.calibration, &q)?;
+    if !singularity {
+        return Ok(q);
+    }
     let solver = leg::Solver::<M>::with_math(s.robot);
     for (&leg, a) in LegId::ALL.iter().zip(q.chunks_exact(3)) {
         let ic = solver.inverse_condition(leg, JointAngles::new(a[0], a[1], a[2]));
@@ -724,11 +733,11 @@ impl<M: Math> Engine<M> {
             period_s,
             end_frame: d.map(|d| frames_to_boundary(d, period_s).max(1)),
         };
-        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(&law, 0.0))?;
+        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(&law, 0.0), true)?;
         let n = START_CHECK_SAMPLES;
         for k in 1..n {
             let t = period_s * f32::from(k) / f32::from(n);
-            check_sample::<M>(s, k, t, Self::law_setpoint(&law, t))?;
+            check_sample::<M>(s, k, t, Self::law_setpoint(&law, t), true)?;
         }
         *program = Program::Law(law);
         Ok(first)
@@ -746,7 +755,7 @@ impl<M: Math> Engine<M> {
         p.cycle_s = w.cycle_s;
         p.order = s.order;
         let walker = Walker::without_reach_check(p)?;
-        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(&walker))?;
+        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(&walker), true)?;
         for k in 0..Walker::ENVELOPE_SAMPLES {
             let frame = Frame {
                 pose: Pose::default(),
@@ -754,8 +763,9 @@ impl<M: Math> Engine<M> {
                 contact: [motion::Contact::Stance; 4],
             };
             let solved = solve_frame::<M>(s.robot, s.order, &frame);
-            // Sample 0 is the first frame; the envelope's points follow.
-            check_sample::<M>(s, k as u16 + 1, 0.0, solved)?;
+            // Sample 0 is the first frame; the envelope's points follow, without the
+            // singularity measure (see the module docs).
+            check_sample::<M>(s, k as u16 + 1, 0.0, solved, false)?;
         }
         *program = Program::Walk {
             walker,
