@@ -100,7 +100,7 @@ impl Rig {
         )
         .expect("encodes");
         self.link.send(frame).expect("send");
-        // A motion start preflights its samples (body IK each) before it answers.
+        // A motion start checks its samples (body IK each) before it answers.
         for _ in 0..250 {
             self.frame();
             if let Some(i) = self.answers.iter().position(|a| a.seq() == Some(self.seq)) {

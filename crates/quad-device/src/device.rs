@@ -301,7 +301,7 @@ where
         Ok(())
     }
 
-    /// Starts a motion of the engine (see [`engine`]): validated and preflighted first, refused
+    /// Starts a motion of the engine (see [`engine`]): validated and start-checked first, refused
     /// with nothing changed. [`engine::Request::StandUp`] with the outputs off holds the rest
     /// pose and enables the outputs at it.
     ///

@@ -51,7 +51,10 @@ fn poses_are_acked_with_the_hosts_angles_and_the_outputs_follow() {
                 .unwrap();
             let now = *stream.client().link().device().output_angles().unwrap();
             for (a, b) in now.iter().zip(&out) {
-                assert!((a - b).abs() <= step * (1.0 + 1e-6), "{a} after {b} > {step}");
+                assert!(
+                    (a - b).abs() <= step * (1.0 + 1e-6),
+                    "{a} after {b} > {step}"
+                );
             }
             out = now;
         }

@@ -141,7 +141,7 @@ impl Walker {
     /// Validates the parameters (those of [`Gait::new`] at zero velocity, and `R > 0`) and the
     /// reach of the stride cylinder (module docs; a failure names `reach_radius_m`), and starts
     /// at phase 0 standing on the neutral footholds with a zero command. The reach checks run
-    /// on the [`DefaultMath`] backend.
+    /// on the [`DefaultMath`](crate::DefaultMath) backend.
     pub fn new(p: WalkerParams) -> Result<Walker, Error> {
         Gait::new(p.gait_params(Velocity::default()))?;
         let walker = Self::without_reach_check(p)?;

@@ -666,7 +666,7 @@ impl<M: Math> Engine<M> {
         !matches!(self.program, Program::Idle)
     }
 
-    /// Validates and preflights `request` against `setup` and, when it passes, starts it: the
+    /// Validates and start-checks `request` against `setup` and, when it passes, starts it: the
     /// first tick begins the ramp from `setup.outputs` (for [`Request::StandUp`] with the
     /// outputs off, from the rest pose at which the device enables them; its returned angles).
     /// A refusal changes nothing.
