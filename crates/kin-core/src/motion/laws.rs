@@ -16,7 +16,7 @@ use super::{
     Motion, Phase,
 };
 use crate::body::{BodyConfig, Pose};
-use crate::math::{wrap_pi, Math};
+use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::paper;
 use crate::robot::{JointAngles, LegId, Robot};
 use crate::rotation::RotationOrder;
@@ -138,17 +138,9 @@ pub struct Sway {
 impl Sway {
     /// Validates the parameters: finite values, `T > 0`, and the feet reachable at `t = 0` and at
     /// both extremes `angle0 ± A` (a quick check; [`crate::preflight`] sweeps the whole motion).
+    /// The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: SwayParams) -> Result<Sway, Error> {
-        p.robot.validate()?;
-        finite(p.amplitude_rad, "amplitude_rad")?;
-        positive(p.period_s, "period_s")?;
-        finite(p.roll0_rad, "roll0_rad")?;
-        finite(p.pitch0_rad, "pitch0_rad")?;
-        finite(p.yaw0_rad, "yaw0_rad")?;
-        for f in p.feet_in_world {
-            finite_vec(f, "feet_in_world")?;
-        }
-        let s = Sway { p };
+        let s = Self::without_reach_check(p)?;
         let cfg = s.body_config();
         check_reach(
             &p.robot,
@@ -167,6 +159,22 @@ impl Sway {
             )?;
         }
         Ok(s)
+    }
+
+    /// [`Sway::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the motion's frames through its own IK (a device's start
+    /// check).
+    pub fn without_reach_check(p: SwayParams) -> Result<Sway, Error> {
+        p.robot.validate()?;
+        finite(p.amplitude_rad, "amplitude_rad")?;
+        positive(p.period_s, "period_s")?;
+        finite(p.roll0_rad, "roll0_rad")?;
+        finite(p.pitch0_rad, "pitch0_rad")?;
+        finite(p.yaw0_rad, "yaw0_rad")?;
+        for f in p.feet_in_world {
+            finite_vec(f, "feet_in_world")?;
+        }
+        Ok(Sway { p })
     }
 
     /// The parameters.
@@ -287,8 +295,29 @@ pub struct YawTurn {
 impl YawTurn {
     /// Validates the parameters: finite values, `T1 > 0`, `h_K ≥ 0` and below the hips, and
     /// the feet reachable at `t = 0`, at both apexes and at the end of each swing (a quick check;
-    /// [`crate::preflight`] sweeps the whole motion).
+    /// [`crate::preflight`] sweeps the whole motion). The checks run on the [`DefaultMath`]
+    /// backend.
     pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
+        let turn = Self::without_reach_check::<DefaultMath>(p)?;
+        let cfg = turn.body_config();
+        let t1 = p.step_period_s;
+        for (t, name) in [
+            (0.0, "stance_feet"),
+            (0.25 * t1, "lift_height_m"),
+            (0.75 * t1, "lift_height_m"),
+            (0.499 * t1, "omega_rad_s"),
+            (0.999 * t1, "omega_rad_s"),
+        ] {
+            let f = turn.frame::<DefaultMath>(t)?;
+            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
+        }
+        Ok(turn)
+    }
+
+    /// [`YawTurn::new`]'s parameter checks without its reach checks, with the foot radii and
+    /// angles on math backend `M`, for a caller that checks the reach itself by running the
+    /// motion's frames through its own IK (a device's start check).
+    pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
         p.robot.validate()?;
         finite(p.omega_rad_s, "omega_rad_s")?;
         positive(p.step_period_s, "step_period_s")?;
@@ -305,24 +334,11 @@ impl YawTurn {
                 });
             }
         }
-        let turn = YawTurn {
+        Ok(YawTurn {
             p,
-            rho_m: p.stance_feet.map(|f| libm::sqrtf(f.x * f.x + f.y * f.y)),
-            alpha_rad: p.stance_feet.map(|f| libm::atan2f(f.y, f.x)),
-        };
-        let cfg = turn.body_config();
-        let t1 = p.step_period_s;
-        for (t, name) in [
-            (0.0, "stance_feet"),
-            (0.25 * t1, "lift_height_m"),
-            (0.75 * t1, "lift_height_m"),
-            (0.499 * t1, "omega_rad_s"),
-            (0.999 * t1, "omega_rad_s"),
-        ] {
-            let f = turn.frame::<crate::DefaultMath>(t)?;
-            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
-        }
-        Ok(turn)
+            rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
+            alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
+        })
     }
 
     /// The parameters.
@@ -477,8 +493,24 @@ impl LegPaths {
     const REACH_SAMPLES: u16 = 64;
 
     /// Validates the parameters: finite values, `cycle_s > 0`, and the path reachable by every
-    /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive).
+    /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive), on
+    /// the [`DefaultMath`] backend.
     pub fn new(p: LegPathsParams) -> Result<LegPaths, Error> {
+        let lp = Self::without_reach_check(p)?;
+        let cfg = lp.body_config();
+        for i in 0..Self::REACH_SAMPLES {
+            let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
+            let feet = LegId::ALL
+                .map(|leg| p.stance_feet[leg.index()] + p.path.offset::<DefaultMath>(phase));
+            check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
+        }
+        Ok(lp)
+    }
+
+    /// [`LegPaths::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the motion's frames through its own IK (a device's start
+    /// check).
+    pub fn without_reach_check(p: LegPathsParams) -> Result<LegPaths, Error> {
         p.robot.validate()?;
         positive(p.cycle_s, "cycle_s")?;
         for o in p.phase_offsets {
@@ -487,15 +519,7 @@ impl LegPaths {
         for f in p.stance_feet {
             finite_vec(f, "stance_feet")?;
         }
-        let lp = LegPaths { p };
-        let cfg = lp.body_config();
-        for i in 0..Self::REACH_SAMPLES {
-            let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
-            let feet = LegId::ALL
-                .map(|leg| p.stance_feet[leg.index()] + p.path.offset::<crate::DefaultMath>(phase));
-            check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
-        }
-        Ok(lp)
+        Ok(LegPaths { p })
     }
 
     /// The parameters.
