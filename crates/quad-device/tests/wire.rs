@@ -11,6 +11,7 @@ mod common;
 
 use common::*;
 use kin_core::body::Pose;
+use kin_core::motion::path::PathKind;
 use kin_core::{Joint, LegId, ReachPolicy, RotationOrder};
 use proptest::prelude::*;
 use quad_device::device::RX_LEN;
@@ -18,8 +19,9 @@ use quad_device::device::{encode_answer, feed_request};
 use quad_device::Config;
 use quad_protocol::servo::{self, Calibration};
 use quad_protocol::{
-    crc, Accumulator, DeviceInfo, DeviceToHost, Feed, FirmwareVersion, Flags, HostToDevice,
-    LinkLossAction, LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request,
+    crc, Accumulator, DeviceInfo, DeviceToHost, Feed, FirmwareVersion, Flags, HostToDevice, LegSet,
+    LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus,
+    NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request,
     RobotPreset, ServoId, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 
@@ -38,6 +40,11 @@ fn request_index(r: &Request) -> u8 {
         Request::GetCalibration { .. } => 8,
         Request::SaveCalibration => 9,
         Request::SetPoseConfig(_) => 10,
+        Request::StartMotion(_) => 11,
+        Request::StopMotion => 12,
+        Request::GetMotion => 13,
+        Request::SetVelocity { .. } => 14,
+        Request::SetJointSpeedLimit { .. } => 15,
     }
 }
 
@@ -47,6 +54,7 @@ fn answer_index(a: &DeviceToHost) -> u8 {
         DeviceToHost::HelloAck { .. } => 1,
         DeviceToHost::Ack { .. } => 2,
         DeviceToHost::Calibration { .. } => 3,
+        DeviceToHost::MotionAck { .. } => 4,
     }
 }
 
@@ -105,6 +113,25 @@ fn requests() -> Vec<Request> {
             order: RotationOrder::Yzx,
             policy: ReachPolicy::Clamp,
         }),
+        Request::StartMotion(MotionCommand::FootPath {
+            path: PathKind::Rectangle,
+            legs: LegSet::One(LegId::RL),
+            stride_m: 0.1,
+            step_height_m: 0.05,
+            duty_factor: 0.75,
+            cycle_s: 3.0,
+            duration_s: Some(6.0),
+        }),
+        Request::StopMotion,
+        Request::GetMotion,
+        Request::SetVelocity {
+            forward_m_s: 0.05,
+            lateral_m_s: -0.01,
+            yaw_rate_rad_s: 0.1,
+        },
+        Request::SetJointSpeedLimit {
+            joint_speed_limit_rad_s: 2.5,
+        },
     ]
 }
 
@@ -134,6 +161,16 @@ fn nack_reasons() -> Vec<NackReason> {
         NackReason::OutputsDisabled,
         NackReason::Storage,
         NackReason::InvalidArgument,
+        NackReason::InvalidParameter {
+            param: MotionParam::CycleS,
+            problem: ParamProblem::NotPositive,
+        },
+        NackReason::Preflight {
+            leg: LegId::FR,
+            fault: PreflightFault::JointLimit(Joint::Knee),
+        },
+        NackReason::MotionRunning,
+        NackReason::NotWalking,
     ]
 }
 
@@ -180,6 +217,26 @@ fn answers() -> Vec<DeviceToHost> {
             seq: 10,
             servo: SERVO,
             calibration: CAL,
+        },
+        DeviceToHost::MotionAck {
+            seq: 11,
+            status: MotionStatus {
+                kind: Some(MotionKind::Walk),
+                stage: MotionStage::Stopping,
+                t_s: 12.5,
+                phase: 0.25,
+                fault: Some(NackReason::Unreachable {
+                    leg: LegId::FL,
+                    fault: ReachFault::TooFar,
+                }),
+            },
+            readback: Readback {
+                angles_rad: core::array::from_fn(|i| i as f32 * 0.1),
+                pulses_half_us: core::array::from_fn(|i| 2500 + 50 * i as u16),
+                flags: Flags(Flags::OUTPUTS_ENABLED),
+                frames_ok: 70_000,
+                frames_bad: 1,
+            },
         },
     ]
 }
@@ -305,9 +362,11 @@ fn every_answer_and_nack_variant_has_its_index_and_round_trips() {
     }
     // Every nack reason through the device's encoder (their indices: quad-protocol's
     // `wire` tests, where the non-exhaustive enum can be matched exhaustively).
-    for (i, reason) in nack_reasons().into_iter().enumerate() {
+    let reasons = nack_reasons();
+    let past = reasons.len() as u8;
+    for (i, reason) in reasons.into_iter().enumerate() {
         let nack = DeviceToHost::Nack { seq: None, reason };
-        check_answer(nack, 2, i as u8, 14);
+        check_answer(nack, 2, i as u8, past);
     }
 }
 
@@ -343,7 +402,9 @@ fn same_as_reference(chunks: &[Vec<u8>]) {
             input = feed.remaining();
             match expected_answer(&mut twin, feed) {
                 Some(mut a) => {
-                    if let DeviceToHost::Ack { readback, .. } = &mut a {
+                    if let DeviceToHost::Ack { readback, .. }
+                    | DeviceToHost::MotionAck { readback, .. } = &mut a
+                    {
                         readback.frames_ok = reference.frames_ok();
                         readback.frames_bad = reference.frames_bad();
                     }
@@ -374,7 +435,7 @@ proptest! {
     #[test]
     fn random_payloads_with_a_good_crc_get_the_reference_answers(
         bodies in prop::collection::vec(
-            (0u8..12, prop::collection::vec(any::<u8>(), 0..60)), 1..6)
+            (0u8..17, prop::collection::vec(any::<u8>(), 0..60)), 1..6)
     ) {
         // A plausible start (seq 0, a variant index near the known ones) and random fields.
         let mut wire = Vec::new();

@@ -321,6 +321,11 @@ pub fn request_name(r: &Request) -> &'static str {
         Request::GetCalibration { .. } => "GetCalibration",
         Request::SaveCalibration => "SaveCalibration",
         Request::SetPoseConfig(_) => "SetPoseConfig",
+        Request::StartMotion(_) => "StartMotion",
+        Request::StopMotion => "StopMotion",
+        Request::GetMotion => "GetMotion",
+        Request::SetVelocity { .. } => "SetVelocity",
+        Request::SetJointSpeedLimit { .. } => "SetJointSpeedLimit",
     }
 }
 

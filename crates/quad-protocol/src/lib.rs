@@ -38,12 +38,13 @@ pub use frame::{
     decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 pub use msg::{
-    DeviceInfo, DeviceToHost, FirmwareVersion, Flags, HostToDevice, LinkLossAction, LinkTimeout,
-    NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+    DeviceInfo, DeviceToHost, FirmwareVersion, Flags, HostToDevice, LegSet, LinkLossAction,
+    LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
+    ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset, ServoId,
 };
 
-/// This crate's protocol version: `major << 8 | minor` (1.0).
-pub const PROTOCOL_VERSION: u16 = 0x0100;
+/// This crate's protocol version: `major << 8 | minor` (1.1: the onboard motions).
+pub const PROTOCOL_VERSION: u16 = 0x0101;
 
 /// Major part of a protocol version.
 #[inline]
@@ -80,9 +81,11 @@ pub const fn negotiated_minor(a: u16, b: u16) -> u8 {
 pub const HOST_TO_DEVICE_MAX_LEN: usize = 3 + 1 + 48 + frame::CRC_LEN;
 
 /// Largest decoded [`DeviceToHost`] frame of this version (postcard bytes + CRC), bytes:
-/// variant (1) + seq (≤ 3) + angles (48) + pulses (12 × ≤ 3) + flags (1) + two counters
-/// (2 × ≤ 5) + CRC (2).
-pub const DEVICE_TO_HOST_MAX_LEN: usize = 1 + 3 + 48 + 12 * 3 + 1 + 2 * 5 + frame::CRC_LEN;
+/// `MotionAck`: variant (1) + seq (≤ 3) + [`MotionStatus`] (kind ≤ 2, stage 1, time and phase
+/// 2 × 4, fault ≤ 1 + 4) + the readback: angles (48) + pulses (12 × ≤ 3) + flags (1) + two
+/// counters (2 × ≤ 5) + CRC (2).
+pub const DEVICE_TO_HOST_MAX_LEN: usize =
+    1 + 3 + (2 + 1 + 2 * 4 + 5) + 48 + 12 * 3 + 1 + 2 * 5 + frame::CRC_LEN;
 
 const _: () = assert!(HOST_TO_DEVICE_MAX_LEN <= MAX_DECODED_LEN);
 const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);

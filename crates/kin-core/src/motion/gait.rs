@@ -24,7 +24,7 @@ use super::{
     check_reach, finite, fract01, non_negative, positive, Contact, Error, Frame, Motion, Phase,
 };
 use crate::body::{BodyConfig, Pose};
-use crate::math::{wrap_pi, Math};
+use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::robot::{LegId, Robot};
 use crate::rotation::RotationOrder;
 use crate::vec::Vec3;
@@ -136,6 +136,47 @@ fn sinc<M: Math>(x: f32) -> f32 {
     }
 }
 
+/// Body displacement `X(s)` of the constant twist `velocity` over a time `s` (s, negative
+/// too), applied to a point `n` of the body frame: `p(s) + Rz(ω·s)·n` with
+/// `p(s) = ∫₀ˢ Rz(ω·u)·v du` (see the module docs). `X(−s)` is the inverse of `X(s)`.
+pub fn displace_with<M: Math>(velocity: &Velocity, s: f32, n: Vec3) -> Vec3 {
+    let v = velocity;
+    let x = v.yaw_rad_s * s;
+    let (sn, cs) = M::sin_cos(x);
+    let (sh, _) = M::sin_cos(0.5 * x);
+    let a = s * sinc::<M>(x); // ∫ cos
+    let b = s * sh * sinc::<M>(0.5 * x); // ∫ sin = (1 − cos x)/ω
+    Vec3::new(
+        v.forward_m_s * a - v.lateral_m_s * b + cs * n.x - sn * n.y,
+        v.forward_m_s * b + v.lateral_m_s * a + sn * n.x + cs * n.y,
+        n.z,
+    )
+}
+
+/// A swing foot at leg phase `phase` (in `[0, 1 − duty_factor)`) on its way from `lift_off`
+/// to `touch_down` (body frame, m): the [`PathKind`] path over the chord between them (stride =
+/// their horizontal distance, apex `step_height_m` above the chord's middle).
+pub fn swing_foot_with<M: Math>(
+    swing: PathKind,
+    step_height_m: f32,
+    duty_factor: f32,
+    lift_off: Vec3,
+    touch_down: Vec3,
+    phase: Phase,
+) -> Vec3 {
+    let chord = touch_down - lift_off;
+    let length = M::sqrt(chord.x * chord.x + chord.y * chord.y);
+    let (ux, uy) = if length > 0.0 {
+        (chord.x / length, chord.y / length)
+    } else {
+        (1.0, 0.0)
+    };
+    let mid = (lift_off + touch_down) * 0.5;
+    let path = AnyPath::new(swing, Stride::unchecked(length, step_height_m, duty_factor));
+    let o = path.offset_with::<M>(phase);
+    Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z)
+}
+
 /// A trot or walk: see the module docs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gait {
@@ -148,8 +189,13 @@ impl Gait {
     /// height ≥ 0 and below the hips; then checks that every foot reaches its neutral foothold
     /// (`stance_height_m`), its lift-off and touch-down points (the velocity command sets the
     /// stride: `velocity`) and its swing apex (`step_height_m`). [`crate::preflight`] sweeps the
-    /// whole motion.
+    /// whole motion. The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: GaitParams) -> Result<Gait, Error> {
+        Self::with_math::<DefaultMath>(p)
+    }
+
+    /// [`Gait::new`] with the reach checks on math backend `M` (a device's own).
+    pub fn with_math<M: Math>(p: GaitParams) -> Result<Gait, Error> {
         p.robot.validate()?;
         positive(p.stance_height_m, "stance_height_m")?;
         positive(p.cycle_s, "cycle_s")?;
@@ -179,13 +225,11 @@ impl Gait {
         };
         let cfg = gait.body_config();
         let zero = Pose::default();
-        check_reach(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
-        let at = |phase: f32| {
-            LegId::ALL.map(|leg| gait.foot_in_body_with::<crate::DefaultMath>(leg, phase).0)
-        };
-        check_reach(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
-        check_reach(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
-        check_reach(&p.robot, &zero, &cfg, &at(0.5 * (1.0 - d)), "step_height_m")?;
+        check_reach::<M>(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
+        let at = |phase: f32| LegId::ALL.map(|leg| gait.foot_in_body_with::<M>(leg, phase).0);
+        check_reach::<M>(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
+        check_reach::<M>(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
+        check_reach::<M>(&p.robot, &zero, &cfg, &at(0.5 * (1.0 - d)), "step_height_m")?;
         Ok(gait)
     }
 
@@ -201,17 +245,7 @@ impl Gait {
 
     /// Body displacement `X(s)` applied to a point `n` of the body frame: `p(s) + Rz(ω·s)·n`.
     fn displaced<M: Math>(&self, s: f32, n: Vec3) -> Vec3 {
-        let v = self.p.velocity;
-        let x = v.yaw_rad_s * s;
-        let (sn, cs) = M::sin_cos(x);
-        let (sh, _) = M::sin_cos(0.5 * x);
-        let a = s * sinc::<M>(x); // ∫ cos
-        let b = s * sh * sinc::<M>(0.5 * x); // ∫ sin = (1 − cos x)/ω
-        Vec3::new(
-            v.forward_m_s * a - v.lateral_m_s * b + cs * n.x - sn * n.y,
-            v.forward_m_s * b + v.lateral_m_s * a + sn * n.x + cs * n.y,
-            n.z,
-        )
+        displace_with::<M>(&self.p.velocity, s, n)
     }
 
     /// Foot of `leg` in the body frame at leg phase `phase` (cycles; wrapped), and its contact.
@@ -228,21 +262,15 @@ impl Gait {
         let half_stance = 0.5 * d * t;
         let lift_off = self.displaced::<M>(-half_stance, n);
         let touch_down = self.displaced::<M>(half_stance, n);
-        let chord = touch_down - lift_off;
-        let length = libm::sqrtf(chord.x * chord.x + chord.y * chord.y);
-        let (ux, uy) = if length > 0.0 {
-            (chord.x / length, chord.y / length)
-        } else {
-            (1.0, 0.0)
-        };
-        let mid = (lift_off + touch_down) * 0.5;
-        let path = AnyPath::new(
-            self.p.swing,
-            Stride::unchecked(length, self.p.step_height_m, d),
-        );
-        let o = path.offset_with::<M>(phase);
         (
-            Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z),
+            swing_foot_with::<M>(
+                self.p.swing,
+                self.p.step_height_m,
+                d,
+                lift_off,
+                touch_down,
+                phase,
+            ),
             Contact::Swing,
         )
     }
@@ -257,9 +285,7 @@ impl Gait {
     pub fn step_length_m(&self, leg: LegId) -> f32 {
         let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
         let n = self.neutral[leg.index()];
-        (self.displaced::<crate::DefaultMath>(half, n)
-            - self.displaced::<crate::DefaultMath>(-half, n))
-        .norm()
+        (self.displaced::<DefaultMath>(half, n) - self.displaced::<DefaultMath>(-half, n)).norm()
     }
 }
 

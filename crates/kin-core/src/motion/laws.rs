@@ -16,7 +16,7 @@ use super::{
     Motion, Phase,
 };
 use crate::body::{BodyConfig, Pose};
-use crate::math::{wrap_pi, Math};
+use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::paper;
 use crate::robot::{JointAngles, LegId, Robot};
 use crate::rotation::RotationOrder;
@@ -138,7 +138,13 @@ pub struct Sway {
 impl Sway {
     /// Validates the parameters: finite values, `T > 0`, and the feet reachable at `t = 0` and at
     /// both extremes `angle0 ± A` (a quick check; [`crate::preflight`] sweeps the whole motion).
+    /// The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: SwayParams) -> Result<Sway, Error> {
+        Self::with_math::<DefaultMath>(p)
+    }
+
+    /// [`Sway::new`] with the reach checks on math backend `M` (a device's own).
+    pub fn with_math<M: Math>(p: SwayParams) -> Result<Sway, Error> {
         p.robot.validate()?;
         finite(p.amplitude_rad, "amplitude_rad")?;
         positive(p.period_s, "period_s")?;
@@ -150,7 +156,7 @@ impl Sway {
         }
         let s = Sway { p };
         let cfg = s.body_config();
-        check_reach(
+        check_reach::<M>(
             &p.robot,
             &s.pose_at(0.0),
             &cfg,
@@ -158,7 +164,7 @@ impl Sway {
             "feet_in_world",
         )?;
         for sign in [1.0, -1.0] {
-            check_reach(
+            check_reach::<M>(
                 &p.robot,
                 &s.pose_at(sign * p.amplitude_rad),
                 &cfg,
@@ -287,8 +293,15 @@ pub struct YawTurn {
 impl YawTurn {
     /// Validates the parameters: finite values, `T1 > 0`, `h_K ≥ 0` and below the hips, and
     /// the feet reachable at `t = 0`, at both apexes and at the end of each swing (a quick check;
-    /// [`crate::preflight`] sweeps the whole motion).
+    /// [`crate::preflight`] sweeps the whole motion). The checks run on the [`DefaultMath`]
+    /// backend.
     pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
+        Self::with_math::<DefaultMath>(p)
+    }
+
+    /// [`YawTurn::new`] with the foot radii, angles and reach checks on math backend `M` (a
+    /// device's own).
+    pub fn with_math<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
         p.robot.validate()?;
         finite(p.omega_rad_s, "omega_rad_s")?;
         positive(p.step_period_s, "step_period_s")?;
@@ -307,8 +320,8 @@ impl YawTurn {
         }
         let turn = YawTurn {
             p,
-            rho_m: p.stance_feet.map(|f| libm::sqrtf(f.x * f.x + f.y * f.y)),
-            alpha_rad: p.stance_feet.map(|f| libm::atan2f(f.y, f.x)),
+            rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
+            alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
         };
         let cfg = turn.body_config();
         let t1 = p.step_period_s;
@@ -319,8 +332,8 @@ impl YawTurn {
             (0.499 * t1, "omega_rad_s"),
             (0.999 * t1, "omega_rad_s"),
         ] {
-            let f = turn.frame_with::<crate::DefaultMath>(t)?;
-            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
+            let f = turn.frame_with::<M>(t)?;
+            check_reach::<M>(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
         }
         Ok(turn)
     }
@@ -477,8 +490,14 @@ impl LegPaths {
     const REACH_SAMPLES: u16 = 64;
 
     /// Validates the parameters: finite values, `cycle_s > 0`, and the path reachable by every
-    /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive).
+    /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive), on
+    /// the [`DefaultMath`] backend.
     pub fn new(p: LegPathsParams) -> Result<LegPaths, Error> {
+        Self::with_math::<DefaultMath>(p)
+    }
+
+    /// [`LegPaths::new`] with the reach checks on math backend `M` (a device's own).
+    pub fn with_math<M: Math>(p: LegPathsParams) -> Result<LegPaths, Error> {
         p.robot.validate()?;
         positive(p.cycle_s, "cycle_s")?;
         for o in p.phase_offsets {
@@ -491,8 +510,9 @@ impl LegPaths {
         let cfg = lp.body_config();
         for i in 0..Self::REACH_SAMPLES {
             let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
-            let feet = LegId::ALL.map(|leg| p.stance_feet[leg.index()] + p.path.offset(phase));
-            check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
+            let feet =
+                LegId::ALL.map(|leg| p.stance_feet[leg.index()] + p.path.offset_with::<M>(phase));
+            check_reach::<M>(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
         }
         Ok(lp)
     }

@@ -11,6 +11,8 @@
 //!   with the crossed-pair leg transfer (eq. 9–11, corrected; see `docs/papers.md`) — plus the
 //!   feet following a path under a fixed body (seed 000 §3.2).
 //! - [`gait`]: trot / walk generator driven by a body velocity command.
+//! - [`walker`]: the same gaits as a stateful stepper, for a velocity command that changes
+//!   while walking (footholds planned at lift-off, a stop that ends at the stance).
 //!
 //! ## Frames
 //! The world frame coincides with the body frame in the nominal pose (see the crate docs): the
@@ -32,6 +34,7 @@ use core::fmt;
 pub mod gait;
 pub mod laws;
 pub mod path;
+pub mod walker;
 
 /// Why a motion parameter or a motion sample was refused. Every variant names the parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -305,16 +308,16 @@ impl Motion for AnyMotion {
     }
 }
 
-/// Checks that the four feet are reachable at `pose` (used by the constructors' quick checks);
-/// a failure is blamed on `parameter`.
-pub(crate) fn check_reach(
+/// Checks that the four feet are reachable at `pose` on backend `M` (used by the constructors'
+/// quick checks); a failure is blamed on `parameter`.
+pub(crate) fn check_reach<M: Math>(
     robot: &Robot,
     pose: &Pose,
     config: &BodyConfig,
     feet_in_world: &[Vec3; 4],
     parameter: &'static str,
 ) -> Result<(), Error> {
-    let solver = body::Solver::new(robot);
+    let solver = body::Solver::<M>::with_math(robot);
     let local = solver.feet_in_hips(pose, config, feet_in_world);
     for leg in LegId::ALL {
         let solution = solver

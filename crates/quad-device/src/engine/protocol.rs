@@ -1,0 +1,237 @@
+//! The engine's requests, status and errors on the wire (quad-protocol's motion messages).
+
+use super::{Error, Kind, Request, Stage, Status, WalkRequest};
+use kin_core::motion;
+use kin_core::preflight::FailureKind;
+use kin_core::Unreachable;
+use quad_protocol::{
+    LegSet, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
+    ParamProblem, PreflightFault, ReachFault,
+};
+
+impl From<MotionCommand> for Request {
+    fn from(m: MotionCommand) -> Request {
+        match m {
+            MotionCommand::StandUp => Request::StandUp,
+            MotionCommand::Sit => Request::Sit,
+            MotionCommand::Rest => Request::Rest,
+            MotionCommand::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            } => Request::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            },
+            MotionCommand::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            } => Request::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            },
+            MotionCommand::FootPath {
+                path,
+                legs,
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            } => Request::FootPath {
+                path,
+                leg: match legs {
+                    LegSet::All => None,
+                    LegSet::One(leg) => Some(leg),
+                },
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            },
+            MotionCommand::Walk {
+                gait,
+                body_height_m,
+                step_height_m,
+                cycle_s,
+                velocity_timeout_ms,
+            } => Request::Walk(WalkRequest {
+                pattern: gait,
+                body_height_m,
+                step_height_m,
+                cycle_s,
+                velocity_timeout_ms,
+            }),
+        }
+    }
+}
+
+impl From<&Request> for MotionCommand {
+    fn from(r: &Request) -> MotionCommand {
+        match *r {
+            Request::StandUp => MotionCommand::StandUp,
+            Request::Sit => MotionCommand::Sit,
+            Request::Rest => MotionCommand::Rest,
+            Request::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            } => MotionCommand::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            },
+            Request::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            } => MotionCommand::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            },
+            Request::FootPath {
+                path,
+                leg,
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            } => MotionCommand::FootPath {
+                path,
+                legs: leg.map_or(LegSet::All, LegSet::One),
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            },
+            Request::Walk(w) => MotionCommand::Walk {
+                gait: w.pattern,
+                body_height_m: w.body_height_m,
+                step_height_m: w.step_height_m,
+                cycle_s: w.cycle_s,
+                velocity_timeout_ms: w.velocity_timeout_ms,
+            },
+        }
+    }
+}
+
+impl From<Status> for MotionStatus {
+    fn from(s: Status) -> MotionStatus {
+        MotionStatus {
+            kind: s.kind.map(|k| match k {
+                Kind::StandUp => MotionKind::StandUp,
+                Kind::Sit => MotionKind::Sit,
+                Kind::Rest => MotionKind::Rest,
+                Kind::Sway => MotionKind::Sway,
+                Kind::YawTurn => MotionKind::YawTurn,
+                Kind::FootPath => MotionKind::FootPath,
+                Kind::Walk => MotionKind::Walk,
+            }),
+            stage: match s.stage {
+                Stage::Approach => MotionStage::Approach,
+                Stage::Run => MotionStage::Run,
+                Stage::Stopping => MotionStage::Stopping,
+                Stage::Leave => MotionStage::Leave,
+            },
+            t_s: s.t_s,
+            phase: s.phase,
+            fault: s.fault.map(NackReason::from),
+        }
+    }
+}
+
+/// The wire name of a kin-core or engine parameter name (the names their errors carry).
+pub fn motion_param(name: &str) -> MotionParam {
+    match name {
+        "amplitude_rad" => MotionParam::AmplitudeRad,
+        "period_s" => MotionParam::PeriodS,
+        "duration_s" => MotionParam::DurationS,
+        // kin-core's yaw turn names seed 001's ω_z; the velocity command its yaw rate.
+        "yaw_rate_rad_s" | "omega_rad_s" | "yaw_rad_s" => MotionParam::YawRateRadS,
+        "step_period_s" => MotionParam::StepPeriodS,
+        "lift_height_m" => MotionParam::LiftHeightM,
+        "stride_m" => MotionParam::StrideM,
+        "step_height_m" => MotionParam::StepHeightM,
+        "duty_factor" => MotionParam::DutyFactor,
+        "cycle_s" => MotionParam::CycleS,
+        "path" => MotionParam::Path,
+        // A walk's body height is its gait's stance height.
+        "stance_height_m" => MotionParam::BodyHeightM,
+        "velocity_timeout_ms" => MotionParam::VelocityTimeoutMs,
+        "forward_m_s" => MotionParam::ForwardMS,
+        "lateral_m_s" => MotionParam::LateralMS,
+        "velocity" => MotionParam::Velocity,
+        "joint_speed_limit_rad_s" => MotionParam::JointSpeedLimitRadS,
+        // The feet a law starts from: the device's stance.
+        "feet_in_world" | "stance_feet" => MotionParam::Stance,
+        "reach_radius_m" => MotionParam::ReachRadiusM,
+        _ => MotionParam::Other,
+    }
+}
+
+fn reach_fault(u: Unreachable) -> PreflightFault {
+    match u {
+        Unreachable::JointLimit(j) => PreflightFault::JointLimit(j),
+        Unreachable::NonFinite => PreflightFault::NonFinite,
+        Unreachable::TooFar => PreflightFault::Reach(ReachFault::TooFar),
+        Unreachable::TooClose => PreflightFault::Reach(ReachFault::TooClose),
+        Unreachable::InsideOffset => PreflightFault::Reach(ReachFault::InsideOffset),
+        _ => PreflightFault::Reach(ReachFault::Other),
+    }
+}
+
+impl From<Error> for NackReason {
+    fn from(e: Error) -> NackReason {
+        let invalid = |name: &str, problem| NackReason::InvalidParameter {
+            param: motion_param(name),
+            problem,
+        };
+        match e {
+            Error::Parameter(p) => match p {
+                motion::Error::NonFinite(n) => invalid(n, ParamProblem::NonFinite),
+                motion::Error::NotPositive(n) => invalid(n, ParamProblem::NotPositive),
+                motion::Error::Negative(n) => invalid(n, ParamProblem::Negative),
+                motion::Error::OutOfRange { parameter, .. } => {
+                    invalid(parameter, ParamProblem::OutOfRange)
+                }
+                motion::Error::BeyondReach { parameter, .. } => {
+                    invalid(parameter, ParamProblem::BeyondReach)
+                }
+                motion::Error::Ik(e) => e.into(),
+                _ => NackReason::InvalidArgument,
+            },
+            Error::Preflight(f) => NackReason::Preflight {
+                leg: f.leg,
+                fault: match f.kind {
+                    FailureKind::Unreachable(u) => reach_fault(u),
+                    FailureKind::Singular { .. } => PreflightFault::Singular,
+                    _ => PreflightFault::Other,
+                },
+            },
+            Error::ServoRange { servo, fault } => NackReason::ServoRange {
+                leg: servo.leg,
+                joint: servo.joint,
+                fault,
+            },
+            Error::OutputsOff => NackReason::OutputsDisabled,
+            Error::Busy => NackReason::MotionRunning,
+            Error::NotWalking => NackReason::NotWalking,
+            Error::Ik(e) => e.into(),
+        }
+    }
+}
