@@ -258,6 +258,7 @@ pub fn answer_name(a: &DeviceToHost) -> &'static str {
         DeviceToHost::HelloAck { .. } => "HelloAck",
         DeviceToHost::Ack { .. } => "Ack",
         DeviceToHost::Calibration { .. } => "Calibration",
+        DeviceToHost::MotionAck { .. } => "MotionAck",
     }
 }
 

@@ -12,6 +12,7 @@ pub mod demo;
 pub mod fk;
 pub mod ik;
 pub mod motion;
+pub mod onboard;
 pub mod play;
 pub mod plot;
 pub mod pose;

@@ -8,6 +8,7 @@ pub mod check;
 pub mod demo;
 pub mod drive;
 pub mod motion;
+pub mod onboard;
 pub mod play;
 pub mod plot;
 pub mod stream;
