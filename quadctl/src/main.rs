@@ -42,6 +42,7 @@ enum Command {
     Rest(cmd::onboard::PostureArgs),
     /// Run one of the device's own motions: sways, yaw turn, foot paths, trot, walk.
     Run(cmd::onboard::RunArgs),
+    Drive(cmd::drive::Args),
 }
 
 fn main() -> ExitCode {
@@ -67,5 +68,6 @@ fn main() -> ExitCode {
         Command::Sit(args) => cmd::onboard::posture(&args, Sit),
         Command::Rest(args) => cmd::onboard::posture(&args, Rest),
         Command::Run(args) => cmd::onboard::run(&args),
+        Command::Drive(args) => cmd::drive::main(&args),
     }
 }

@@ -9,6 +9,7 @@ pub mod accuracy;
 pub mod calibrate;
 pub mod check;
 pub mod demo;
+pub mod drive;
 pub mod fk;
 pub mod ik;
 pub mod motion;

@@ -427,3 +427,73 @@ pub fn run<L: Link>(
 pub fn ramping(status: &MotionStatus) -> bool {
     matches!(status.stage, MotionStage::Approach | MotionStage::Leave)
 }
+
+/// The teleop's device end ([`crate::ops::drive::Walker`]) on a [`Session`]: a trot or walk
+/// at a body height, velocity commands, stop and sit.
+pub struct SessionWalker<'a, L> {
+    /// The session.
+    pub session: &'a mut Session<L>,
+    /// Trot or walk.
+    pub pattern: kin_core::motion::gait::Pattern,
+    /// How long a stop or a sit may take, link time.
+    pub limit: Duration,
+}
+
+impl<L: Link> crate::ops::drive::Walker for SessionWalker<'_, L> {
+    type State = MotionAnswer;
+    type Error = Error;
+
+    fn start(
+        &mut self,
+        body_height_m: f32,
+    ) -> Result<crate::ops::drive::Answer<MotionAnswer>, Error> {
+        use crate::ops::drive::Answer;
+        self.session.stand_if_off(self.limit)?;
+        let request = engine::Request::Walk(engine::WalkRequest::new(self.pattern, body_height_m));
+        match self.session.start(&request) {
+            Ok(a) => Ok(Answer::Accepted(a)),
+            Err(Error::Refused { reason, .. }) => Ok(Answer::Refused(words(&reason))),
+            Err(e) => Err(e),
+        }
+    }
+
+    fn velocity(
+        &mut self,
+        c: &crate::ops::drive::Command,
+    ) -> Result<crate::ops::drive::Answer<MotionAnswer>, Error> {
+        use crate::ops::drive::Answer;
+        match self.session.motion(Request::SetVelocity {
+            forward_m_s: c.forward_m_s,
+            lateral_m_s: c.lateral_m_s,
+            yaw_rate_rad_s: c.yaw_rate_rad_s,
+        }) {
+            Ok(a) => Ok(Answer::Accepted(a)),
+            Err(Error::Refused { reason, .. }) => Ok(Answer::Refused(words(&reason))),
+            Err(e) => Err(e),
+        }
+    }
+
+    fn stop(&mut self) -> Result<(), Error> {
+        self.session.motion(Request::StopMotion)?;
+        self.session.wait_idle(self.limit, |_| {})?;
+        Ok(())
+    }
+
+    fn sit(&mut self) -> Result<(), Error> {
+        self.stop()?;
+        self.session.start(&engine::Request::Sit)?;
+        self.session.wait_idle(self.limit, |_| {})?;
+        Ok(())
+    }
+
+    fn now(&self) -> Duration {
+        self.session.now()
+    }
+
+    fn idle_until(&mut self, deadline: Duration) -> Result<(), Error> {
+        self.session
+            .client
+            .idle_until(deadline)
+            .map_err(|e| Error::Client(e.into()))
+    }
+}
