@@ -179,7 +179,15 @@ pub fn main(args: &Args) -> ExitCode {
         None
     };
     let mut script = script.unwrap_or_default();
+    let wall = std::time::Instant::now();
     let keys = |at: Duration| -> Option<Key> {
+        if interactive {
+            // A person at the keyboard: the link's clock must not run ahead of the wall clock
+            // (it does on the simulated and emulated links, which run as fast as they can).
+            if let Some(ahead) = at.checked_sub(wall.elapsed()) {
+                std::thread::sleep(ahead);
+            }
+        }
         if !interactive {
             let next = script.front().filter(|k| k.at <= at)?;
             let key = next.key;
