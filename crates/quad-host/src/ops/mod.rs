@@ -6,6 +6,7 @@ pub mod batch;
 pub mod calibrate;
 pub mod check;
 pub mod demo;
+pub mod demo_motions;
 pub mod drive;
 pub mod motion;
 pub mod onboard;
