@@ -250,7 +250,7 @@ fn seed001_sways_and_yaw_turn_run_for_their_duration_as_kin_core_computes_them()
         p.order = config.pose_config.order;
         let sway = laws::Sway::new(p).unwrap();
         let rig = run_law(config, Request::seed001_sway(axis, Some(20.0)), |t| {
-            motion::solve_with::<DefaultMath, _>(&sway, t, ReachPolicy::Reject)
+            motion::solve::<DefaultMath>(&sway, t, ReachPolicy::Reject)
                 .unwrap()
                 .1
                 .flat()
@@ -266,7 +266,7 @@ fn seed001_sways_and_yaw_turn_run_for_their_duration_as_kin_core_computes_them()
     let request = Request::seed001_yaw_turn(Some(12.0));
     assert!(matches!(request, Request::YawTurn { yaw_rate_rad_s, .. } if yaw_rate_rad_s < 0.0));
     let rig = run_law(config, request, |t| {
-        motion::solve_with::<DefaultMath, _>(&turn, t, ReachPolicy::Reject)
+        motion::solve::<DefaultMath>(&turn, t, ReachPolicy::Reject)
             .unwrap()
             .1
             .flat()
@@ -311,7 +311,7 @@ fn seed000_foot_paths_run_on_one_leg_or_all_four() {
             })
             .unwrap();
             run_law(config, request, |t| {
-                let mut f = paths.frame(t).unwrap();
+                let mut f = paths.frame::<DefaultMath>(t).unwrap();
                 for l in LegId::ALL {
                     if leg.is_some_and(|x| x != l) {
                         f.feet_in_world[l.index()] = stance_feet[l.index()];

@@ -834,6 +834,11 @@ impl<L: Link> PoseStream<L> {
         &self.client
     }
 
+    /// The client, the stream done.
+    pub fn into_client(self) -> Client<L> {
+        self.client
+    }
+
     /// The client, e.g. to send other requests between poses.
     pub fn client_mut(&mut self) -> &mut Client<L> {
         &mut self.client

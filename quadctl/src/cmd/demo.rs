@@ -60,6 +60,11 @@ pub struct Args {
     /// Poses per sweep (three sweeps).
     #[arg(long, value_name = "N", default_value_t = demo::DEFAULT_POSES_PER_SWEEP, value_parser = clap::value_parser!(usize))]
     pub poses_per_sweep: usize,
+    /// After the sweeps, the device's own motions: stand-up, seed 001's roll and pitch sways,
+    /// the yaw turn, a trot with a changing velocity and sit, every answer and (emulator) pin
+    /// checked against the host's kin-core.
+    #[arg(long)]
+    pub motions: bool,
 }
 
 /// Runs `quadctl demo`.
@@ -71,6 +76,7 @@ pub fn main(args: &Args) -> ExitCode {
         baud: args.baud,
         elf: args.elf.clone(),
         poses_per_sweep: args.poses_per_sweep,
+        motions: args.motions,
     };
     let run = match demo::run(&request, &mut out) {
         Ok(run) => run,
@@ -99,7 +105,32 @@ pub fn main(args: &Args) -> ExitCode {
     ) {
         return args::fail("quadctl demo", &e);
     }
-    if run.summary.passed() {
+    if let Some(legs) = &run.motions {
+        for l in legs {
+            let line = format!(
+                "  onboard {}: {} answers, {} angle checks (largest |device − host| {:.1e} rad), \
+                 {} pins, {} errors, {:.1} s of motion",
+                l.motion,
+                l.answers,
+                l.angles_checked,
+                l.max_angle_err_rad,
+                l.pins_checked,
+                l.errors,
+                l.motion_s
+            );
+            if let Err(e) = writeln!(out, "{line}") {
+                return args::fail("quadctl demo", &e);
+            }
+            if let Some(first) = &l.first_error {
+                eprintln!("    first: {first}");
+            }
+        }
+        let verdict = if run.passed() { "PASS" } else { "FAIL" };
+        if let Err(e) = writeln!(out, "  onboard result: {verdict}") {
+            return args::fail("quadctl demo", &e);
+        }
+    }
+    if run.passed() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(EXIT_CHECK_FAILED)

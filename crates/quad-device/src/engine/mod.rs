@@ -782,9 +782,9 @@ impl<M: Math> Engine<M> {
         // The engine's law motions only: matching them keeps the gait's frame code out of the
         // firmware.
         let mut f = match &law.motion {
-            AnyMotion::Sway(m) => m.frame_with::<M>(t_s),
-            AnyMotion::YawTurn(m) => m.frame_with::<M>(t_s),
-            AnyMotion::LegPaths(m) => m.frame_with::<M>(t_s),
+            AnyMotion::Sway(m) => m.frame::<M>(t_s),
+            AnyMotion::YawTurn(m) => m.frame::<M>(t_s),
+            AnyMotion::LegPaths(m) => m.frame::<M>(t_s),
             _ => Err(motion::Error::NonFinite("t_s")),
         }?;
         for (i, moves) in law.legs.iter().enumerate() {
