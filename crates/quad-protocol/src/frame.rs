@@ -172,6 +172,10 @@ impl<'b> CobsCrcSlice<'b> {
 impl<'b> Flavor for CobsCrcSlice<'b> {
     type Output = &'b [u8];
 
+    // Out of line: serde writes a message field by field, and each field's bytes come here; one
+    // copy of the CRC and COBS step serves them all instead of one inlined per field (on the
+    // AVR the inlined copies were most of the answer encoder's code).
+    #[inline(never)]
     fn try_push(&mut self, data: u8) -> postcard::Result<()> {
         self.crc = crc::update(self.crc, data);
         self.put(data)
