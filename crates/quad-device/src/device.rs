@@ -102,8 +102,9 @@ pub struct Device<O, C, S, M = DefaultMath> {
     engine: Engine<M>,
     /// The angles on the outputs while they are enabled.
     out_rad: [f32; 12],
-    /// When the next servo frame begins, ms.
-    next_frame_ms: u32,
+    /// When the next servo frame begins, ms (frames timed by the clock), or the PWM period of
+    /// the last frame (frames latched to the outputs' periods).
+    next_frame: u32,
     /// True until the first frame boundary after enabling.
     enabling_frame: bool,
     _math: PhantomData<fn() -> M>,
@@ -175,7 +176,7 @@ where
             last_framing_nack_ms: None,
             engine: Engine::new(limiter),
             out_rad: [0.0; 12],
-            next_frame_ms: now,
+            next_frame: now,
             enabling_frame: false,
             _math: PhantomData,
         })
@@ -282,19 +283,35 @@ where
     }
 
     /// One servo frame, when a frame boundary has passed: the engine's new target, then one
-    /// limiter step of the outputs toward the held target.
+    /// limiter step of the outputs toward the held target. The boundaries are the outputs' PWM
+    /// periods when they count them ([`ServoOutputs::periods_begun`]), else the clock's 20 ms.
     #[inline(never)]
     fn frame_tick(&mut self) {
         if !self.outputs_enabled {
             return;
         }
         let now = self.clock.now_ms();
-        let late_ms = now.wrapping_sub(self.next_frame_ms);
-        if late_ms > i32::MAX as u32 {
-            return; // Before the boundary.
-        }
-        let frames = 1 + late_ms / FRAME_MS;
-        self.next_frame_ms = self.next_frame_ms.wrapping_add(frames * FRAME_MS);
+        let frames = match self.outputs.periods_begun() {
+            // Latched to the PWM periods: one frame per period at most, and none while the last
+            // write waits for a period to show it.
+            Some(period) => {
+                let frames = period.wrapping_sub(self.next_frame);
+                if frames == 0 || self.outputs.write_pending() {
+                    return;
+                }
+                self.next_frame = period;
+                frames
+            }
+            None => {
+                let late_ms = now.wrapping_sub(self.next_frame);
+                if late_ms > i32::MAX as u32 {
+                    return; // Before the boundary.
+                }
+                let frames = 1 + late_ms / FRAME_MS;
+                self.next_frame = self.next_frame.wrapping_add(frames * FRAME_MS);
+                frames
+            }
+        };
         self.enabling_frame = false;
         let mut disable = false;
         if self.engine.is_active() {
@@ -754,7 +771,10 @@ where
             };
             self.out_rad = held.angles_rad;
             self.enabling_frame = true;
-            self.next_frame_ms = self.clock.now_ms().wrapping_add(FRAME_MS);
+            self.next_frame = match self.outputs.periods_begun() {
+                Some(period) => period,
+                None => self.clock.now_ms().wrapping_add(FRAME_MS),
+            };
         }
         if !self.write_out() {
             return Err(NackReason::InvalidArgument);
