@@ -720,33 +720,67 @@ impl<M: Math> Engine<M> {
         Ok(start)
     }
 
-    /// Builds a law motion and runs its start check; once it passes, the law goes into
-    /// `program`. Its first setpoint.
+    /// Builds a law motion into `program` and runs its start check there; a refusal leaves
+    /// `program` idle. Its first setpoint.
+    ///
+    /// Built first, checked after, each out of line: the check's deep calls (the body IK)
+    /// then start from a small stack frame, not from one that holds the builder's copies of
+    /// the motion's parameters.
     #[inline(never)]
     fn law(request: &Request, s: &Setup<'_>, program: &mut Program) -> Result<[f32; 12], Error> {
+        Self::build_law(request, s, program)?;
+        let checked = match program {
+            Program::Law(law) => Self::check_law(law, s),
+            _ => Err(Error::Busy),
+        };
+        if checked.is_err() {
+            *program = Program::Idle;
+        }
+        checked
+    }
+
+    #[inline(never)]
+    fn build_law(request: &Request, s: &Setup<'_>, program: &mut Program) -> Result<(), Error> {
         let (motion, legs, d) = law_motion::<M>(request, s)?;
         let period_s = motion.period_s().unwrap_or(1.0);
-        let law = Law {
+        *program = Program::Law(Law {
             motion,
             legs,
             stance_feet: s.robot.stance_feet(s.stance_height_m),
             period_s,
             end_frame: d.map(|d| frames_to_boundary(d, period_s).max(1)),
-        };
-        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(&law, 0.0), true)?;
+        });
+        Ok(())
+    }
+
+    #[inline(never)]
+    fn check_law(law: &Law, s: &Setup<'_>) -> Result<[f32; 12], Error> {
+        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(law, 0.0), true)?;
         let n = START_CHECK_SAMPLES;
         for k in 1..n {
-            let t = period_s * f32::from(k) / f32::from(n);
-            check_sample::<M>(s, k, t, Self::law_setpoint(&law, t), true)?;
+            let t = law.period_s * f32::from(k) / f32::from(n);
+            check_sample::<M>(s, k, t, Self::law_setpoint(law, t), true)?;
         }
-        *program = Program::Law(law);
         Ok(first)
     }
 
-    /// Builds a walk and runs its start check; once it passes, the walk goes into `program`.
-    /// Its first setpoint.
+    /// Builds a walk into `program` and runs its start check there (as [`Engine::law`]); a
+    /// refusal leaves `program` idle. Its first setpoint.
     #[inline(never)]
     fn walk(w: &WalkRequest, s: &Setup<'_>, program: &mut Program) -> Result<[f32; 12], Error> {
+        Self::build_walk(w, s, program)?;
+        let checked = match program {
+            Program::Walk { walker, .. } => Self::check_walk(walker, s),
+            _ => Err(Error::Busy),
+        };
+        if checked.is_err() {
+            *program = Program::Idle;
+        }
+        checked
+    }
+
+    #[inline(never)]
+    fn build_walk(w: &WalkRequest, s: &Setup<'_>, program: &mut Program) -> Result<(), Error> {
         if w.velocity_timeout_ms == 0 {
             return Err(motion::Error::NotPositive("velocity_timeout_ms").into());
         }
@@ -754,8 +788,17 @@ impl<M: Math> Engine<M> {
         p.step_height_m = w.step_height_m;
         p.cycle_s = w.cycle_s;
         p.order = s.order;
-        let walker = Walker::without_reach_check(p)?;
-        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(&walker), true)?;
+        *program = Program::Walk {
+            walker: Walker::without_reach_check(p)?,
+            timeout_ms: w.velocity_timeout_ms,
+            last_command_ms: s.now_ms,
+        };
+        Ok(())
+    }
+
+    #[inline(never)]
+    fn check_walk(walker: &Walker, s: &Setup<'_>) -> Result<[f32; 12], Error> {
+        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(walker), true)?;
         for k in 0..Walker::ENVELOPE_SAMPLES {
             let frame = Frame {
                 pose: Pose::default(),
@@ -767,11 +810,6 @@ impl<M: Math> Engine<M> {
             // singularity measure (see the module docs).
             check_sample::<M>(s, k as u16 + 1, 0.0, solved, false)?;
         }
-        *program = Program::Walk {
-            walker,
-            timeout_ms: w.velocity_timeout_ms,
-            last_command_ms: s.now_ms,
-        };
         Ok(first)
     }
 
