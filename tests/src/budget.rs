@@ -16,8 +16,8 @@ use quad_host::client::{Client, ClientConfig};
 use quad_host::emu::elf;
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::{
-    DeviceToHost, LegSet, LinkLossAction, LinkTimeout, MotionCommand, PoseConfig, Request,
-    ServoId, PROTOCOL_VERSION,
+    DeviceToHost, LegSet, LinkLossAction, LinkTimeout, MotionCommand, PoseConfig, Request, ServoId,
+    PROTOCOL_VERSION,
 };
 use std::fmt;
 use std::path::Path;

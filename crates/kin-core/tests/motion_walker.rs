@@ -193,7 +193,7 @@ fn bad_parameters_and_commands_are_refused_by_name() {
             Error::OutOfRange { parameter, .. } | Error::BeyondReach { parameter, .. } => parameter,
             other => panic!("{other:?}"),
         };
-        assert_eq!(named, name, "{e}");
+        assert_eq!(named.name(), name, "{e}");
     }
     let mut w = Walker::new(good).unwrap();
     let vmax = w.max_forward_m_s();
@@ -237,7 +237,7 @@ fn bad_parameters_and_commands_are_refused_by_name() {
     ] {
         match w.set_velocity::<DefaultMath>(v) {
             Err(Error::NonFinite(n)) | Err(Error::OutOfRange { parameter: n, .. }) => {
-                assert_eq!(n, name, "{v:?}")
+                assert_eq!(n.name(), name, "{v:?}")
             }
             other => panic!("{v:?}: {other:?}"),
         }

@@ -120,11 +120,11 @@ fn parameter(e: Error) -> &'static str {
             motion::Error::NonFinite(n)
             | motion::Error::NotPositive(n)
             | motion::Error::Negative(n),
-        ) => n,
+        ) => n.name(),
         Error::Parameter(
             motion::Error::OutOfRange { parameter, .. }
             | motion::Error::BeyondReach { parameter, .. },
-        ) => parameter,
+        ) => parameter.name(),
         other => panic!("not a parameter error: {other:?}"),
     }
 }

@@ -40,10 +40,10 @@ pub use frame::{
     decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 pub use msg::{
-    DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet,
-    LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage,
-    MotionStatus, NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback,
-    Request, RobotPreset, ServoId, Setting,
+    DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet, LinkLossAction,
+    LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
+    ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset, ServoId,
+    Setting,
 };
 pub use range::check_request;
 

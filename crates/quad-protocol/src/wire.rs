@@ -434,10 +434,10 @@ mod tests {
     use super::*;
     use crate::frame::{encode_frame, Accumulator, Feed, MAX_DECODED_LEN, MAX_FRAME_LEN};
     use crate::msg::{
-        DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet, LinkLossAction,
-        LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
-        ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset,
-        ServoId, Setting,
+        DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet,
+        LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage,
+        MotionStatus, NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback,
+        Request, RobotPreset, ServoId, Setting,
     };
     use crate::servo;
     use serde::de::DeserializeOwned;

@@ -23,6 +23,7 @@ use super::path::{AnyPath, FootPath, PathKind, Stride};
 use super::{
     check_reach, finite, fract01, non_negative, positive, Contact, Error, Frame, Motion, Phase,
 };
+use super::{Expected, Param};
 use crate::body::{BodyConfig, Pose};
 use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::robot::{LegId, Robot};
@@ -196,12 +197,11 @@ impl Gait {
         let zero = Pose::default();
         let d = p.duty_factor;
         let reach = |feet: &[Vec3; 4], name| check_reach(&p.robot, &zero, &cfg, feet, name);
-        reach(&gait.neutral, "stance_height_m")?;
-        let at =
-            |phase: f32| LegId::ALL.map(|leg| gait.foot_in_body::<DefaultMath>(leg, phase).0);
-        reach(&at(0.0), "velocity")?;
-        reach(&at(1.0 - 0.5 * d), "velocity")?;
-        reach(&at(0.5 * (1.0 - d)), "step_height_m")?;
+        reach(&gait.neutral, Param::StanceHeightM)?;
+        let at = |phase: f32| LegId::ALL.map(|leg| gait.foot_in_body::<DefaultMath>(leg, phase).0);
+        reach(&at(0.0), Param::Velocity)?;
+        reach(&at(1.0 - 0.5 * d), Param::Velocity)?;
+        reach(&at(0.5 * (1.0 - d)), Param::StepHeightM)?;
         Ok(gait)
     }
 
@@ -209,28 +209,28 @@ impl Gait {
     /// the reach itself through its own IK (a device's start check).
     pub fn without_reach_check(p: GaitParams) -> Result<Gait, Error> {
         p.robot.validate()?;
-        positive(p.stance_height_m, "stance_height_m")?;
-        positive(p.cycle_s, "cycle_s")?;
-        let d = finite(p.duty_factor, "duty_factor")?;
+        positive(p.stance_height_m, Param::StanceHeightM)?;
+        positive(p.cycle_s, Param::CycleS)?;
+        let d = finite(p.duty_factor, Param::DutyFactor)?;
         if !(d > 0.0 && d < 1.0) {
             return Err(Error::OutOfRange {
-                parameter: "duty_factor",
-                expected: "in (0, 1)",
+                parameter: Param::DutyFactor,
+                expected: Expected::OpenUnitInterval,
             });
         }
         for o in p.phase_offsets {
-            finite(o, "phase_offsets")?;
+            finite(o, Param::PhaseOffsets)?;
         }
-        non_negative(p.step_height_m, "step_height_m")?;
+        non_negative(p.step_height_m, Param::StepHeightM)?;
         if !(p.step_height_m < p.stance_height_m) {
             return Err(Error::OutOfRange {
-                parameter: "step_height_m",
-                expected: "below the stance height (a lifted foot stays below the hips)",
+                parameter: Param::StepHeightM,
+                expected: Expected::BelowStanceHeight,
             });
         }
-        finite(p.velocity.forward_m_s, "forward_m_s")?;
-        finite(p.velocity.lateral_m_s, "lateral_m_s")?;
-        finite(p.velocity.yaw_rad_s, "yaw_rad_s")?;
+        finite(p.velocity.forward_m_s, Param::ForwardMS)?;
+        finite(p.velocity.lateral_m_s, Param::LateralMS)?;
+        finite(p.velocity.yaw_rad_s, Param::YawRadS)?;
         Ok(Gait {
             p,
             neutral: p.robot.stance_feet(p.stance_height_m),
@@ -303,7 +303,7 @@ impl Motion for Gait {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         let body = self.displaced::<M>(t_s, Vec3::ZERO);
         let yaw = wrap_pi(self.p.velocity.yaw_rad_s * t_s);
         let (sn, cs) = M::sin_cos(yaw);

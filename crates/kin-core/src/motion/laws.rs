@@ -15,6 +15,7 @@ use super::{
     check_reach, finite, finite_vec, fract01, non_negative, positive, Contact, Error, Frame,
     Motion, Phase,
 };
+use super::{Expected, Param};
 use crate::body::{BodyConfig, Pose};
 use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::paper;
@@ -147,7 +148,7 @@ impl Sway {
             &s.pose_at(0.0),
             &cfg,
             &p.feet_in_world,
-            "feet_in_world",
+            Param::FeetInWorld,
         )?;
         for sign in [1.0, -1.0] {
             check_reach(
@@ -155,7 +156,7 @@ impl Sway {
                 &s.pose_at(sign * p.amplitude_rad),
                 &cfg,
                 &p.feet_in_world,
-                "amplitude_rad",
+                Param::AmplitudeRad,
             )?;
         }
         Ok(s)
@@ -166,13 +167,13 @@ impl Sway {
     /// check).
     pub fn without_reach_check(p: SwayParams) -> Result<Sway, Error> {
         p.robot.validate()?;
-        finite(p.amplitude_rad, "amplitude_rad")?;
-        positive(p.period_s, "period_s")?;
-        finite(p.roll0_rad, "roll0_rad")?;
-        finite(p.pitch0_rad, "pitch0_rad")?;
-        finite(p.yaw0_rad, "yaw0_rad")?;
+        finite(p.amplitude_rad, Param::AmplitudeRad)?;
+        positive(p.period_s, Param::PeriodS)?;
+        finite(p.roll0_rad, Param::Roll0Rad)?;
+        finite(p.pitch0_rad, Param::Pitch0Rad)?;
+        finite(p.yaw0_rad, Param::Yaw0Rad)?;
         for f in p.feet_in_world {
-            finite_vec(f, "feet_in_world")?;
+            finite_vec(f, Param::FeetInWorld)?;
         }
         Ok(Sway { p })
     }
@@ -209,7 +210,7 @@ impl Motion for Sway {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         Ok(Frame {
             pose: self.pose_at(self.offset_rad::<M>(t_s)),
             feet_in_world: self.p.feet_in_world,
@@ -302,11 +303,11 @@ impl YawTurn {
         let cfg = turn.body_config();
         let t1 = p.step_period_s;
         for (t, name) in [
-            (0.0, "stance_feet"),
-            (0.25 * t1, "lift_height_m"),
-            (0.75 * t1, "lift_height_m"),
-            (0.499 * t1, "omega_rad_s"),
-            (0.999 * t1, "omega_rad_s"),
+            (0.0, Param::StanceFeet),
+            (0.25 * t1, Param::LiftHeightM),
+            (0.75 * t1, Param::LiftHeightM),
+            (0.499 * t1, Param::OmegaRadS),
+            (0.999 * t1, Param::OmegaRadS),
         ] {
             let f = turn.frame::<DefaultMath>(t)?;
             check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
@@ -319,18 +320,18 @@ impl YawTurn {
     /// motion's frames through its own IK (a device's start check).
     pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
         p.robot.validate()?;
-        finite(p.omega_rad_s, "omega_rad_s")?;
-        positive(p.step_period_s, "step_period_s")?;
-        non_negative(p.lift_height_m, "lift_height_m")?;
-        finite(p.yaw0_rad, "yaw0_rad")?;
-        finite(p.roll0_rad, "roll0_rad")?;
-        finite(p.pitch0_rad, "pitch0_rad")?;
+        finite(p.omega_rad_s, Param::OmegaRadS)?;
+        positive(p.step_period_s, Param::StepPeriodS)?;
+        non_negative(p.lift_height_m, Param::LiftHeightM)?;
+        finite(p.yaw0_rad, Param::Yaw0Rad)?;
+        finite(p.roll0_rad, Param::Roll0Rad)?;
+        finite(p.pitch0_rad, Param::Pitch0Rad)?;
         for f in p.stance_feet {
-            finite_vec(f, "stance_feet")?;
+            finite_vec(f, Param::StanceFeet)?;
             if !(f.z + p.lift_height_m < 0.0) {
                 return Err(Error::OutOfRange {
-                    parameter: "lift_height_m",
-                    expected: "below the stance height (a lifted foot stays below the hips)",
+                    parameter: Param::LiftHeightM,
+                    expected: Expected::BelowStanceHeight,
                 });
             }
         }
@@ -401,7 +402,7 @@ impl Motion for YawTurn {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         let p = &self.p;
         let t1 = p.step_period_s;
         let (k, tau) = self.split(t_s);
@@ -502,7 +503,7 @@ impl LegPaths {
             let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
             let feet = LegId::ALL
                 .map(|leg| p.stance_feet[leg.index()] + p.path.offset::<DefaultMath>(phase));
-            check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
+            check_reach(&p.robot, &Pose::default(), &cfg, &feet, Param::Path)?;
         }
         Ok(lp)
     }
@@ -512,12 +513,12 @@ impl LegPaths {
     /// check).
     pub fn without_reach_check(p: LegPathsParams) -> Result<LegPaths, Error> {
         p.robot.validate()?;
-        positive(p.cycle_s, "cycle_s")?;
+        positive(p.cycle_s, Param::CycleS)?;
         for o in p.phase_offsets {
-            finite(o, "phase_offsets")?;
+            finite(o, Param::PhaseOffsets)?;
         }
         for f in p.stance_feet {
-            finite_vec(f, "stance_feet")?;
+            finite_vec(f, Param::StanceFeet)?;
         }
         Ok(LegPaths { p })
     }
@@ -538,7 +539,7 @@ impl Motion for LegPaths {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         let base = fract01(t_s / self.p.cycle_s);
         let mut feet = self.p.stance_feet;
         let mut contact = [Contact::Stance; 4];

@@ -42,7 +42,9 @@
 
 use super::gait::{displace, swing_foot, Gait, GaitParams, Pattern, Velocity};
 use super::path::PathKind;
-use super::{check_reach, finite, fract01, positive, Contact, Error, Frame, Phase};
+use super::{
+    check_reach, finite, fract01, positive, Contact, Error, Expected, Frame, Param, Phase,
+};
 use crate::body::{BodyConfig, Pose};
 use crate::math::Math;
 use crate::robot::{LegId, Robot};
@@ -152,7 +154,7 @@ impl Walker {
                 &Pose::default(),
                 &cfg,
                 &walker.envelope(k),
-                "reach_radius_m",
+                Param::ReachRadiusM,
             )?;
         }
         Ok(walker)
@@ -163,7 +165,7 @@ impl Walker {
     /// start check).
     pub fn without_reach_check(p: WalkerParams) -> Result<Walker, Error> {
         let gait = Gait::without_reach_check(p.gait_params(Velocity::default()))?;
-        positive(p.reach_radius_m, "reach_radius_m")?;
+        positive(p.reach_radius_m, Param::ReachRadiusM)?;
         let neutral = gait.neutral_feet();
         let leg = |n: Vec3| Leg {
             foot: n,
@@ -262,15 +264,15 @@ impl Walker {
     /// within the stride disc (module docs). A component that is too large on its own is named
     /// (`forward_m_s`, `lateral_m_s`, `yaw_rad_s`); a combination that is, `velocity`.
     pub fn check_velocity<M: Math>(&self, v: &Velocity) -> Result<(), Error> {
-        finite(v.forward_m_s, "forward_m_s")?;
-        finite(v.lateral_m_s, "lateral_m_s")?;
-        finite(v.yaw_rad_s, "yaw_rad_s")?;
-        const EXPECTED: &str = "within the gait's reach (footholds inside the stride disc)";
+        finite(v.forward_m_s, Param::ForwardMS)?;
+        finite(v.lateral_m_s, Param::LateralMS)?;
+        finite(v.yaw_rad_s, Param::YawRadS)?;
+        const EXPECTED: Expected = Expected::WithinGaitReach;
         let stance_s = self.p.duty_factor * self.p.cycle_s;
         if !(libm::fabsf(v.yaw_rad_s) * stance_s <= core::f32::consts::PI) {
             return Err(Error::OutOfRange {
-                parameter: "yaw_rad_s",
-                expected: "at most half a turn per stance (|ω|·d·T ≤ π)",
+                parameter: Param::YawRadS,
+                expected: Expected::HalfTurnPerStance,
             });
         }
         let limit = self.p.reach_radius_m / self.overshoot_factor();
@@ -281,23 +283,23 @@ impl Walker {
                     forward_m_s: v.forward_m_s,
                     ..zero
                 },
-                "forward_m_s",
+                Param::ForwardMS,
             ),
             (
                 Velocity {
                     lateral_m_s: v.lateral_m_s,
                     ..zero
                 },
-                "lateral_m_s",
+                Param::LateralMS,
             ),
             (
                 Velocity {
                     yaw_rad_s: v.yaw_rad_s,
                     ..zero
                 },
-                "yaw_rad_s",
+                Param::YawRadS,
             ),
-            (*v, "velocity"),
+            (*v, Param::Velocity),
         ] {
             if !(self.excursion_m::<M>(&single) <= limit) {
                 return Err(Error::OutOfRange {
@@ -387,7 +389,7 @@ impl Walker {
     /// Advances by `dt_s` (> 0, less than the shorter of swing and stance; one servo frame) on
     /// math backend `M`. A non-finite or non-positive `dt_s` is refused and changes nothing.
     pub fn step<M: Math>(&mut self, dt_s: f32) -> Result<(), Error> {
-        positive(dt_s, "dt_s")?;
+        positive(dt_s, Param::DtS)?;
         let old = self.phase;
         let new = fract01(old + dt_s / self.p.cycle_s);
         // Stance feet within R/f: a swing from there overshoots by at most the factor.

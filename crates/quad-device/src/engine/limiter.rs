@@ -26,12 +26,12 @@ impl Limiter {
     pub fn new(speed_rad_s: f32) -> Result<Limiter, Error> {
         if !speed_rad_s.is_finite() {
             return Err(Error::Parameter(motion::Error::NonFinite(
-                "joint_speed_limit_rad_s",
+                motion::Param::JointSpeedLimitRadS,
             )));
         }
         if !(speed_rad_s > 0.0) {
             return Err(Error::Parameter(motion::Error::NotPositive(
-                "joint_speed_limit_rad_s",
+                motion::Param::JointSpeedLimitRadS,
             )));
         }
         Ok(Limiter {

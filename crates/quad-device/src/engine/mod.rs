@@ -90,7 +90,7 @@ use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
 use kin_core::motion::path::{AnyPath, PathKind, Stride};
 use kin_core::motion::walker::{Walker, WalkerParams};
-use kin_core::motion::{self, AnyMotion, Frame, Motion};
+use kin_core::motion::{self, AnyMotion, Frame, Motion, Param};
 use kin_core::preflight::{Failure, FailureKind};
 use kin_core::{
     leg, IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3,
@@ -564,7 +564,7 @@ fn law_motion<M: Math>(
         } => {
             let d = duration(duration_s)?;
             if !yaw_rate_rad_s.is_finite() {
-                return Err(motion::Error::NonFinite("yaw_rate_rad_s").into());
+                return Err(motion::Error::NonFinite(Param::YawRateRadS).into());
             }
             let turn = laws::YawTurn::without_reach_check::<M>(laws::YawTurnParams {
                 robot,
@@ -624,8 +624,8 @@ fn frames_to_boundary(t_s: f32, period_s: f32) -> u32 {
 fn duration(d: Option<f32>) -> Result<Option<f32>, Error> {
     match d {
         None => Ok(None),
-        Some(d) if !d.is_finite() => Err(motion::Error::NonFinite("duration_s").into()),
-        Some(d) if !(d > 0.0) => Err(motion::Error::NotPositive("duration_s").into()),
+        Some(d) if !d.is_finite() => Err(motion::Error::NonFinite(Param::DurationS).into()),
+        Some(d) if !(d > 0.0) => Err(motion::Error::NotPositive(Param::DurationS).into()),
         Some(d) => Ok(Some(d)),
     }
 }
@@ -782,7 +782,7 @@ impl<M: Math> Engine<M> {
     #[inline(never)]
     fn build_walk(w: &WalkRequest, s: &Setup<'_>, program: &mut Program) -> Result<(), Error> {
         if w.velocity_timeout_ms == 0 {
-            return Err(motion::Error::NotPositive("velocity_timeout_ms").into());
+            return Err(motion::Error::NotPositive(Param::VelocityTimeoutMs).into());
         }
         let mut p = WalkerParams::new(w.pattern, *s.robot, w.body_height_m);
         p.step_height_m = w.step_height_m;
@@ -823,7 +823,7 @@ impl<M: Math> Engine<M> {
             AnyMotion::Sway(m) => m.frame::<M>(t_s),
             AnyMotion::YawTurn(m) => m.frame::<M>(t_s),
             AnyMotion::LegPaths(m) => m.frame::<M>(t_s),
-            _ => Err(motion::Error::NonFinite("t_s")),
+            _ => Err(motion::Error::NonFinite(Param::TS)),
         }?;
         for (i, moves) in law.legs.iter().enumerate() {
             if !moves {

@@ -155,31 +155,32 @@ impl From<Status> for MotionStatus {
     }
 }
 
-/// The wire name of a kin-core or engine parameter name (the names their errors carry).
-pub fn motion_param(name: &str) -> MotionParam {
-    match name {
-        "amplitude_rad" => MotionParam::AmplitudeRad,
-        "period_s" => MotionParam::PeriodS,
-        "duration_s" => MotionParam::DurationS,
+/// The wire name of a kin-core or engine parameter.
+pub fn motion_param(param: motion::Param) -> MotionParam {
+    use motion::Param as P;
+    match param {
+        P::AmplitudeRad => MotionParam::AmplitudeRad,
+        P::PeriodS => MotionParam::PeriodS,
+        P::DurationS => MotionParam::DurationS,
         // kin-core's yaw turn names seed 001's ω_z; the velocity command its yaw rate.
-        "yaw_rate_rad_s" | "omega_rad_s" | "yaw_rad_s" => MotionParam::YawRateRadS,
-        "step_period_s" => MotionParam::StepPeriodS,
-        "lift_height_m" => MotionParam::LiftHeightM,
-        "stride_m" => MotionParam::StrideM,
-        "step_height_m" => MotionParam::StepHeightM,
-        "duty_factor" => MotionParam::DutyFactor,
-        "cycle_s" => MotionParam::CycleS,
-        "path" => MotionParam::Path,
+        P::YawRateRadS | P::OmegaRadS | P::YawRadS => MotionParam::YawRateRadS,
+        P::StepPeriodS => MotionParam::StepPeriodS,
+        P::LiftHeightM => MotionParam::LiftHeightM,
+        P::StrideM => MotionParam::StrideM,
+        P::StepHeightM => MotionParam::StepHeightM,
+        P::DutyFactor => MotionParam::DutyFactor,
+        P::CycleS => MotionParam::CycleS,
+        P::Path => MotionParam::Path,
         // A walk's body height is its gait's stance height.
-        "stance_height_m" => MotionParam::BodyHeightM,
-        "velocity_timeout_ms" => MotionParam::VelocityTimeoutMs,
-        "forward_m_s" => MotionParam::ForwardMS,
-        "lateral_m_s" => MotionParam::LateralMS,
-        "velocity" => MotionParam::Velocity,
-        "joint_speed_limit_rad_s" => MotionParam::JointSpeedLimitRadS,
+        P::StanceHeightM => MotionParam::BodyHeightM,
+        P::VelocityTimeoutMs => MotionParam::VelocityTimeoutMs,
+        P::ForwardMS => MotionParam::ForwardMS,
+        P::LateralMS => MotionParam::LateralMS,
+        P::Velocity => MotionParam::Velocity,
+        P::JointSpeedLimitRadS => MotionParam::JointSpeedLimitRadS,
         // The feet a law starts from: the device's stance.
-        "feet_in_world" | "stance_feet" => MotionParam::Stance,
-        "reach_radius_m" => MotionParam::ReachRadiusM,
+        P::FeetInWorld | P::StanceFeet => MotionParam::Stance,
+        P::ReachRadiusM => MotionParam::ReachRadiusM,
         _ => MotionParam::Other,
     }
 }
@@ -197,7 +198,7 @@ fn reach_fault(u: Unreachable) -> PreflightFault {
 
 impl From<Error> for NackReason {
     fn from(e: Error) -> NackReason {
-        let invalid = |name: &str, problem| NackReason::InvalidParameter {
+        let invalid = |name: motion::Param, problem| NackReason::InvalidParameter {
             param: motion_param(name),
             problem,
         };

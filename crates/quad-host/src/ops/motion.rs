@@ -201,9 +201,9 @@ pub fn param_err(e: motion::Error) -> Error {
     let name = match e {
         motion::Error::NonFinite(p)
         | motion::Error::NotPositive(p)
-        | motion::Error::Negative(p) => Some(p),
+        | motion::Error::Negative(p) => Some(p.name()),
         motion::Error::OutOfRange { parameter, .. }
-        | motion::Error::BeyondReach { parameter, .. } => Some(parameter),
+        | motion::Error::BeyondReach { parameter, .. } => Some(parameter.name()),
         _ => None,
     };
     Error::Parameter {
@@ -297,10 +297,14 @@ impl Params {
         match self.stance_height_m.or(default_height_m) {
             Some(h) => {
                 if !h.is_finite() {
-                    return Err(param_err(motion::Error::NonFinite("stance_height_m")));
+                    return Err(param_err(motion::Error::NonFinite(
+                        motion::Param::StanceHeightM,
+                    )));
                 }
                 if h <= 0.0 {
-                    return Err(param_err(motion::Error::NotPositive("stance_height_m")));
+                    return Err(param_err(motion::Error::NotPositive(
+                        motion::Param::StanceHeightM,
+                    )));
                 }
                 Ok(robot.stance_feet(h))
             }
@@ -414,7 +418,7 @@ impl Params {
 pub fn sweep(duration_s: f32, rate_hz: f32) -> Result<Sweep, Error> {
     Sweep::new(0.0, duration_s, rate_hz).map_err(|e| match e {
         motion::Error::OutOfRange {
-            parameter: "duration_s",
+            parameter: motion::Param::DurationS,
             ..
         } if duration_s.is_finite() && rate_hz.is_finite() => {
             let max = MAX_SWEEP_SAMPLES as f32;

@@ -10,9 +10,9 @@ use kin_core::motion::path::PathKind;
 use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 use quad_protocol::{
     servo, DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet,
-    LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage,
-    MotionStatus, NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback,
-    Request, RobotPreset, ServoId, Setting,
+    LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus,
+    NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request,
+    RobotPreset, ServoId, Setting,
 };
 
 pub fn h2d(seq: u16, request: Request) -> HostToDevice {
