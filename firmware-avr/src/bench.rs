@@ -19,8 +19,8 @@
 //! | one servo frame of it | `N` | `n`, status u8, stage u8 |
 //!
 //! Motions of `M` ([`EngineBench`]): 0 = trot at a forward speed and yaw rate within the
-//! gait's reach, 1 = seed 001's roll sway, 2 = seed 001's yaw turn, 3 = seed 000's rectangle on
-//! all four legs; each starts from the stance of [`quad_device::Config::shahriar2023`] (the
+//! gait's reach, 1 = seed 001's roll sway, 2 = seed 001's yaw turn (its rate and period, a lift
+//! this robot reaches), 3 = seed 000's rectangle on all four legs; each starts from the stance of [`quad_device::Config::shahriar2023`] (the
 //! firmware's configuration) and its approach ramp is run before the timed frames. A timed
 //! frame is what `Device::poll` does at a servo frame boundary: the engine's tick (the motion
 //! and its body IK), the limiter step of the twelve outputs and their calibrated pulses.
@@ -32,7 +32,7 @@
 
 use crate::pac;
 use crate::usart::Usart0;
-use kin_core::motion::gait::{Pattern, Velocity};
+use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::Axis;
 use kin_core::{body, leg, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
 use quad_device::engine::{self, Engine, Limiter, Request, Setup, Stage, WalkRequest, FRAME_MS};
@@ -198,7 +198,21 @@ impl<M: Math> MotionBench for EngineBench<M> {
         let request = match motion {
             0 => Request::Walk(WalkRequest::new(Pattern::Trot, h)),
             1 => Request::seed001_sway(Axis::Roll, None),
-            2 => Request::seed001_yaw_turn(None),
+            // Seed 001's rate and period with a lift that this robot reaches (the paper's
+            // 0.3 m is for its own, larger robot).
+            2 => match Request::seed001_yaw_turn(None) {
+                Request::YawTurn {
+                    yaw_rate_rad_s,
+                    step_period_s,
+                    ..
+                } => Request::YawTurn {
+                    yaw_rate_rad_s,
+                    step_period_s,
+                    lift_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * h,
+                    duration_s: None,
+                },
+                other => other,
+            },
             3 => Request::seed000_rectangle(None, None),
             _ => return STATUS_UNKNOWN_BACKEND,
         };

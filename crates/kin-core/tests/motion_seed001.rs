@@ -421,8 +421,8 @@ fn bad_parameters_are_named() {
     p.step_period_s = -6.0;
     assert_eq!(YawTurn::new(p), Err(Error::NotPositive(Param::StepPeriodS)));
     let mut p = YawTurnParams::seed001();
-    p.omega_rad_s = f32::NAN;
-    assert_eq!(YawTurn::new(p), Err(Error::NonFinite(Param::OmegaRadS)));
+    p.yaw_rate_rad_s = f32::NAN;
+    assert_eq!(YawTurn::new(p), Err(Error::NonFinite(Param::YawRateRadS)));
     let mut p = YawTurnParams::seed001();
     p.lift_height_m = 1.0;
     assert!(matches!(

@@ -223,15 +223,18 @@ impl Motion for Sway {
     }
 }
 
-/// Parameters of seed 001's yaw turn (eq. 9–11): `ψ(t) = ψ0 − ω_z·t` about the fixed body
+/// Parameters of seed 001's yaw turn (eq. 9–11): `ψ(t) = ψ0 + r·t` about the fixed body
 /// centre, the crossed pairs (FL, RR) and (FR, RL) stepping alternately along the circles of
-/// their feet.
+/// their feet. The yaw rate `r` counts counter-clockwise seen from above as positive (REP 103,
+/// as the gaits' velocity command does); the paper's `ω_z` (eq. 9, `ψ = ψ0 − ω_z·t`) counts
+/// clockwise: `r = −ω_z` (`docs/papers.md`, seed 001 errata).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawTurnParams {
     /// The robot.
     pub robot: Robot,
-    /// `ω_z`, rad/s; positive turns clockwise seen from above (ψ decreases, eq. 9).
-    pub omega_rad_s: f32,
+    /// Yaw rate `r = −ω_z`, rad/s; positive turns counter-clockwise seen from above (ψ
+    /// increases).
+    pub yaw_rate_rad_s: f32,
     /// Step period `T1` (one full cycle of both pairs), s.
     pub step_period_s: f32,
     /// Lift height `h_K` of the half-wave sine, m.
@@ -250,13 +253,14 @@ pub struct YawTurnParams {
 }
 
 impl YawTurnParams {
-    /// Seed 001's values: [`Robot::fernando2025`], ω_z = 0.085 rad/s, T1 = 6 s, h_K = 0.3 m,
+    /// Seed 001's values: [`Robot::fernando2025`], ω_z = 0.085 rad/s (clockwise: a yaw rate of
+    /// −0.085 rad/s), T1 = 6 s, h_K = 0.3 m,
     /// ψ0 = θ0 = γ0 = 0, order `zxy`, feet at [`seed001_stance`].
     pub fn seed001() -> YawTurnParams {
         let robot = Robot::fernando2025();
         YawTurnParams {
             robot,
-            omega_rad_s: 0.085,
+            yaw_rate_rad_s: -0.085,
             step_period_s: 6.0,
             lift_height_m: 0.3,
             yaw0_rad: 0.0,
@@ -279,13 +283,13 @@ pub const fn in_pair_13(leg: LegId) -> bool {
 /// With `τ = t mod T1` and `k = ⌊t/T1⌋`:
 /// - `Δ13 = k·T1 + (2τ if τ < T1/2 else T1)`, `Δ24 = k·T1 + (0 if τ < T1/2 else 2(τ − T1/2))`
 ///   (eq. 11 with a floored `mod`);
-/// - foot `i` at `ρ_i·(cos a_i, sin a_i)` with `a_i = α_i + ψ0 − ω_z·Δ_i` and
+/// - foot `i` at `ρ_i·(cos a_i, sin a_i)` with `a_i = α_i + ψ0 + r·Δ_i` (`r = −ω_z`) and
 ///   `α_i = atan2(y_i, x_i)` of its stance position (eq. 10 corrected: atan2, cos/sin, sign);
 /// - lift `h_K·max(0, sin(2πt/T1))` for (FL, RR) and `h_K·max(0, −sin(2πt/T1))` for (FR, RL)
 ///   above the stance height (eq. 10's half-wave).
 ///
-/// A stance foot stays fixed while the body turns by `ω_z·T1/2`; a swing foot moves by
-/// `ω_z·T1` along its circle in `T1/2`. The joint angles repeat with period `T1`.
+/// A stance foot stays fixed while the body turns by `r·T1/2`; a swing foot moves by
+/// `r·T1` along its circle in `T1/2`. The joint angles repeat with period `T1`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawTurn {
     p: YawTurnParams,
@@ -306,8 +310,8 @@ impl YawTurn {
             (0.0, Param::StanceFeet),
             (0.25 * t1, Param::LiftHeightM),
             (0.75 * t1, Param::LiftHeightM),
-            (0.499 * t1, Param::OmegaRadS),
-            (0.999 * t1, Param::OmegaRadS),
+            (0.499 * t1, Param::YawRateRadS),
+            (0.999 * t1, Param::YawRateRadS),
         ] {
             let f = turn.frame::<DefaultMath>(t)?;
             check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
@@ -320,7 +324,7 @@ impl YawTurn {
     /// motion's frames through its own IK (a device's start check).
     pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
         p.robot.validate()?;
-        finite(p.omega_rad_s, Param::OmegaRadS)?;
+        finite(p.yaw_rate_rad_s, Param::YawRateRadS)?;
         positive(p.step_period_s, Param::StepPeriodS)?;
         non_negative(p.lift_height_m, Param::LiftHeightM)?;
         finite(p.yaw0_rad, Param::Yaw0Rad)?;
@@ -407,8 +411,8 @@ impl Motion for YawTurn {
         let t1 = p.step_period_s;
         let (k, tau) = self.split(t_s);
         // Yaw at the start of this step period, wrapped once so that body and feet share it.
-        let base = wrap_pi(p.yaw0_rad - p.omega_rad_s * (k * t1));
-        let yaw = wrap_pi(base - p.omega_rad_s * tau);
+        let base = wrap_pi(p.yaw0_rad + p.yaw_rate_rad_s * (k * t1));
+        let yaw = wrap_pi(base + p.yaw_rate_rad_s * tau);
         let (d13, d24) = Self::local_deltas(t1, tau);
         let first_half = tau < 0.5 * t1;
         let wave = M::sin_cos(2.0 * PI * (tau / t1)).0;
@@ -427,7 +431,7 @@ impl Motion for YawTurn {
             } else {
                 (d24, lift24, !first_half)
             };
-            let a = self.alpha_rad[i] + base - p.omega_rad_s * delta;
+            let a = self.alpha_rad[i] + base + p.yaw_rate_rad_s * delta;
             let (s, c) = M::sin_cos(a);
             feet[i] = Vec3::new(
                 self.rho_m[i] * c,

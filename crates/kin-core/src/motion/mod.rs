@@ -63,8 +63,6 @@ pub enum Param {
     StanceFeet,
     /// `feet_in_world`: The feet in the world frame, m.
     FeetInWorld,
-    /// `omega_rad_s`: The yaw turn rate ω_z, rad/s.
-    OmegaRadS,
     /// `lift_height_m`: The lift height h_K of a yaw turn, m.
     LiftHeightM,
     /// `yaw0_rad`: The initial yaw, rad.
@@ -103,7 +101,7 @@ pub enum Param {
     Parked,
     /// `max_joint_speed_rad_s`: The highest joint speed of a sweep, rad/s.
     MaxJointSpeedRadS,
-    /// `yaw_rate_rad_s`: A yaw rate of a device motion request, rad/s (counter-clockwise positive).
+    /// `yaw_rate_rad_s`: The yaw rate of a yaw turn, rad/s (counter-clockwise positive).
     YawRateRadS,
     /// `velocity_timeout_ms`: A walk's velocity command timeout, ms.
     VelocityTimeoutMs,
@@ -125,7 +123,6 @@ impl Param {
             Param::StepHeightM => "step_height_m",
             Param::StanceFeet => "stance_feet",
             Param::FeetInWorld => "feet_in_world",
-            Param::OmegaRadS => "omega_rad_s",
             Param::LiftHeightM => "lift_height_m",
             Param::Yaw0Rad => "yaw0_rad",
             Param::Roll0Rad => "roll0_rad",

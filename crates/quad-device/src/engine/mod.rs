@@ -37,7 +37,7 @@
 //!   the same and then stops the outputs.
 //! - [`Request::Sway`]: seed 001's roll or pitch sway (eq. 6–8), [`Request::YawTurn`]: its yaw
 //!   turn with the crossed pairs (eq. 9–11 as corrected in `docs/papers.md`), with the yaw rate
-//!   counter-clockwise positive (REP 103; kin-core's `omega_rad_s` is its negation),
+//!   counter-clockwise positive (REP 103, as in kin-core and the walk's velocity command),
 //!   [`Request::FootPath`]: a seed 000 foot path on one leg or all four under a held body. They
 //!   run for their duration rounded up to whole periods, or until [`Engine::stop`]: a stop or
 //!   the end takes effect at the next period boundary, where the joints are back at their start.
@@ -251,7 +251,7 @@ impl Request {
     pub fn seed001_yaw_turn(duration_s: Option<f32>) -> Request {
         let p = laws::YawTurnParams::seed001();
         Request::YawTurn {
-            yaw_rate_rad_s: -p.omega_rad_s,
+            yaw_rate_rad_s: p.yaw_rate_rad_s,
             step_period_s: p.step_period_s,
             lift_height_m: p.lift_height_m,
             duration_s,
@@ -563,13 +563,9 @@ fn law_motion<M: Math>(
             duration_s,
         } => {
             let d = duration(duration_s)?;
-            if !yaw_rate_rad_s.is_finite() {
-                return Err(motion::Error::NonFinite(Param::YawRateRadS).into());
-            }
             let turn = laws::YawTurn::without_reach_check::<M>(laws::YawTurnParams {
                 robot,
-                // Seed 001's ω_z turns clockwise (eq. 9).
-                omega_rad_s: -yaw_rate_rad_s,
+                yaw_rate_rad_s,
                 step_period_s,
                 lift_height_m,
                 yaw0_rad: 0.0,

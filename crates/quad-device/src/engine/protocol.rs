@@ -162,8 +162,8 @@ pub fn motion_param(param: motion::Param) -> MotionParam {
         P::AmplitudeRad => MotionParam::AmplitudeRad,
         P::PeriodS => MotionParam::PeriodS,
         P::DurationS => MotionParam::DurationS,
-        // kin-core's yaw turn names seed 001's ω_z; the velocity command its yaw rate.
-        P::YawRateRadS | P::OmegaRadS | P::YawRadS => MotionParam::YawRateRadS,
+        // The yaw turn's rate and the velocity command's: both counter-clockwise positive.
+        P::YawRateRadS | P::YawRadS => MotionParam::YawRateRadS,
         P::StepPeriodS => MotionParam::StepPeriodS,
         P::LiftHeightM => MotionParam::LiftHeightM,
         P::StrideM => MotionParam::StrideM,

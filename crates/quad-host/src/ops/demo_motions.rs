@@ -136,9 +136,7 @@ fn host_law_angles(
             ..
         } => laws::YawTurn::new(laws::YawTurnParams {
             robot: *robot,
-            // kin-core's ω_z counts clockwise (seed 001 eq. 9); the protocol's rate
-            // counter-clockwise.
-            omega_rad_s: -yaw_rate_rad_s,
+            yaw_rate_rad_s,
             step_period_s,
             lift_height_m,
             yaw0_rad: 0.0,

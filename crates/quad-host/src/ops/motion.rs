@@ -103,8 +103,8 @@ pub struct Params {
     pub amplitude_rad: Option<f32>,
     /// Sways: period T, s.
     pub period_s: Option<f32>,
-    /// yaw-turn: ω_z, rad/s.
-    pub omega_rad_s: Option<f32>,
+    /// yaw-turn: yaw rate, rad/s (counter-clockwise positive).
+    pub yaw_rate_rad_s: Option<f32>,
     /// yaw-turn: step period T1, s.
     pub step_period_s: Option<f32>,
     /// yaw-turn: lift height h_K, m.
@@ -219,7 +219,7 @@ impl Params {
             ("--stance-height-m", self.stance_height_m.is_some()),
             ("--amplitude-rad", self.amplitude_rad.is_some()),
             ("--period-s", self.period_s.is_some()),
-            ("--omega-rad-s", self.omega_rad_s.is_some()),
+            ("--yaw-rate-rad-s", self.yaw_rate_rad_s.is_some()),
             ("--step-period-s", self.step_period_s.is_some()),
             ("--lift-height-m", self.lift_height_m.is_some()),
             ("--path", self.path.is_some()),
@@ -245,8 +245,8 @@ impl Params {
             ("--amplitude-rad", self.amplitude_rad.is_some(), sway),
             ("--period-s", self.period_s.is_some(), sway),
             (
-                "--omega-rad-s",
-                self.omega_rad_s.is_some(),
+                "--yaw-rate-rad-s",
+                self.yaw_rate_rad_s.is_some(),
                 law == Law::YawTurn,
             ),
             (
@@ -343,8 +343,8 @@ impl Params {
                 p.robot = robot;
                 p.stance_feet = self.stance(&robot, None)?;
                 p.order = order(RotationOrder::Zxy);
-                if let Some(v) = self.omega_rad_s {
-                    p.omega_rad_s = v;
+                if let Some(v) = self.yaw_rate_rad_s {
+                    p.yaw_rate_rad_s = v;
                 }
                 if let Some(v) = self.step_period_s {
                     p.step_period_s = v;
