@@ -8,7 +8,7 @@ use crate::client::{
     AVR_ANGLE_TOLERANCE_RAD, DEFAULT_RETRIES,
 };
 use crate::emu::{build, elf};
-use crate::link::emulator::EmulatorConfig;
+use crate::link::emulator::{EmulatorConfig, PulseStats};
 use crate::link::{self, Link, Target};
 use kin_core::motion::laws::{Axis, Sway, SwayParams};
 use kin_core::motion::Motion;
@@ -283,6 +283,14 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
         }
     })?;
     let info = *stream.info();
+    // The sweeps' pin check: the readbacks explain every pulse of the sweeps. During the
+    // onboard motions the device moves its outputs at every frame between answers; their pins
+    // are checked against the host's kin-core by the motions' own check.
+    let sweep_pins = stream
+        .client_mut()
+        .link_mut()
+        .emulator()
+        .map(|link| link.pulse_stats());
     let mut motions = None;
     if args.motions {
         writeln!(log, "quadctl demo: the device's own motions")?;
@@ -297,37 +305,56 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
         motions = Some(legs);
         return finish(
             session.client_mut(),
-            summary,
+            Sweeps {
+                summary,
+                pins: sweep_pins,
+                mismatches,
+            },
             info,
             wall,
-            mismatches,
             motions,
         );
     }
     finish(
         stream.client_mut(),
-        summary,
+        Sweeps {
+            summary,
+            pins: sweep_pins,
+            mismatches,
+        },
         info,
         wall,
-        mismatches,
         motions,
     )
+}
+
+/// What the pose sweeps gave: the stream's summary, the pin check at their end and the
+/// readback mismatches.
+struct Sweeps {
+    summary: Summary,
+    pins: Option<PulseStats>,
+    mismatches: Vec<(usize, Mismatch)>,
 }
 
 /// The pin statistics and the MCU of an emulated run, and the result.
 fn finish<L: Link>(
     client: &mut Client<L>,
-    mut summary: Summary,
+    sweeps: Sweeps,
     info: DeviceInfo,
     wall: Instant,
-    mismatches: Vec<(usize, Mismatch)>,
     motions: Option<Vec<crate::ops::demo_motions::Leg>>,
 ) -> Result<Demo, Error> {
-    let mcu = client.link_mut().emulator().map(|link| {
-        let pulses = link.pulse_stats();
+    let Sweeps {
+        mut summary,
+        pins,
+        mismatches,
+    } = sweeps;
+    if let Some(pulses) = pins {
         summary.pulses_checked = Some(pulses.checked);
         summary.pulse_width_errors = Some(pulses.errors);
         summary.first_pulse_error = pulses.first_error;
+    }
+    let mcu = client.link_mut().emulator().map(|link| {
         summary.rx_overruns = Some(link.rx_overruns());
         Mcu {
             resets: link.mcu().resets().count,
