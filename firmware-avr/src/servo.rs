@@ -30,12 +30,14 @@
 //! **Whole poses per period, without waiting.** The four timers are started together (the
 //! synchronous prescaler reset of GTCCR) and run in lockstep. [`Servos::set_all_pulse_ticks`],
 //! [`Servos::enable`] and [`Servos::disable`] stage the outputs' next state and return; the
-//! state is written (all twelve compare registers, then the compare-unit connections) between
-//! the end of the longest pulse and the last [`WRITE_GUARD_TICKS`] of a period — at once when
-//! the call falls there, else by the Timer2 millisecond interrupt ([`on_tick`]) at the first
-//! tick that does. Every period thus shows either the old or the new widths on all twelve
-//! pins, never a mix; switching never cuts a pulse short or starts one late; the main loop never
-//! waits for the window and no interrupts-off stretch is needed.
+//! state is written (per timer: its three compare registers, then its compare-unit
+//! connections) between the end of the longest pulse and the last [`WRITE_GUARD_TICKS`] of a
+//! period — at once when the call falls there, else by the Timer2 millisecond interrupt
+//! ([`on_tick`]) at the first tick that does. Each timer's check of its count and its writes
+//! form one short interrupts-off stretch (a few dozen cycles), so no interrupt can carry a
+//! write past the window: switching never cuts a pulse short or starts one late. An apply
+//! begins only with a millisecond of the window left, so every period shows either the old or
+//! the new widths on all twelve pins; the main loop never waits for the window.
 
 use crate::pac;
 use core::cell::{Cell, UnsafeCell};
@@ -54,10 +56,14 @@ pub const TICKS_PER_US: u16 = 2;
 /// Period of the servo signal, µs.
 pub const PERIOD_US: u32 = 20_000;
 
-/// Ticks at the end of each period in which the compare registers are not written: the writes
-/// after the window check, plus the interrupts that may come between them, plus timers that
-/// are a few ticks apart (as in simulators that ignore GTCCR).
+/// Ticks at the end of each period in which the compare registers are not written: one timer's
+/// writes after its window check (interrupts are off in between), plus timers that are a few
+/// ticks apart (as in simulators that ignore GTCCR).
 pub const WRITE_GUARD_TICKS: u16 = 64;
+
+/// Ticks of the window that must remain for an apply to begin (1 ms): room for the writes of all
+/// four timers, interrupts included, so that they switch in the same period.
+const START_GUARD_TICKS: u16 = 2_000;
 
 /// Ticks after the longest pulse before the compare units may be switched.
 const QUIET_MARGIN_TICKS: u16 = 16;
@@ -187,7 +193,9 @@ fn stage(ticks: &[u16; CHANNELS], enabled: bool) {
 #[inline(never)]
 pub fn on_tick() {
     count_period();
-    if BUSY.get() != 0 {
+    // Nothing pending: return before `apply_staged` sets up its frame (this interrupt may come
+    // on top of the main loop's deepest stack).
+    if BUSY.get() != 0 || PENDING.get() == 0 {
         return;
     }
     BUSY.set(1);
@@ -200,6 +208,7 @@ pub fn on_tick() {
 /// Counts a period when Timer1's overflow flag says one began, and clears the flag (a one
 /// written clears it). Only the tick interrupt calls it: the millisecond tick sees every
 /// period start within 1 ms, long before the longest pulse ends and a state can be applied.
+#[inline(always)]
 fn count_period() {
     // SAFETY: TIFR1 is touched only here; writing TOV1 alone leaves the other flags.
     let dp = unsafe { pac::Peripherals::steal() };
@@ -211,9 +220,15 @@ fn count_period() {
 
 /// Writes the staged widths and connections when a state is pending and every timer is in the
 /// quiet part of its period: after the longest pulse (old or new) and before the last
-/// [`WRITE_GUARD_TICKS`]. The guard also covers the interrupts that may delay the writes
-/// after the check (a few hundred cycles at most, under the guard's 512). With pulses so long
-/// that no such moment exists, applies at once.
+/// [`WRITE_GUARD_TICKS`]. With pulses so long that no such moment exists, applies at once.
+///
+/// Each timer's registers are written in one short stretch with interrupts off that begins by
+/// checking that timer's count: an interrupt can delay the writes, but never carry them past
+/// the window, where a compare unit switched on or off would cut or start a pulse (and where a
+/// simulator that applies compare registers at once would change the pulse in progress). The
+/// apply starts only with [`START_GUARD_TICKS`] of the window left, so all four timers take the
+/// new state in the same period; should interrupts ever delay the writes that long, the
+/// remaining timers keep their state (each pin its old width) and follow at the next tick.
 fn apply_staged() {
     if PENDING.get() == 0 {
         return;
@@ -227,21 +242,32 @@ fn apply_staged() {
         .max(longest_new)
         .saturating_add(QUIET_MARGIN_TICKS);
     let before = PERIOD_TICKS - WRITE_GUARD_TICKS;
+    let connections: [(u8, u8); 4] = core::array::from_fn(|t| connection(t, enabled, &ticks));
     // SAFETY: after `Servos::new` the timers' compare and control registers and the servo
     // bits of the ports are written only here, under `BUSY` (or by the panic handler, which
     // never returns).
     let dp = unsafe { pac::Peripherals::steal() };
-    if after < before && !all_in_window(&dp, after, before) {
-        return;
-    }
-    for (channel, &t) in ticks.iter().enumerate() {
-        if t > 0 {
-            // Fast PWM: the pin is high for OCR + 1 ticks; OCR = TOP keeps it high.
-            write_ocr(&dp, channel, t - 1);
+    if after >= before {
+        for (t, &c) in connections.iter().enumerate() {
+            write_timer(&dp, t, &ticks, c);
         }
-    }
-    for t in 0..4 {
-        apply_connections(&dp, t, enabled, &ticks);
+    } else {
+        let start_before = before.saturating_sub(START_GUARD_TICKS).max(after);
+        if !(0..4).all(|t| in_window(tcnt(&dp, t), after, start_before)) {
+            return;
+        }
+        for (t, &c) in connections.iter().enumerate() {
+            let written = avr_device::interrupt::free(|_| {
+                if !in_window(tcnt(&dp, t), after, before) {
+                    return false;
+                }
+                write_timer(&dp, t, &ticks, c);
+                true
+            });
+            if !written {
+                return;
+            }
+        }
     }
     ACTIVE_LONGEST.set(longest_new);
     APPLIED_IN.set(PERIODS.get());
@@ -249,15 +275,36 @@ fn apply_staged() {
     PENDING.set(0);
 }
 
-/// True when every timer is in the window `(after, before)` of its period. The timers run in
-/// lockstep on the chip; checking all four keeps the window right where they do not
-/// (simulators that ignore GTCCR, or reconfigure a timer's phase).
-fn all_in_window(dp: &pac::Peripherals, after: u16, before: u16) -> bool {
-    let inside = |t: u16| t > after && t < before;
-    inside(dp.TC1.tcnt1().read().bits())
-        && inside(dp.TC3.tcnt3().read().bits())
-        && inside(dp.TC4.tcnt4().read().bits())
-        && inside(dp.TC5.tcnt5().read().bits())
+/// True when a timer count `t` is strictly between `after` and `before`.
+#[inline(always)]
+fn in_window(t: u16, after: u16, before: u16) -> bool {
+    t > after && t < before
+}
+
+/// The count of timer `t` (0..4: Timer1, 3, 4, 5).
+#[inline(always)]
+fn tcnt(dp: &pac::Peripherals, t: usize) -> u16 {
+    match t {
+        0 => dp.TC1.tcnt1().read().bits(),
+        1 => dp.TC3.tcnt3().read().bits(),
+        2 => dp.TC4.tcnt4().read().bits(),
+        _ => dp.TC5.tcnt5().read().bits(),
+    }
+}
+
+/// Writes timer `t`'s three compare registers (channels with a non-zero width) and its
+/// connections `(TCCRnA, port bits to drive low)`.
+#[inline(always)]
+fn write_timer(dp: &pac::Peripherals, t: usize, ticks: &[u16; CHANNELS], connection: (u8, u8)) {
+    for unit in 0..3 {
+        let channel = 3 * t + unit;
+        let width = ticks[channel];
+        if width > 0 {
+            // Fast PWM: the pin is high for OCR + 1 ticks; OCR = TOP keeps it high.
+            write_ocr(dp, channel, width - 1);
+        }
+    }
+    apply_connections(dp, t, connection);
 }
 
 fn write_ocr(dp: &pac::Peripherals, channel: usize, ocr: u16) {
@@ -277,11 +324,10 @@ fn write_ocr(dp: &pac::Peripherals, channel: usize, ocr: u16) {
     };
 }
 
-/// Writes TCCRnA of timer `t` (0..4) with the compare units of the channels that should drive
-/// their pins (outputs `enabled` and a non-zero width).
-fn apply_connections(dp: &pac::Peripherals, t: usize, enabled: bool, ticks: &[u16; CHANNELS]) {
+/// TCCRnA of timer `t` (0..4) with the compare units of the channels that should drive their
+/// pins (outputs `enabled` and a non-zero width), and the port bits of the others.
+fn connection(t: usize, enabled: bool, ticks: &[u16; CHANNELS]) -> (u8, u8) {
     let mut v = TCCRA_MODE14;
-    // Port bits of the disconnected channels of this timer.
     let mut low = 0u8;
     for (unit, com) in COM_CLEAR.iter().enumerate() {
         if enabled && ticks[3 * t + unit] != 0 {
@@ -290,33 +336,49 @@ fn apply_connections(dp: &pac::Peripherals, t: usize, enabled: bool, ticks: &[u1
             low |= PIN_BIT[t][unit];
         }
     }
+    (v, low)
+}
+
+/// Writes TCCRnA of timer `t` and drives the port bits `low` low.
+#[inline(always)]
+fn apply_connections(dp: &pac::Peripherals, t: usize, (v, low): (u8, u8)) {
     // SAFETY: mode-14 bits plus COM bits: a valid TCCRnA value; any PORTx value is valid.
     // Clearing the PORT bits after disconnecting is a no-op on the chip (the compare unit never
-    // writes PORTx) and keeps simulators that model the output through PORTx right.
+    // writes PORTx) and keeps simulators that model the output through PORTx right. The port is
+    // written only when a channel is disconnected: such a simulator also drives every
+    // connected pin of the port from PORTx on any write.
     match t {
         0 => {
             dp.TC1.tccr1a().write(|w| unsafe { w.bits(v) });
-            dp.PORTB
-                .portb()
-                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            if low != 0 {
+                dp.PORTB
+                    .portb()
+                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            }
         }
         1 => {
             dp.TC3.tccr3a().write(|w| unsafe { w.bits(v) });
-            dp.PORTE
-                .porte()
-                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            if low != 0 {
+                dp.PORTE
+                    .porte()
+                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            }
         }
         2 => {
             dp.TC4.tccr4a().write(|w| unsafe { w.bits(v) });
-            dp.PORTH
-                .porth()
-                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            if low != 0 {
+                dp.PORTH
+                    .porth()
+                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            }
         }
         _ => {
             dp.TC5.tccr5a().write(|w| unsafe { w.bits(v) });
-            dp.PORTL
-                .portl()
-                .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            if low != 0 {
+                dp.PORTL
+                    .portl()
+                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
+            }
         }
     }
 }

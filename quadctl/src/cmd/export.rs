@@ -14,11 +14,18 @@ the servos as position actuators (MJCF). docs/twin.md lists the assumptions.
 Exit status: 0 written; 2 a bad robot or value, or the file could not be written (nothing is
 left at --output).";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl export --format mjcf --output robot.xml
+  quadctl export --format urdf --robot examples/robots/shahriar2023.toml --output shahriar2023.urdf";
+
 /// Arguments of `quadctl export`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Write the robot as a MuJoCo MJCF model or a URDF",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// Description format.

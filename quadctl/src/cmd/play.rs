@@ -42,11 +42,20 @@ Exit status: 0 every row answered or lost, every check passed; 2 nothing or not 
 could be played (arguments, robot, file, link, handshake); 3 a readback mismatch, a pulse out
 of its travel or a pulse width error on the pins.";
 
+/// `--help`'s examples, run from the repository root (the files of `examples/`).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl play examples/stance.csv --robot shahriar2023 --sim
+  quadctl motion roll-sway --robot shahriar2023 --duration-s 4 --rate-hz 50 --output roll.csv
+  quadctl play roll.csv --robot shahriar2023 --emulator
+  quadctl play roll.csv --robot shahriar2023 --port /dev/ttyACM0";
+
 /// Arguments of `quadctl play`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Play a timed file of joint angles, feet or body poses to the device in real time",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// The file: `quadctl motion` output or a t_s + joints/feet/pose CSV; `-` for stdin.

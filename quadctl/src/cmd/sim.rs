@@ -30,11 +30,19 @@ URDF with this project's leg chain.
 Exit status: 0 the run finished (a fall is a result, reported); 2 a bad argument, robot or
 value, or the twin could not run (no output file is left behind).";
 
+/// `--help`'s examples, run from the repository root.
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl sim stand --robot fernando2025
+  quadctl sim trot --robot shahriar2023 --out-dir trot
+  quadctl sim stand --emulator --out-dir stand --render stand.gif";
+
 /// Arguments of `quadctl sim`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Run a motion in the physics twin (MuJoCo) and print its metrics",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     /// The motion.

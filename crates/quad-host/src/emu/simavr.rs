@@ -31,11 +31,14 @@
 //!   (the firmware waits for that interrupt, so saves take their real time here too).
 //! - A 16-bit output-compare register (OCRnx) takes effect in simavr when its low byte is
 //!   written, and only if the value changed — judged with the high byte already written, so a
-//!   change of the high byte alone is missed (the pin keeps the old width). [`Mega2560`]
-//!   corrects this: after each instruction it compares the twelve servo OCRs with their last
-//!   values; when only the high byte changed, it re-issues the low-byte write one instruction
-//!   later (after the program's own low-byte write, which follows the high byte), unless that
-//!   write changed the low byte and simavr took the value itself.
+//!   change of the high byte alone is missed (the pin keeps the old width). The chip has no
+//!   such gap: the high byte waits in the timer's TEMP register and the low-byte write commits
+//!   both. [`Mega2560`] models that: it wraps simavr's write handler of the twelve servo OCR
+//!   low bytes and, when a low-byte write leaves the value unchanged while the high byte
+//!   changed since the last one, has simavr take the new value there and then. The commit
+//!   happens at the program's own low-byte write, whatever runs between the two bytes (an
+//!   interrupt entered between them used to make a guess one instruction later commit a
+//!   half-written value: a runt pulse of a few cycles).
 //! - simavr applies a compare register at once, not at the next period as the chip does (the
 //!   firmware writes them between pulses, where both agree).
 
@@ -219,6 +222,44 @@ struct Hooks {
     out: VecDeque<(u64, u8)>,
     /// simavr's receiver has room.
     xon: bool,
+    /// The wrapped write handlers of the servo compare registers' low bytes, in channel order.
+    ocr: [OcrWrite; 12],
+}
+
+/// simavr's write handler of one OCR low byte, and the value the register had after the
+/// previous low-byte write.
+struct OcrWrite {
+    handler: ffi::avr_io_write_t,
+    param: *mut c_void,
+    committed: u16,
+}
+
+/// The write handler installed on a servo OCR low byte: simavr's own, then — when that one
+/// saw no change because only the high byte changed — simavr's again with the low byte
+/// perturbed before the call, so that it reconfigures the timer with the committed value.
+unsafe extern "C" fn on_ocr_low_write(
+    avr: *mut ffi::avr_t,
+    addr: ffi::avr_io_addr_t,
+    v: u8,
+    param: *mut c_void,
+) {
+    // SAFETY: `param` points into the `Hooks` allocation (see `on_uart_output`); `avr` is the
+    // running simulator and `addr`, `addr + 1` are the register's bytes in its data space.
+    unsafe {
+        let w = &mut *param.cast::<OcrWrite>();
+        let data = (*avr).data;
+        let lo = usize::from(addr);
+        let before = u16::from_le_bytes([*data.add(lo), *data.add(lo + 1)]);
+        if let Some(handler) = w.handler {
+            handler(avr, addr, v, w.param);
+            let after = u16::from_le_bytes([*data.add(lo), *data.add(lo + 1)]);
+            if after == before && after != w.committed {
+                *data.add(lo) ^= 1;
+                handler(avr, addr, v, w.param);
+            }
+            w.committed = after;
+        }
+    }
 }
 
 unsafe extern "C" fn on_uart_output(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
@@ -271,10 +312,6 @@ pub struct Mega2560 {
     output: VecDeque<(u64, u8)>,
     /// Lowest stack pointer seen after an instruction since the C runtime set it up.
     min_sp: u16,
-    /// The servo compare registers after the last instruction.
-    ocr: [u16; 12],
-    /// Compare registers whose high byte alone changed in the last instruction.
-    ocr_high_only: [bool; 12],
 }
 
 impl Mega2560 {
@@ -351,7 +388,20 @@ impl Mega2560 {
                 base: 0,
                 out: VecDeque::new(),
                 xon: true,
+                ocr: std::array::from_fn(|_| OcrWrite {
+                    handler: None,
+                    param: std::ptr::null_mut(),
+                    committed: 0,
+                }),
             })));
+            for (i, &lo) in OCR_LOW.iter().enumerate() {
+                let slot = &mut (*avr.as_ptr()).io[usize::from(lo) - 0x20].w;
+                let w = &mut (*hooks.as_ptr()).ocr[i];
+                w.handler = slot.c;
+                w.param = slot.param;
+                slot.c = Some(on_ocr_low_write);
+                slot.param = (w as *mut OcrWrite).cast();
+            }
             let param: *mut c_void = hooks.as_ptr().cast();
             ffi::avr_irq_register_notify(out.as_ptr(), Some(on_uart_output), param);
             ffi::avr_irq_register_notify(xon.as_ptr(), Some(on_uart_xon), param);
@@ -374,8 +424,6 @@ impl Mega2560 {
                 pulses: VecDeque::new(),
                 output: VecDeque::new(),
                 min_sp: u16::MAX,
-                ocr: [0; 12],
-                ocr_high_only: [false; 12],
             })
         }
     }
@@ -446,7 +494,6 @@ impl Mega2560 {
         // SAFETY: no hook runs now.
         let hooks = unsafe { self.hooks.as_mut() };
         self.output.extend(hooks.out.drain(..));
-        self.fix_ocr_writes();
         self.owe_dor();
         self.track_interrupts_off(before, pc_before);
         let step = self.cycle().saturating_sub(before).max(1);
@@ -782,37 +829,6 @@ impl Mega2560 {
     /// True while a pulse is in progress on `channel`.
     pub fn pulse_in_progress(&self, channel: usize) -> bool {
         self.rise.get(channel).is_some_and(Option::is_some)
-    }
-
-    /// Re-issues the low-byte write of a servo compare register whose high byte alone changed
-    /// (see the module docs), so that simavr reconfigures the timer as the chip would.
-    fn fix_ocr_writes(&mut self) {
-        for (i, &lo) in OCR_LOW.iter().enumerate() {
-            let v = u16::from_le_bytes([self.data(lo), self.data(lo + 1)]);
-            let old = std::mem::replace(&mut self.ocr[i], v);
-            let high_only_before = std::mem::take(&mut self.ocr_high_only[i]);
-            if v != old && (v ^ old) & 0xFF == 0 {
-                // The high byte was written; the low byte follows in the next instruction.
-                self.ocr_high_only[i] = true;
-                continue;
-            }
-            if !high_only_before || v != old {
-                // Nothing pending, or the low byte changed: simavr took the value itself.
-                continue;
-            }
-            let avr = self.avr.as_ptr();
-            // SAFETY: `lo` is the I/O address of an OCR low byte of this MCU; its write handler
-            // is the timer's, with its parameter. Between instructions nothing else runs.
-            unsafe {
-                let slot = (*avr).io[usize::from(lo) - 0x20].w;
-                if let Some(write) = slot.c {
-                    let data = (*avr).data.add(usize::from(lo));
-                    // Make the low byte differ so that the handler sees a change.
-                    *data ^= 1;
-                    write(avr, lo, v as u8, slot.param);
-                }
-            }
-        }
     }
 
     fn track_servos(&mut self, step: u64) {

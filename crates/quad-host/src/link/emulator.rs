@@ -26,15 +26,16 @@
 //! ## Pin check
 //! Every pulse on the twelve servo pins (Timer1/3/4/5 incl. port L) is measured and compared
 //! with the readbacks the firmware sent (decoded from its UART output before any line fault):
-//! the device writes the compare registers between pulses — before it answers, or, when the
-//! request came during the pulses, after them and before the period ends — and the hardware
-//! takes them over at the start of a period, so a pulse that starts at cycle `t` must be as wide
-//! as the pulses of the last readback sent before `t` or of the next one, within one timer tick
-//! (0.5 µs) — or, as every output passes the device's joint-speed limiter, which brings the
-//! pins to a new target over several frames, lie between the channel's previous pulse and that
-//! width (the limiter's bound per frame is checked by the emulator tests of the motions). A
-//! pulse while both say the outputs are off, or at power-on before any answer, is an error
-//! too. See [`PulseStats`].
+//! the device stages the widths before it answers and writes the compare registers in the next
+//! quiet part of a period (after the pulses, with a millisecond of the period left), and the
+//! hardware takes them over at the start of the following period. So a pulse that starts at
+//! cycle `t` must be as wide as the pulses of the next readback, of the last one sent before
+//! `t`, or of an earlier one superseded less than [`APPLY_LATENCY`] before `t`, within one timer
+//! tick (0.5 µs) — or, as every output passes the device's joint-speed limiter, which brings the
+//! pins to a new target over several frames, lie between the channel's previous pulse and one
+//! of those widths (the limiter's bound per frame is checked by the emulator tests of the
+//! motions). A pulse while all of them say the outputs are off, or at power-on before any
+//! answer, is an error too. See [`PulseStats`].
 
 use super::{Faults, LineStats, Link};
 use crate::emu::{
@@ -132,6 +133,10 @@ pub struct PulseStats {
     /// The first error, described.
     pub first_error: Option<String>,
 }
+
+/// The longest a staged state may wait before the pins show it: a period, the window's last
+/// millisecond in which no apply begins, and the millisecond tick that applies it.
+pub const APPLY_LATENCY: std::time::Duration = std::time::Duration::from_millis(23);
 
 /// What the firmware reported at one cycle: the pulses on its outputs (`None`: off).
 #[derive(Debug, Clone, Copy)]
@@ -234,17 +239,19 @@ impl PulseCheck {
                 break;
             }
             self.pending.pop_front();
-            self.judge(p, self.expects[k], next);
-            // Readbacks superseded more than a period before this pulse are not needed again.
-            while self.expects.len() > 2
-                && self.expects[1].start_cycle + PERIOD_CYCLES < p.rise_cycle
-            {
+            self.judge(p, k, next);
+            // Readbacks superseded longer than the apply latency before this pulse are not
+            // needed again.
+            let latency = duration_to_cycles(APPLY_LATENCY);
+            while self.expects.len() > 2 && self.expects[1].start_cycle + latency < p.rise_cycle {
                 self.expects.pop_front();
             }
         }
     }
 
-    fn judge(&mut self, p: Pulse, before: Expect, after: Option<Expect>) {
+    /// Judges pulse `p` against the readback `k` (the last sent before it), the next one
+    /// (`after`) and the earlier ones still within the apply latency.
+    fn judge(&mut self, p: Pulse, k: usize, after: Option<Expect>) {
         self.stats.checked += 1;
         // The channel's previous pulse, when it came in the period before this one.
         let previous = self.last[p.channel].filter(|q| {
@@ -258,7 +265,12 @@ impl PulseCheck {
         };
         let exact =
             |e: &Expect| width(e).is_some_and(|w| p.width_could_be(w, PULSE_TOLERANCE_CYCLES));
-        if exact(&before) || after.as_ref().is_some_and(exact) {
+        let latency = duration_to_cycles(APPLY_LATENCY);
+        let mut in_force = (0..=k)
+            .rev()
+            .take_while(|&j| j == k || self.expects[j + 1].start_cycle + latency > p.rise_cycle);
+        let before = self.expects[k];
+        if after.as_ref().is_some_and(exact) || in_force.any(|j| exact(&self.expects[j])) {
             return;
         }
         // On its way from the previous pulse to a target held since (the limiter steps the
