@@ -273,15 +273,22 @@ impl PulseCheck {
         if after.as_ref().is_some_and(exact) || in_force.any(|j| exact(&self.expects[j])) {
             return;
         }
-        // On its way from the previous pulse to a target held since (the limiter steps the
-        // outputs toward the target held at each frame; readbacks may come faster than frames).
+        // On its way from the previous pulse to a target held since: the limiter steps the
+        // outputs toward the target held at each frame, which is written during the period
+        // before its pulse; that target is the one of the last readback sent before the
+        // previous pulse or of a later one (readbacks may come faster than frames).
         if let Some(q) = previous {
             let slack = PULSE_TOLERANCE_CYCLES + p.rise_step_cycles + p.fall_step_cycles;
-            let since = q.rise_cycle.saturating_sub(PERIOD_CYCLES);
+            let first = self
+                .expects
+                .iter()
+                .rposition(|e| e.start_cycle <= q.rise_cycle)
+                .unwrap_or(0);
             let between = self
                 .expects
                 .iter()
-                .filter(|e| e.start_cycle >= since && e.start_cycle <= p.rise_cycle)
+                .skip(first)
+                .filter(|e| e.start_cycle <= p.rise_cycle)
                 .chain([&before])
                 .chain(after.as_ref())
                 .filter_map(width)
@@ -303,13 +310,19 @@ impl PulseCheck {
                 }) => format!("{} µs", f64::from(ps[p.channel]) / 2.0),
             };
             let (port, bit) = SERVO_PINS[p.channel];
-            self.stats.first_error = Some(format!(
-                "channel {} (P{port}{bit}): pulse of {:.2} µs at {:.3} ms; readback before: {}, after: {}",
+            self.stats.first_error =
+                Some(format!(
+                "channel {} (P{port}{bit}): pulse of {:.2} µs at {:.3} ms; readback before: {}, \
+                 after: {}; the channel's previous pulse: {}",
                 p.channel,
                 p.high_us(),
                 p.rise_cycle as f64 / 16_000.0,
                 show(Some(&before)),
                 show(after.as_ref()),
+                previous.map_or_else(
+                    || "-".to_string(),
+                    |q| format!("{:.2} µs at {:.3} ms", q.high_us(), q.rise_cycle as f64 / 16_000.0)
+                ),
             ));
         }
     }
