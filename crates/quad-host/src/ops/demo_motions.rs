@@ -12,11 +12,11 @@
 //!   math differs from the host's);
 //! - after stand-up, the angles are the host's IK of the nominal stance; after sit, the device's
 //!   rest pose;
-//! - on the emulator, the pulses on the twelve pins right after a sway's or the yaw turn's
-//!   answer are the calibration's mapping of the host's angles at that motion time or one or
-//!   two servo frames later (the outputs follow the target frame by frame; these motions move
-//!   slower than the joint-speed limit, so the limiter never holds them back), within one
-//!   0.5 µs timer tick.
+//! - on the emulator, the pulses on the twelve pins at every servo frame of a sway or the yaw
+//!   turn are the calibration's mapping of the host's angles at that frame's motion time (the
+//!   last answer's time plus a frame per period since, give or take a frame: the frames are
+//!   latched to the PWM periods; these motions move slower than the joint-speed limit, so the
+//!   limiter never holds them back), within one 0.5 µs timer tick.
 //!
 //! The walk's footholds depend on when each velocity command arrived, so the trot is checked
 //! by its readbacks' pulses and, on the pins, by the travel of every pulse.
@@ -322,8 +322,8 @@ fn last_enabled<L: Link>(session: &mut Session<L>) -> Result<bool, onboard::Erro
 }
 
 /// Runs a sway or the yaw turn, asking for the state every [`POLL_PERIOD`]: each answer's
-/// angles against the host's kin-core, and on the emulator the pins right after it. Returns
-/// the last motion time.
+/// angles against the host's kin-core, and on the emulator the pins of every servo frame.
+/// Returns the last motion time.
 fn law_run<L: Link>(
     session: &mut Session<L>,
     c: &mut Checker<'_>,
@@ -336,9 +336,11 @@ fn law_run<L: Link>(
     let first = session.start(request)?;
     c.readback(&first.readback);
     let until = session.now() + WAIT;
+    let end_s = law_end_s(request);
     let mut motion_s = 0.0f32;
     loop {
         let a = session.get()?;
+        let poll_end = session.now() + POLL_PERIOD;
         c.readback(&a.readback);
         motion_s = motion_s.max(a.status.t_s);
         let running = matches!(a.status.kind, Some(MotionKind::Sway | MotionKind::YawTurn))
@@ -350,33 +352,30 @@ fn law_run<L: Link>(
             }
             let calibration = *c.calibration;
             if let Some(emu) = session.client_mut().link_mut().emulator() {
-                let pins = emu
-                    .next_pulses()
-                    .map_err(|e| onboard::Error::Client(e.into()))?;
-                // The target at this frame or one or two frames later.
-                let candidates: Vec<[u16; 12]> = (0..3)
-                    .filter_map(|k| {
-                        host_law_angles(robot, request, h, order, t + k as f32 * FRAME_S)
-                            .and_then(|q| pulses(&calibration, &q))
-                    })
-                    .collect();
-                for (i, p) in pins.iter().enumerate() {
-                    c.leg.pins_checked += 1;
-                    let fits = p.is_some_and(|p| {
-                        candidates.iter().any(|w| {
-                            p.width_could_be(u64::from(w[i]) * CYCLES_PER_TICK, PIN_TOLERANCE)
-                        })
-                    });
-                    if !fits {
-                        c.error(format!(
-                            "{}: channel {i} at {t:.2} s: pulse {:?} µs, host {:?} µs",
-                            c.leg.motion,
-                            p.map(|p| p.high_us()),
-                            candidates
-                                .iter()
-                                .map(|w| f64::from(w[i]) / 2.0)
-                                .collect::<Vec<_>>()
-                        ));
+                // Every servo frame until the next question: frame `j` after the answer shows
+                // the target of the motion time `t + j·FRAME_S`, give or take a frame (the
+                // frames are latched to the PWM periods; the answer may come before or after
+                // a frame's write).
+                let mut j = 0u32;
+                loop {
+                    let pins = emu
+                        .next_pulses()
+                        .map_err(|e| onboard::Error::Client(e.into()))?;
+                    let base = t + j as f32 * FRAME_S;
+                    // Near its end the motion leaves for the stance: not the law any more.
+                    if end_s.is_none_or(|end| base + 3.0 * FRAME_S < end) {
+                        let candidates: Vec<[u16; 12]> = (-1..=2)
+                            .filter_map(|k| {
+                                let at = base + k as f32 * FRAME_S;
+                                host_law_angles(robot, request, h, order, at)
+                                    .and_then(|q| pulses(&calibration, &q))
+                            })
+                            .collect();
+                        check_law_pins(c, &pins, &candidates, base);
+                    }
+                    j += 1;
+                    if emu.now() >= poll_end {
+                        break;
                     }
                 }
             }
@@ -391,9 +390,58 @@ fn law_run<L: Link>(
         if now >= until {
             return Err(onboard::Error::NoEnd(WAIT));
         }
-        session
-            .client_mut()
-            .idle_until(now + POLL_PERIOD)
-            .map_err(client::Error::from)?;
+        if now < poll_end {
+            session
+                .client_mut()
+                .idle_until(poll_end)
+                .map_err(client::Error::from)?;
+        }
+    }
+}
+
+/// The motion time at which a law request with a duration ends (its duration rounded up to
+/// whole periods, as the device runs it), s.
+fn law_end_s(request: &Motion_) -> Option<f32> {
+    let (duration_s, period_s) = match *request {
+        Motion_::Sway {
+            duration_s,
+            period_s,
+            ..
+        } => (duration_s?, period_s),
+        Motion_::YawTurn {
+            duration_s,
+            step_period_s,
+            ..
+        } => (duration_s?, step_period_s),
+        _ => return None,
+    };
+    Some((duration_s / period_s - 1e-4).ceil() * period_s)
+}
+
+/// One frame's twelve pins against the host's pulses at the candidate motion times.
+fn check_law_pins(
+    c: &mut Checker<'_>,
+    pins: &[Option<crate::emu::Pulse>; 12],
+    candidates: &[[u16; 12]],
+    t: f32,
+) {
+    for (i, p) in pins.iter().enumerate() {
+        c.leg.pins_checked += 1;
+        let fits = p.is_some_and(|p| {
+            candidates
+                .iter()
+                .any(|w| p.width_could_be(u64::from(w[i]) * CYCLES_PER_TICK, PIN_TOLERANCE))
+        });
+        if !fits {
+            c.error(format!(
+                "{}: channel {i} at {t:.2} s: pulse {:?} µs, host {:?} µs",
+                c.leg.motion,
+                p.map(|p| p.high_us()),
+                candidates
+                    .iter()
+                    .map(|w| f64::from(w[i]) / 2.0)
+                    .collect::<Vec<_>>()
+            ));
+        }
     }
 }
