@@ -69,6 +69,13 @@ const IOCTL_EEPROM_SET: u32 = ioctl(b'e', b'e', b's', b'p');
 pub const EEPROM_LEN: usize = 4096;
 
 /// Data-space addresses of USART0's registers.
+/// `out A, Rr` with the register bits masked out (`1011 1AAr rrrr AAAA`).
+const OUT_IO_MASK: u16 = 0xFE0F;
+/// `out 0x3e, Rr`: a write of SPH.
+const OUT_SPH: u16 = 0xBE0E;
+/// `out 0x3d, Rr`: a write of SPL.
+const OUT_SPL: u16 = 0xBE0D;
+
 const UCSR0A: u16 = 0xC0;
 const UDR0: u16 = 0xC6;
 /// UCSR0A's data-overrun flag.
@@ -312,6 +319,9 @@ pub struct Mega2560 {
     output: VecDeque<(u64, u8)>,
     /// Lowest stack pointer seen after an instruction since the C runtime set it up.
     min_sp: u16,
+    /// True between a write of SPH and the write of SPL that completes a stack-pointer update:
+    /// the stack pointer read in between mixes the new high byte with the old low byte.
+    sp_half_written: bool,
 }
 
 impl Mega2560 {
@@ -424,6 +434,7 @@ impl Mega2560 {
                 pulses: VecDeque::new(),
                 output: VecDeque::new(),
                 min_sp: u16::MAX,
+                sp_half_written: false,
             })
         }
     }
@@ -499,8 +510,15 @@ impl Mega2560 {
         let step = self.cycle().saturating_sub(before).max(1);
         self.track_servos(step);
         let sp = self.sp();
+        // A frame is set up (or torn down) by `out SPH` then `out SPL`, interrupts held off in
+        // between: the stack pointer between the two is no stack depth the program reached.
+        match self.flash_word(pc_before) & OUT_IO_MASK {
+            OUT_SPH => self.sp_half_written = true,
+            OUT_SPL => self.sp_half_written = false,
+            _ => {}
+        }
         // SP starts at 0 until the C runtime loads RAMEND.
-        if sp != 0 && sp < self.min_sp {
+        if sp != 0 && sp < self.min_sp && !self.sp_half_written {
             self.min_sp = sp;
         }
         Ok(step)
@@ -739,6 +757,18 @@ impl Mega2560 {
     /// Last SRAM address (RAMEND).
     pub fn ramend(&self) -> u16 {
         self.avr().ramend
+    }
+
+    /// The program word at byte address `pc` (0 beyond the flash).
+    fn flash_word(&self, pc: u32) -> u16 {
+        let avr = self.avr();
+        let i = pc as usize;
+        if avr.flash.is_null() || i + 1 > avr.flashend as usize {
+            return 0;
+        }
+        // SAFETY: `flash` holds `flashend + 1` bytes for the simulator's lifetime; `i + 1` is
+        // within them.
+        unsafe { u16::from_le_bytes([*avr.flash.add(i), *avr.flash.add(i + 1)]) }
     }
 
     /// The stack pointer.
