@@ -15,6 +15,7 @@ use quad_host::names;
 use quad_host::ops::accuracy::Angles;
 use quad_host::ops::batch::PoseFormat;
 use quad_host::ops::motion::{Law, Params};
+use quad_host::ops::session::Session;
 use quad_host::robot_file;
 use quad_protocol::RobotPreset;
 use std::fmt;
@@ -192,6 +193,46 @@ impl TargetArgs {
                 },
                 storage: self.sim_storage.clone(),
             }
+        }
+    }
+}
+
+/// The device side of the commands that stream setpoints (`stream`, `play`): robot, device,
+/// what is set on it and how its answers are checked.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct SessionArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub target: TargetArgs,
+    /// Stance height H set on the device, metres; default: the device's own.
+    #[arg(long, value_name = "H", value_parser = parse_positive_m)]
+    pub stance_height_m: Option<f32>,
+    /// Rotation order set on the device; default: the input's (`play`: a rotation_order=
+    /// comment), else the device's own.
+    #[arg(long, value_parser = rotation_order())]
+    pub rotation_order: Option<RotationOrder>,
+    /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
+    /// exact with --sim, 5e-5 rad with --emulator and --port (the AVR's math differs from the
+    /// host's).
+    #[arg(long, value_name = "RAD")]
+    pub angle_tolerance_rad: Option<f32>,
+}
+
+impl SessionArgs {
+    /// The library's session. The simulated device runs the robot given; the session refuses
+    /// a robot that is not a preset before the link is opened.
+    pub fn session(&self) -> Session {
+        let preset = RobotPreset::from_name(self.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
+        Session {
+            robot: self.robot.robot.clone(),
+            target: self.target.target(preset),
+            retries: self.target.retries,
+            stance_height_m: self.stance_height_m,
+            rotation_order: self.rotation_order,
+            angle_tolerance_rad: self.angle_tolerance_rad,
         }
     }
 }

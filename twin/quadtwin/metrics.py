@@ -4,6 +4,7 @@ Thresholds are named constants here; docs/twin.md says why each has its value.""
 
 import math
 
+import mujoco
 import numpy as np
 
 from .model import JOINT_NAMES
@@ -58,13 +59,28 @@ class Recorder:
         self.stance = []
         self.feet = []
         self.body_touch = []
+        self.q = []
+        self.q_target = []
+        self.contact = []
+        self.frame_peak = []
+        self._frame_peak = np.zeros(12)
+        self.frame_mean = []
+        self._frame_sum = np.zeros(12)
+        self._frame_n = 0
+        self.feet_in_body = []
+        self.feet_in_body_cmd = []
+        self._scratch = twin.new_data()
         self.t0 = 0.0
 
     def begin(self, d):
         self.t0 = float(d.time)
 
     def step(self, d, u):
-        self.torque.append(d.actuator_force[self.twin.actuator].copy())
+        tau = d.actuator_force[self.twin.actuator].copy()
+        self.torque.append(tau)
+        self._frame_peak = np.maximum(self._frame_peak, np.abs(tau))
+        self._frame_sum += tau
+        self._frame_n += 1
         self.saturated.append(bool(np.any(np.abs(u) >= 1.0)))
 
     def frame(self, d, msg, state):
@@ -75,6 +91,26 @@ class Recorder:
         self.stance.append(msg["stance"])
         self.feet.append([d.site_xpos[s].copy() for s in self.twin.foot_site])
         self.body_touch.append(body_on_floor(self.twin, d))
+        self.q.append(d.qpos[self.twin.qpos_adr].copy())
+        self.q_target.append(np.array(msg["angles_rad"], dtype=float))
+        self.contact.append(state["feet_contact"])
+        self.feet_in_body.append(self.in_body(d))
+        # The commanded feet: the same kinematics at the frame's joint targets.
+        s = self._scratch
+        self.twin.set_pose(s, msg["angles_rad"])
+        mujoco.mj_kinematics(self.twin.model, s)
+        self.feet_in_body_cmd.append(self.in_body(s))
+        self.frame_peak.append(self._frame_peak)
+        self._frame_peak = np.zeros(12)
+        self.frame_mean.append(self._frame_sum / max(1, self._frame_n))
+        self._frame_sum = np.zeros(12)
+        self._frame_n = 0
+
+    def in_body(self, d):
+        """The four foot centres in the body frame, m."""
+        b = self.twin.body
+        r = d.xmat[b].reshape(3, 3)
+        return np.array([r.T @ (d.site_xpos[s] - d.xpos[b]) for s in self.twin.foot_site])
 
     def duration_s(self):
         return self.t[-1] if self.t else 0.0
@@ -87,6 +123,26 @@ class Recorder:
             np.array(self.cmd),
             np.array(self.stance, dtype=bool),
             np.array(self.feet),
+        )
+
+    def save_trace(self, path):
+        """Every frame's samples (body, commanded pose, joint targets and angles, feet,
+        contacts) as a NumPy archive, for studies beyond the summary."""
+        t, pos, rpy, cmd, stance, feet = self.arrays()
+        np.savez_compressed(
+            path,
+            t_s=t,
+            pos_m=pos,
+            rpy_rad=rpy,
+            commanded_pose=cmd,
+            stance=stance,
+            feet_m=feet,
+            q_rad=np.array(self.q),
+            q_target_rad=np.array(self.q_target),
+            contact=np.array(self.contact, dtype=bool),
+            torque_peak_nm=np.array(self.frame_peak),
+            torque_frame_mean_nm=np.array(self.frame_mean),
+            stance_height_m=self.start["stance_height_m"],
         )
 
     def commanded_height_m(self, cmd):
@@ -106,7 +162,50 @@ class Recorder:
         out["slip"] = self.slip(stance, feet)
         out["torque"] = self.torques()
         out["tracking"] = self.tracking(rpy, cmd)
+        out["stepping"] = self.stepping(stance)
         return out
+
+    def stepping(self, stance):
+        """Why a gait covers less ground than commanded: per leg, how far the foot swept back
+        under the body (along the commanded sweep) during each whole commanded stance against
+        the commanded sweep, the
+        share of the commanded stance and swing frames with the foot on the floor, and the
+        mean knee position error (reached − target) in stance."""
+        if stance.all():
+            return None
+        contact = np.array(self.contact, dtype=bool)
+        fb = np.array(self.feet_in_body)
+        fc = np.array(self.feet_in_body_cmd)
+        err = np.array(self.q) - np.array(self.q_target)
+        legs = []
+        for leg in range(4):
+            st = stance[:, leg]
+            swept, commanded = [], []
+            i, n = 0, len(st)
+            while i < n:
+                if st[i]:
+                    j = i
+                    while j < n and st[j]:
+                        j += 1
+                    if i > 0 and j < n:  # whole stances only
+                        c = fc[i, leg, 0:2] - fc[j - 1, leg, 0:2]
+                        length = float(np.linalg.norm(c))
+                        if length > 0.0:
+                            # The reached sweep along the commanded one.
+                            swept.append(float(np.dot(fb[i, leg, 0:2] - fb[j - 1, leg, 0:2], c)) / length)
+                            commanded.append(length)
+                    i = j
+                else:
+                    i += 1
+            legs.append(
+                {
+                    "stance_sweep_ratio": float(np.sum(swept) / np.sum(commanded)) if commanded else None,
+                    "contact_in_stance": float(np.mean(contact[st, leg])) if st.any() else None,
+                    "contact_in_swing": float(np.mean(contact[~st, leg])) if (~st).any() else None,
+                    "knee_error_in_stance_rad": float(np.mean(err[st, 3 * leg + 2])) if st.any() else None,
+                }
+            )
+        return {"legs": legs}
 
     def fall(self, t, pos, rpy, cmd):
         h_cmd = self.commanded_height_m(cmd)

@@ -20,7 +20,8 @@ STRIP_FRAMES = 6
 
 def plots(rec, summary, out_dir):
     t, pos, rpy, cmd, stance, feet = rec.arrays()
-    fig, ax = plt.subplots(2, 2, figsize=(11, 7))
+    stepping = summary.get("stepping") is not None
+    fig, ax = plt.subplots(2, 3 if stepping else 2, figsize=(16 if stepping else 11, 7))
     title = f"{summary['robot']} / {summary['motion']} / {summary['servo']}" + (
         "  — FELL" if summary["fell"] else ""
     )
@@ -60,11 +61,44 @@ def plots(rec, summary, out_dir):
     a.set_xticks(x, JOINT_NAMES, rotation=60, fontsize=7)
     a.set_ylabel("N·m")
     a.legend(fontsize=8)
+    if stepping:
+        step_panels(ax[0, 2], ax[1, 2], rec, t, stance)
     fig.tight_layout()
     path = os.path.join(out_dir, "plots.png")
     fig.savefig(path, dpi=90)
     plt.close(fig)
     return [path]
+
+
+#: The leg and the time span the stepping panels show.
+STEP_LEG, STEP_WINDOW_S = 2, (4.0, 7.0)
+
+
+def step_panels(a, b, rec, t, stance):
+    """One leg's foot under the body (along x) and knee error over a few cycles: where the
+    stance sweep is lost."""
+    leg = STEP_LEG
+    w = (t >= STEP_WINDOW_S[0]) & (t <= STEP_WINDOW_S[1])
+    if not w.any():
+        w = np.ones_like(t, dtype=bool)
+    fb = np.array(rec.feet_in_body)[:, leg]
+    fc = np.array(rec.feet_in_body_cmd)[:, leg]
+    contact = np.array(rec.contact, dtype=bool)[:, leg]
+    a.plot(t[w], fc[w, 0], "--", label="commanded")
+    a.plot(t[w], fb[w, 0], label="reached")
+    lo, hi = a.get_ylim()
+    a.fill_between(t[w], lo, hi, where=stance[w, leg], color="0.9", label="commanded stance")
+    a.fill_between(t[w], lo, lo + 0.08 * (hi - lo), where=contact[w], color="tab:green", alpha=0.5, label="on the floor")
+    a.set_ylim(lo, hi)
+    a.set_xlabel("t (s)")
+    a.set_ylabel(f"{JOINT_NAMES[3 * leg][:2]} foot x in the body (m)")
+    a.legend(fontsize=7)
+    err = np.array(rec.q)[:, 3 * leg + 2] - np.array(rec.q_target)[:, 3 * leg + 2]
+    b.plot(t[w], np.degrees(err[w]), label=f"{JOINT_NAMES[3 * leg + 2]} reached − target")
+    b.axhline(-np.degrees(rec.twin.servo["full_duty_error_rad"]), color="r", ls="--", label="full duty")
+    b.set_xlabel("t (s)")
+    b.set_ylabel("deg")
+    b.legend(fontsize=7)
 
 
 def pictures(twin, snapshots, out_dir):

@@ -117,6 +117,9 @@ class Run:
             from . import render
 
             files += render.plots(self.rec, summary, out_dir)
+            trace = f"{out_dir}/trace.npz"
+            self.rec.save_trace(trace)
+            files.append(trace)
             if self.start.get("render") and self.snapshots:
                 files += render.pictures(self.twin, self.snapshots, out_dir)
             summary["files"] = files

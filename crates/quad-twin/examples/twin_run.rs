@@ -3,7 +3,9 @@
 //! ```sh
 //! cargo run --release -p quad-twin --example twin_run -- shahriar2023 trot target/twin/shahriar2023-trot --render
 //! # options: --servo NAME (another servo preset), --stance-height-m H (another stance),
-//! #          --emulator (the firmware in simavr instead of the in-process device)
+//! #          --emulator (the firmware in simavr instead of the in-process device);
+//! #          the trot's shape: --cycle-s T, --duty D, --step-height-fraction F (of H),
+//! #          --speed-heights-per-s V (kin-core's own trot: --duty 0.5 --cycle-s 0.8)
 //! ```
 //!
 //! `quadctl sim` is the command; this example keeps the parameter studies scriptable.
@@ -11,7 +13,7 @@
 use quad_device::Config;
 use quad_model::Physical;
 use quad_protocol::RobotPreset;
-use quad_twin::{run, MotionKind, RunOptions};
+use quad_twin::{run_plan, MotionKind, Plan, RunOptions, TrotShape};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -73,7 +75,41 @@ fn main() -> ExitCode {
         },
         ..RunOptions::default()
     };
-    match run(&config, &physical, kind, &options) {
+    let number = |flag: &str| -> Result<Option<f32>, String> {
+        value(flag)
+            .map(|v| {
+                v.parse::<f32>()
+                    .map_err(|_| format!("{flag}: `{v}` is not a number"))
+            })
+            .transpose()
+    };
+    let mut shape = TrotShape::default();
+    let plan = (|| -> Result<Plan, String> {
+        for (flag, field) in [
+            ("--cycle-s", &mut shape.cycle_s),
+            ("--duty", &mut shape.duty_factor),
+            ("--step-height-fraction", &mut shape.step_height_fraction),
+            ("--speed-heights-per-s", &mut shape.speed_heights_per_s),
+        ] {
+            if let Some(v) = number(flag)? {
+                *field = v;
+            }
+        }
+        let plan = match kind {
+            MotionKind::Trot => Plan::trot(&config, shape),
+            MotionKind::TrotTurn => Plan::trot_turn(&config, shape),
+            _ => Plan::new(kind, &config),
+        };
+        plan.map_err(|e| e.to_string())
+    })();
+    let plan = match plan {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    match run_plan(&config, &physical, &plan, &options) {
         Ok(r) => {
             print!("{r}");
             ExitCode::SUCCESS

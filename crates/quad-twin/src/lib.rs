@@ -31,7 +31,7 @@ use source::FrameSource;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-pub use motions::{MotionKind, Plan};
+pub use motions::{MotionKind, Plan, TrotShape};
 
 /// Why a twin run failed.
 #[derive(Debug)]
@@ -180,6 +180,28 @@ pub struct TrackingMetric {
     pub amplitude_ratio: Option<f64>,
 }
 
+/// How one leg stepped (motions that lift feet).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct LegStepping {
+    /// How far the foot moved back under the body over its whole commanded stances, along the
+    /// commanded sweep, against the commanded sweep (1 = the stride is swept; none without a
+    /// whole stance).
+    pub stance_sweep_ratio: Option<f64>,
+    /// Share of the commanded-stance frames with the foot on the floor.
+    pub contact_in_stance: Option<f64>,
+    /// Share of the commanded-swing frames with the foot on the floor.
+    pub contact_in_swing: Option<f64>,
+    /// Mean knee error (reached − target) in stance, rad.
+    pub knee_error_in_stance_rad: Option<f64>,
+}
+
+/// Why a gait covers less ground than commanded, per leg.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct SteppingMetric {
+    /// Per leg, FL, FR, RL, RR.
+    pub legs: [LegStepping; 4],
+}
+
 /// The metrics of one run (the twin's `summary.json`).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct Summary {
@@ -213,6 +235,9 @@ pub struct Summary {
     pub torque: TorqueMetric,
     /// Roll/pitch tracking of the commanded body pose.
     pub tracking: TrackingMetric,
+    /// Stance sweep and contact timing, for motions that lift feet.
+    #[serde(default)]
+    pub stepping: Option<SteppingMetric>,
     /// Files written (summary, plots, pictures).
     #[serde(default)]
     pub files: Vec<PathBuf>,
@@ -314,6 +339,22 @@ impl fmt::Display for Run {
             s.tracking.pitch_rms_error_rad,
             s.tracking.amplitude_ratio
         )?;
+        if let Some(st) = &s.stepping {
+            let per_leg = |value: fn(&LegStepping) -> Option<f64>| {
+                st.legs
+                    .iter()
+                    .map(|l| value(l).map_or_else(|| "-".to_owned(), |v| format!("{v:.2}")))
+                    .collect::<Vec<_>>()
+                    .join(" / ")
+            };
+            writeln!(
+                f,
+                "  stepping (FL / FR / RL / RR): stance sweep {}, on the floor in swing {}, knee error in stance {} rad",
+                per_leg(|l| l.stance_sweep_ratio),
+                per_leg(|l| l.contact_in_swing),
+                per_leg(|l| l.knee_error_in_stance_rad)
+            )?;
+        }
         writeln!(
             f,
             "  speed: physics {:.1} sim s / wall s; whole loop {:.2} sim s / wall s ({:.2} s wall)",
@@ -338,8 +379,22 @@ pub fn run(
     kind: MotionKind,
     options: &RunOptions,
 ) -> Result<Run, Error> {
-    let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
     let plan = Plan::new(kind, config).map_err(Error::Motion)?;
+    run_plan(config, physical, &plan, options)
+}
+
+/// [`run`] with a plan built by the caller (e.g. [`Plan::trot`] with another shape).
+///
+/// # Errors
+/// [`Error`].
+pub fn run_plan(
+    config: &quad_device::Config,
+    physical: &Physical,
+    plan: &Plan,
+    options: &RunOptions,
+) -> Result<Run, Error> {
+    let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
+    let plan = *plan;
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {
             let device = device::SimDevice::start(*config)

@@ -22,8 +22,16 @@ pub const STAND_HOLD_S: f32 = 2.0;
 /// Seed 001's stance height with its robot (eq. 5), m: the yaw turn's lift is scaled from
 /// seed 001's 0.3 m by the robot's stance height over this one.
 pub const SEED001_STANCE_HEIGHT_M: f32 = 0.9294;
-/// Trot speed as stance heights per second (a step of 0.1·H at the default 0.8 s cycle).
+/// Trot speed as stance heights per second (0.1 m/s for seed 000's robot).
 pub const TROT_SPEED_HEIGHTS_PER_S: f32 = 0.25;
+/// Gait cycle of the twin's trot, s (kin-core's default is 0.8 s).
+pub const TROT_CYCLE_S: f32 = 1.0;
+/// Stance fraction of the twin's trot (kin-core's trot has 0.5): each diagonal pair hands the
+/// body over to the other while all four feet are down, so no stance leg carries half the
+/// body alone for its whole stance. With hobby-class servos, whose position error grows with
+/// the load, a 0.5 duty factor lets the two loaded knees sag through the stance and eat the
+/// stride; docs/twin.md has the measurements.
+pub const TROT_DUTY_FACTOR: f32 = 0.75;
 /// Duration of the trot, s.
 pub const TROT_DURATION_S: f32 = 10.0;
 /// Yaw-turn duration, in step periods.
@@ -33,6 +41,60 @@ pub const YAW_TURN_PERIODS: f32 = 2.0;
 pub const FAST_YAW_TURN_PERIOD_S: f32 = 0.8;
 /// Step height of the fast yaw turn as a fraction of the stance height (the gait's default).
 pub const FAST_YAW_TURN_LIFT_FRACTION: f32 = 0.15;
+
+/// The shape of the twin's trot: kin-core's gait parameters that a parameter study varies,
+/// relative to the stance height `H` where they scale with the robot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrotShape {
+    /// Gait cycle, s.
+    pub cycle_s: f32,
+    /// Stance fraction of the cycle, in (0, 1).
+    pub duty_factor: f32,
+    /// Swing apex above the ground, as a fraction of `H`.
+    pub step_height_fraction: f32,
+    /// Forward speed, stance heights per second.
+    pub speed_heights_per_s: f32,
+}
+
+impl TrotShape {
+    /// The gait phase the twin's trot starts at, cycles: the start of the first span with all
+    /// four feet down (the first pair has just touched down), so that the body has the whole
+    /// span to pick up the gait's speed before a pair lifts; 0 (a pair lifts at once) when
+    /// there is no such span (duty factor ½ or less).
+    pub fn four_feet_start(&self) -> f32 {
+        // Pairs at phase offsets 0 and ½ (kin-core's trot): the first pair is in stance from
+        // 1 − d, the second until ½.
+        let d = self.duty_factor;
+        if d > 0.5 {
+            1.0 - d
+        } else {
+            0.0
+        }
+    }
+
+    /// kin-core's own trot: [`GaitParams::DEFAULT_CYCLE_S`], [`Pattern::Trot`]'s duty factor
+    /// (0.5), [`GaitParams::DEFAULT_STEP_HEIGHT_FRACTION`], at [`TROT_SPEED_HEIGHTS_PER_S`].
+    pub fn kin_core() -> TrotShape {
+        TrotShape {
+            cycle_s: GaitParams::DEFAULT_CYCLE_S,
+            duty_factor: Pattern::Trot.duty_factor(),
+            ..TrotShape::default()
+        }
+    }
+}
+
+impl Default for TrotShape {
+    /// [`TROT_CYCLE_S`], [`TROT_DUTY_FACTOR`], kin-core's default step height, at
+    /// [`TROT_SPEED_HEIGHTS_PER_S`].
+    fn default() -> TrotShape {
+        TrotShape {
+            cycle_s: TROT_CYCLE_S,
+            duty_factor: TROT_DUTY_FACTOR,
+            step_height_fraction: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION,
+            speed_heights_per_s: TROT_SPEED_HEIGHTS_PER_S,
+        }
+    }
+}
 
 /// A motion of the twin's catalogue.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -54,13 +116,17 @@ pub enum MotionKind {
     /// Seed 001's yaw turn at the same turn rate with a step period of
     /// [`FAST_YAW_TURN_PERIOD_S`] (dynamic, trot-like) over the same 12 s.
     YawTurnFast,
-    /// A trot forward at [`TROT_SPEED_HEIGHTS_PER_S`], [`TROT_DURATION_S`].
+    /// A trot forward at [`TROT_SPEED_HEIGHTS_PER_S`], [`TROT_DURATION_S`], shaped by
+    /// [`TrotShape::default`].
     Trot,
+    /// A turn on the spot with the trot of [`TrotShape::default`] at seed 001's yaw rate
+    /// (ω = 0.085 rad/s, clockwise) over the yaw turn's 12 s.
+    TrotTurn,
 }
 
 impl MotionKind {
     /// Every motion.
-    pub const ALL: [MotionKind; 9] = [
+    pub const ALL: [MotionKind; 10] = [
         MotionKind::Stand,
         MotionKind::Roll,
         MotionKind::Pitch,
@@ -70,6 +136,7 @@ impl MotionKind {
         MotionKind::YawTurn,
         MotionKind::YawTurnFast,
         MotionKind::Trot,
+        MotionKind::TrotTurn,
     ];
 
     /// Command-line name.
@@ -84,6 +151,7 @@ impl MotionKind {
             MotionKind::YawTurn => "yaw-turn",
             MotionKind::YawTurnFast => "yaw-turn-fast",
             MotionKind::Trot => "trot",
+            MotionKind::TrotTurn => "trot-turn",
         }
     }
 
@@ -99,6 +167,7 @@ impl MotionKind {
             MotionKind::YawTurn => "Seed 001's crossed-pair yaw turn (eq. 9-11, T1 = 6 s)",
             MotionKind::YawTurnFast => "The yaw turn with a trot's step period, same turn rate",
             MotionKind::Trot => "A trot forward, 10 s",
+            MotionKind::TrotTurn => "A turn on the spot with the trot, seed 001's turn rate",
         }
     }
 
@@ -140,6 +209,8 @@ pub struct Plan {
     stance_height_m: f32,
     duration_s: f32,
     script: Script,
+    /// The law's time at the plan's start, s.
+    law_start_s: f32,
 }
 
 impl Plan {
@@ -203,14 +274,21 @@ impl Plan {
                     YAW_TURN_PERIODS * base.step_period_s,
                 )
             }
-            MotionKind::Trot => {
-                let mut p = GaitParams::new(Pattern::Trot, robot, h);
-                p.order = order;
-                p.velocity = Velocity {
-                    forward_m_s: TROT_SPEED_HEIGHTS_PER_S * h,
-                    ..Velocity::default()
-                };
-                (Script::Law(AnyMotion::Gait(Gait::new(p)?)), TROT_DURATION_S)
+            MotionKind::Trot => return Plan::trot(config, TrotShape::default()),
+            MotionKind::TrotTurn => {
+                let base = YawTurnParams::seed001();
+                return Plan::gait(
+                    MotionKind::TrotTurn,
+                    config,
+                    TrotShape::default(),
+                    Velocity {
+                        // Seed 001's positive ω turns clockwise; the gait's yaw rate is
+                        // counter-clockwise positive.
+                        yaw_rad_s: -base.omega_rad_s,
+                        ..Velocity::default()
+                    },
+                    YAW_TURN_PERIODS * base.step_period_s,
+                );
             }
         };
         Ok(Plan {
@@ -220,6 +298,60 @@ impl Plan {
             stance_height_m: h,
             duration_s,
             script,
+            law_start_s: 0.0,
+        })
+    }
+
+    /// The trot of the catalogue ([`MotionKind::Trot`]) with another shape: a parameter
+    /// study's entry point.
+    ///
+    /// # Errors
+    /// kin-core's [`kin_core::motion::Error`] naming the gait parameter it refuses.
+    pub fn trot(config: &Config, shape: TrotShape) -> Result<Plan, kin_core::motion::Error> {
+        let velocity = Velocity {
+            forward_m_s: shape.speed_heights_per_s * config.pose_config.stance_height_m,
+            ..Velocity::default()
+        };
+        Plan::gait(MotionKind::Trot, config, shape, velocity, TROT_DURATION_S)
+    }
+
+    /// The trot turning on the spot ([`MotionKind::TrotTurn`]) with another shape (its
+    /// speed is not used).
+    ///
+    /// # Errors
+    /// kin-core's [`kin_core::motion::Error`] naming the gait parameter it refuses.
+    pub fn trot_turn(config: &Config, shape: TrotShape) -> Result<Plan, kin_core::motion::Error> {
+        let mut plan = Plan::new(MotionKind::TrotTurn, config)?;
+        if let Script::Law(AnyMotion::Gait(g)) = plan.script {
+            let v = g.params().velocity;
+            plan = Plan::gait(MotionKind::TrotTurn, config, shape, v, plan.duration_s)?;
+        }
+        Ok(plan)
+    }
+
+    fn gait(
+        kind: MotionKind,
+        config: &Config,
+        shape: TrotShape,
+        velocity: Velocity,
+        duration_s: f32,
+    ) -> Result<Plan, kin_core::motion::Error> {
+        let robot = config.robot;
+        let h = config.pose_config.stance_height_m;
+        let mut p = GaitParams::new(Pattern::Trot, robot, h);
+        p.order = config.pose_config.order;
+        p.cycle_s = shape.cycle_s;
+        p.duty_factor = shape.duty_factor;
+        p.step_height_m = shape.step_height_fraction * h;
+        p.velocity = velocity;
+        Ok(Plan {
+            kind,
+            robot,
+            order: p.order,
+            stance_height_m: h,
+            duration_s,
+            script: Script::Law(AnyMotion::Gait(Gait::new(p)?)),
+            law_start_s: shape.four_feet_start() * shape.cycle_s,
         })
     }
 
@@ -257,7 +389,7 @@ impl Plan {
                 (pose, self.robot.stance_feet(stance_m), [Contact::Stance; 4])
             }
             Script::Law(m) => {
-                let f = m.frame::<kin_core::DefaultMath>(t_s)?;
+                let f = m.frame::<kin_core::DefaultMath>(t_s + self.law_start_s)?;
                 (f.pose, f.feet_in_world, f.contact)
             }
         };

@@ -1,6 +1,6 @@
 //! The physics twin in the loop (the twin's Python environment is required: its absence fails
-//! these tests; `scripts/install-deps.sh` creates it). Bounded: about 70 simulated seconds in
-//! all, a few wall seconds.
+//! these tests; `scripts/install-deps.sh` creates it). Bounded: about 115 simulated seconds in
+//! all, a few tens of wall seconds.
 
 use quad_device::Config;
 use quad_model::Physical;
@@ -13,6 +13,34 @@ const SWAY_SLIP_LIMIT_M: f64 = 0.02;
 const AMPLITUDE_BAND: (f64, f64) = (0.8, 1.25);
 /// The yaw turn must reach this fraction of its commanded yaw.
 const YAW_RATIO_MIN: f64 = 0.8;
+/// The trot must cover this fraction of its commanded distance.
+const TRAVEL_RATIO_MIN: f64 = 0.5;
+/// Each stance foot of the trot must sweep at least this fraction of its commanded stride
+/// under the body (kin-core's trot, duty 0.5, sweeps 0.2–0.3 on seed 000's robot: its
+/// two-leg stances sag).
+const STANCE_SWEEP_MIN: f64 = 0.6;
+/// The stepping motions may have a servo at full duty for at most this share of the physics
+/// steps.
+const STEPPING_SATURATED_MAX: f64 = 0.05;
+
+fn assert_steps(name: &str, s: &Summary) {
+    assert!(!s.fell, "{name} {}: fell: {:?}", s.motion, s.fall_reason);
+    assert!(
+        s.torque.peak_nm < s.torque.stall_nm,
+        "{name} {}: peak {:.2} N·m at {} exceeds the {} stall torque {:.2} N·m",
+        s.motion,
+        s.torque.peak_nm,
+        s.torque.peak_joint,
+        s.servo,
+        s.torque.stall_nm
+    );
+    assert!(
+        s.torque.saturated_fraction < STEPPING_SATURATED_MAX,
+        "{name} {}: {:?}",
+        s.motion,
+        s.torque
+    );
+}
 
 fn presets() -> [(&'static str, Config, Physical); 2] {
     [
@@ -77,6 +105,31 @@ fn the_fast_yaw_turn_turns_seed_000s_robot() {
     assert!(!s.fell, "{:?}", s.fall_reason);
     let yaw = s.yaw.expect("a turning motion");
     assert!(yaw.ratio >= YAW_RATIO_MIN, "{yaw:?}");
+}
+
+#[test]
+fn the_trot_covers_half_its_distance_on_both_presets() {
+    for (name, config, physical) in presets() {
+        let s = run_ok(&config, &physical, MotionKind::Trot);
+        assert_steps(name, &s);
+        let travel = s.travel.expect("a travelling motion");
+        assert!(travel.ratio >= TRAVEL_RATIO_MIN, "{name}: {travel:?}");
+        let stepping = s.stepping.as_ref().expect("a stepping motion");
+        for leg in &stepping.legs {
+            let sweep = leg.stance_sweep_ratio.expect("whole stances in 10 s");
+            assert!(sweep >= STANCE_SWEEP_MIN, "{name}: {stepping:?}");
+        }
+    }
+}
+
+#[test]
+fn the_trot_turns_both_presets_on_the_spot() {
+    for (name, config, physical) in presets() {
+        let s = run_ok(&config, &physical, MotionKind::TrotTurn);
+        assert_steps(name, &s);
+        let yaw = s.yaw.expect("a turning motion");
+        assert!(yaw.ratio >= YAW_RATIO_MIN, "{name}: {yaw:?}");
+    }
 }
 
 #[test]

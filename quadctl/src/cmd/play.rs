@@ -2,11 +2,9 @@
 //! output) played to the device in real time, every answer checked; a JSON summary as the last
 //! line of stdout.
 
-use crate::args::{self, RobotArgs, TargetArgs, EXIT_CHECK_FAILED, EXIT_OK};
-use kin_core::RotationOrder;
+use crate::args::{self, SessionArgs, EXIT_CHECK_FAILED, EXIT_OK};
 use quad_host::csv::play::ColumnKind;
 use quad_host::ops::play::{self, Request};
-use quad_protocol::RobotPreset;
 use std::io::{self, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -63,41 +61,21 @@ pub struct Args {
     pub file: PathBuf,
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub target: TargetArgs,
+    pub session: SessionArgs,
     /// Time scale: 2 plays twice as fast, 0.5 half as fast.
     #[arg(long, value_name = "X", default_value_t = 1.0)]
     pub speed: f64,
     /// The kind of columns to send [default: joints, else feet, else pose].
     #[arg(long, value_parser = args::column_kind())]
     pub send: Option<ColumnKind>,
-    /// Stance height H set on the device, metres (for poses); default: the device's own.
-    #[arg(long, value_name = "H", value_parser = args::parse_positive_m)]
-    pub stance_height_m: Option<f32>,
-    /// Rotation order set on the device; default: the file's (rotation_order= comment), else
-    /// the device's own.
-    #[arg(long, value_parser = args::rotation_order())]
-    pub rotation_order: Option<RotationOrder>,
-    /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
-    /// exact with --sim, 5e-5 rad with --emulator and --port.
-    #[arg(long, value_name = "RAD")]
-    pub angle_tolerance_rad: Option<f32>,
 }
 
 /// Runs `quadctl play` and returns its exit status.
 pub fn main(args: &Args) -> ExitCode {
-    let preset = RobotPreset::from_name(args.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
     let request = Request {
-        robot: args.robot.robot.clone(),
-        target: args.target.target(preset),
-        retries: args.target.retries,
+        session: args.session.session(),
         speed: args.speed,
         send: args.send,
-        stance_height_m: args.stance_height_m,
-        rotation_order: args.rotation_order,
-        angle_tolerance_rad: args.angle_tolerance_rad,
         input: args.file.clone(),
     };
     let summary = match play::run(&request, &mut io::stderr().lock()) {

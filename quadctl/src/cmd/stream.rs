@@ -2,12 +2,8 @@
 //! real (`--port`), every answer checked against the host's own kin-core; a JSON summary as the
 //! last line of stdout.
 
-use crate::args::{
-    self, InputArgs, RobotArgs, TargetArgs, EXIT_CHECK_FAILED, EXIT_MALFORMED, EXIT_OK,
-};
-use kin_core::RotationOrder;
+use crate::args::{self, InputArgs, SessionArgs, EXIT_CHECK_FAILED, EXIT_MALFORMED, EXIT_OK};
 use quad_host::ops::stream::{self, Request};
-use quad_protocol::RobotPreset;
 use std::io::{self, Write};
 use std::process::ExitCode;
 
@@ -64,21 +60,7 @@ Examples (from the repository root):
 pub struct Args {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub target: TargetArgs,
-    /// Stance height H set on the device, metres; default: the device's own.
-    #[arg(long, value_name = "H", value_parser = args::parse_positive_m)]
-    pub stance_height_m: Option<f32>,
-    /// Rotation order set on the device; default: the device's own.
-    #[arg(long, value_parser = args::rotation_order())]
-    pub rotation_order: Option<RotationOrder>,
-    /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
-    /// exact with --sim, 5e-5 rad with --emulator and --port (the AVR's math differs from the
-    /// host's).
-    #[arg(long, value_name = "RAD")]
-    pub angle_tolerance_rad: Option<f32>,
+    pub session: SessionArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub input: InputArgs,
@@ -86,16 +68,8 @@ pub struct Args {
 
 /// Runs `quadctl stream` and returns its exit status.
 pub fn main(args: &Args) -> ExitCode {
-    // The simulated device runs the robot given; `stream::run` refuses a robot that is not a
-    // preset before the link is opened.
-    let preset = RobotPreset::from_name(args.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
     let request = Request {
-        robot: args.robot.robot.clone(),
-        target: args.target.target(preset),
-        retries: args.target.retries,
-        stance_height_m: args.stance_height_m,
-        rotation_order: args.rotation_order,
-        angle_tolerance_rad: args.angle_tolerance_rad,
+        session: args.session.session(),
         input: args.input.input.clone(),
     };
     let outcome = match stream::run(&request, &mut io::stderr().lock()) {

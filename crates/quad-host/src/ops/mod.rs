@@ -12,4 +12,5 @@ pub mod motion;
 pub mod onboard;
 pub mod play;
 pub mod plot;
+pub mod session;
 pub mod stream;

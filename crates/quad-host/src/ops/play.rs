@@ -18,16 +18,13 @@
 //! (feet at the device's stance). With several kinds, joint angles come first, then feet,
 //! then the pose, unless [`Request::send`] names one.
 
-use crate::client::{
-    AngleCheck, Client, ClientConfig, PoseResult, PoseStream, Setpoint, StreamSetup, StreamStats,
-};
+use crate::client::{self, PoseStream, Setpoint, StreamStats};
+use crate::csv;
 use crate::csv::play::{self as play_csv, ColumnKind, PlayFile};
-use crate::link::{self, Link, Target};
-use crate::ops::stream::Pins;
-use crate::{client, csv, robot_file};
+use crate::link::Link;
+use crate::ops::session::{self, Pins, Session};
 use kin_core::body;
 use kin_core::{BodyConfig, LegId, Robot, RotationOrder, Vec3};
-use quad_protocol::RobotPreset;
 use serde::Serialize;
 use std::io::Write;
 use std::path::PathBuf;
@@ -36,23 +33,13 @@ use std::time::Duration;
 /// What [`run`] is asked.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Request {
-    /// The robot: a preset name (the device reports its preset).
-    pub robot: String,
-    /// The device.
-    pub target: Target,
-    /// Resends per row after the first attempt.
-    pub retries: u32,
+    /// The device, the robot and the answers' check; its rotation order `None`: the file's
+    /// (a `rotation_order=` comment), else the device's own.
+    pub session: Session,
     /// Time scale: 2 plays twice as fast (finite, > 0).
     pub speed: f64,
     /// The kind of columns to send; `None`: joints, else feet, else pose.
     pub send: Option<ColumnKind>,
-    /// Stance height H set on the device, m; `None`: the device's own.
-    pub stance_height_m: Option<f32>,
-    /// Rotation order set on the device; `None`: the file's (a `rotation_order=` comment),
-    /// else the device's own.
-    pub rotation_order: Option<RotationOrder>,
-    /// Compare angles within this bound (rad); `None`: [`AngleCheck::for_target`].
-    pub angle_tolerance_rad: Option<f32>,
     /// The file (`-`: stdin).
     pub input: PathBuf,
 }
@@ -61,15 +48,9 @@ pub struct Request {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The robot is not a preset.
-    #[error(
-        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
-         device reports its preset and both sides must run the same geometry"
-    )]
-    NotAPreset(String),
-    /// The robot could not be resolved.
+    /// The session could not start (robot, tolerance, link, handshake), or the link failed.
     #[error(transparent)]
-    Robot(#[from] robot_file::Error),
+    Session(#[from] session::Error),
     /// The file cannot be played.
     #[error(transparent)]
     File(#[from] play_csv::Error),
@@ -86,18 +67,15 @@ pub enum Error {
     /// A speed that is not finite and > 0.
     #[error("--speed {0} must be finite and > 0")]
     Speed(f64),
-    /// A negative or non-finite angle tolerance.
-    #[error("--angle-tolerance-rad {0} must be finite and >= 0")]
-    Tolerance(f32),
-    /// The link could not be opened.
-    #[error(transparent)]
-    Link(#[from] link::Error),
-    /// The handshake or the link failed.
-    #[error(transparent)]
-    Client(#[from] client::Error),
     /// The report could not be written.
     #[error(transparent)]
     Report(#[from] csv::Error),
+}
+
+impl From<client::Error> for Error {
+    fn from(e: client::Error) -> Error {
+        Error::Session(e.into())
+    }
 }
 
 /// How late the rows were sent, and how long their answers took.
@@ -136,14 +114,9 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// True when a readback disagreed with the host, a pulse left its travel or a pulse on
-    /// the pins matched no readback.
+    /// See [`session::check_failed`].
     pub fn check_failed(&self) -> bool {
-        self.stream.readback_mismatches > 0
-            || self.stream.pulses_out_of_range > 0
-            || self
-                .pins
-                .is_some_and(|p| p.pulse_width_errors > 0 || p.rx_overruns > 0)
+        session::check_failed(&self.stream, self.pins)
     }
 }
 
@@ -207,52 +180,16 @@ pub fn setpoint(
 /// # Errors
 /// See [`Error`]; a link failure in the middle stops the playing.
 pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Summary, Error> {
-    let preset = RobotPreset::from_name(args.robot.trim())
-        .ok_or_else(|| Error::NotAPreset(args.robot.clone()))?;
-    let robot = robot_file::resolve(&args.robot)?;
+    let checked = args.session.check()?;
     if !(args.speed.is_finite() && args.speed > 0.0) {
         return Err(Error::Speed(args.speed));
     }
-    let check = match args.angle_tolerance_rad {
-        Some(t) if t.is_finite() && t >= 0.0 => AngleCheck::Within(t),
-        Some(t) => return Err(Error::Tolerance(t)),
-        None => AngleCheck::for_target(&args.target),
-    };
     let file = play_csv::read(&args.input)?;
     let kind = kind_to_send(&file, args.send)?;
-    let link = link::open(&args.target)?;
-    let setup = StreamSetup {
-        robot,
-        preset,
-        stance_height_m: args.stance_height_m,
-        order: args.rotation_order.or(file.rotation_order),
-        check,
-    };
-    let config = ClientConfig::for_target(&args.target, args.retries);
-    let mut stream = PoseStream::connect(Client::new(link, config), setup)?;
+    let mut stream = args.session.connect(checked, file.rotation_order)?;
     let timing = play(&mut stream, &file, kind, args.speed, diag)?;
-    let mut pins = None;
-    if let Some(emu) = stream.client_mut().link_mut().emulator() {
-        let pulses = emu.pulse_stats();
-        if let Some(e) = &pulses.first_error {
-            writeln!(diag, "{}: PULSE WIDTH ERROR: {e}", file.name)
-                .map_err(|source| csv::Error::Write { path: None, source })?;
-        }
-        let rx_overruns = emu.rx_overruns();
-        if rx_overruns > 0 {
-            writeln!(
-                diag,
-                "{}: RECEIVE OVERRUN: {rx_overruns} bytes lost by the chip's receive buffer",
-                file.name
-            )
-            .map_err(|source| csv::Error::Write { path: None, source })?;
-        }
-        pins = Some(Pins {
-            rx_overruns,
-            pulses_checked: pulses.checked,
-            pulse_width_errors: pulses.errors,
-        });
-    }
+    let pins = Pins::after(&mut stream, &file.name, diag)
+        .map_err(|source| csv::Error::Write { path: None, source })?;
     Ok(Summary {
         kind,
         rows: file.frames.len() as u64,
@@ -305,15 +242,7 @@ pub fn play<L: Link>(
         sent += 1;
         timing.late_max_ms = timing.late_max_ms.max(late_ms);
         timing.answer_max_ms = timing.answer_max_ms.max(answer_ms);
-        let report = match result {
-            PoseResult::Acked { .. } => None,
-            PoseResult::Nacked(reason) => {
-                Some(format!("nacked: {reason} (the host's kin-core agrees)"))
-            }
-            PoseResult::Lost => Some("lost: no answer after every retry".to_owned()),
-            PoseResult::Mismatch(what) => Some(format!("READBACK MISMATCH: {what}")),
-        };
-        if let Some(r) = report {
+        if let Some(r) = session::report(&result) {
             writeln!(diag, "{}:{}: {r}", file.name, frame.line)
                 .map_err(|source| csv::Error::Write { path: None, source })?;
         }

@@ -1,15 +1,10 @@
 //! Body poses from a CSV to the device, every answer checked against the host's own kin-core:
 //! the operation behind `quadctl stream`. Its summary is one JSON object ([`Summary`]).
 
-use crate::client::{
-    AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, StreamStats,
-};
+use crate::client::{self, StreamStats};
 use crate::csv::{self, AnswerError, FirstColumn, Input, Schema};
-use crate::link::{self, Link, Target};
-use crate::{client, robot_file};
+use crate::ops::session::{self, Pins, Session};
 use kin_core::body::Pose;
-use kin_core::RotationOrder;
-use quad_protocol::RobotPreset;
 use serde::Serialize;
 use std::cell::RefCell;
 use std::io::{self, Write};
@@ -24,19 +19,8 @@ pub const POSE_COLUMNS: Schema = Schema {
 /// What [`run`] is asked.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Request {
-    /// The robot: a preset name (the device reports its preset and both sides must run the
-    /// same geometry).
-    pub robot: String,
-    /// The device.
-    pub target: Target,
-    /// Resends per pose after the first attempt.
-    pub retries: u32,
-    /// Stance height H set on the device, m; `None`: the device's own.
-    pub stance_height_m: Option<f32>,
-    /// Rotation order set on the device; `None`: the device's own.
-    pub rotation_order: Option<RotationOrder>,
-    /// Compare angles within this bound (rad); `None`: [`AngleCheck::for_target`].
-    pub angle_tolerance_rad: Option<f32>,
+    /// The device, the robot and the answers' check.
+    pub session: Session,
     /// The poses, CSV (`-`: stdin).
     pub input: PathBuf,
 }
@@ -45,39 +29,18 @@ pub struct Request {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The robot is not a preset.
-    #[error(
-        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
-         device reports its preset and both sides must run the same geometry"
-    )]
-    NotAPreset(String),
-    /// The robot could not be resolved.
+    /// The session could not start (robot, tolerance, link, handshake), or the link failed.
     #[error(transparent)]
-    Robot(#[from] robot_file::Error),
+    Session(#[from] session::Error),
     /// The input could not be read, or the output written.
     #[error(transparent)]
     Csv(#[from] csv::Error),
-    /// The link could not be opened.
-    #[error(transparent)]
-    Link(#[from] link::Error),
-    /// The handshake or the link failed.
-    #[error(transparent)]
-    Client(#[from] client::Error),
-    /// A negative or non-finite angle tolerance.
-    #[error("--angle-tolerance-rad {0} must be finite and >= 0")]
-    Tolerance(f32),
 }
 
-/// The emulator's checks of the chip, in the summary: the receive buffer and the pins.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct Pins {
-    /// Bytes the chip's two-byte receive buffer lost because the firmware did not read them in
-    /// time (data overruns).
-    pub rx_overruns: u64,
-    /// Pulses measured on the 12 servo pins and compared with the readbacks.
-    pub pulses_checked: u64,
-    /// Pulses off their readback by more than one 0.5 µs timer tick.
-    pub pulse_width_errors: u64,
+impl From<client::Error> for Error {
+    fn from(e: client::Error) -> Error {
+        Error::Session(e.into())
+    }
 }
 
 /// `quadctl stream`'s JSON summary: the stream's statistics, then the pin check with
@@ -93,14 +56,9 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// True when a readback disagreed with the host, a pulse left its travel, a pulse on
-    /// the pins matched no readback or the chip's receive buffer overran.
+    /// See [`session::check_failed`].
     pub fn check_failed(&self) -> bool {
-        self.stream.readback_mismatches > 0
-            || self.stream.pulses_out_of_range > 0
-            || self
-                .pins
-                .is_some_and(|p| p.pulse_width_errors > 0 || p.rx_overruns > 0)
+        session::check_failed(&self.stream, self.pins)
     }
 }
 
@@ -119,25 +77,9 @@ pub struct Outcome {
 /// # Errors
 /// See [`Error`]; a link failure in the middle stops the stream.
 pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
-    let preset = RobotPreset::from_name(args.robot.trim())
-        .ok_or_else(|| Error::NotAPreset(args.robot.clone()))?;
-    let robot = robot_file::resolve(&args.robot)?;
+    let checked = args.session.check()?;
     let input = Input::open(&args.input)?;
-    let link = link::open(&args.target)?;
-    let check = match args.angle_tolerance_rad {
-        Some(t) if t.is_finite() && t >= 0.0 => AngleCheck::Within(t),
-        Some(t) => return Err(Error::Tolerance(t)),
-        None => AngleCheck::for_target(&args.target),
-    };
-    let setup = StreamSetup {
-        robot,
-        preset,
-        stance_height_m: args.stance_height_m,
-        order: args.rotation_order,
-        check,
-    };
-    let config = ClientConfig::for_target(&args.target, args.retries);
-    let mut stream = PoseStream::connect(Client::new(link, config), setup)?;
+    let mut stream = args.session.connect(checked, None)?;
     let name = input.name.clone();
     let mut failure: Option<client::Error> = None;
     // Malformed records (reported by `for_each_row`) and pose reports share `diag`, in order.
@@ -160,17 +102,8 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
                     return Err(AnswerError::Io(io::Error::other("link failed")));
                 }
             };
-            let line = row.line;
-            let report = match result {
-                PoseResult::Acked { .. } => None,
-                PoseResult::Nacked(reason) => {
-                    Some(format!("nacked: {reason} (the host's kin-core agrees)"))
-                }
-                PoseResult::Lost => Some("lost: no answer after every retry".to_owned()),
-                PoseResult::Mismatch(what) => Some(format!("READBACK MISMATCH: {what}")),
-            };
-            if let Some(r) = report {
-                writeln!(diag.borrow_mut(), "{name}:{line}: {r}")?;
+            if let Some(r) = session::report(&result) {
+                writeln!(diag.borrow_mut(), "{name}:{}: {r}", row.line)?;
             }
             Ok(())
         },
@@ -179,27 +112,8 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
         return Err(e.into());
     }
     let rows = rows?;
-    let mut pins = None;
-    if let Some(emu) = stream.client_mut().link_mut().emulator() {
-        let pulses = emu.pulse_stats();
-        if let Some(e) = &pulses.first_error {
-            writeln!(diag.borrow_mut(), "{name}: PULSE WIDTH ERROR: {e}")
-                .map_err(|source| csv::Error::Write { path: None, source })?;
-        }
-        let rx_overruns = emu.rx_overruns();
-        if rx_overruns > 0 {
-            writeln!(
-                diag.borrow_mut(),
-                "{name}: RECEIVE OVERRUN: {rx_overruns} bytes lost by the chip's receive buffer"
-            )
-            .map_err(|source| csv::Error::Write { path: None, source })?;
-        }
-        pins = Some(Pins {
-            rx_overruns,
-            pulses_checked: pulses.checked,
-            pulse_width_errors: pulses.errors,
-        });
-    }
+    let pins = Pins::after(&mut stream, &name, &mut Shared(&diag))
+        .map_err(|source| csv::Error::Write { path: None, source })?;
     Ok(Outcome {
         summary: Summary {
             stream: stream.stats(),

@@ -1,0 +1,173 @@
+//! What the operations that stream setpoints to a device (`quadctl stream`, `quadctl play`)
+//! share: the device and robot they run on, how the answers are checked, the connected
+//! stream, the report of one answer and the emulator's checks of the chip.
+
+use crate::client::{
+    self, AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, StreamStats,
+};
+use crate::link::{self, Link, Target};
+use crate::robot_file;
+use kin_core::{Robot, RotationOrder};
+use quad_protocol::RobotPreset;
+use serde::Serialize;
+use std::io::{self, Write};
+
+/// The device side of a stream: robot, device, retries and the configuration set on it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Session {
+    /// The robot: a preset name (the device reports its preset and both sides must run the
+    /// same geometry).
+    pub robot: String,
+    /// The device.
+    pub target: Target,
+    /// Resends per setpoint after the first attempt.
+    pub retries: u32,
+    /// Stance height H set on the device, m; `None`: the device's own.
+    pub stance_height_m: Option<f32>,
+    /// Rotation order set on the device; `None`: the operation's default, else the device's
+    /// own.
+    pub rotation_order: Option<RotationOrder>,
+    /// Compare angles within this bound (rad); `None`: [`AngleCheck::for_target`].
+    pub angle_tolerance_rad: Option<f32>,
+}
+
+/// Why a session could not start.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The robot is not a preset.
+    #[error(
+        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
+         device reports its preset and both sides must run the same geometry"
+    )]
+    NotAPreset(String),
+    /// The robot could not be resolved.
+    #[error(transparent)]
+    Robot(#[from] robot_file::Error),
+    /// A negative or non-finite angle tolerance.
+    #[error("--angle-tolerance-rad {0} must be finite and >= 0")]
+    Tolerance(f32),
+    /// The link could not be opened.
+    #[error(transparent)]
+    Link(#[from] link::Error),
+    /// The handshake or the link failed.
+    #[error(transparent)]
+    Client(#[from] client::Error),
+}
+
+/// A session whose arguments were checked ([`Session::check`]); nothing is opened yet.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    preset: RobotPreset,
+    robot: Robot,
+    check: AngleCheck,
+}
+
+impl Session {
+    /// Checks the robot and the tolerance, before any file is read or link opened.
+    ///
+    /// # Errors
+    /// [`Error::NotAPreset`], [`Error::Robot`], [`Error::Tolerance`].
+    pub fn check(&self) -> Result<Checked, Error> {
+        let preset = RobotPreset::from_name(self.robot.trim())
+            .ok_or_else(|| Error::NotAPreset(self.robot.clone()))?;
+        let robot = robot_file::resolve(&self.robot)?;
+        let check = match self.angle_tolerance_rad {
+            Some(t) if t.is_finite() && t >= 0.0 => AngleCheck::Within(t),
+            Some(t) => return Err(Error::Tolerance(t)),
+            None => AngleCheck::for_target(&self.target),
+        };
+        Ok(Checked {
+            preset,
+            robot,
+            check,
+        })
+    }
+
+    /// Opens the link and connects the stream (handshake, configuration); the rotation order
+    /// is [`Session::rotation_order`], else `default_order`, else the device's own.
+    ///
+    /// # Errors
+    /// [`Error::Link`], [`Error::Client`].
+    pub fn connect(
+        &self,
+        checked: Checked,
+        default_order: Option<RotationOrder>,
+    ) -> Result<PoseStream<Box<dyn Link>>, Error> {
+        let link = link::open(&self.target)?;
+        let setup = StreamSetup {
+            robot: checked.robot,
+            preset: checked.preset,
+            stance_height_m: self.stance_height_m,
+            order: self.rotation_order.or(default_order),
+            check: checked.check,
+        };
+        let config = ClientConfig::for_target(&self.target, self.retries);
+        Ok(PoseStream::connect(Client::new(link, config), setup)?)
+    }
+}
+
+/// What to report of an answer: `None` when acked, else one line.
+pub fn report(result: &PoseResult) -> Option<String> {
+    match result {
+        PoseResult::Acked { .. } => None,
+        PoseResult::Nacked(reason) => {
+            Some(format!("nacked: {reason} (the host's kin-core agrees)"))
+        }
+        PoseResult::Lost => Some("lost: no answer after every retry".to_owned()),
+        PoseResult::Mismatch(what) => Some(format!("READBACK MISMATCH: {what}")),
+    }
+}
+
+/// The emulator's checks of the chip, in the summary: the receive buffer and the pins.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Pins {
+    /// Bytes the chip's two-byte receive buffer lost because the firmware did not read them in
+    /// time (data overruns).
+    pub rx_overruns: u64,
+    /// Pulses measured on the 12 servo pins and compared with the readbacks.
+    pub pulses_checked: u64,
+    /// Pulses off their readback by more than one 0.5 µs timer tick.
+    pub pulse_width_errors: u64,
+}
+
+impl Pins {
+    /// The emulator's checks after a stream (`None` on other links); the first pulse width
+    /// error and any receive overrun are reported on `diag` as `<name>: …`.
+    ///
+    /// # Errors
+    /// A failing `diag`.
+    pub fn after<L: Link>(
+        stream: &mut PoseStream<L>,
+        name: &str,
+        diag: &mut dyn Write,
+    ) -> io::Result<Option<Pins>> {
+        let Some(emu) = stream.client_mut().link_mut().emulator() else {
+            return Ok(None);
+        };
+        let pulses = emu.pulse_stats();
+        if let Some(e) = &pulses.first_error {
+            writeln!(diag, "{name}: PULSE WIDTH ERROR: {e}")?;
+        }
+        let rx_overruns = emu.rx_overruns();
+        if rx_overruns > 0 {
+            writeln!(
+                diag,
+                "{name}: RECEIVE OVERRUN: {rx_overruns} bytes lost by the chip's receive buffer"
+            )?;
+        }
+        Ok(Some(Pins {
+            rx_overruns,
+            pulses_checked: pulses.checked,
+            pulse_width_errors: pulses.errors,
+        }))
+    }
+}
+
+/// True when a readback disagreed with the host, a pulse left its travel, a pulse on the pins
+/// matched no readback or the chip's receive buffer overran.
+pub fn check_failed(stream: &StreamStats, pins: Option<Pins>) -> bool {
+    stream.readback_mismatches > 0
+        || stream.pulses_out_of_range > 0
+        || pins.is_some_and(|p| p.pulse_width_errors > 0 || p.rx_overruns > 0)
+}
