@@ -38,6 +38,11 @@
 //! write past the window: switching never cuts a pulse short or starts one late. An apply
 //! begins only with a millisecond of the window left, so every period shows either the old or
 //! the new widths on all twelve pins; the main loop never waits for the window.
+//!
+//! **Periods counted.** The tick interrupt counts the PWM periods (Timer1's overflow flag, set
+//! at TOP) and notes the period in which a staged state was written; the controller latches its
+//! servo frames to them (`quad_device::ServoOutputs::periods_begun`, `write_pending`), so that
+//! each period gets at most one new state and no setpoint is replaced before a pulse showed it.
 
 use crate::pac;
 use core::cell::{Cell, UnsafeCell};
