@@ -37,10 +37,13 @@ enum Command {
     Sim(cmd::sim::Args),
     Export(cmd::export::Args),
     /// Stand up: outputs on at the rest pose, then up to the stance (onboard motion).
+    #[command(after_help = cmd::onboard::STAND_EXAMPLES)]
     Stand(cmd::onboard::PostureArgs),
     /// Sit: down to the rest pose, held (onboard motion).
+    #[command(after_help = cmd::onboard::SIT_EXAMPLES)]
     Sit(cmd::onboard::PostureArgs),
     /// Rest: down to the rest pose, then the outputs off (onboard motion).
+    #[command(after_help = cmd::onboard::REST_EXAMPLES)]
     Rest(cmd::onboard::PostureArgs),
     /// Run one of the device's own motions: sways, yaw turn, foot paths, trot, walk.
     Run(cmd::onboard::RunArgs),

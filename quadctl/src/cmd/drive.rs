@@ -39,11 +39,17 @@ Output: the last line of stdout is one JSON object: commands_sent, refused, keys
 height_changes, max_gap_ms, elapsed_s, last (the last accepted command). Exit status: 0 done;
 2 the link failed or the script is malformed.";
 
+/// `--help`'s examples (run from the repository root).
+pub const EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl drive --robot shahriar2023 --sim --keys examples/drive.keys";
+
 /// Arguments of `quadctl drive`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
     about = "Keyboard teleop of the onboard trot: arrows/WASD velocity, +/- height, space stop, q sit and quit",
-    long_about = LONG_ABOUT
+    long_about = LONG_ABOUT,
+    after_help = EXAMPLES
 )]
 pub struct Args {
     #[command(flatten)]

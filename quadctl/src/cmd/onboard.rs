@@ -26,6 +26,24 @@ Output: the last line of stdout is one JSON object: motion, stood_up_first, moti
 velocity_commands, elapsed_s, outputs_enabled. Exit status: 0 done; 2 refused (the device's
 reason in words) or the link failed.";
 
+/// `--help`'s examples of `stand`, `sit` and `rest` (run from the repository root).
+pub const STAND_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl stand --robot shahriar2023 --sim
+  quadctl stand --robot shahriar2023 --port /dev/ttyACM0";
+
+/// `quadctl sit --help`'s examples.
+pub const SIT_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl sit --robot shahriar2023 --sim
+  quadctl sit --robot shahriar2023 --port /dev/ttyACM0";
+
+/// `quadctl rest --help`'s examples.
+pub const REST_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl rest --robot shahriar2023 --sim
+  quadctl rest --robot shahriar2023 --port /dev/ttyACM0";
+
 /// Arguments of `quadctl stand`, `sit` and `rest`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(long_about = POSTURE_ABOUT)]
@@ -75,9 +93,17 @@ Bad values (NaN, zero or negative periods and durations, amplitudes or heights b
 velocities beyond what the gait reaches) are refused by the device before anything moves; the
 refusal names the option. Exit status: 0 done; 2 refused, stopped early or the link failed.";
 
+/// `quadctl run --help`'s examples (run from the repository root).
+pub const RUN_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl run sway-roll --robot shahriar2023 --sim --amplitude-rad 0.1 --period-s 2
+  quadctl run yaw-turn --robot shahriar2023 --sim --yaw-rate-rad-s 0.1 --step-period-s 2 --lift-height-m 0.03
+  quadctl run trot --robot shahriar2023 --sim --forward-m-s 0.02 --duration-s 2
+  quadctl run sway-pitch --robot shahriar2023 --port /dev/ttyACM0";
+
 /// Arguments of `quadctl run`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
-#[command(long_about = RUN_ABOUT)]
+#[command(long_about = RUN_ABOUT, after_help = RUN_EXAMPLES)]
 pub struct RunArgs {
     /// The motion.
     #[arg(value_enum)]
