@@ -37,12 +37,15 @@ pub enum Error {
     #[error(transparent)]
     Client(#[from] client::Error),
     /// The device refused a request.
-    #[error("the device refused {request}: {}", words(.reason))]
+    #[error("the device refused {request}: {}{}", words(.reason), reach_hint(.reason, .shaped_by))]
     Refused {
         /// The request.
         request: &'static str,
         /// Why.
         reason: NackReason,
+        /// The options that set where a started motion's feet go (empty for other
+        /// requests): named when the device's start check finds a foot it cannot place.
+        shaped_by: &'static str,
     },
     /// The motion stopped early on the device.
     #[error("the motion stopped early on the device: {}", words(.0))]
@@ -85,6 +88,34 @@ pub fn option(param: MotionParam) -> &'static str {
         MotionParam::Stance => "the device's stance height",
         MotionParam::ReachRadiusM => "--body-height-m (it sets the stride's reach)",
         _ => "a parameter",
+    }
+}
+
+/// The options that set where the feet of a started motion go: the device's start check
+/// refuses a sample by the leg that cannot reach it, and these are what to change.
+fn reach_options(request: &Request) -> &'static str {
+    match request {
+        Request::StartMotion(MotionCommand::Sway { .. }) => "--amplitude-rad",
+        Request::StartMotion(MotionCommand::YawTurn { .. }) => {
+            "--yaw-rate-rad-s, --step-period-s, --lift-height-m"
+        }
+        Request::StartMotion(MotionCommand::FootPath { .. }) => "--stride-m, --step-height-m",
+        Request::StartMotion(MotionCommand::Walk { .. }) => "--body-height-m, --step-height-m",
+        _ => "",
+    }
+}
+
+/// " (set by OPTIONS)" after a start check's refusal of a sample, when the motion has such
+/// options.
+fn reach_hint(reason: &NackReason, shaped_by: &str) -> String {
+    let sample = matches!(
+        reason,
+        NackReason::Preflight { .. } | NackReason::ServoRange { .. }
+    );
+    if sample && !shaped_by.is_empty() {
+        format!(" (the motion's feet are set by {shaped_by})")
+    } else {
+        String::new()
     }
 }
 
@@ -208,6 +239,7 @@ impl<L: Link> Session<L> {
             Outcome::Accepted(DeviceToHost::Nack { reason, .. }) => Err(Error::Refused {
                 request: name,
                 reason,
+                shaped_by: reach_options(&request),
             }),
             Outcome::Accepted(other) | Outcome::Rejected(other) => Err(client::Error::Unexpected {
                 request: name,
