@@ -261,17 +261,14 @@ fn apply_staged() {
         if !(0..4).all(|t| in_window(tcnt(&dp, t), after, start_before)) {
             return;
         }
-        for (t, &c) in connections.iter().enumerate() {
-            let written = avr_device::interrupt::free(|_| {
-                if !in_window(tcnt(&dp, t), after, before) {
-                    return false;
-                }
-                write_timer(&dp, t, &ticks, c);
-                true
-            });
-            if !written {
-                return;
-            }
+        // One stretch per timer, each with its timer's registers as constants (a timer index
+        // looked up inside the stretch made it longer than a byte time at 1 Mbaud).
+        let written = write_in_window::<0>(&dp, &ticks, connections[0], after, before)
+            && write_in_window::<1>(&dp, &ticks, connections[1], after, before)
+            && write_in_window::<2>(&dp, &ticks, connections[2], after, before)
+            && write_in_window::<3>(&dp, &ticks, connections[3], after, before);
+        if !written {
+            return;
         }
     }
     ACTIVE_LONGEST.set(longest_new);
@@ -297,6 +294,36 @@ fn tcnt(dp: &pac::Peripherals, t: usize) -> u16 {
     }
 }
 
+/// Timer `T`'s writes ([`write_timer`]) in one interrupts-off stretch that begins by checking
+/// that its count lies in `(after, before)`; false (nothing written) when it does not.
+#[inline(always)]
+fn write_in_window<const T: usize>(
+    dp: &pac::Peripherals,
+    ticks: &[u16; CHANNELS],
+    connection: (u8, u8),
+    after: u16,
+    before: u16,
+) -> bool {
+    // The compare values before the stretch.
+    let ocr: [u16; 3] = core::array::from_fn(|unit| ticks[3 * T + unit].wrapping_sub(1));
+    let on: [bool; 3] = core::array::from_fn(|unit| ticks[3 * T + unit] > 0);
+    // Not `interrupt::free`: its closure may be left out of line, and the call would lengthen
+    // the stretch.
+    let irq = avr_device::interrupt::disable_save();
+    let inside = in_window(tcnt(dp, T), after, before);
+    if inside {
+        for unit in 0..3 {
+            if on[unit] {
+                write_ocr(dp, 3 * T + unit, ocr[unit]);
+            }
+        }
+        apply_connections(dp, T, connection);
+    }
+    // SAFETY: restores the interrupt flag saved above, at the end of the stretch it began.
+    unsafe { avr_device::interrupt::restore(irq) };
+    inside
+}
+
 /// Writes timer `t`'s three compare registers (channels with a non-zero width) and its
 /// connections `(TCCRnA, port bits to drive low)`.
 #[inline(always)]
@@ -312,6 +339,7 @@ fn write_timer(dp: &pac::Peripherals, t: usize, ticks: &[u16; CHANNELS], connect
     apply_connections(dp, t, connection);
 }
 
+#[inline(always)]
 fn write_ocr(dp: &pac::Peripherals, channel: usize, ocr: u16) {
     match channel {
         0 => dp.TC1.ocr1a().write(|w| w.set(ocr)),
