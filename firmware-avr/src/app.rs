@@ -20,7 +20,7 @@
 //!   robot, the one with the Arduino Mega): body poses in rotation order zyx at its default
 //!   stance height, unreachable targets rejected, no link-loss timeout until the host sets one.
 //! - Math: [`avr_libc_math::AvrFast`] (avr-libc's `sqrt`, kin-core's fixed-point arctangent
-//!   `poly::atan2_fixed` and `poly::sin_cos_deg5`), the fastest backend measured (`cargo xtask
+//!   `poly::atan2_fixed` and sine/cosine `poly::sin_cos_fixed`), the fastest backend measured (`cargo xtask
 //!   avr-bench`).
 //! - Outputs stay low until the host sends `SetOutputs { enabled: true }`.
 //! - Watchdog: [`WATCHDOG_TIMEOUT`], fed by the main loop and during EEPROM writes. A hung main

@@ -215,7 +215,7 @@ pub struct SessionArgs {
     #[arg(long, value_parser = rotation_order())]
     pub rotation_order: Option<RotationOrder>,
     /// Compare the device's angles within this bound (rad) instead of bit for bit; default:
-    /// exact with --sim, 5e-5 rad with --emulator and --port (the AVR's math differs from the
+    /// exact with --sim, 2e-5 rad with --emulator and --port (the AVR's math differs from the
     /// host's).
     #[arg(long, value_name = "RAD")]
     pub angle_tolerance_rad: Option<f32>,

@@ -371,7 +371,8 @@ impl<M: Math> Solver<M> {
             }; 4],
         };
         for (i, leg) in LegId::ALL.into_iter().enumerate() {
-            out.legs[i] = self.leg.inverse_out_of_line(leg, local[i], policy)?;
+            self.leg
+                .inverse_into(leg, local[i], policy, &mut out.legs[i])?;
         }
         Ok(out)
     }

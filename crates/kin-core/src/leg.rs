@@ -483,7 +483,7 @@ impl<M: Math> Solver<M> {
 
     /// [`Solver::inverse`], always inlined into its two wrappers: the public one, which the
     /// compiler may then inline into the caller (a host's loop keeps the solve, its `atan2`
-    /// kernels included, in one piece), and [`Solver::inverse_out_of_line`].
+    /// kernels included, in one piece), and [`Solver::inverse_into`].
     #[inline(always)]
     fn inverse_inline(
         &self,
@@ -544,17 +544,21 @@ impl<M: Math> Solver<M> {
         Ok(LegSolution { angles, clamped })
     }
 
-    /// [`Solver::inverse`] kept out of line: the body IK's legs one after the other through
-    /// one copy of the leg solve ([`Math::STAGE_LEGS`] false, and the fallback that names the
-    /// first failing leg).
+    /// [`Solver::inverse`] kept out of line, its solution written into `out`: the body IK's
+    /// legs one after the other through one copy of the leg solve ([`Math::STAGE_LEGS`]
+    /// false, and the fallback that names the first failing leg). Only the small error comes
+    /// back by value (a returned solution would be copied once more on CPUs that return it
+    /// through memory).
     #[inline(never)]
-    pub(crate) fn inverse_out_of_line(
+    pub(crate) fn inverse_into(
         &self,
         leg: LegId,
         foot_in_hip: Vec3,
         policy: ReachPolicy,
-    ) -> Result<LegSolution, IkError> {
-        self.inverse_inline(leg, foot_in_hip, policy)
+        out: &mut LegSolution,
+    ) -> Result<(), IkError> {
+        *out = self.inverse_inline(leg, foot_in_hip, policy)?;
+        Ok(())
     }
 
     /// Solves the abduction and planar problem exactly for a point known to be reachable

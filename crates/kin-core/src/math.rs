@@ -14,12 +14,13 @@
 //!   The reference the others are tested against.
 //! - [`SoftFloat`]: the choices for CPUs without floating-point hardware (the ATmega2560
 //!   firmware's backend is `SoftFloat` over avr-libc's square root): the kernels
-//!   [`poly::atan2_fixed`] and [`poly::sin_cos_deg5`], which cost far fewer software-float
-//!   operations, comparisons of the bit patterns instead of software-float comparisons, and
+//!   [`poly::atan2_fixed`] and [`poly::sin_cos_fixed`] (tables of quadratic cells in fixed
+//!   point), which cost far fewer software-float operations, comparisons of the bit patterns instead of software-float comparisons, and
 //!   the four legs of a body solved one after the other.
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
-//! minimax fit); they are constants, not tables.
+//! minimax fit), and so do the fixed-point kernels' cell tables (quadratics through Chebyshev
+//! nodes).
 
 use core::marker::PhantomData;
 
@@ -124,14 +125,15 @@ impl Math for Fast {
 /// (the ATmega2560 firmware: `SoftFloat<AvrLibm>`, avr-libc's hand-written `sqrt`; the host
 /// tests: `SoftFloat<Libm>`, the default, which rounds the same):
 ///
-/// - [`poly::atan2_fixed`]: one float division, the polynomial in 16-bit fixed point on the
-///   integer multiplier (error ≤ 3.5e-5 rad);
-/// - [`poly::sin_cos_deg5`]: short polynomials, no range reduction within ±π/4 (error ≤ 7e-7);
+/// - [`poly::atan2_fixed`]: one float division, then in 16-bit fixed point on the
+///   integer multiplier, atan from a table of quadratic cells (error ≤ 2e-6 rad);
+/// - [`poly::sin_cos_fixed`]: no range reduction within ±π/4, then a table of quadratic cells
+///   in 16-bit fixed point (error ≤ 1e-6);
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
 /// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false).
 ///
-/// Against [`DefaultMath`] the angles of a leg or body solve differ by at most about 4e-5 rad
+/// Against [`DefaultMath`] the angles of a leg or body solve differ by at most about 4e-6 rad
 /// (the fixed-point arctangent's error plus rounding; `tests/avr_kernels.rs`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SoftFloat<S: Math = Libm>(PhantomData<S>);
@@ -151,7 +153,7 @@ impl<S: Math> Math for SoftFloat<S> {
 
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
-        poly::sin_cos_deg5(x)
+        poly::sin_cos_fixed(x)
     }
 
     #[inline(always)]
@@ -180,9 +182,10 @@ const PI: f32 = core::f32::consts::PI;
 /// |---|---|---|
 /// | [`atan2_deg15`](poly::atan2_deg15) | 3e-7 rad | hosts: branch-free, Estrin |
 /// | [`atan2_deg9`](poly::atan2_deg9) | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
-/// | [`atan2_fixed`](poly::atan2_fixed) | 3.5e-5 rad (0.002°) | CPUs with software floats and an integer multiplier (the ATmega2560): 1 float division, the polynomial in 16-bit fixed point |
+/// | [`atan2_fixed`](poly::atan2_fixed) | 2e-6 rad (0.0001°) | CPUs with software floats and an integer multiplier (the ATmega2560): 1 float division, a table of 32 quadratic cells in 16-bit fixed point |
 /// | [`sin_cos_deg9`](poly::sin_cos_deg9) | 2e-7 | hosts: branch-free |
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
+/// | [`sin_cos_fixed`](poly::sin_cos_fixed) | 1e-6 | CPUs with software floats and an integer multiplier (the ATmega2560): no range reduction for \|x\| ≤ π/4, a table of 26 quadratic cells in 16-bit fixed point, two integer-to-float conversions |
 pub mod poly {
     use super::{FRAC_PI_2, PI};
 
@@ -306,11 +309,155 @@ pub mod poly {
         f32::from_bits(r.to_bits() | (yb & SIGN))
     }
 
-    /// Magnitudes of [`ATAN_DEG9`]'s coefficients in the fixed-point formats of
-    /// [`atan2_fixed`]'s Horner levels: Q16, Q16, Q17, Q18, Q20 (each level in the bits its
-    /// magnitude allows in 16 bits). The signs alternate (+ − + − +), and so do those of the
-    /// levels for t ∈ [0, 1], so that the evaluation runs on magnitudes.
-    const ATAN_DEG9_Q: [u16; 5] = [65527, 21647, 23614, 22323, 21858];
+    /// [`atan2_fixed`]'s arctangent on `t ∈ [0, 1]` in 32 cells of width 1/32 (and cell 32,
+    /// `t = 1` alone): in cell `k`, `atan(k/32 + d) ≈ a + b·d − c·d²` for `d ∈ [0, 1/32)`, the
+    /// quadratic through the cell's three Chebyshev nodes, rounded to `a` in Q29 (`a₀ = 0`:
+    /// exact at `t = 0`), `b` in Q15 and `c` in Q16 (`c ≥ 0`, atan being concave there), from
+    /// `scripts/fit_polynomials.py`: error 9.4e-7 rad in this fixed-point arithmetic. Three
+    /// 16 × 16-bit products per arctangent instead of a polynomial's seven; the 264 bytes of
+    /// tables are what it costs.
+    const ATAN_CELL_A_Q29: [u32; 33] = [
+        0,
+        16_771_589,
+        33_510_678,
+        50_184_805,
+        66_762_427,
+        83_213_099,
+        99_507_789,
+        115_619_162,
+        131_521_807,
+        147_192_431,
+        162_609_989,
+        177_755_778,
+        192_613_475,
+        207_169_131,
+        221_411_131,
+        235_330_121,
+        248_918_896,
+        262_172_285,
+        275_086_996,
+        287_661_475,
+        299_895_737,
+        311_791_212,
+        323_350_581,
+        334_577_621,
+        345_477_059,
+        356_054_431,
+        366_315_948,
+        376_268_384,
+        385_918_958,
+        395_275_239,
+        404_345_057,
+        413_136_426,
+        421_657_471,
+    ];
+
+    /// `b` of [`ATAN_CELL_A_Q29`]'s cells, Q15.
+    const ATAN_CELL_B_Q15: [u16; 33] = [
+        32_774, 32_742, 32_646, 32_488, 32_269, 31_992, 31_660, 31_276, 30_844, 30_369, 29_856,
+        29_308, 28_730, 28_128, 27_505, 26_866, 26_215, 25_556, 24_892, 24_227, 23_563, 22_903,
+        22_250, 21_605, 20_970, 20_347, 19_737, 19_140, 18_557, 17_990, 17_438, 16_902, 16_383,
+    ];
+
+    /// `c` of [`ATAN_CELL_A_Q29`]'s cells, Q16.
+    const ATAN_CELL_C_Q16: [u16; 33] = [
+        1023, 3058, 5057, 6998, 8861, 10_625, 12_276, 13_800, 15_187, 16_430, 17_524, 18_470,
+        19_268, 19_922, 20_438, 20_824, 21_086, 21_236, 21_282, 21_235, 21_105, 20_901, 20_633,
+        20_311, 19_942, 19_535, 19_097, 18_633, 18_151, 17_655, 17_150, 16_640, 16_128,
+    ];
+
+    /// [`sin_cos_fixed`]'s sine on `r ∈ [0, 0.8125]` (π/4 and the rounding of a range
+    /// reduction) in 26 cells of width 1/32: in cell `k`, `sin(k/32 + d) ≈ a + b·d − c·d²` for
+    /// `d ∈ [0, 1/32)`, the quadratic through the cell's three Chebyshev nodes
+    /// (`scripts/fit_polynomials.py`), `a` in Q29 (`a₀ = 0`), `b` in Q15, `c` in Q16.
+    const SIN_CELL_A_Q29: [u32; 26] = [
+        0,
+        16_774_400,
+        33_532_506,
+        50_257_868,
+        66_934_153,
+        83_545_079,
+        100_074_424,
+        116_506_049,
+        132_823_907,
+        149_012_065,
+        165_054_715,
+        180_936_192,
+        196_640_988,
+        212_153_767,
+        227_459_382,
+        242_542_886,
+        257_389_552,
+        271_984_881,
+        286_314_621,
+        300_364_780,
+        314_121_638,
+        327_571_761,
+        340_702_017,
+        353_499_582,
+        365_951_961,
+        378_046_994,
+    ];
+
+    /// `b` of [`SIN_CELL_A_Q29`]'s cells, Q15.
+    const SIN_CELL_B_Q15: [u16; 26] = [
+        32_771, 32_755, 32_707, 32_627, 32_515, 32_372, 32_197, 31_990, 31_752, 31_483, 31_184,
+        30_854, 30_494, 30_104, 29_684, 29_236, 28_759, 28_254, 27_722, 27_162, 26_576, 25_964,
+        25_327, 24_664, 23_978, 23_268,
+    ];
+
+    /// `c` of [`SIN_CELL_A_Q29`]'s cells, Q16.
+    const SIN_CELL_C_Q16: [u16; 26] = [
+        512, 1535, 2557, 3577, 4593, 5604, 6610, 7610, 8602, 9586, 10_560, 11_524, 12_477, 13_417,
+        14_345, 15_258, 16_157, 17_040, 17_906, 18_755, 19_585, 20_396, 21_188, 21_958, 22_707,
+        23_435,
+    ];
+
+    /// [`sin_cos_fixed`]'s cosine in the cells of [`SIN_CELL_A_Q29`]:
+    /// `cos(k/32 + d) ≈ a − b·d − c·d²`, `a` in Q29 (`a₀ = 1`: `cos 0` exact), `b` and `c` in
+    /// Q16.
+    const COS_CELL_A_Q29: [u32; 26] = [
+        536_870_912,
+        536_608_793,
+        535_822_684,
+        534_513_352,
+        532_682_078,
+        530_330_649,
+        527_461_361,
+        524_077_015,
+        520_180_918,
+        515_776_872,
+        510_869_179,
+        505_462_631,
+        499_562_508,
+        493_174_570,
+        486_305_055,
+        478_960_672,
+        471_148_592,
+        462_876_443,
+        454_152_304,
+        444_984_692,
+        435_382_560,
+        425_355_285,
+        414_912_657,
+        404_064_875,
+        392_822_529,
+        381_196_599,
+    ];
+
+    /// `b` of [`COS_CELL_A_Q29`]'s cells, Q16.
+    const COS_CELL_B_Q16: [u16; 26] = [
+        0, 2048, 4094, 6136, 8171, 10_199, 12_217, 14_223, 16_215, 18_192, 20_150, 22_089, 24_006,
+        25_900, 27_769, 29_610, 31_423, 33_204, 34_954, 36_669, 38_349, 39_991, 41_593, 43_156,
+        44_676, 46_153,
+    ];
+
+    /// `c` of [`COS_CELL_A_Q29`]'s cells, Q16.
+    const COS_CELL_C_Q16: [u16; 26] = [
+        32_764, 32_732, 32_668, 32_572, 32_444, 32_285, 32_094, 31_872, 31_618, 31_334, 31_019,
+        30_674, 30_299, 29_895, 29_461, 28_998, 28_507, 27_988, 27_442, 26_870, 26_270, 25_646,
+        24_996, 24_322, 23_624, 22_903,
+    ];
 
     /// `a·b` of two 16-bit numbers from its four 8 × 8-bit partial products: on the
     /// ATmega2560 four hardware multiplications inline, where `a as u32 * b as u32` would call
@@ -324,16 +471,15 @@ pub mod poly {
     }
 
     /// Four-quadrant arctangent for CPUs without hardware floating point: one float division
-    /// `t = min(|x|,|y|) / max(|x|,|y|)`, then [`ATAN_DEG9`] evaluated in 16-bit fixed point
-    /// (six 16 × 16-bit products), the octant added in fixed point, and one integer-to-float
-    /// conversion: on the ATmega2560 far fewer cycles than [`atan2_deg9`] in software floats
-    /// (see `BENCHMARKS.md`). Absolute error ≤ 3.5e-5 rad (0.002°): the degree-9 fit's 1.1e-5 plus
-    /// the 16-bit quantization of `t²` and of the Horner levels (tests). `atan2(±0, ±0)` as libm
-    /// (±0 or ±π); exact on the axes.
+    /// `t = min(|x|,|y|) / max(|x|,|y|)`, then atan(t) from a table of 32 quadratic cells
+    /// (`ATAN_CELL_A_Q29`) in 16-bit fixed point (three 16 × 16-bit products), the octant
+    /// added in fixed point, and one integer-to-float conversion: on the ATmega2560 far fewer
+    /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
+    /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
+    /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes.
     ///
-    /// Formats: `t` in Q24 (`T`, from the float's mantissa) and Q16, `s = t²` in Q16, the
-    /// Horner levels in Q20…Q16 (as magnitudes, the signs being known), the result in Q29
-    /// (π < 2²).
+    /// Formats: `t` in Q24 (`T`, from the float's mantissa, truncated), the cell offset `d` in Q21, the
+    /// result in Q29 (π < 2²).
     ///
     /// Never inlined: on the AVR its `mul` instructions stay in this function's own small stack
     /// frame, clear of an LLVM AVR miscompilation in frames beyond 63 bytes (see the
@@ -347,45 +493,41 @@ pub mod poly {
         let (ay, ax) = (yb & ABS, xb & ABS);
         let swap = ay > ax;
         let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+        // The octant in one byte (swap, x < 0, y < 0), the only state kept across the
+        // division's call: fewer registers to save.
+        let octant = swap as u8 | ((xb >> 30) as u8 & 2) | ((yb >> 29) as u8 & 4);
         // p = atan(t) in Q29, t ∈ [0, 1].
         let p: u32 = if den == 0 {
             0
         } else {
             let t = (f32::from_bits(num) / f32::from_bits(den)).to_bits();
-            // t = m·2^(e − 23) with the 24-bit mantissa m, so T = round(t·2²⁴) = m >> (−e − 1).
-            // (Exponents above −1 come only from t = 1 and from NaN arguments, for which any
-            // bounded value will do.)
+            // t = m·2^(e − 23) with the 24-bit mantissa m, so T = t·2²⁴ = m >> (−e − 1),
+            // truncated (2⁻²⁴ is far below the cells' error); 0 for t < 2⁻²⁴ (t = 0 and
+            // subnormals included). t ≥ 1 is t = 1 (or a NaN argument, for which any bounded
+            // value will do).
             let m = (t & 0x007f_ffff) | 0x0080_0000;
             let shift = 126i32 - (t >> 23) as i32; // −e − 1
-            let big_t: u32 = if t == 0 {
-                0
-            } else if shift < 0 {
-                m << 1
-            } else if shift == 0 {
-                m
+            let big_t: u32 = if t >= 0x3f80_0000 {
+                1 << 24
             } else if shift < 25 {
-                (m + (1 << (shift - 1))) >> shift
+                m >> shift
             } else {
                 0
             };
-            let t16 = ((big_t + 128) >> 8).min(65_535) as u16;
-            let s = ((mul_16x16(t16, t16) + (1 << 15)) >> 16) as u16; // t² in Q16
-            let c = &ATAN_DEG9_Q;
-            // Levels |c3 + s·c4| (Q18), c2 − s·|…| (Q17), |c1 + s·…| (Q16), q = c0 − s·|…|
-            // (Q16): each stays positive and below 2¹⁶ for s ∈ [0, 1].
-            let l3 = c[3] - ((mul_16x16(c[4], s) + (1 << 17)) >> 18) as u16;
-            let l2 = c[2] - ((mul_16x16(l3, s) + (1 << 16)) >> 17) as u16;
-            let l1 = c[1] - ((mul_16x16(l2, s) + (1 << 16)) >> 17) as u16;
-            let q = c[0] - ((mul_16x16(l1, s) + (1 << 15)) >> 16) as u16;
-            // p = T·q (Q40) in Q29, from the 8 high and 16 low bits of T.
-            let (t_hi, t_lo) = ((big_t >> 16) as u16, big_t as u16);
-            (mul_16x16(t_hi, q) << 5) + ((mul_16x16(t_lo, q) + (1 << 10)) >> 11)
+            // Cell k = ⌊32·t⌋ (t = 1: cell 32) and the offset d = t − k/32 in Q21 (16 bits).
+            let k = (big_t >> 19) as usize;
+            let d = ((big_t & 0x7_ffff) >> 3) as u16;
+            // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
+            let lin = (mul_16x16(d, ATAN_CELL_B_Q15[k]) + (1 << 6)) >> 7;
+            let d_sq = (mul_16x16(d, d) >> 16) as u16;
+            let quad = (mul_16x16(d_sq, ATAN_CELL_C_Q16[k]) + (1 << 12)) >> 13;
+            ATAN_CELL_A_Q29[k] + lin - quad
         };
-        let r = match (swap, xb & SIGN != 0) {
-            (false, false) => p,
-            (false, true) => PI_Q29 - p,
-            (true, false) => FRAC_PI_2_Q29 - p,
-            (true, true) => FRAC_PI_2_Q29 + p,
+        let r = match octant & 3 {
+            0 => p,
+            2 => PI_Q29 - p,
+            1 => FRAC_PI_2_Q29 - p,
+            _ => FRAC_PI_2_Q29 + p,
         };
         // r ≥ 0; r·2⁻²⁹ by the exponent (r = 0 stays 0), then the sign of y.
         let r = if r == 0 {
@@ -393,7 +535,7 @@ pub mod poly {
         } else {
             (r as f32).to_bits() - (29 << 23)
         };
-        f32::from_bits(r | (yb & SIGN))
+        f32::from_bits(r | ((octant as u32 & 4) << 29))
     }
 
     /// `(sin x, cos x)` with degree-9/8 polynomials after a Cody–Waite reduction to
@@ -429,6 +571,66 @@ pub mod poly {
             (sin, cos)
         } else {
             quadrant(k, sin, cos)
+        }
+    }
+
+    /// `(sin x, cos x)` for CPUs without hardware floating point: arguments within ±π/4 (body
+    /// rotations) skip the range reduction (an integer comparison finds them); then `|r|` in
+    /// Q24 from the float's mantissa, sine and cosine from a table of 26 quadratic cells
+    /// (`SIN_CELL_A_Q29`, `COS_CELL_A_Q29`) in 16-bit fixed point (five 16 × 16-bit
+    /// products for both), two integer-to-float conversions: on the ATmega2560 far fewer
+    /// cycles than [`sin_cos_deg5`]'s twelve software-float operations (see
+    /// `BENCHMARKS.md`). Absolute error ≤ 1e-6 (tests; the cells' 8.4e-7 in this arithmetic).
+    /// `sin_cos_fixed(0) = (0, 1)`; odd in the sine, even in the cosine.
+    ///
+    /// Never inlined, for [`atan2_fixed`]'s reason (its `mul` instructions in a small frame).
+    #[inline(never)]
+    pub fn sin_cos_fixed(x: f32) -> (f32, f32) {
+        const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
+                                                 // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
+                                                 // range reduction of huge arguments, for which any bounded value will do.
+        const CELLS_END_Q24: u32 = (26 << 19) - 1;
+        let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
+        let (k, r) = if reduced { reduce(x) } else { (0.0, x) };
+        let rb = r.to_bits();
+        // |r| = m·2^(e − 150) with the 24-bit mantissa m: R = |r|·2²⁴ = m >> (126 − e),
+        // truncated (2⁻²⁴ is far below the cells' error); 0 for |r| < 2⁻²⁴ and subnormals.
+        let e = (rb >> 23) & 0xff;
+        let m = (rb & 0x007f_ffff) | 0x0080_0000;
+        let big_r = if e > 126 {
+            CELLS_END_Q24
+        } else if 126 - e > 24 {
+            0
+        } else {
+            (m >> (126 - e)).min(CELLS_END_Q24)
+        };
+        // Cell k = ⌊32·|r|⌋, offset d in Q21 (16 bits), d² in Q26.
+        let cell = (big_r >> 19) as usize;
+        let d = ((big_r & 0x7_ffff) >> 3) as u16;
+        let d_sq = (mul_16x16(d, d) >> 16) as u16;
+        // b·d: Q36 (sine) or Q37 (cosine) → Q29; c·d²: Q42 → Q29.
+        let sin_q = SIN_CELL_A_Q29[cell] + ((mul_16x16(d, SIN_CELL_B_Q15[cell]) + (1 << 6)) >> 7)
+            - ((mul_16x16(d_sq, SIN_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
+        let cos_q = COS_CELL_A_Q29[cell]
+            - ((mul_16x16(d, COS_CELL_B_Q16[cell]) + (1 << 7)) >> 8)
+            - ((mul_16x16(d_sq, COS_CELL_C_Q16[cell]) + (1 << 12)) >> 13);
+        let sin = f32::from_bits(q29_bits(sin_q) | (rb & SIGN));
+        let cos = f32::from_bits(q29_bits(cos_q));
+        if reduced {
+            quadrant(k, sin, cos)
+        } else {
+            (sin, cos)
+        }
+    }
+
+    /// The bits of the float `v·2⁻²⁹` (`v < 2³¹`, positive): one integer-to-float conversion,
+    /// then the exponent lowered by 29 (`v = 0` stays +0).
+    #[inline(always)]
+    fn q29_bits(v: u32) -> u32 {
+        if v == 0 {
+            0
+        } else {
+            (v as f32).to_bits() - (29 << 23)
         }
     }
 
@@ -688,6 +890,34 @@ mod tests {
         }
     }
 
+    /// [`poly::atan2_fixed`]'s cells: the tight bound of its documentation, on the circle,
+    /// densely over `t` in every cell, and at the cells' edges.
+    #[test]
+    fn atan2_fixed_cells_are_within_2e_6() {
+        const TOL_RAD: f64 = 2.0e-6;
+        let mut worst = worst_atan2_error(poly::atan2_fixed);
+        for i in 0..=400_000 {
+            let t = i as f32 / 400_000.0;
+            for (y, x) in [(t, 1.0f32), (1.0, t), (-t, -1.0), (-1.0, -t)] {
+                let d = (poly::atan2_fixed(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+                worst = worst.max(d);
+            }
+        }
+        for k in 0..=32u32 {
+            let edge = k as f32 / 32.0;
+            for t in [
+                f32::from_bits(edge.to_bits().saturating_sub(1)),
+                edge,
+                f32::from_bits(edge.to_bits() + 1).min(1.0),
+            ] {
+                let d = (poly::atan2_fixed(t, 1.0) as f64 - (t as f64).atan()).abs();
+                worst = worst.max(d);
+            }
+        }
+        std::eprintln!("atan2_fixed: worst error {worst:e} rad");
+        assert!(worst < TOL_RAD, "worst atan2_fixed error {worst}");
+    }
+
     #[test]
     fn polynomial_atan2_signed_zeros_and_axes_match_libm() {
         let cases = [
@@ -786,6 +1016,53 @@ mod tests {
             assert!((c as f64 - (x as f64).cos()).abs() < 7.0e-7, "cos {x}");
         }
         assert_eq!(poly::sin_cos_deg5(0.0), (0.0, 1.0));
+    }
+
+    #[test]
+    fn sin_cos_fixed_matches_f64() {
+        const TOL: f64 = 1.0e-6;
+        let mut worst = 0.0f64;
+        for i in -400_000..=400_000 {
+            let x = i as f32 * 0.000_025; // ±10 rad, across the ±π/4 switch and every cell
+            let (s, c) = poly::sin_cos_fixed(x);
+            worst = worst
+                .max((s as f64 - (x as f64).sin()).abs())
+                .max((c as f64 - (x as f64).cos()).abs());
+            assert_eq!(
+                poly::sin_cos_fixed(-x),
+                (-s, c),
+                "odd sine, even cosine at {x}"
+            );
+        }
+        let q = core::f32::consts::FRAC_PI_4;
+        for x in [
+            f32::from_bits(q.to_bits() - 1),
+            q,
+            f32::from_bits(q.to_bits() + 1),
+            1e-30,
+            f32::MIN_POSITIVE,
+            1e-7,
+        ] {
+            let (s, c) = poly::sin_cos_fixed(x);
+            worst = worst
+                .max((s as f64 - (x as f64).sin()).abs())
+                .max((c as f64 - (x as f64).cos()).abs());
+        }
+        std::eprintln!("sin_cos_fixed: worst error {worst:e}");
+        assert!(worst < TOL, "worst sin/cos error {worst}");
+        assert_eq!(poly::sin_cos_fixed(0.0), (0.0, 1.0));
+        // Bounded on any finite argument (huge ones are not reduced exactly).
+        let mut rng = SplitMix64::new(0x5eed_5eed_0000_0001u64);
+        for _ in 0..100_000 {
+            let x = f32::from_bits(rng.next_u64() as u32);
+            if x.is_finite() {
+                let (s, c) = poly::sin_cos_fixed(x);
+                assert!(
+                    s.abs() <= 1.0 && c.abs() <= 1.0,
+                    "sin_cos_fixed({x:e}) = ({s}, {c})"
+                );
+            }
+        }
     }
 
     /// The byte-wise 16 × 16-bit product is the product.

@@ -1,6 +1,6 @@
 //! The ATmega2560 firmware's math on the host: the firmware's backend `avr_libc_math::AvrFast`
 //! is `kin_core::math::SoftFloat` over avr-libc's `sqrt` (correctly rounded, as libm's `sqrtf`
-//! of `SoftFloat`'s default here): the kernels `poly::atan2_fixed` and `poly::sin_cos_deg5`,
+//! of `SoftFloat`'s default here): the kernels `poly::atan2_fixed` and `poly::sin_cos_fixed`,
 //! the bit-pattern comparisons and the legs one after the other, as on the board. The same
 //! backend runs here on the same benchmark inputs as
 //! `bench_accuracy.rs`, against the generating f64 angles (the hard limit of the firmware:

@@ -46,12 +46,12 @@ use serde::Serialize;
 use std::time::Duration;
 
 /// Bound on |device angle − host angle| for the ATmega2560 firmware, whose math backend
-/// (`avr_libc_math::AvrFast`: avr-libc `sqrt`, kin-core's fast polynomial `atan2` and
-/// `sin_cos`) differs from the host's, rad: the backend's documented worst case (about 4e-5 rad
+/// (`avr_libc_math::AvrFast`: avr-libc `sqrt`, kin-core's fixed-point `atan2` and `sin_cos`
+/// kernels) differs from the host's, rad: the backend's documented worst case (about 4e-6 rad
 /// per angle) with margin. Measured in the emulator tests (`tests/tests/avr_firmware.rs`,
-/// `angle_tolerance_bounds_the_firmware_against_the_host`): 2.4e-5 rad over 100 seeded poses.
-/// 5e-5 rad is 0.003°, far below a servo's resolution (about 0.1° per 0.5 µs tick).
-pub const AVR_ANGLE_TOLERANCE_RAD: f32 = 5e-5;
+/// `angle_tolerance_bounds_the_firmware_against_the_host`): 4.8e-6 rad over 100 seeded poses.
+/// 2e-5 rad is 0.001°, far below a servo's resolution (about 0.1° per 0.5 µs tick).
+pub const AVR_ANGLE_TOLERANCE_RAD: f32 = 2e-5;
 
 /// Default number of retries of a streamed request (a body pose).
 pub const DEFAULT_RETRIES: u32 = 10;

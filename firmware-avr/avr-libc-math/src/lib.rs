@@ -78,6 +78,6 @@ impl Math for AvrLibm {
 /// measured in simavr (see `BENCHMARKS.md`).
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by
-/// at most about 4e-5 rad (the fixed-point arctangent's error plus rounding); see the readback
+/// at most about 4e-6 rad (the fixed-point arctangent's error plus rounding); see the readback
 /// bound in `BENCHMARKS.md`.
 pub type AvrFast = SoftFloat<AvrLibm>;

@@ -2,7 +2,7 @@
 //!
 //! Backends: 0 = `AvrLibm` (avr-libc math), 1 = kin-core `Fast` (polynomials), 2 = kin-core
 //! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`, kin-core `poly::atan2_fixed` and
-//! `poly::sin_cos_deg5`), all on avr-libc's float primitives (`__mulsf3`, …).
+//! `poly::sin_cos_fixed`), all on avr-libc's float primitives (`__mulsf3`, …).
 
 #![no_std]
 #![no_main]
@@ -43,8 +43,8 @@ static BACKENDS: [Backend; 4] = [
 /// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrLibm`:
 /// 10 the rotation matrix (roll = yaw = a, pitch = b), 11 the four feet in their hip frames
 /// (including the matrix); kin-core's kernels for `AvrFast`: 12 `poly::atan2_fixed`,
-/// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5` (sum of both).
-static PRIMS: [bench::PrimFn; 15] = [
+/// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5`, 15 `poly::sin_cos_fixed` (sums of both).
+static PRIMS: [bench::PrimFn; 16] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -75,6 +75,10 @@ static PRIMS: [bench::PrimFn; 15] = [
     |a, b| poly::atan2_deg9(a, b),
     |a, _| {
         let (s, c) = poly::sin_cos_deg5(a);
+        s + c
+    },
+    |a, _| {
+        let (s, c) = poly::sin_cos_fixed(a);
         s + c
     },
 ];

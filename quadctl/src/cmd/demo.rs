@@ -29,7 +29,7 @@ at --poses-per-sweep poses and streamed as fast as the link allows. Then the dev
 motions (--sweeps-only leaves them out): stand-up, seed 001's roll and pitch sways and yaw turn
 (counter-clockwise), a trot whose velocity command changes, sit.
 
-Checks: every pose is acked with the 12 angles of the host's own kin-core (within 5e-5 rad: the
+Checks: every pose is acked with the 12 angles of the host's own kin-core (within 2e-5 rad: the
 AVR's math differs) and the 12 pulses of the device calibration's mapping of those angles; on the
 emulator every pulse measured on the 12 servo pins (Timer1/3/4/5, port L included) must match
 the readback in force within one 0.5 us timer tick (or lie on the joint-speed limiter's way to
