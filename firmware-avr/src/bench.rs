@@ -15,6 +15,15 @@
 //! | body pose at the stance | `B`, backend u8, roll pitch yaw x y z f32 | `b`, status u8, 12 × f32 |
 //! | memory | `S` | `s`, static SRAM u16, max stack u16 |
 //! | one primitive | `F`, op u8, a b f32 | `f`, status u8, result f32 |
+//! | start an onboard motion (untimed) | `M`, motion u8 | `m`, status u8 |
+//! | one servo frame of it | `N` | `n`, status u8, stage u8 |
+//!
+//! Motions of `M` ([`EngineBench`]): 0 = trot at a forward speed and yaw rate within the
+//! gait's reach, 1 = seed 001's roll sway, 2 = seed 001's yaw turn (its rate and period, a lift
+//! this robot reaches), 3 = seed 000's rectangle on all four legs; each starts from the stance of [`quad_device::Config::shahriar2023`] (the
+//! firmware's configuration) and its approach ramp is run before the timed frames. A timed
+//! frame is what `Device::poll` does at a servo frame boundary: the engine's tick (the motion
+//! and its body IK), the limiter step of the twelve outputs and their calibrated pulses.
 //!
 //! Status 0 = solved, 1 = unreachable, 2 = unknown backend. Boot sends `R` once ready.
 //! Robot: [`kin_core::Robot::shahriar2023`] with its knee bend and limits; body poses about
@@ -23,7 +32,12 @@
 
 use crate::pac;
 use crate::usart::Usart0;
+use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
+use kin_core::motion::laws::Axis;
 use kin_core::{body, leg, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
+use quad_device::engine::{self, Engine, Limiter, Request, Setup, Stage, WalkRequest, FRAME_MS};
+use quad_device::store::Table;
+use quad_device::{default_calibration, Config};
 
 /// Stance height of the body-pose benchmark: seed 000 Table 4 body height, m.
 pub const STANCE_HEIGHT_M: f32 = 0.277;
@@ -108,9 +122,146 @@ fn marker(porta: &pac::PORTA, high: bool) {
     });
 }
 
+/// Onboard motion frames under test (requests `M` and `N`).
+pub trait MotionBench {
+    /// Starts motion `motion` and runs its approach (untimed): a status.
+    fn start(&mut self, motion: u8) -> u8;
+    /// One servo frame: a status and the motion's stage.
+    fn frame(&mut self) -> (u8, u8);
+}
+
+/// A firmware without the motion engine.
+pub struct NoMotion;
+
+impl MotionBench for NoMotion {
+    fn start(&mut self, _: u8) -> u8 {
+        STATUS_UNKNOWN_BACKEND
+    }
+    fn frame(&mut self) -> (u8, u8) {
+        (STATUS_UNKNOWN_BACKEND, 0)
+    }
+}
+
+/// The device's motion engine on backend `M` with the firmware's configuration.
+pub struct EngineBench<M> {
+    config: Config,
+    calibration: Table,
+    engine: Engine<M>,
+    out: [f32; 12],
+    pulses: [u16; 12],
+    now_ms: u32,
+}
+
+impl<M: Math> EngineBench<M> {
+    /// Idle, the outputs at the stance (zeros when it is out of reach).
+    pub fn new() -> Self {
+        let config = Config::shahriar2023();
+        let calibration = default_calibration::<M>(&config.robot, &config.pose_config);
+        let limiter = Limiter::new(config.joint_speed_limit_rad_s).unwrap_or_else(|_| {
+            Limiter::new(engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S).unwrap_or_else(|_| panic!())
+        });
+        let out = calibration.map(|c| c.zero_rad);
+        EngineBench {
+            config,
+            calibration,
+            engine: Engine::new(limiter),
+            out,
+            pulses: [0; 12],
+            now_ms: 0,
+        }
+    }
+
+    fn tick(&mut self) -> Stage {
+        self.now_ms += FRAME_MS;
+        let tick = self.engine.tick(1, self.now_ms, &self.out);
+        if let Some(target) = tick.target {
+            self.engine.limiter().step(&mut self.out, &target);
+        }
+        for ((p, c), &a) in self.pulses.iter_mut().zip(&self.calibration).zip(&self.out) {
+            *p = c.pulse_half_us(a).unwrap_or(0);
+        }
+        core::hint::black_box(&self.pulses);
+        self.engine.status().stage
+    }
+}
+
+impl<M: Math> Default for EngineBench<M> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<M: Math> MotionBench for EngineBench<M> {
+    fn start(&mut self, motion: u8) -> u8 {
+        self.engine.cancel();
+        let h = self.config.pose_config.stance_height_m;
+        let request = match motion {
+            0 => Request::Walk(WalkRequest::new(Pattern::Trot, h)),
+            1 => Request::seed001_sway(Axis::Roll, None),
+            // Seed 001's rate and period with a lift that this robot reaches (the paper's
+            // 0.3 m is for its own, larger robot).
+            2 => match Request::seed001_yaw_turn(None) {
+                Request::YawTurn {
+                    yaw_rate_rad_s,
+                    step_period_s,
+                    ..
+                } => Request::YawTurn {
+                    yaw_rate_rad_s,
+                    step_period_s,
+                    lift_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * h,
+                    duration_s: None,
+                },
+                other => other,
+            },
+            3 => Request::seed000_rectangle(None, None),
+            _ => return STATUS_UNKNOWN_BACKEND,
+        };
+        let setup = Setup {
+            robot: &self.config.robot,
+            stance_height_m: h,
+            order: self.config.pose_config.order,
+            calibration: &self.calibration,
+            outputs: Some(&self.out),
+            now_ms: self.now_ms,
+        };
+        if self.engine.start(&request, &setup).is_err() {
+            return STATUS_UNREACHABLE;
+        }
+        for _ in 0..500 {
+            if self.tick() == Stage::Run {
+                break;
+            }
+        }
+        if motion == 0 {
+            // Forward and turning within the gait's reach.
+            let mut v = Velocity {
+                forward_m_s: 0.2,
+                lateral_m_s: 0.0,
+                yaw_rad_s: 0.2,
+            };
+            while self.engine.set_velocity(v, self.now_ms).is_err() && v.forward_m_s > 1e-3 {
+                v.forward_m_s *= 0.5;
+                v.yaw_rad_s *= 0.5;
+            }
+        }
+        STATUS_OK
+    }
+
+    fn frame(&mut self) -> (u8, u8) {
+        let stage = self.tick();
+        (STATUS_OK, stage as u8)
+    }
+}
+
 /// Serves benchmark requests forever (see the module docs). Interrupts must be enabled (the
 /// receiver is interrupt-driven).
-pub fn serve(usart: &mut Usart0, porta: &pac::PORTA, backends: &[Backend], prims: &[PrimFn]) -> ! {
+pub fn serve(
+    usart: &mut Usart0,
+    porta: &pac::PORTA,
+    backends: &[Backend],
+    prims: &[PrimFn],
+    motion: &mut dyn MotionBench,
+) -> ! {
     // SAFETY: any DDRA value is valid; PA0 becomes an output, low.
     marker(porta, false);
     porta
@@ -175,6 +326,20 @@ pub fn serve(usart: &mut Usart0, porta: &pac::PORTA, backends: &[Backend], prims
                     }
                     None => send_status(usart, STATUS_UNKNOWN_BACKEND, 1),
                 }
+            }
+            b'M' => {
+                let m = read_byte(usart);
+                let status = motion.start(m);
+                usart.write(b'm');
+                usart.write(status);
+            }
+            b'N' => {
+                marker(porta, true);
+                let (status, stage) = motion.frame();
+                marker(porta, false);
+                usart.write(b'n');
+                usart.write(status);
+                usart.write(stage);
             }
             b'S' => {
                 usart.write(b's');

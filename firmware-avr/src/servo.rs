@@ -38,9 +38,14 @@
 //! write past the window: switching never cuts a pulse short or starts one late. An apply
 //! begins only with a millisecond of the window left, so every period shows either the old or
 //! the new widths on all twelve pins; the main loop never waits for the window.
+//!
+//! **Periods counted.** The tick interrupt counts the PWM periods (Timer1's overflow flag, set
+//! at TOP) and notes the period in which a staged state was written; the controller latches its
+//! servo frames to them (`quad_device::ServoOutputs::periods_begun`, `write_pending`), so that
+//! each period gets at most one new state and no setpoint is replaced before a pulse showed it.
 
 use crate::pac;
-use core::cell::UnsafeCell;
+use core::cell::{Cell, UnsafeCell};
 use core::sync::atomic::{compiler_fence, Ordering};
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
 
@@ -159,6 +164,12 @@ static STAGED_ENABLED: Shared<bool> = Shared::new(false);
 static PENDING: Shared<u8> = Shared::new(0);
 /// 1 while the main loop applies (the tick interrupt then leaves it alone).
 static BUSY: Shared<u8> = Shared::new(0);
+/// PWM periods begun, wrapping (counted by the tick interrupt from Timer1's overflow flag,
+/// which the chip sets at TOP, the end of each period).
+static PERIODS: Shared<u8> = Shared::new(0);
+/// [`PERIODS`] when the last staged state was written to the registers: the chip takes it over
+/// when the next period begins.
+static APPLIED_IN: Shared<u8> = Shared::new(0);
 /// The longest width the hardware may still be producing in this or the next period, ticks
 /// (written by whoever applies, under `BUSY` or inside the interrupt).
 static ACTIVE_LONGEST: Shared<u16> = Shared::new(0);
@@ -186,6 +197,7 @@ fn stage(ticks: &[u16; CHANNELS], enabled: bool) {
 /// byte time at 1 Mbaud and needs no protection from the receive interrupt).
 #[inline(never)]
 pub fn on_tick() {
+    count_period();
     // Nothing pending: return before `apply_staged` sets up its frame (this interrupt may come
     // on top of the main loop's deepest stack).
     if BUSY.get() != 0 || PENDING.get() == 0 {
@@ -196,6 +208,19 @@ pub fn on_tick() {
     apply_staged();
     compiler_fence(Ordering::SeqCst);
     BUSY.set(0);
+}
+
+/// Counts a period when Timer1's overflow flag says one began, and clears the flag (a one
+/// written clears it). Only the tick interrupt calls it: the millisecond tick sees every
+/// period start within 1 ms, long before the longest pulse ends and a state can be applied.
+#[inline(always)]
+fn count_period() {
+    // SAFETY: TIFR1 is touched only here; writing TOV1 alone leaves the other flags.
+    let dp = unsafe { pac::Peripherals::steal() };
+    if dp.TC1.tifr1().read().tov1().bit_is_set() {
+        dp.TC1.tifr1().write(|w| w.tov1().set_bit());
+        PERIODS.set(PERIODS.get().wrapping_add(1));
+    }
 }
 
 /// Writes the staged widths and connections when a state is pending and every timer is in the
@@ -247,6 +272,7 @@ fn apply_staged() {
         }
     }
     ACTIVE_LONGEST.set(longest_new);
+    APPLIED_IN.set(PERIODS.get());
     compiler_fence(Ordering::SeqCst);
     PENDING.set(0);
 }
@@ -401,6 +427,9 @@ pub struct Servos {
     /// Pulse width of each channel, ticks (0 = no pulse).
     pulse_ticks: [u16; CHANNELS],
     enabled: bool,
+    /// [`PERIODS`] widened to 32 bits for the controller: the count and the byte it was
+    /// last widened from.
+    periods: Cell<(u32, u8)>,
 }
 
 impl Servos {
@@ -477,6 +506,7 @@ impl Servos {
             _ports: (portb, porte, porth, portl),
             pulse_ticks: [0; CHANNELS],
             enabled: false,
+            periods: Cell::new((0, 0)),
         }
     }
 
@@ -593,6 +623,22 @@ impl quad_device::ServoOutputs for Servos {
         } else {
             self.disable();
         }
+    }
+
+    /// The periods counted by the tick interrupt, widened (the controller polls far more often
+    /// than every 255 periods, 5.1 s).
+    fn periods_begun(&self) -> Option<u32> {
+        let (count, last) = self.periods.get();
+        let now = PERIODS.get();
+        let count = count.wrapping_add(u32::from(now.wrapping_sub(last)));
+        self.periods.set((count, now));
+        Some(count)
+    }
+
+    /// A staged state not written yet, or written in the period running now: the chip has not
+    /// taken it over.
+    fn write_pending(&self) -> bool {
+        PENDING.get() != 0 || APPLIED_IN.get() == PERIODS.get()
     }
 }
 

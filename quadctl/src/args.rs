@@ -260,9 +260,10 @@ pub struct LawArgs {
     /// Sways: period T, s [default: 20].
     #[arg(long, value_name = "S")]
     pub period_s: Option<f32>,
-    /// yaw-turn: ω_z, rad/s; positive turns clockwise seen from above [default: 0.085].
+    /// yaw-turn: yaw rate, rad/s; positive turns counter-clockwise seen from above (REP 103,
+    /// as trot's --yaw-rad-s; seed 001's ω_z = 0.085 clockwise is −0.085) [default: -0.085].
     #[arg(long, value_name = "RAD_S")]
-    pub omega_rad_s: Option<f32>,
+    pub yaw_rate_rad_s: Option<f32>,
     /// yaw-turn: step period T1, s [default: 6].
     #[arg(long, value_name = "S")]
     pub step_period_s: Option<f32>,
@@ -305,7 +306,7 @@ impl LawArgs {
             stance_height_m: self.stance_height_m,
             amplitude_rad: self.amplitude_rad,
             period_s: self.period_s,
-            omega_rad_s: self.omega_rad_s,
+            yaw_rate_rad_s: self.yaw_rate_rad_s,
             step_period_s: self.step_period_s,
             lift_height_m: self.lift_height_m,
             path: self.path,

@@ -5,6 +5,7 @@ mod cmd;
 mod progress;
 
 use clap::{Parser, Subcommand};
+use quad_device::engine::Request::{Rest, Sit, StandUp};
 use std::process::ExitCode;
 
 const ABOUT: &str = "Kinematics of a 12-DoF quadruped: leg IK/FK and body poses, as CSV batches.
@@ -36,6 +37,18 @@ enum Command {
     Play(cmd::play::Args),
     Sim(cmd::sim::Args),
     Export(cmd::export::Args),
+    /// Stand up: outputs on at the rest pose, then up to the stance (onboard motion).
+    #[command(after_help = cmd::onboard::STAND_EXAMPLES)]
+    Stand(cmd::onboard::PostureArgs),
+    /// Sit: down to the rest pose, held (onboard motion).
+    #[command(after_help = cmd::onboard::SIT_EXAMPLES)]
+    Sit(cmd::onboard::PostureArgs),
+    /// Rest: down to the rest pose, then the outputs off (onboard motion).
+    #[command(after_help = cmd::onboard::REST_EXAMPLES)]
+    Rest(cmd::onboard::PostureArgs),
+    /// Run one of the device's own motions: sways, yaw turn, foot paths, trot, walk.
+    Run(cmd::onboard::RunArgs),
+    Drive(cmd::drive::Args),
 }
 
 fn main() -> ExitCode {
@@ -60,5 +73,10 @@ fn main() -> ExitCode {
         Command::Play(args) => cmd::play::main(&args),
         Command::Sim(args) => cmd::sim::run(&args),
         Command::Export(args) => cmd::export::run(&args),
+        Command::Stand(args) => cmd::onboard::posture(&args, StandUp),
+        Command::Sit(args) => cmd::onboard::posture(&args, Sit),
+        Command::Rest(args) => cmd::onboard::posture(&args, Rest),
+        Command::Run(args) => cmd::onboard::run(&args),
+        Command::Drive(args) => cmd::drive::main(&args),
     }
 }

@@ -212,10 +212,10 @@ fn output_file_appears_complete_and_bad_input_leaves_nothing() {
                 "1",
                 "--rate-hz",
                 "10",
-                "--omega-rad-s",
+                "--yaw-rate-rad-s",
                 "1",
             ],
-            "--omega-rad-s",
+            "--yaw-rate-rad-s",
         ),
         (
             &["moonwalk", "--duration-s", "1", "--rate-hz", "10"],

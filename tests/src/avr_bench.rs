@@ -319,6 +319,25 @@ impl BenchFirmware {
         )
     }
 
+    /// Starts onboard motion `motion` of the firmware's engine (untimed; see
+    /// `firmware_avr::bench`): true when it started.
+    pub fn start_motion(&mut self, motion: u8) -> bool {
+        self.emu.uart_write(&[b'M', motion]);
+        let a = self
+            .emu
+            .read_exact(2, REQUEST_TIMEOUT_CYCLES * 20)
+            .expect("motion start answer");
+        assert_eq!(a[0], b'm');
+        a[1] == 0
+    }
+
+    /// One servo frame of the running motion: cycles (overhead removed) and the stage.
+    pub fn motion_frame(&mut self) -> (u64, u8) {
+        let (c, answer) = self.timed(b"N", 3);
+        assert_eq!(&answer[..2], b"n\0", "the firmware runs no motion");
+        (c - self.overhead_cycles, answer[2])
+    }
+
     /// Static SRAM and the stack high-water mark, bytes.
     pub fn memory(&mut self) -> (u16, u16) {
         self.emu.uart_write(b"S");
@@ -469,6 +488,48 @@ pub struct Summary {
     pub sram_static_bytes: u64,
     /// Stack high-water mark of the release firmware after body-pose solves, bytes.
     pub max_stack_bytes: u64,
+    /// Worst servo frame of an onboard trot (motion, body IK, limiter, pulses), cycles.
+    pub trot_frame_cycles: u64,
+    /// Its share of the 20 ms servo frame at 16 MHz, %.
+    pub trot_frame_share_pct: f64,
+}
+
+/// Cycles of one 20 ms servo frame at 16 MHz.
+pub const SERVO_FRAME_CYCLES: u64 = 16_000_000 / 50;
+
+/// Onboard motions of the benchmark firmware, by id (`firmware_avr::bench`).
+pub const MOTIONS: [&str; 4] = ["trot", "roll sway", "yaw turn", "rectangle (4 legs)"];
+
+/// Servo frames timed per motion: 150 frames (3 s) cover several gait cycles of the trot,
+/// the yaw turn's swings and the rectangle's loop at every phase class.
+pub const MOTION_FRAMES: usize = 150;
+
+/// Per-frame cycles of one onboard motion.
+#[derive(Debug, Clone, Serialize)]
+pub struct MotionFigures {
+    /// The motion.
+    pub name: &'static str,
+    /// Worst frame, cycles.
+    pub max_cycles: u64,
+    /// Mean frame, cycles.
+    pub mean_cycles: f64,
+}
+
+/// Times [`MOTION_FRAMES`] frames of each of [`MOTIONS`] on `fw`.
+pub fn measure_motions(fw: &mut BenchFirmware) -> Vec<MotionFigures> {
+    MOTIONS
+        .iter()
+        .enumerate()
+        .map(|(id, &name)| {
+            assert!(fw.start_motion(id as u8), "{name} refused by the firmware");
+            let cycles: Vec<u64> = (0..MOTION_FRAMES).map(|_| fw.motion_frame().0).collect();
+            MotionFigures {
+                name,
+                max_cycles: cycles.iter().copied().max().unwrap_or(0),
+                mean_cycles: cycles.iter().sum::<u64>() as f64 / cycles.len() as f64,
+            }
+        })
+        .collect()
 }
 
 /// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
@@ -513,6 +574,8 @@ pub struct Report {
     pub backends: Vec<BackendFigures>,
     /// Stack high-water mark of `bench.elf` after all its solves, bytes.
     pub bench_stack_bytes: u16,
+    /// Per-frame cycles of the onboard motions (`bench.elf`).
+    pub motions: Vec<MotionFigures>,
     /// The JSON figures.
     pub summary: Summary,
 }
@@ -535,6 +598,7 @@ pub fn run() -> Report {
     ] {
         backends.push(measure_backend(&mut fw, b, "bench.elf", &targets));
     }
+    let motions = measure_motions(&mut fw);
     let (_, bench_stack_bytes) = fw.memory();
     let mut fw_libm = BenchFirmware::boot(&libm_elf);
     let libm = measure_backend(&mut fw_libm, Backend::Libm, "bench-libm.elf", &targets);
@@ -565,7 +629,10 @@ pub fn run() -> Report {
             flash_bytes: sizes.flash_bytes,
             sram_static_bytes: sizes.sram_static_bytes,
             max_stack_bytes: stack as u64,
+            trot_frame_cycles: motions[0].max_cycles,
+            trot_frame_share_pct: 100.0 * motions[0].max_cycles as f64 / SERVO_FRAME_CYCLES as f64,
         },
+        motions,
         backends,
         bench_stack_bytes,
         primitives,

@@ -1,18 +1,23 @@
 //! The firmware's flash and SRAM budget, measured: flash and static SRAM from the release ELF's
 //! sections, the stack as the deepest of the firmware's own paint mark and the stack pointer's
-//! low-water mark in simavr, after a workload that sends every request type (`cargo xtask ci
+//! low-water mark in simavr, after a workload that sends every request type and runs every
+//! onboard motion (`cargo xtask ci
 //! budget`, `cargo run -p integration-tests --bin firmware-budget`).
 //!
 //! The budget leaves most of the ATmega2560 (248 KB of flash for the application, 8 KB of SRAM)
 //! for what comes next, and keeps an eye on growth: flash ≤ [`FLASH_BUDGET_BYTES`], static SRAM
 //! plus the worst stack ≤ [`SRAM_BUDGET_BYTES`].
 
+use kin_core::motion::gait::{GaitParams, Pattern};
+use kin_core::motion::laws::Axis;
+use kin_core::motion::path::PathKind;
 use kin_core::{LegId, Pose, ReachPolicy, RotationOrder};
 use quad_host::client::{Client, ClientConfig};
 use quad_host::emu::elf;
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::{
-    DeviceToHost, LinkLossAction, LinkTimeout, PoseConfig, Request, ServoId, PROTOCOL_VERSION,
+    DeviceToHost, LegSet, LinkLossAction, LinkTimeout, MotionCommand, PoseConfig, Request, ServoId,
+    PROTOCOL_VERSION,
 };
 use std::fmt;
 use std::path::Path;
@@ -154,6 +159,11 @@ pub fn measure(elf_path: &Path, poses: &[Pose]) -> Figures {
             let calibration = client.calibration(servo).unwrap_or_else(|e| panic!("{e}"));
             answer(&mut client, Request::SetCalibration { servo, calibration });
         }
+        if let Request::SetOutputs { enabled: false } = request {
+            // The onboard motions before the outputs go off: each start runs its start check,
+            // the deepest calls of the firmware.
+            run_motions(&mut client);
+        }
         if let DeviceToHost::Ack { readback, .. } = answer(&mut client, request) {
             if readback.angles_rad.iter().any(|a| *a != 0.0) {
                 last_angles = readback.angles_rad;
@@ -171,6 +181,71 @@ pub fn measure(elf_path: &Path, poses: &[Pose]) -> Figures {
         sram_static_bytes: sizes.sram_static_bytes,
         stack_paint_bytes: u64::from(mcu.painted_stack_bytes(heap_start, STACK_PAINT)),
         stack_pointer_bytes: u64::from(mcu.stack_peak_bytes()),
+    }
+}
+
+/// Every onboard motion once, each run for a second of emulated time and then stopped cleanly:
+/// stand-up, seed 001's sways and yaw turn, seed 000's rectangle, a trot with velocity
+/// commands, sit.
+fn run_motions(client: &mut Client<EmulatorLink>) {
+    let h = crate::avr_bench::STANCE_HEIGHT_M;
+    let motions = [
+        MotionCommand::StandUp,
+        MotionCommand::Sway {
+            axis: Axis::Roll,
+            amplitude_rad: 0.1,
+            period_s: 2.0,
+            duration_s: None,
+        },
+        MotionCommand::YawTurn {
+            yaw_rate_rad_s: 0.085,
+            step_period_s: 2.0,
+            lift_height_m: 0.03,
+            duration_s: None,
+        },
+        MotionCommand::FootPath {
+            path: PathKind::Rectangle,
+            legs: LegSet::All,
+            stride_m: 0.03,
+            step_height_m: 0.02,
+            duty_factor: 0.75,
+            cycle_s: 2.0,
+            duration_s: None,
+        },
+        MotionCommand::Walk {
+            gait: Pattern::Trot,
+            body_height_m: h,
+            step_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * h,
+            cycle_s: GaitParams::DEFAULT_CYCLE_S,
+            velocity_timeout_ms: 500,
+        },
+        MotionCommand::Sit,
+    ];
+    for m in motions {
+        answer(client, Request::StartMotion(m));
+        for frame in 0..50 {
+            if frame % 5 == 0 && matches!(m, MotionCommand::Walk { .. }) {
+                answer(
+                    client,
+                    Request::SetVelocity {
+                        forward_m_s: 0.02,
+                        lateral_m_s: 0.0,
+                        yaw_rate_rad_s: 0.05,
+                    },
+                );
+            }
+            client.link_mut().next_pulses().expect("the MCU runs");
+        }
+        answer(client, Request::StopMotion);
+        // Until the motion has ended (a period, the strides, the ramp home): at most 20 s.
+        for _ in 0..1000 {
+            match answer(client, Request::GetMotion) {
+                DeviceToHost::MotionAck { status, .. } if status.kind.is_none() => break,
+                _ => {
+                    client.link_mut().next_pulses().expect("the MCU runs");
+                }
+            }
+        }
     }
 }
 

@@ -113,6 +113,29 @@ fn pins(stream: &mut PoseStream<EmulatorLink>) -> [Pulse; 12] {
     })
 }
 
+/// Frames the joint-speed limiter may take to bring the outputs to a new target: the largest
+/// joint travel (2π) at its step per 20 ms frame, plus one.
+fn limiter_frames() -> u32 {
+    let step_rad = quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S * 0.02;
+    (2.0 * std::f32::consts::PI / step_rad).ceil() as u32 + 1
+}
+
+/// The pins once the outputs have reached `want_ticks`: every output passes the joint-speed
+/// limiter, so a new target is on the pins after a few frames (at most [`limiter_frames`]).
+fn settled_pins(stream: &mut PoseStream<EmulatorLink>, want_ticks: &[u16; 12]) -> [Pulse; 12] {
+    let mut got = pins(stream);
+    for _ in 0..limiter_frames() {
+        let there = got.iter().zip(want_ticks).all(|(p, &w)| {
+            p.width_could_be(u64::from(w) * CYCLES_PER_TICK, PULSE_TOLERANCE_CYCLES)
+        });
+        if there {
+            break;
+        }
+        got = pins(stream);
+    }
+    got
+}
+
 fn assert_pins(got: &[Pulse; 12], want_ticks: &[u16; 12], what: &str) {
     for (ch, (p, &w)) in got.iter().zip(want_ticks).enumerate() {
         let want = u64::from(w) * CYCLES_PER_TICK;
@@ -309,7 +332,7 @@ fn fifty_random_targets_put_the_host_calibration_of_the_host_ik_on_all_twelve_pi
             "target {i}: {result:?}"
         );
         let want = host_pulses(&stream, pose);
-        let got = pins(&mut stream);
+        let got = settled_pins(&mut stream, &want);
         assert_pins(&got, &want, &format!("target {i}"));
     }
     let stats = stream.stats();
@@ -337,7 +360,8 @@ fn unreachable_target_is_nacked_and_the_pins_keep_their_pulses_at(baud: u32) {
         stream.send(&pose).expect("link"),
         PoseResult::Acked { .. }
     ));
-    let before = pins(&mut stream);
+    let settled = host_pulses(&stream, &pose);
+    let before = settled_pins(&mut stream, &settled);
     // Body lifted 1 m: no leg reaches.
     let lifted = Pose {
         z_m: 1.0,

@@ -41,9 +41,15 @@ impl core::error::Error for Singular {}
 
 /// Analytic leg Jacobian `∂foot_in_hip/∂(abduction, hip, knee)`, m/rad.
 pub fn leg_jacobian(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
-    let (sa, ca) = DefaultMath::sin_cos(q.abduction_rad);
-    let (sh, ch) = DefaultMath::sin_cos(q.hip_rad);
-    let (shk, chk) = DefaultMath::sin_cos(q.hip_rad + q.knee_rad);
+    leg_jacobian_on::<DefaultMath>(g, leg, q)
+}
+
+/// [`leg_jacobian`] on backend `M` (reached through [`crate::leg::Solver::inverse_condition`]).
+#[inline(never)]
+pub(crate) fn leg_jacobian_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
+    let (sa, ca) = M::sin_cos(q.abduction_rad);
+    let (sh, ch) = M::sin_cos(q.hip_rad);
+    let (shk, chk) = M::sin_cos(q.hip_rad + q.knee_rad);
     let (l1, l2) = (g.femur_m, g.tibia_m);
     let u = -l1 * sh - l2 * shk;
     let w = -g.d_ax_m - l1 * ch - l2 * chk;
@@ -62,20 +68,28 @@ pub fn manipulability(j: &Mat3) -> f32 {
 }
 
 /// Inverse condition number `σ_min / σ_max` of `j` ∈ [0, 1] (1 = isotropic, 0 = singular),
-/// from the closed-form eigenvalues of the symmetric `JᵀJ`.
+/// from the closed-form eigenvalues of the symmetric `JᵀJ`, on the [`DefaultMath`] backend.
 pub fn inverse_condition(j: &Mat3) -> f32 {
+    inverse_condition_on::<DefaultMath>(j)
+}
+
+/// [`inverse_condition`] on backend `M` (reached through
+/// [`crate::leg::Solver::inverse_condition`]).
+#[inline(never)]
+pub(crate) fn inverse_condition_on<M: Math>(j: &Mat3) -> f32 {
     let jt = j.transpose();
     let a = jt.mul_mat(j); // symmetric positive semi-definite
-    let e = symmetric_eigenvalues(&a.rows);
+    let e = symmetric_eigenvalues::<M>(&a.rows);
     let (lo, hi) = (e[0].max(0.0), e[2].max(0.0));
     if hi <= 0.0 {
         return 0.0;
     }
-    libm::sqrtf(lo / hi)
+    M::sqrt(lo / hi)
 }
 
 /// Eigenvalues of a symmetric 3×3 matrix, ascending (trigonometric closed form).
-fn symmetric_eigenvalues(a: &[[f32; 3]; 3]) -> [f32; 3] {
+#[inline(never)]
+fn symmetric_eigenvalues<M: Math>(a: &[[f32; 3]; 3]) -> [f32; 3] {
     let p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
     let tr = a[0][0] + a[1][1] + a[2][2];
     let q = tr / 3.0;
@@ -89,7 +103,7 @@ fn symmetric_eigenvalues(a: &[[f32; 3]; 3]) -> [f32; 3] {
         + (a[1][1] - q) * (a[1][1] - q)
         + (a[2][2] - q) * (a[2][2] - q)
         + 2.0 * p1;
-    let p = libm::sqrtf(p2 / 6.0);
+    let p = M::sqrt(p2 / 6.0);
     let inv_p = 1.0 / p;
     let b = [
         [(a[0][0] - q) * inv_p, a[0][1] * inv_p, a[0][2] * inv_p],
@@ -98,9 +112,10 @@ fn symmetric_eigenvalues(a: &[[f32; 3]; 3]) -> [f32; 3] {
     ];
     let det_b = Mat3 { rows: b }.determinant();
     let r = (det_b / 2.0).clamp(-1.0, 1.0);
-    let phi = libm::acosf(r) / 3.0;
-    let e_hi = q + 2.0 * p * libm::cosf(phi);
-    let e_lo = q + 2.0 * p * libm::cosf(phi + 2.0 * core::f32::consts::PI / 3.0);
+    // acos r = atan2(√(1 − r²), r) for r in [−1, 1]: the backend's own functions.
+    let phi = M::atan2(M::sqrt((1.0 - r) * (1.0 + r)), r) / 3.0;
+    let e_hi = q + 2.0 * p * M::sin_cos(phi).1;
+    let e_lo = q + 2.0 * p * M::sin_cos(phi + 2.0 * core::f32::consts::PI / 3.0).1;
     let e_mid = tr - e_hi - e_lo;
     [e_lo, e_mid, e_hi]
 }

@@ -435,6 +435,15 @@ impl<M: Math> Solver<M> {
         }
     }
 
+    /// The singularity measure of `leg` at `q`: the inverse condition number of its Jacobian
+    /// ([`crate::jacobian::inverse_condition`] of [`crate::jacobian::leg_jacobian`]) on this
+    /// solver's backend, in `[0, 1]`; below [`crate::jacobian::SINGULARITY_THRESHOLD`] counts
+    /// as near-singular.
+    pub fn inverse_condition(&self, leg: LegId, q: JointAngles) -> f32 {
+        let j = crate::jacobian::leg_jacobian_on::<M>(&self.geometry, leg, q);
+        crate::jacobian::inverse_condition_on::<M>(&j)
+    }
+
     /// The leg geometry.
     #[inline]
     pub fn geometry(&self) -> &LegGeometry {

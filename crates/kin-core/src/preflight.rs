@@ -21,7 +21,7 @@ use crate::body::{self, BodyConfig};
 use crate::jacobian::{self, SINGULARITY_THRESHOLD};
 use crate::leg::{self, Unreachable};
 use crate::math::wrap_pi;
-use crate::motion::{finite, positive, Error, Frame, Motion};
+use crate::motion::{finite, positive, Error, Expected, Frame, Motion, Param};
 use crate::robot::{Joint, JointAngles, JointLimits, LegId, Robot};
 use crate::vec::Vec3;
 use crate::ReachPolicy;
@@ -47,17 +47,17 @@ impl Sweep {
     /// Validates: `start_s` finite, `duration_s ≥ 0`, `rate_hz > 0`, at most
     /// [`MAX_SWEEP_SAMPLES`] samples.
     pub fn new(start_s: f32, duration_s: f32, rate_hz: f32) -> Result<Sweep, Error> {
-        finite(start_s, "start_s")?;
-        if !(finite(duration_s, "duration_s")? >= 0.0) {
-            return Err(Error::Negative("duration_s"));
+        finite(start_s, Param::StartS)?;
+        if !(finite(duration_s, Param::DurationS)? >= 0.0) {
+            return Err(Error::Negative(Param::DurationS));
         }
-        positive(rate_hz, "rate_hz")?;
+        positive(rate_hz, Param::RateHz)?;
         // The small allowance absorbs rounding of products such as 0.3 s × 10 Hz.
         let n = libm::floorf(duration_s * rate_hz + 1e-3) + 1.0;
         if !(n <= MAX_SWEEP_SAMPLES as f32) {
             return Err(Error::OutOfRange {
-                parameter: "duration_s",
-                expected: "at most 2^24 samples (duration_s × rate_hz)",
+                parameter: Param::DurationS,
+                expected: Expected::SweepSamples,
             });
         }
         Ok(Sweep {
@@ -355,7 +355,7 @@ impl Checker {
     ) -> Result<Checker, Error> {
         robot.validate()?;
         for v in max_joint_speed_rad_s {
-            positive(v, "max_joint_speed_rad_s")?;
+            positive(v, Param::MaxJointSpeedRadS)?;
         }
         let mut geometric = *robot;
         geometric.limits = JointLimits::FULL_TURN;

@@ -4,7 +4,7 @@
 
 use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
 use kin_core::motion::path::PathKind;
-use kin_core::motion::{self, Contact, Error, Motion};
+use kin_core::motion::{self, Contact, Error, Motion, Param};
 use kin_core::{body, preflight, DefaultMath, LegId, ReachPolicy, Robot, Vec3};
 
 /// Largest allowed drift of a stance foot in the world, m.
@@ -197,31 +197,31 @@ fn gait_parameters_are_validated_by_name() {
     };
     assert_eq!(
         with(&|p| p.cycle_s = -1.0),
-        Err(Error::NotPositive("cycle_s"))
+        Err(Error::NotPositive(Param::CycleS))
     );
     assert_eq!(
         with(&|p| p.stance_height_m = 0.0),
-        Err(Error::NotPositive("stance_height_m"))
+        Err(Error::NotPositive(Param::StanceHeightM))
     );
     assert_eq!(
         with(&|p| p.velocity.forward_m_s = f32::NAN),
-        Err(Error::NonFinite("forward_m_s"))
+        Err(Error::NonFinite(Param::ForwardMS))
     );
     assert_eq!(
         with(&|p| p.step_height_m = -0.01),
-        Err(Error::Negative("step_height_m"))
+        Err(Error::Negative(Param::StepHeightM))
     );
     assert!(matches!(
         with(&|p| p.duty_factor = 1.0),
         Err(Error::OutOfRange {
-            parameter: "duty_factor",
+            parameter: Param::DutyFactor,
             ..
         })
     ));
     assert!(matches!(
         with(&|p| p.step_height_m = 0.45),
         Err(Error::OutOfRange {
-            parameter: "step_height_m",
+            parameter: Param::StepHeightM,
             ..
         })
     ));
@@ -229,21 +229,21 @@ fn gait_parameters_are_validated_by_name() {
     assert!(matches!(
         with(&|p| p.step_height_m = 0.35),
         Err(Error::BeyondReach {
-            parameter: "step_height_m",
+            parameter: Param::StepHeightM,
             ..
         })
     ));
     assert!(matches!(
         with(&|p| p.velocity.forward_m_s = 3.0),
         Err(Error::BeyondReach {
-            parameter: "velocity",
+            parameter: Param::Velocity,
             ..
         })
     ));
     assert!(matches!(
         with(&|p| p.stance_height_m = 0.6),
         Err(Error::BeyondReach {
-            parameter: "stance_height_m",
+            parameter: Param::StanceHeightM,
             ..
         })
     ));

@@ -5,7 +5,7 @@ use kin_core::motion::laws::{LegPaths, LegPathsParams};
 use kin_core::motion::path::{
     AnyPath, Bezier, Cycloid, Ellipse, FootPath, PathKind, Rectangle, Semicircle, Stride,
 };
-use kin_core::motion::{Contact, Error, Motion, Phase};
+use kin_core::motion::{Contact, Error, Motion, Param, Phase};
 use kin_core::{preflight, DefaultMath, LegId, Vec3};
 
 /// Geometric tolerance of the shape checks, m.
@@ -195,20 +195,23 @@ fn shapes_are_what_their_names_say() {
 fn path_parameters_are_validated_by_name() {
     assert_eq!(
         Stride::new(-0.1, 0.05, 0.5),
-        Err(Error::Negative("stride_m"))
+        Err(Error::Negative(Param::StrideM))
     );
     assert_eq!(
         Stride::new(0.1, f32::NAN, 0.5),
-        Err(Error::NonFinite("step_height_m"))
+        Err(Error::NonFinite(Param::StepHeightM))
     );
     assert!(matches!(
         Stride::new(0.1, 0.05, 1.0),
         Err(Error::OutOfRange {
-            parameter: "duty_factor",
+            parameter: Param::DutyFactor,
             ..
         })
     ));
-    assert_eq!(Phase::new(f32::INFINITY), Err(Error::NonFinite("phase")));
+    assert_eq!(
+        Phase::new(f32::INFINITY),
+        Err(Error::NonFinite(Param::Phase))
+    );
     assert_eq!(Phase::new(-0.25).unwrap().value(), 0.75);
     assert_eq!(Phase::new(-1e-12).unwrap().value(), 0.0);
     assert_eq!(PathKind::parse("Bezier"), Some(PathKind::Bezier));
@@ -242,7 +245,7 @@ fn rect_path_motion_is_reachable_and_periodic() {
     assert!(matches!(
         LegPaths::new(params),
         Err(Error::BeyondReach {
-            parameter: "path",
+            parameter: Param::Path,
             ..
         })
     ));

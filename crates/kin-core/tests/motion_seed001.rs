@@ -4,7 +4,7 @@
 
 use kin_core::jacobian::SINGULARITY_THRESHOLD;
 use kin_core::motion::laws::{self, Axis, Sway, SwayParams, YawTurn, YawTurnParams};
-use kin_core::motion::{self, Contact, Motion};
+use kin_core::motion::{self, Contact, Motion, Param};
 use kin_core::preflight::{self, Sweep};
 use kin_core::{body, leg, paper, DefaultMath, LegId, ReachPolicy, Robot, Vec3};
 use std::f64::consts::PI;
@@ -419,16 +419,16 @@ fn bad_parameters_are_named() {
     use kin_core::motion::Error;
     let mut p = YawTurnParams::seed001();
     p.step_period_s = -6.0;
-    assert_eq!(YawTurn::new(p), Err(Error::NotPositive("step_period_s")));
+    assert_eq!(YawTurn::new(p), Err(Error::NotPositive(Param::StepPeriodS)));
     let mut p = YawTurnParams::seed001();
-    p.omega_rad_s = f32::NAN;
-    assert_eq!(YawTurn::new(p), Err(Error::NonFinite("omega_rad_s")));
+    p.yaw_rate_rad_s = f32::NAN;
+    assert_eq!(YawTurn::new(p), Err(Error::NonFinite(Param::YawRateRadS)));
     let mut p = YawTurnParams::seed001();
     p.lift_height_m = 1.0;
     assert!(matches!(
         YawTurn::new(p),
         Err(Error::OutOfRange {
-            parameter: "lift_height_m",
+            parameter: Param::LiftHeightM,
             ..
         })
     ));
@@ -437,25 +437,25 @@ fn bad_parameters_are_named() {
     assert!(matches!(
         YawTurn::new(p),
         Err(Error::BeyondReach {
-            parameter: "lift_height_m",
+            parameter: Param::LiftHeightM,
             ..
         })
     ));
     let mut p = SwayParams::seed001(Axis::Roll);
     p.period_s = 0.0;
-    assert_eq!(Sway::new(p), Err(Error::NotPositive("period_s")));
+    assert_eq!(Sway::new(p), Err(Error::NotPositive(Param::PeriodS)));
     let mut p = SwayParams::seed001(Axis::Roll);
     p.amplitude_rad = 1.2;
     assert!(matches!(
         Sway::new(p),
         Err(Error::BeyondReach {
-            parameter: "amplitude_rad",
+            parameter: Param::AmplitudeRad,
             ..
         })
     ));
     let sway = Sway::new(SwayParams::seed001(Axis::Pitch)).unwrap();
     assert_eq!(
         sway.frame::<DefaultMath>(f32::NAN),
-        Err(Error::NonFinite("t_s"))
+        Err(Error::NonFinite(Param::TS))
     );
 }

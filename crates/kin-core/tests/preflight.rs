@@ -4,7 +4,7 @@
 use kin_core::body::BodyConfig;
 use kin_core::leg::Unreachable;
 use kin_core::motion::laws::{Axis, Sway, SwayParams, SEED000_SWEEP_STANCE_HEIGHT_M};
-use kin_core::motion::{Contact, Error, Frame};
+use kin_core::motion::{Contact, Error, Frame, Param};
 use kin_core::preflight::{self, workspace_margin, Boundary, Checker, FailureKind, Sweep};
 use kin_core::{leg, Joint, JointAngles, JointLimits, LegId, Pose, ReachPolicy, Robot, Vec3};
 use proptest::prelude::*;
@@ -130,20 +130,20 @@ fn joint_limit_violations_give_negative_margins() {
 fn sweeps_and_limits_are_validated_by_name() {
     assert_eq!(
         Sweep::new(0.0, -1.0, 100.0),
-        Err(Error::Negative("duration_s"))
+        Err(Error::Negative(Param::DurationS))
     );
     assert_eq!(
         Sweep::new(0.0, 1.0, 0.0),
-        Err(Error::NotPositive("rate_hz"))
+        Err(Error::NotPositive(Param::RateHz))
     );
     assert_eq!(
         Sweep::new(f32::NAN, 1.0, 10.0),
-        Err(Error::NonFinite("start_s"))
+        Err(Error::NonFinite(Param::StartS))
     );
     assert!(matches!(
         Sweep::new(0.0, 1e6, 1e3),
         Err(Error::OutOfRange {
-            parameter: "duration_s",
+            parameter: Param::DurationS,
             ..
         })
     ));
@@ -158,7 +158,7 @@ fn sweeps_and_limits_are_validated_by_name() {
             BodyConfig::default(),
             [1.0, 0.0, 1.0]
         ),
-        Err(Error::NotPositive("max_joint_speed_rad_s"))
+        Err(Error::NotPositive(Param::MaxJointSpeedRadS))
     ));
 }
 

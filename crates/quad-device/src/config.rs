@@ -39,6 +39,9 @@ pub struct Config {
     pub firmware: FirmwareVersion,
     /// Storage address of calibration bank A; [`crate::store::STORAGE_LEN`] bytes are used.
     pub storage_base: u16,
+    /// Joint-speed limit of every output at power-on, rad/s (finite, > 0; see
+    /// [`crate::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S`]).
+    pub joint_speed_limit_rad_s: f32,
 }
 
 /// Why a [`Config`] or a pose configuration was refused.
@@ -53,6 +56,8 @@ pub enum ConfigError {
     PresetMismatch,
     /// The storage banks do not fit below address 65536.
     StorageBase,
+    /// The joint-speed limit is not a finite speed > 0.
+    JointSpeedLimit,
 }
 
 impl fmt::Display for ConfigError {
@@ -62,6 +67,9 @@ impl fmt::Display for ConfigError {
             ConfigError::StanceHeight => f.write_str("stance height must be a finite length > 0"),
             ConfigError::PresetMismatch => f.write_str("preset and robot geometry differ"),
             ConfigError::StorageBase => f.write_str("calibration storage exceeds 64 KiB"),
+            ConfigError::JointSpeedLimit => {
+                f.write_str("joint speed limit must be a finite speed > 0, in rad/s")
+            }
         }
     }
 }
@@ -79,7 +87,9 @@ pub fn validate_pose_config(p: &PoseConfig) -> Result<(), ConfigError> {
 
 impl Config {
     /// [`Robot::fernando2025`] at [`FERNANDO2025_STANCE_HEIGHT_M`], seed 001's rotation order
-    /// `zxy`, unreachable poses rejected, no link-loss timeout.
+    /// `zxy`, unreachable poses rejected, no link-loss timeout, the default joint-speed limit.
+    /// The stance height and rotation order here are the robot's one default: the motion
+    /// engine's stance, stand-up and motions use them.
     pub const fn fernando2025() -> Config {
         Config {
             preset: RobotPreset::Fernando2025,
@@ -99,6 +109,7 @@ impl Config {
                 patch: 0,
             },
             storage_base: 0,
+            joint_speed_limit_rad_s: crate::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S,
         }
     }
 
@@ -134,6 +145,9 @@ impl Config {
         }
         if u32::from(self.storage_base) + u32::from(crate::store::STORAGE_LEN) > 0x1_0000 {
             return Err(ConfigError::StorageBase);
+        }
+        if crate::engine::Limiter::new(self.joint_speed_limit_rad_s).is_err() {
+            return Err(ConfigError::JointSpeedLimit);
         }
         Ok(())
     }

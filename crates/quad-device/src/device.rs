@@ -4,9 +4,11 @@
 use crate::config::{
     validate_pose_config, write_default_calibration, Config, ConfigError, UNBOOTED_CALIBRATION,
 };
+use crate::engine::{self, Engine, Limiter, Setup, FRAME_MS};
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use kin_core::body::{self, BodySolution, Pose};
+use kin_core::motion::gait::Velocity;
 use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
@@ -68,6 +70,14 @@ struct Held {
 /// - Unreadable frames are answered with a nack without a sequence number (`BadCrc`,
 ///   `BadFrame`, `Oversize`), at most one per [`FRAMING_NACK_INTERVAL_MS`], and change nothing
 ///   but the frame counters.
+/// - Every output passes the one joint-speed limiter of the [`engine`]: from the second servo
+///   frame after enabling on, a new target is approached by at most `limit · 20 ms` per frame
+///   ([`Device::poll`] runs the frames); within the enabling frame a target is written at once
+///   (the servos' positions are unknown until then). The readback reports the held target;
+///   [`Device::output_angles`] what is on the outputs.
+/// - The motion engine ([`Device::start_motion`]) runs stand-up, sit, rest, the sways, the yaw
+///   turn, the foot paths and the walk; a direct setpoint request or stopping the outputs
+///   cancels a running motion, a link loss with [`LinkLossAction::Hold`] stops it cleanly.
 pub struct Device<O, C, S, M: Math = DefaultMath> {
     outputs: O,
     clock: C,
@@ -91,6 +101,14 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     last_valid_ms: u32,
     /// When the last nack of an unreadable frame was sent (`None`: never).
     last_framing_nack_ms: Option<u32>,
+    engine: Engine<M>,
+    /// The angles on the outputs while they are enabled.
+    out_rad: [f32; 12],
+    /// When the next servo frame begins, ms (frames timed by the clock), or the PWM period of
+    /// the last frame (frames latched to the outputs' periods).
+    next_frame: u32,
+    /// True until the first frame boundary after enabling.
+    enabling_frame: bool,
 }
 
 // The request handlers are `#[inline(never)]` on purpose: inlined into one function (as LTO
@@ -134,6 +152,8 @@ where
         storage: S,
     ) -> Result<Self, ConfigError> {
         config.validate()?;
+        let limiter = Limiter::new(config.joint_speed_limit_rad_s)
+            .map_err(|_| ConfigError::JointSpeedLimit)?;
         outputs.set_enabled(false);
         let now = clock.now_ms();
         Ok(Device {
@@ -156,6 +176,10 @@ where
             calibration_default: true,
             last_valid_ms: now,
             last_framing_nack_ms: None,
+            engine: Engine::new(limiter),
+            out_rad: [0.0; 12],
+            next_frame: now,
+            enabling_frame: false,
         })
     }
 
@@ -233,8 +257,14 @@ where
         }
     }
 
-    /// Runs the link-loss failsafe; call it from the main loop.
+    /// Runs the link-loss failsafe and, at each servo frame boundary, the motion engine and the
+    /// joint-speed limiter; call it from the main loop (at least every 20 ms).
     pub fn poll(&mut self) {
+        self.failsafe_check();
+        self.frame_tick();
+    }
+
+    fn failsafe_check(&mut self) {
         let LinkTimeout { timeout_ms, action } = self.config.link_timeout;
         if timeout_ms == 0 || !self.failsafe_armed {
             return;
@@ -247,6 +277,155 @@ where
         self.failsafe_armed = false;
         if action == LinkLossAction::Disable {
             self.stop_outputs();
+        } else {
+            // Holding a motion mid-stride would freeze it: it ends cleanly instead.
+            self.engine.stop();
+        }
+    }
+
+    /// One servo frame, when a frame boundary has passed: the engine's new target, then one
+    /// limiter step of the outputs toward the held target. The boundaries are the outputs' PWM
+    /// periods when they count them ([`ServoOutputs::periods_begun`]), else the clock's 20 ms.
+    #[inline(never)]
+    fn frame_tick(&mut self) {
+        if !self.outputs_enabled {
+            return;
+        }
+        let now = self.clock.now_ms();
+        let frames = match self.outputs.periods_begun() {
+            // Latched to the PWM periods: one frame per period at most, and none while the last
+            // write waits for a period to show it.
+            Some(period) => {
+                let frames = period.wrapping_sub(self.next_frame);
+                if frames == 0 || self.outputs.write_pending() {
+                    return;
+                }
+                self.next_frame = period;
+                frames
+            }
+            None => {
+                let late_ms = now.wrapping_sub(self.next_frame);
+                if late_ms > i32::MAX as u32 {
+                    return; // Before the boundary.
+                }
+                let frames = 1 + late_ms / FRAME_MS;
+                self.next_frame = self.next_frame.wrapping_add(frames * FRAME_MS);
+                frames
+            }
+        };
+        self.enabling_frame = false;
+        let mut disable = false;
+        if self.engine.is_active() {
+            let tick = self.engine.tick(frames, now, &self.out_rad);
+            if let Some(q) = tick.target {
+                if let Err(e) = self.hold_motion_target(q) {
+                    self.engine.fail(e, self.out_rad);
+                }
+            }
+            disable = tick.disable_outputs;
+        }
+        if let Some(held) = &self.held {
+            let mut out = self.out_rad;
+            self.engine.limiter().step(&mut out, &held.angles_rad);
+            if out != self.out_rad {
+                self.out_rad = out;
+                self.write_out();
+            }
+        }
+        if disable {
+            self.stop_outputs();
+        }
+    }
+
+    /// Makes a motion setpoint the held target, after mapping it through the calibration.
+    fn hold_motion_target(&mut self, angles_rad: [f32; 12]) -> Result<(), engine::Error> {
+        let mut pulses_half_us = [0u16; 12];
+        for s in ServoId::ALL {
+            pulses_half_us[s.index()] = self.calibration[s.index()]
+                .pulse_half_us(angles_rad[s.index()])
+                .map_err(|fault| engine::Error::ServoRange { servo: s, fault })?;
+        }
+        self.held = Some(Held {
+            angles_rad,
+            pulses_half_us,
+        });
+        self.clamped = false;
+        self.limited = false;
+        Ok(())
+    }
+
+    /// Starts a motion of the engine (see [`engine`]): validated and start-checked first, refused
+    /// with nothing changed. [`engine::Request::StandUp`] with the outputs off holds the rest
+    /// pose and enables the outputs at it.
+    ///
+    /// # Errors
+    /// [`engine::Error`].
+    pub fn start_motion(&mut self, request: &engine::Request) -> Result<(), engine::Error> {
+        let setup = Setup {
+            robot: &self.config.robot,
+            stance_height_m: self.config.pose_config.stance_height_m,
+            order: self.config.pose_config.order,
+            calibration: &self.calibration,
+            outputs: if self.outputs_enabled {
+                Some(&self.out_rad)
+            } else {
+                None
+            },
+            now_ms: self.clock.now_ms(),
+        };
+        let start = self.engine.start(request, &setup)?;
+        if !self.outputs_enabled {
+            let enabled = self.hold_motion_target(start).and_then(|()| {
+                self.set_outputs(true)
+                    .map_err(|_| engine::Error::OutputsOff)
+            });
+            if let Err(e) = enabled {
+                self.engine.cancel();
+                return Err(e);
+            }
+        }
+        Ok(())
+    }
+
+    /// Stops the running motion cleanly ([`Engine::stop`]).
+    pub fn stop_motion(&mut self) {
+        self.engine.stop();
+    }
+
+    /// Sets the running walk's velocity command (body frame; yaw counter-clockwise positive);
+    /// it must be refreshed within the walk's timeout.
+    ///
+    /// # Errors
+    /// [`engine::Error::NotWalking`], or the component beyond the gait's reach.
+    pub fn set_velocity(&mut self, velocity: Velocity) -> Result<(), engine::Error> {
+        let now = self.clock.now_ms();
+        self.engine.set_velocity(velocity, now)
+    }
+
+    /// Sets the joint-speed limit of every output, rad/s (finite, > 0).
+    ///
+    /// # Errors
+    /// [`engine::Error::Parameter`] naming `joint_speed_limit_rad_s`.
+    pub fn set_joint_speed_limit(&mut self, rad_s: f32) -> Result<(), engine::Error> {
+        self.engine.set_joint_speed_limit(rad_s)
+    }
+
+    /// The motion engine's status.
+    pub fn motion_status(&self) -> engine::Status {
+        self.engine.status()
+    }
+
+    /// The limiter in effect.
+    pub fn limiter(&self) -> &Limiter {
+        self.engine.limiter()
+    }
+
+    /// The angles on the outputs (`None` while they are stopped).
+    pub fn output_angles(&self) -> Option<&[f32; 12]> {
+        if self.outputs_enabled {
+            Some(&self.out_rad)
+        } else {
+            None
         }
     }
 
@@ -323,6 +502,32 @@ where
                     Err(reason) => nack(Some(seq), reason),
                 };
             }
+            Request::SetJointSpeedLimit {
+                joint_speed_limit_rad_s,
+            } => self
+                .set_joint_speed_limit(joint_speed_limit_rad_s)
+                .map_err(NackReason::from),
+            Request::StartMotion(m) => {
+                let r = self.start_motion(&engine::Request::from(m));
+                return self.motion_answer(seq, r);
+            }
+            Request::StopMotion => {
+                self.stop_motion();
+                return self.motion_answer(seq, Ok(()));
+            }
+            Request::GetMotion => return self.motion_answer(seq, Ok(())),
+            Request::SetVelocity {
+                forward_m_s,
+                lateral_m_s,
+                yaw_rate_rad_s,
+            } => {
+                let r = self.set_velocity(Velocity {
+                    forward_m_s,
+                    lateral_m_s,
+                    yaw_rad_s: yaw_rate_rad_s,
+                });
+                return self.motion_answer(seq, r);
+            }
         };
         match result {
             Ok(()) => DeviceToHost::Ack {
@@ -339,6 +544,20 @@ where
             seq,
             setting,
             readback: self.readback(),
+        }
+    }
+
+    /// The answer to a motion request: `MotionAck` with the engine's status and the readback,
+    /// or the nack of `result`'s error. Out of line: one instance for the four requests.
+    #[inline(never)]
+    fn motion_answer(&self, seq: u16, result: Result<(), engine::Error>) -> DeviceToHost {
+        match result {
+            Ok(()) => DeviceToHost::MotionAck {
+                seq,
+                status: self.engine.status().into(),
+                readback: self.readback(),
+            },
+            Err(e) => nack(Some(seq), e.into()),
         }
     }
 
@@ -505,36 +724,40 @@ where
         });
         self.clamped = clamped;
         self.limited = limited;
-        if self.outputs_enabled {
-            self.drive();
+        // A direct setpoint takes over from a running motion.
+        self.engine.cancel();
+        if self.outputs_enabled && self.enabling_frame {
+            self.out_rad = angles_rad;
+            self.write_out();
         }
         Ok(())
     }
 
-    /// Writes the held pulses to the outputs, after checking each against its calibration;
-    /// stops the outputs instead if any check fails (unreachable by construction).
-    fn drive(&mut self) -> bool {
-        // Borrowed, not copied (72 bytes).
-        let Some(held) = &self.held else {
-            self.stop_outputs();
-            return false;
-        };
-        let all_in_travel = self
-            .calibration
-            .iter()
-            .zip(&held.pulses_half_us)
-            .all(|(c, &p)| c.min_half_us() <= p && p <= c.max_half_us());
-        if !all_in_travel {
-            self.stop_outputs();
-            return false;
+    /// Writes the output angles through the calibration; stops the outputs instead if one maps
+    /// outside its travel (unreachable by construction: the outputs lie between admitted
+    /// targets).
+    fn write_out(&mut self) -> bool {
+        let mut pulses = [0u16; 12];
+        for (p, (c, &a)) in pulses
+            .iter_mut()
+            .zip(self.calibration.iter().zip(&self.out_rad))
+        {
+            match c.pulse_half_us(a) {
+                Ok(v) => *p = v,
+                Err(_) => {
+                    self.stop_outputs();
+                    return false;
+                }
+            }
         }
-        self.outputs.set_pulses(&held.pulses_half_us);
+        self.outputs.set_pulses(&pulses);
         true
     }
 
     fn stop_outputs(&mut self) {
         self.outputs.set_enabled(false);
         self.outputs_enabled = false;
+        self.engine.cancel();
     }
 
     fn set_outputs(&mut self, enabled: bool) -> Result<(), NackReason> {
@@ -542,7 +765,20 @@ where
             self.stop_outputs();
             return Ok(());
         }
-        if !self.drive() {
+        if !self.outputs_enabled {
+            // The enabling frame: the held target is written as it is (module docs).
+            let Some(held) = &self.held else {
+                self.stop_outputs();
+                return Err(NackReason::InvalidArgument);
+            };
+            self.out_rad = held.angles_rad;
+            self.enabling_frame = true;
+            self.next_frame = match self.outputs.periods_begun() {
+                Some(period) => period,
+                None => self.clock.now_ms().wrapping_add(FRAME_MS),
+            };
+        }
+        if !self.write_out() {
             return Err(NackReason::InvalidArgument);
         }
         if !self.outputs_enabled {
@@ -566,12 +802,21 @@ where
                     })?;
             held.pulses_half_us[i] = pulse;
         }
+        if self.outputs_enabled {
+            // The outputs may still be on their way to the held angle.
+            c.pulse_half_us(self.out_rad[i])
+                .map_err(|fault| NackReason::ServoRange {
+                    leg: servo.leg,
+                    joint: servo.joint,
+                    fault,
+                })?;
+        }
         if self.calibration[i] != c {
             self.calibration[i] = c;
             self.calibration_unsaved = true;
         }
         if self.outputs_enabled {
-            self.drive();
+            self.write_out();
         }
         Ok(())
     }

@@ -19,6 +19,22 @@ pub trait ServoOutputs {
     /// servos then hold no torque. The controller starts with the outputs stopped and calls
     /// `set_enabled(false)` once at construction.
     fn set_enabled(&mut self, enabled: bool);
+
+    /// The PWM periods begun so far (wrapping), for a controller that latches its servo frames
+    /// to them: it then writes at most one new set of pulses per period, so that no pulse
+    /// train skips a setpoint (two writes between two pulses would move a servo two limiter
+    /// steps at once). `None` (the default): the outputs count no periods and the controller
+    /// times its frames by its clock.
+    fn periods_begun(&self) -> Option<u32> {
+        None
+    }
+
+    /// True while the pulses written last have not been taken over by the start of a period
+    /// (a new write now would replace them before any pulse showed them). Only asked when
+    /// [`ServoOutputs::periods_begun`] counts.
+    fn write_pending(&self) -> bool {
+        false
+    }
 }
 
 /// A monotonic millisecond clock. It may wrap at `u32::MAX` (49.7 days); the controller only
@@ -54,6 +70,12 @@ pub trait Storage {
 impl<T: ServoOutputs + ?Sized> ServoOutputs for &mut T {
     fn set_pulses(&mut self, pulses_half_us: &[u16; 12]) {
         (**self).set_pulses(pulses_half_us);
+    }
+    fn periods_begun(&self) -> Option<u32> {
+        (**self).periods_begun()
+    }
+    fn write_pending(&self) -> bool {
+        (**self).write_pending()
     }
     fn set_enabled(&mut self, enabled: bool) {
         (**self).set_enabled(enabled);

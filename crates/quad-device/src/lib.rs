@@ -11,8 +11,11 @@
 //! ```
 //!
 //! - [`Device`]: the controller ([`Device::receive`] for bytes, [`Device::poll`] for the
-//!   link-loss failsafe, [`Device::handle`] at message level). Its documentation lists the
-//!   behaviour and invariants.
+//!   link-loss failsafe and the 50 Hz servo frames, [`Device::handle`] at message level,
+//!   [`Device::start_motion`] and its siblings for the motion engine). Its documentation lists
+//!   the behaviour and invariants.
+//! - [`engine`]: the motion engine (stand-up, sit, the papers' motions, the walk) and the one
+//!   joint-speed limiter every output passes.
 //! - [`hal`]: the traits a target implements — [`ServoOutputs`] (twelve pulse widths in 0.5 µs
 //!   timer ticks, enable/disable), [`Clock`] (monotonic ms) and [`Storage`] (EEPROM-like bytes).
 //!   The kin-core [`kin_core::Math`] backend is a type parameter: the firmware passes its
@@ -33,15 +36,16 @@
 //! loop {
 //!     let n = usart.read_into(&mut chunk);            // bytes queued by the USART RX interrupt
 //!     device.receive(&chunk[..n], |frame| usart.write_all(frame));
-//!     device.poll();                                  // link-loss failsafe
+//!     device.poll();                                  // link-loss failsafe, motion frame
 //! }
 //! ```
 //!
 //! ## Memory
 //! A [`Device`] holds one receive buffer ([`device::RX_LEN`] bytes plus the accumulator's
 //! state; the answer frame, at most [`device::TX_LEN`] bytes, is encoded there once the request
-//! is decoded), the calibration table, the held angles and pulses, the configuration with the
-//! robot, and a few flags. Saving or loading the calibration streams one record at a time. Its
+//! is decoded), the calibration table, the held target and the output angles and pulses, the
+//! configuration with the robot, the motion [`engine`] (the running motion's parameters and
+//! state, one ramp, the limiter) and a few flags. Saving or loading the calibration streams one record at a time. Its
 //! size on the ATmega2560 and the firmware's flash and SRAM are in `BENCHMARKS.md`; `cargo
 //! xtask ci budget` checks them against the budget.
 
@@ -50,6 +54,7 @@
 
 pub mod config;
 pub mod device;
+pub mod engine;
 pub mod hal;
 pub mod store;
 

@@ -115,7 +115,9 @@ fn hello_checks_the_major_version() {
     let mut dev = device(Config::fernando2025());
     assert_eq!(
         nack_reason(ask(&mut dev, 1, Request::Hello { version: 0x0100 })),
-        NackReason::UnknownVersion { supported: 0x0200 }
+        NackReason::UnknownVersion {
+            supported: quad_protocol::PROTOCOL_VERSION
+        }
     );
     assert_eq!(
         nack_reason(ask(&mut dev, 2, Request::SetBodyPose(POSE))),

@@ -11,6 +11,7 @@ mod common;
 
 use common::*;
 use kin_core::body::Pose;
+use kin_core::motion::path::PathKind;
 use kin_core::{Joint, LegId, ReachPolicy, RotationOrder};
 use proptest::prelude::*;
 use quad_device::device::RX_LEN;
@@ -19,8 +20,9 @@ use quad_device::Config;
 use quad_protocol::servo::{self, Calibration};
 use quad_protocol::{
     crc, Accumulator, DeviceInfo, DeviceToHost, Feed, Field, FirmwareVersion, Flags, HostToDevice,
-    LinkLossAction, LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request,
-    RobotPreset, ServoId, Setting, MAX_DECODED_LEN, MAX_FRAME_LEN,
+    LegSet, LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage,
+    MotionStatus, NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback,
+    Request, RobotPreset, ServoId, Setting, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 
 // ---- The expected index of every variant (written here, independently of the declarations).
@@ -38,6 +40,11 @@ fn request_index(r: &Request) -> u8 {
         Request::GetCalibration { .. } => 8,
         Request::SaveCalibration => 9,
         Request::SetPoseConfig(_) => 10,
+        Request::StartMotion(_) => 11,
+        Request::StopMotion => 12,
+        Request::GetMotion => 13,
+        Request::SetVelocity { .. } => 14,
+        Request::SetJointSpeedLimit { .. } => 15,
     }
 }
 
@@ -48,6 +55,7 @@ fn answer_index(a: &DeviceToHost) -> u8 {
         DeviceToHost::Ack { .. } => 2,
         DeviceToHost::Calibration { .. } => 3,
         DeviceToHost::Configured { .. } => 4,
+        DeviceToHost::MotionAck { .. } => 5,
     }
 }
 
@@ -106,6 +114,25 @@ fn requests() -> Vec<Request> {
             order: RotationOrder::Yzx,
             policy: ReachPolicy::Clamp,
         }),
+        Request::StartMotion(MotionCommand::FootPath {
+            path: PathKind::Rectangle,
+            legs: LegSet::One(LegId::RL),
+            stride_m: 0.1,
+            step_height_m: 0.05,
+            duty_factor: 0.75,
+            cycle_s: 3.0,
+            duration_s: Some(6.0),
+        }),
+        Request::StopMotion,
+        Request::GetMotion,
+        Request::SetVelocity {
+            forward_m_s: 0.05,
+            lateral_m_s: -0.01,
+            yaw_rate_rad_s: 0.1,
+        },
+        Request::SetJointSpeedLimit {
+            joint_speed_limit_rad_s: 2.5,
+        },
     ]
 }
 
@@ -141,6 +168,16 @@ fn nack_reasons() -> Vec<NackReason> {
                 joint: Joint::Abduction,
             },
         },
+        NackReason::InvalidParameter {
+            param: MotionParam::CycleS,
+            problem: ParamProblem::NotPositive,
+        },
+        NackReason::Preflight {
+            leg: LegId::FR,
+            fault: PreflightFault::JointLimit(Joint::Knee),
+        },
+        NackReason::MotionRunning,
+        NackReason::NotWalking,
     ]
 }
 
@@ -200,6 +237,26 @@ fn answers() -> Vec<DeviceToHost> {
                 flags: Flags(Flags::CALIBRATION_UNSAVED),
                 frames_ok: 20,
                 frames_bad: 0,
+            },
+        },
+        DeviceToHost::MotionAck {
+            seq: 11,
+            status: MotionStatus {
+                kind: Some(MotionKind::Walk),
+                stage: MotionStage::Stopping,
+                t_s: 12.5,
+                phase: 0.25,
+                fault: Some(NackReason::Unreachable {
+                    leg: LegId::FL,
+                    fault: ReachFault::TooFar,
+                }),
+            },
+            readback: Readback {
+                angles_rad: core::array::from_fn(|i| i as f32 * 0.1),
+                pulses_half_us: core::array::from_fn(|i| 2500 + 50 * i as u16),
+                flags: Flags(Flags::OUTPUTS_ENABLED),
+                frames_ok: 70_000,
+                frames_bad: 1,
             },
         },
     ]
@@ -326,9 +383,11 @@ fn every_answer_and_nack_variant_has_its_index_and_round_trips() {
     }
     // Every nack reason through the device's encoder (their indices: quad-protocol's
     // `wire` tests, where the non-exhaustive enum can be matched exhaustively).
-    for (i, reason) in nack_reasons().into_iter().enumerate() {
+    let reasons = nack_reasons();
+    let past = reasons.len() as u8;
+    for (i, reason) in reasons.into_iter().enumerate() {
         let nack = DeviceToHost::Nack { seq: None, reason };
-        check_answer(nack, 2, i as u8, 15);
+        check_answer(nack, 2, i as u8, past);
     }
 }
 
@@ -375,7 +434,8 @@ fn same_as_reference(chunks: &[Vec<u8>]) {
             match expected_answer(&mut twin, &mut framing_nacked, feed) {
                 Some(Some(mut a)) => {
                     if let DeviceToHost::Ack { readback, .. }
-                    | DeviceToHost::Configured { readback, .. } = &mut a
+                    | DeviceToHost::Configured { readback, .. }
+                    | DeviceToHost::MotionAck { readback, .. } = &mut a
                     {
                         readback.frames_ok = reference.frames_ok();
                         readback.frames_bad = reference.frames_bad();
@@ -408,7 +468,7 @@ proptest! {
     #[test]
     fn random_payloads_with_a_good_crc_get_the_reference_answers(
         bodies in prop::collection::vec(
-            (0u8..12, prop::collection::vec(any::<u8>(), 0..60)), 1..6)
+            (0u8..17, prop::collection::vec(any::<u8>(), 0..60)), 1..6)
     ) {
         // A plausible start (seq 0, a variant index near the known ones) and random fields.
         let mut wire = Vec::new();

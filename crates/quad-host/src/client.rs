@@ -263,6 +263,7 @@ pub fn answer_name(a: &DeviceToHost) -> &'static str {
         DeviceToHost::Ack { .. } => "Ack",
         DeviceToHost::Calibration { .. } => "Calibration",
         DeviceToHost::Configured { .. } => "Configured",
+        DeviceToHost::MotionAck { .. } => "MotionAck",
     }
 }
 
@@ -326,6 +327,11 @@ pub fn request_name(r: &Request) -> &'static str {
         Request::GetCalibration { .. } => "GetCalibration",
         Request::SaveCalibration => "SaveCalibration",
         Request::SetPoseConfig(_) => "SetPoseConfig",
+        Request::StartMotion(_) => "StartMotion",
+        Request::StopMotion => "StopMotion",
+        Request::GetMotion => "GetMotion",
+        Request::SetVelocity { .. } => "SetVelocity",
+        Request::SetJointSpeedLimit { .. } => "SetJointSpeedLimit",
     }
 }
 
@@ -826,6 +832,11 @@ impl<L: Link> PoseStream<L> {
     /// The client.
     pub fn client(&self) -> &Client<L> {
         &self.client
+    }
+
+    /// The client, the stream done.
+    pub fn into_client(self) -> Client<L> {
+        self.client
     }
 
     /// The client, e.g. to send other requests between poses.

@@ -32,6 +32,33 @@ fn poses_are_acked_with_the_hosts_angles_and_the_outputs_follow() {
         let rb = dev.readback();
         assert_eq!(rb.angles_rad, want);
         assert!(dev.outputs().enabled);
+        // The outputs follow through the joint-speed limiter: never more than its step per
+        // servo frame, and at the target within the frames that step implies.
+        let step = dev.limiter().max_step_rad();
+        let mut out = *dev.output_angles().expect("outputs on");
+        let far = out
+            .iter()
+            .zip(&want)
+            .map(|(o, w)| (o - w).abs())
+            .fold(0.0f32, f32::max);
+        let frames = (far / step).ceil() as u32 + 1;
+        for _ in 0..frames {
+            let mut buf = [0u8; 64];
+            stream
+                .client_mut()
+                .link_mut()
+                .recv(&mut buf, Duration::from_millis(20))
+                .unwrap();
+            let now = *stream.client().link().device().output_angles().unwrap();
+            for (a, b) in now.iter().zip(&out) {
+                assert!(
+                    (a - b).abs() <= step * (1.0 + 1e-6),
+                    "{a} after {b} > {step}"
+                );
+            }
+            out = now;
+        }
+        let dev = stream.client().link().device();
         assert_eq!(dev.outputs().pulses_half_us, rb.pulses_half_us);
     }
     let s = stream.stats();

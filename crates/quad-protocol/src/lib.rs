@@ -40,14 +40,15 @@ pub use frame::{
     decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 pub use msg::{
-    DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
-    LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
+    DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet, LinkLossAction,
+    LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
+    ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset, ServoId,
     Setting,
 };
 pub use range::check_request;
 
-/// This crate's protocol version: `major << 8 | minor` (2.0).
-pub const PROTOCOL_VERSION: u16 = 0x0200;
+/// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions).
+pub const PROTOCOL_VERSION: u16 = 0x0201;
 
 /// Major part of a protocol version.
 #[inline]
@@ -87,10 +88,24 @@ pub const HOST_TO_DEVICE_MAX_LEN: usize = 3 + 1 + 48 + frame::CRC_LEN;
 /// counters (2 × ≤ 5).
 pub const READBACK_MAX_LEN: usize = 48 + 12 * 3 + 1 + 2 * 5;
 
-/// Largest decoded [`DeviceToHost`] frame of this version (postcard bytes + CRC), bytes: a
-/// [`DeviceToHost::Configured`] echoing a calibration — variant (1) + seq (≤ 3) + setting
-/// (variant 1 + servo 2 + calibration ≤ 18) + [`READBACK_MAX_LEN`] + CRC (2).
-pub const DEVICE_TO_HOST_MAX_LEN: usize = 1 + 3 + (1 + 2 + 18) + READBACK_MAX_LEN + frame::CRC_LEN;
+/// Largest [`DeviceToHost::Configured`] frame (postcard bytes + CRC), bytes: echoing a
+/// calibration — variant (1) + seq (≤ 3) + setting (variant 1 + servo 2 + calibration ≤ 18) +
+/// [`READBACK_MAX_LEN`] + CRC (2).
+const CONFIGURED_MAX_LEN: usize = 1 + 3 + (1 + 2 + 18) + READBACK_MAX_LEN + frame::CRC_LEN;
+
+/// Largest [`DeviceToHost::MotionAck`] frame (postcard bytes + CRC), bytes: variant (1) + seq
+/// (≤ 3) + [`MotionStatus`] (kind ≤ 2, stage 1, time and phase 2 × 4, fault ≤ 1 + 4) +
+/// [`READBACK_MAX_LEN`] + CRC (2).
+const MOTION_ACK_MAX_LEN: usize = 1 + 3 + (2 + 1 + 2 * 4 + 5) + READBACK_MAX_LEN + frame::CRC_LEN;
+
+/// Largest decoded [`DeviceToHost`] frame of this version (postcard bytes + CRC), bytes: the
+/// larger of a [`DeviceToHost::Configured`] echoing a calibration and a
+/// [`DeviceToHost::MotionAck`].
+pub const DEVICE_TO_HOST_MAX_LEN: usize = if CONFIGURED_MAX_LEN > MOTION_ACK_MAX_LEN {
+    CONFIGURED_MAX_LEN
+} else {
+    MOTION_ACK_MAX_LEN
+};
 
 const _: () = assert!(HOST_TO_DEVICE_MAX_LEN <= MAX_DECODED_LEN);
 const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);

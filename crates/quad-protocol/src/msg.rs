@@ -17,6 +17,9 @@
 use crate::servo;
 use crate::wire::{self, wire_enum};
 use core::fmt;
+use kin_core::motion::gait::Pattern;
+use kin_core::motion::laws::Axis;
+use kin_core::motion::path::PathKind;
 use kin_core::{IkError, Joint, LegId, Pose, ReachPolicy, RotationOrder, Unreachable};
 use serde::{Deserialize, Serialize};
 
@@ -84,6 +87,246 @@ wire_enum! {
         /// Set how [`Request::SetBodyPose`] is interpreted. → [`DeviceToHost::Ack`] or
         /// [`NackReason::InvalidArgument`].
         10 => SetPoseConfig(PoseConfig),
+        /// Start a motion that the device runs by itself, frame by frame (since 2.1). Its
+        /// parameters are checked and the motion preflighted first. → [`DeviceToHost::MotionAck`],
+        /// or a nack naming the parameter ([`NackReason::InvalidParameter`]), the failing sample
+        /// ([`NackReason::Preflight`], [`NackReason::ServoRange`]), [`NackReason::MotionRunning`]
+        /// or [`NackReason::OutputsDisabled`] (nothing moves, a running motion keeps running).
+        11 => StartMotion(MotionCommand),
+        /// Stop the running motion cleanly: a periodic motion at the end of its period, a walk
+        /// once its strides are finished, then a ramp to the stance (since 2.1).
+        /// → [`DeviceToHost::MotionAck`].
+        12 => StopMotion,
+        /// Report the motion engine's state (since 2.1). → [`DeviceToHost::MotionAck`].
+        13 => GetMotion,
+        /// The running walk's velocity command, body frame; it must be refreshed within the
+        /// walk's `velocity_timeout_ms` (since 2.1). → [`DeviceToHost::MotionAck`], or
+        /// [`NackReason::NotWalking`] or [`NackReason::InvalidParameter`] naming the component
+        /// beyond the gait's reach.
+        14 => SetVelocity {
+            /// Forward speed, m/s.
+            forward_m_s: f32,
+            /// Lateral speed (to the left), m/s.
+            lateral_m_s: f32,
+            /// Yaw rate, rad/s, counter-clockwise positive (REP 103).
+            yaw_rate_rad_s: f32,
+        },
+        /// The joint-speed limit of every output, rad/s (finite, > 0; since 1.1).
+        /// → [`DeviceToHost::Ack`] or [`NackReason::InvalidParameter`].
+        15 => SetJointSpeedLimit {
+            /// The limit, rad/s.
+            joint_speed_limit_rad_s: f32,
+        },
+    }
+}
+
+wire_enum! {
+    /// A motion the device runs by itself ([`Request::StartMotion`]). Durations are rounded
+    /// up to whole periods; `None` runs until [`Request::StopMotion`].
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub enum MotionCommand {
+        /// Outputs on at the rest pose (when off), then a ramp to the stance.
+        0 => StandUp,
+        /// A ramp to the rest pose, held.
+        1 => Sit,
+        /// A ramp to the rest pose, then the outputs off.
+        2 => Rest,
+        /// Seed 001's sway about `axis`, `angle = A·sin(2πt/T)`, feet fixed.
+        3 => Sway {
+            /// Roll, pitch or yaw.
+            axis: Axis as wire::sway_axis,
+            /// Amplitude `A`, rad.
+            amplitude_rad: f32,
+            /// Period `T`, s.
+            period_s: f32,
+            /// Duration, s; `None`: until stopped.
+            duration_s: Option<f32>,
+        },
+        /// Seed 001's crossed-pair yaw turn about the body centre.
+        4 => YawTurn {
+            /// Turn rate, rad/s, counter-clockwise positive (REP 103).
+            yaw_rate_rad_s: f32,
+            /// Step period `T1`, s.
+            step_period_s: f32,
+            /// Lift `h_K`, m.
+            lift_height_m: f32,
+            /// Duration, s; `None`: until stopped.
+            duration_s: Option<f32>,
+        },
+        /// A seed 000 foot path around the stance point of one leg or all four, body held.
+        5 => FootPath {
+            /// The path's shape.
+            path: PathKind as wire::path_kind,
+            /// The legs that follow it.
+            legs: LegSet,
+            /// Stride (length along x), m.
+            stride_m: f32,
+            /// Lift, m.
+            step_height_m: f32,
+            /// Stance fraction of the loop, in (0, 1).
+            duty_factor: f32,
+            /// One loop, s.
+            cycle_s: f32,
+            /// Duration, s; `None`: until stopped.
+            duration_s: Option<f32>,
+        },
+        /// Trot or walk from a velocity command ([`Request::SetVelocity`]), zero at the start.
+        6 => Walk {
+            /// Trot or walk.
+            gait: Pattern as wire::gait_pattern,
+            /// Body height (hip plane above the ground), m.
+            body_height_m: f32,
+            /// Swing apex above the ground, m.
+            step_height_m: f32,
+            /// Gait cycle, s.
+            cycle_s: f32,
+            /// Timeout of the velocity command, ms (> 0): a command not refreshed within it
+            /// stops the walk as [`Request::StopMotion`] does.
+            velocity_timeout_ms: u16,
+        },
+    }
+}
+
+wire_enum! {
+    /// The legs a foot path moves.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum LegSet {
+        /// All four, in phase.
+        0 => All,
+        /// One leg; the others stay at their stance points.
+        1 => One(LegId as wire::leg_id),
+    }
+}
+
+wire_enum! {
+    /// The kinds of motion ([`MotionStatus::kind`]).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum MotionKind {
+        /// [`MotionCommand::StandUp`].
+        0 => StandUp,
+        /// [`MotionCommand::Sit`].
+        1 => Sit,
+        /// [`MotionCommand::Rest`].
+        2 => Rest,
+        /// [`MotionCommand::Sway`].
+        3 => Sway,
+        /// [`MotionCommand::YawTurn`].
+        4 => YawTurn,
+        /// [`MotionCommand::FootPath`].
+        5 => FootPath,
+        /// [`MotionCommand::Walk`].
+        6 => Walk,
+    }
+}
+
+wire_enum! {
+    /// Where a motion is ([`MotionStatus::stage`]).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum MotionStage {
+        /// Ramping from the outputs to the motion's first setpoint.
+        0 => Approach,
+        /// Running.
+        1 => Run,
+        /// Stop requested: running to the end of the period (or of the strides).
+        2 => Stopping,
+        /// Ramping to the stance (or the rest pose).
+        3 => Leave,
+    }
+}
+
+/// The motion engine's state, in [`DeviceToHost::MotionAck`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MotionStatus {
+    /// The motion running; `None` when idle.
+    pub kind: Option<MotionKind>,
+    /// Its stage (`Run` when idle).
+    pub stage: MotionStage,
+    /// Motion time since the run began, s.
+    pub t_s: f32,
+    /// Phase within the motion's period (the walk's gait phase), in `[0, 1)`.
+    pub phase: f32,
+    /// Why the last motion stopped early (a run-time sample failed), if it did.
+    pub fault: Option<NackReason>,
+}
+
+wire_enum! {
+    /// A parameter of a motion request ([`NackReason::InvalidParameter`]).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum MotionParam {
+        /// A sway's amplitude.
+        0 => AmplitudeRad,
+        /// A sway's period.
+        1 => PeriodS,
+        /// A duration.
+        2 => DurationS,
+        /// A yaw turn's or a velocity command's yaw rate.
+        3 => YawRateRadS,
+        /// A yaw turn's step period.
+        4 => StepPeriodS,
+        /// A yaw turn's lift.
+        5 => LiftHeightM,
+        /// A foot path's stride.
+        6 => StrideM,
+        /// A foot path's or a walk's step height.
+        7 => StepHeightM,
+        /// A foot path's duty factor.
+        8 => DutyFactor,
+        /// A foot path's or a walk's cycle.
+        9 => CycleS,
+        /// A foot path's shape (out of reach at some phase).
+        10 => Path,
+        /// A walk's body height.
+        11 => BodyHeightM,
+        /// A walk's velocity timeout.
+        12 => VelocityTimeoutMs,
+        /// A velocity command's forward speed.
+        13 => ForwardMS,
+        /// A velocity command's lateral speed.
+        14 => LateralMS,
+        /// A velocity command's combination of components.
+        15 => Velocity,
+        /// The joint-speed limit.
+        16 => JointSpeedLimitRadS,
+        /// The stance the motion starts from (the device's stance height).
+        17 => Stance,
+        /// A walk's stride disc (reach radius, set from the body height).
+        18 => ReachRadiusM,
+        /// A parameter this protocol version has no code for.
+        19 => Other,
+    }
+}
+
+wire_enum! {
+    /// What is wrong with a [`MotionParam`].
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum ParamProblem {
+        /// NaN or infinite.
+        0 => NonFinite,
+        /// Zero or negative where it must be > 0.
+        1 => NotPositive,
+        /// Negative where it must be ≥ 0.
+        2 => Negative,
+        /// Outside its admissible range.
+        3 => OutOfRange,
+        /// It puts a foot out of reach.
+        4 => BeyondReach,
+    }
+}
+
+wire_enum! {
+    /// Why a preflight sample of a motion fails ([`NackReason::Preflight`]).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum PreflightFault {
+        /// The foot cannot be reached.
+        0 => Reach(ReachFault),
+        /// A joint leaves the robot's joint limits.
+        1 => JointLimit(Joint as wire::joint),
+        /// The leg comes too close to a singular configuration.
+        2 => Singular,
+        /// A sample is NaN or infinite.
+        3 => NonFinite,
+        /// A reason this protocol version has no code for.
+        4 => Other,
     }
 }
 
@@ -356,6 +599,16 @@ wire_enum! {
             /// The state after the request.
             readback: Readback,
         },
+        /// Answer to [`Request::StartMotion`], [`Request::StopMotion`], [`Request::GetMotion`]
+        /// and [`Request::SetVelocity`] (since 2.1).
+        5 => MotionAck {
+            /// The request's sequence number.
+            seq: u16,
+            /// The motion engine after the request.
+            status: MotionStatus,
+            /// The state after the request, as [`DeviceToHost::Ack`] reports it.
+            readback: Readback,
+        },
     }
 }
 
@@ -399,16 +652,17 @@ impl DeviceToHost {
             DeviceToHost::HelloAck { seq, .. }
             | DeviceToHost::Ack { seq, .. }
             | DeviceToHost::Calibration { seq, .. }
-            | DeviceToHost::Configured { seq, .. } => Some(*seq),
+            | DeviceToHost::Configured { seq, .. }
+            | DeviceToHost::MotionAck { seq, .. } => Some(*seq),
         }
     }
 
-    /// The readback an answer carries (`Ack`, `Configured`); `None` for the others.
+    /// The readback an answer carries (`Ack`, `Configured`, `MotionAck`); `None` for the others.
     pub const fn readback(&self) -> Option<&Readback> {
         match self {
-            DeviceToHost::Ack { readback, .. } | DeviceToHost::Configured { readback, .. } => {
-                Some(readback)
-            }
+            DeviceToHost::Ack { readback, .. }
+            | DeviceToHost::Configured { readback, .. }
+            | DeviceToHost::MotionAck { readback, .. } => Some(readback),
             DeviceToHost::Nack { .. }
             | DeviceToHost::HelloAck { .. }
             | DeviceToHost::Calibration { .. } => None,
@@ -490,6 +744,24 @@ wire_enum! {
             /// The field.
             field: Field,
         },
+        /// A motion parameter is invalid (since 2.1).
+        15 => InvalidParameter {
+            /// The parameter.
+            param: MotionParam,
+            /// What is wrong with it.
+            problem: ParamProblem,
+        },
+        /// A preflight sample of the motion fails (since 2.1).
+        16 => Preflight {
+            /// The first leg that fails.
+            leg: LegId as wire::leg_id,
+            /// Why.
+            fault: PreflightFault,
+        },
+        /// A motion runs: stop it first (since 2.1).
+        17 => MotionRunning,
+        /// A velocity command arrived while no walk runs (since 2.1).
+        18 => NotWalking,
     }
 }
 
@@ -589,6 +861,12 @@ impl fmt::Display for NackReason {
             NackReason::Storage => f.write_str("storage error"),
             NackReason::InvalidArgument => f.write_str("invalid argument"),
             NackReason::OutOfRange { field } => write!(f, "out of range: {field}"),
+            NackReason::InvalidParameter { param, problem } => {
+                write!(f, "invalid parameter {param:?}: {problem:?}")
+            }
+            NackReason::Preflight { leg, fault } => write!(f, "preflight: {leg} {fault:?}"),
+            NackReason::MotionRunning => f.write_str("a motion is running (stop it first)"),
+            NackReason::NotWalking => f.write_str("no walk is running"),
         }
     }
 }

@@ -23,7 +23,8 @@
 //! [`NackReason::InvalidArgument`], as in protocol 1.x); a finite value outside its range is
 //! [`NackReason::OutOfRange`] naming the field. Calibrations have their own check
 //! ([`crate::servo::Calibration::validate`]); the other fields (sequence numbers, flags, enum
-//! indices, `timeout_ms`) admit every value their type can hold.
+//! indices, `timeout_ms`) admit every value their type can hold. The motion requests' parameters
+//! are checked by the device's motion engine, which knows how they bound each other.
 
 use crate::msg::{Field, NackReason, PoseConfig, Request};
 use core::f32::consts::PI;
@@ -70,6 +71,14 @@ pub fn check_request(request: &Request, robot: &Robot) -> Result<(), NackReason>
         | Request::SetCalibration { .. }
         | Request::GetCalibration { .. }
         | Request::SaveCalibration => Ok(()),
+        // A motion's parameters depend on each other and on the robot's reach: the device's
+        // motion engine checks them before the motion starts and names the parameter it
+        // refuses (`NackReason::InvalidParameter`, `NackReason::Preflight`).
+        Request::StartMotion(_)
+        | Request::StopMotion
+        | Request::GetMotion
+        | Request::SetVelocity { .. }
+        | Request::SetJointSpeedLimit { .. } => Ok(()),
     }
 }
 

@@ -17,6 +17,9 @@
 //! derive does (enum → variant index and name, struct variant → its fields in sequence), so any
 //! index-based format reads them; the protocol uses postcard only.
 
+use kin_core::motion::gait::Pattern;
+use kin_core::motion::laws::Axis;
+use kin_core::motion::path::PathKind;
 use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 
 /// Serializes the field `$value` (a reference) of type `$ty`, through the table `$with` when one
@@ -391,6 +394,23 @@ wire_index! {
     pub mod reach_policy for ReachPolicy { 0 => Reject, 1 => Clamp }
 }
 
+wire_index! {
+    /// [`Axis`] of a sway on the wire.
+    pub mod sway_axis for Axis { 0 => Roll, 1 => Pitch, 2 => Yaw }
+}
+
+wire_index! {
+    /// [`PathKind`] on the wire.
+    pub mod path_kind for PathKind {
+        0 => Rectangle, 1 => Semicircle, 2 => Ellipse, 3 => Cycloid, 4 => Bezier,
+    }
+}
+
+wire_index! {
+    /// A gait [`Pattern`] on the wire.
+    pub mod gait_pattern for Pattern { 0 => Trot, 1 => Walk }
+}
+
 wire_fields! {
     /// [`Pose`] on the wire: roll, pitch, yaw (rad), then x, y, z (m).
     pub mod pose for Pose {
@@ -414,9 +434,10 @@ mod tests {
     use super::*;
     use crate::frame::{encode_frame, Accumulator, Feed, MAX_DECODED_LEN, MAX_FRAME_LEN};
     use crate::msg::{
-        DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
-        LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
-        Setting,
+        DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet,
+        LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage,
+        MotionStatus, NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback,
+        Request, RobotPreset, ServoId, Setting,
     };
     use crate::servo;
     use serde::de::DeserializeOwned;
@@ -440,6 +461,10 @@ mod tests {
             NackReason::Storage => 12,
             NackReason::InvalidArgument => 13,
             NackReason::OutOfRange { .. } => 14,
+            NackReason::InvalidParameter { .. } => 15,
+            NackReason::Preflight { .. } => 16,
+            NackReason::MotionRunning => 17,
+            NackReason::NotWalking => 18,
         }
     }
 
@@ -462,6 +487,116 @@ mod tests {
             Setting::LinkTimeout(_) => 0,
             Setting::PoseConfig(_) => 1,
             Setting::Calibration { .. } => 2,
+        }
+    }
+
+    fn motion_command_index(m: &MotionCommand) -> u8 {
+        match m {
+            MotionCommand::StandUp => 0,
+            MotionCommand::Sit => 1,
+            MotionCommand::Rest => 2,
+            MotionCommand::Sway { .. } => 3,
+            MotionCommand::YawTurn { .. } => 4,
+            MotionCommand::FootPath { .. } => 5,
+            MotionCommand::Walk { .. } => 6,
+        }
+    }
+
+    fn leg_set_index(l: &LegSet) -> u8 {
+        match l {
+            LegSet::All => 0,
+            LegSet::One(_) => 1,
+        }
+    }
+
+    fn motion_kind_index(k: &MotionKind) -> u8 {
+        match k {
+            MotionKind::StandUp => 0,
+            MotionKind::Sit => 1,
+            MotionKind::Rest => 2,
+            MotionKind::Sway => 3,
+            MotionKind::YawTurn => 4,
+            MotionKind::FootPath => 5,
+            MotionKind::Walk => 6,
+        }
+    }
+
+    fn motion_stage_index(s: &MotionStage) -> u8 {
+        match s {
+            MotionStage::Approach => 0,
+            MotionStage::Run => 1,
+            MotionStage::Stopping => 2,
+            MotionStage::Leave => 3,
+        }
+    }
+
+    fn motion_param_index(p: &MotionParam) -> u8 {
+        match p {
+            MotionParam::AmplitudeRad => 0,
+            MotionParam::PeriodS => 1,
+            MotionParam::DurationS => 2,
+            MotionParam::YawRateRadS => 3,
+            MotionParam::StepPeriodS => 4,
+            MotionParam::LiftHeightM => 5,
+            MotionParam::StrideM => 6,
+            MotionParam::StepHeightM => 7,
+            MotionParam::DutyFactor => 8,
+            MotionParam::CycleS => 9,
+            MotionParam::Path => 10,
+            MotionParam::BodyHeightM => 11,
+            MotionParam::VelocityTimeoutMs => 12,
+            MotionParam::ForwardMS => 13,
+            MotionParam::LateralMS => 14,
+            MotionParam::Velocity => 15,
+            MotionParam::JointSpeedLimitRadS => 16,
+            MotionParam::Stance => 17,
+            MotionParam::ReachRadiusM => 18,
+            MotionParam::Other => 19,
+        }
+    }
+
+    fn param_problem_index(p: &ParamProblem) -> u8 {
+        match p {
+            ParamProblem::NonFinite => 0,
+            ParamProblem::NotPositive => 1,
+            ParamProblem::Negative => 2,
+            ParamProblem::OutOfRange => 3,
+            ParamProblem::BeyondReach => 4,
+        }
+    }
+
+    fn preflight_fault_index(f: &PreflightFault) -> u8 {
+        match f {
+            PreflightFault::Reach(_) => 0,
+            PreflightFault::JointLimit(_) => 1,
+            PreflightFault::Singular => 2,
+            PreflightFault::NonFinite => 3,
+            PreflightFault::Other => 4,
+        }
+    }
+
+    fn axis_index(a: &Axis) -> u8 {
+        match a {
+            Axis::Roll => 0,
+            Axis::Pitch => 1,
+            Axis::Yaw => 2,
+        }
+    }
+
+    fn path_kind_index(p: &PathKind) -> u8 {
+        match p {
+            PathKind::Rectangle => 0,
+            PathKind::Semicircle => 1,
+            PathKind::Ellipse => 2,
+            PathKind::Cycloid => 3,
+            PathKind::Bezier => 4,
+        }
+    }
+
+    fn pattern_index(p: &Pattern) -> u8 {
+        match p {
+            Pattern::Trot => 0,
+            Pattern::Walk => 1,
         }
     }
 
@@ -610,6 +745,16 @@ mod tests {
             NackReason::OutOfRange {
                 field: Field::BodyZ,
             },
+            NackReason::InvalidParameter {
+                param: MotionParam::DurationS,
+                problem: ParamProblem::NonFinite,
+            },
+            NackReason::Preflight {
+                leg: LegId::RL,
+                fault: PreflightFault::Singular,
+            },
+            NackReason::MotionRunning,
+            NackReason::NotWalking,
         ]
         .into();
         // Nack | seq None (00) | reason ...
@@ -772,5 +917,189 @@ mod tests {
             };
             check(answer, 2, i as u8, settings.len() as u8);
         }
+    }
+
+    #[test]
+    fn every_motion_variant_has_its_index_and_round_trips() {
+        let h2d = |m| HostToDevice {
+            seq: 5,
+            request: Request::StartMotion(m),
+        };
+        let sway = |axis| MotionCommand::Sway {
+            axis,
+            amplitude_rad: 0.2,
+            period_s: 20.0,
+            duration_s: None,
+        };
+        let path = |path, legs| MotionCommand::FootPath {
+            path,
+            legs,
+            stride_m: 0.1,
+            step_height_m: 0.05,
+            duty_factor: 0.75,
+            cycle_s: 3.0,
+            duration_s: Some(6.0),
+        };
+        let walk = |gait| MotionCommand::Walk {
+            gait,
+            body_height_m: 0.25,
+            step_height_m: 0.05,
+            cycle_s: 0.6,
+            velocity_timeout_ms: 500,
+        };
+        let commands = [
+            MotionCommand::StandUp,
+            MotionCommand::Sit,
+            MotionCommand::Rest,
+            sway(Axis::Roll),
+            MotionCommand::YawTurn {
+                yaw_rate_rad_s: 0.085,
+                step_period_s: 6.0,
+                lift_height_m: 0.03,
+                duration_s: Some(12.0),
+            },
+            path(PathKind::Rectangle, LegSet::All),
+            walk(Pattern::Trot),
+        ];
+        // seq (05) | StartMotion (0b) | command | fields
+        for (i, m) in commands.iter().enumerate() {
+            assert_eq!(usize::from(motion_command_index(m)), i);
+            check(h2d(*m), 2, i as u8, commands.len() as u8);
+        }
+        for (i, a) in [Axis::Roll, Axis::Pitch, Axis::Yaw].iter().enumerate() {
+            assert_eq!(usize::from(axis_index(a)), i);
+            check(h2d(sway(*a)), 3, i as u8, 3);
+        }
+        let kinds = [
+            PathKind::Rectangle,
+            PathKind::Semicircle,
+            PathKind::Ellipse,
+            PathKind::Cycloid,
+            PathKind::Bezier,
+        ];
+        for (i, k) in kinds.iter().enumerate() {
+            assert_eq!(usize::from(path_kind_index(k)), i);
+            check(h2d(path(*k, LegSet::All)), 3, i as u8, 5);
+        }
+        for (i, l) in [LegSet::All, LegSet::One(LegId::RR)].iter().enumerate() {
+            assert_eq!(usize::from(leg_set_index(l)), i);
+            check(h2d(path(PathKind::Ellipse, *l)), 4, i as u8, 2);
+        }
+        for (i, p) in [Pattern::Trot, Pattern::Walk].iter().enumerate() {
+            assert_eq!(usize::from(pattern_index(p)), i);
+            check(h2d(walk(*p)), 3, i as u8, 2);
+        }
+        let readback = Readback {
+            angles_rad: [0.5; 12],
+            pulses_half_us: [3000; 12],
+            flags: Flags(Flags::OUTPUTS_ENABLED),
+            frames_ok: 1,
+            frames_bad: 0,
+        };
+        let ack = |kind, stage| DeviceToHost::MotionAck {
+            seq: 9,
+            status: MotionStatus {
+                kind,
+                stage,
+                t_s: 1.5,
+                phase: 0.5,
+                fault: None,
+            },
+            readback,
+        };
+        let kinds = [
+            MotionKind::StandUp,
+            MotionKind::Sit,
+            MotionKind::Rest,
+            MotionKind::Sway,
+            MotionKind::YawTurn,
+            MotionKind::FootPath,
+            MotionKind::Walk,
+        ];
+        // MotionAck (05) | seq (09) | Some (01) | kind | stage ...
+        for (i, k) in kinds.iter().enumerate() {
+            assert_eq!(usize::from(motion_kind_index(k)), i);
+            check(ack(Some(*k), MotionStage::Run), 3, i as u8, 7);
+        }
+        let stages = [
+            MotionStage::Approach,
+            MotionStage::Run,
+            MotionStage::Stopping,
+            MotionStage::Leave,
+        ];
+        // MotionAck (05) | seq (09) | None (00) | stage ...
+        for (i, s) in stages.iter().enumerate() {
+            assert_eq!(usize::from(motion_stage_index(s)), i);
+            check(ack(None, *s), 3, i as u8, 4);
+        }
+        let params = [
+            MotionParam::AmplitudeRad,
+            MotionParam::PeriodS,
+            MotionParam::DurationS,
+            MotionParam::YawRateRadS,
+            MotionParam::StepPeriodS,
+            MotionParam::LiftHeightM,
+            MotionParam::StrideM,
+            MotionParam::StepHeightM,
+            MotionParam::DutyFactor,
+            MotionParam::CycleS,
+            MotionParam::Path,
+            MotionParam::BodyHeightM,
+            MotionParam::VelocityTimeoutMs,
+            MotionParam::ForwardMS,
+            MotionParam::LateralMS,
+            MotionParam::Velocity,
+            MotionParam::JointSpeedLimitRadS,
+            MotionParam::Stance,
+            MotionParam::ReachRadiusM,
+            MotionParam::Other,
+        ];
+        // Nack (00) | None (00) | InvalidParameter (0f) | param | problem
+        for (i, p) in params.iter().enumerate() {
+            assert_eq!(usize::from(motion_param_index(p)), i);
+            let r = NackReason::InvalidParameter {
+                param: *p,
+                problem: ParamProblem::OutOfRange,
+            };
+            check(nack(r), 3, i as u8, params.len() as u8);
+        }
+        let problems = [
+            ParamProblem::NonFinite,
+            ParamProblem::NotPositive,
+            ParamProblem::Negative,
+            ParamProblem::OutOfRange,
+            ParamProblem::BeyondReach,
+        ];
+        for (i, p) in problems.iter().enumerate() {
+            assert_eq!(usize::from(param_problem_index(p)), i);
+            let r = NackReason::InvalidParameter {
+                param: MotionParam::CycleS,
+                problem: *p,
+            };
+            check(nack(r), 4, i as u8, 5);
+        }
+        let faults = [
+            PreflightFault::Reach(ReachFault::InsideOffset),
+            PreflightFault::JointLimit(Joint::Hip),
+            PreflightFault::Singular,
+            PreflightFault::NonFinite,
+            PreflightFault::Other,
+        ];
+        // Nack (00) | None (00) | Preflight (10) | leg | fault ...
+        for (i, f) in faults.iter().enumerate() {
+            assert_eq!(usize::from(preflight_fault_index(f)), i);
+            let r = NackReason::Preflight {
+                leg: LegId::FR,
+                fault: *f,
+            };
+            check(nack(r), 4, i as u8, 5);
+        }
+        for (a, i) in [(Axis::Roll, 0), (Axis::Pitch, 1), (Axis::Yaw, 2)] {
+            assert_eq!(sway_axis::index(&a), i);
+            assert_eq!(sway_axis::from_index(i), Some(a));
+        }
+        assert_eq!(sway_axis::from_index(3), None);
+        assert_eq!(path_kind::from_index(5), None);
+        assert_eq!(gait_pattern::from_index(2), None);
     }
 }

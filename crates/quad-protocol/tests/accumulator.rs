@@ -10,8 +10,8 @@ use proptest::prelude::*;
 use quad_protocol::frame::Error;
 use quad_protocol::{
     encode_frame, servo, Accumulator, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction,
-    LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId, Setting, MAX_DECODED_LEN,
-    MAX_FRAME_LEN,
+    LinkTimeout, MotionKind, MotionStage, MotionStatus, NackReason, PoseConfig, Readback, Request,
+    ServoId, Setting, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 use serde::Serialize;
 
@@ -416,19 +416,39 @@ fn largest_messages_fit_the_declared_bounds() {
             supported: u16::MAX,
         },
     };
+    // A motion ack (since 2.1): the readback and the engine's status with the longest fault,
+    // still below a `Configured` echoing a calibration.
+    let motion_ack = DeviceToHost::MotionAck {
+        seq: u16::MAX,
+        status: MotionStatus {
+            kind: Some(MotionKind::Walk),
+            stage: MotionStage::Leave,
+            t_s: f32::MAX,
+            phase: f32::MAX,
+            fault: Some(NackReason::UnknownVersion {
+                supported: u16::MAX,
+            }),
+        },
+        readback: match ack {
+            DeviceToHost::Ack { readback, .. } => readback,
+            _ => unreachable!(),
+        },
+    };
     let mut buf = [0u8; MAX_DECODED_LEN];
     let ack_len = postcard::to_slice(&ack, &mut buf).unwrap().len() + 2;
     let configured_len = postcard::to_slice(&configured, &mut buf).unwrap().len() + 2;
     assert_eq!(configured_len, quad_protocol::DEVICE_TO_HOST_MAX_LEN);
     assert!(ack_len < configured_len);
+    let motion_len = postcard::to_slice(&motion_ack, &mut buf).unwrap().len() + 2;
+    assert!(ack_len < motion_len && motion_len < configured_len);
     let joints_len = postcard::to_slice(&joints, &mut buf).unwrap().len() + 2;
     assert_eq!(joints_len, quad_protocol::HOST_TO_DEVICE_MAX_LEN);
     let nack_len = postcard::to_slice(&nack, &mut buf).unwrap().len() + 2;
     assert!(nack_len < ack_len);
     let mut wire = [0u8; MAX_FRAME_LEN];
     assert_eq!(
-        encode_frame(&ack, &mut wire).unwrap().len(),
-        quad_protocol::frame::encoded_len_max(ack_len)
+        encode_frame(&motion_ack, &mut wire).unwrap().len(),
+        quad_protocol::frame::encoded_len_max(motion_len)
     );
     assert_eq!(
         encode_frame(&configured, &mut wire).unwrap().len(),

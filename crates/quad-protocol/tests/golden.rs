@@ -68,10 +68,15 @@ fn every_request_has_its_golden_bytes() {
             | Request::SetCalibration { .. }
             | Request::GetCalibration { .. }
             | Request::SaveCalibration
-            | Request::SetPoseConfig(_) => {}
+            | Request::SetPoseConfig(_)
+            | Request::StartMotion(_)
+            | Request::StopMotion
+            | Request::GetMotion
+            | Request::SetVelocity { .. }
+            | Request::SetJointSpeedLimit { .. } => {}
         }
     }
-    assert_eq!(cases.len(), 11);
+    assert_eq!(cases.len(), 20);
     for (name, msg, golden) in cases {
         check(name, &msg, golden);
     }
@@ -87,6 +92,7 @@ fn every_answer_has_its_golden_bytes() {
         "Calibration",
         "Configured",
         "Nack OutOfRange",
+        "MotionAck",
     ];
     for v in variants {
         assert!(cases.iter().any(|(n, _, _)| *n == v), "{v} has no golden");
@@ -124,10 +130,11 @@ fn hand_written_frames() {
 }
 
 #[test]
-fn version_is_two_zero() {
-    assert_eq!(PROTOCOL_VERSION, 0x0200);
+fn version_is_two_one() {
+    // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0.
+    assert_eq!(PROTOCOL_VERSION, 0x0201);
     assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
-    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 0);
+    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 1);
     assert!(quad_protocol::is_compatible(0x0207));
     assert!(!quad_protocol::is_compatible(0x0100));
     assert!(!quad_protocol::is_compatible(0x0300));

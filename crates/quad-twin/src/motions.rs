@@ -272,9 +272,8 @@ impl Plan {
                     config,
                     TrotShape::default(),
                     Velocity {
-                        // Seed 001's positive ω turns clockwise; the gait's yaw rate is
-                        // counter-clockwise positive.
-                        yaw_rad_s: -base.omega_rad_s,
+                        // Seed 001's turn rate; both counter-clockwise positive.
+                        yaw_rad_s: base.yaw_rate_rad_s,
                         ..Velocity::default()
                     },
                     YAW_TURN_PERIODS * base.step_period_s,

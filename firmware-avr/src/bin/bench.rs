@@ -90,7 +90,8 @@ fn main() -> ! {
     let mut usart = Usart0::new(dp.USART0, Baud::B1000000);
     // SAFETY: the handlers are defined below and touch only their own state.
     unsafe { avr_device::interrupt::enable() };
-    bench::serve(&mut usart, &dp.PORTA, &BACKENDS, &PRIMS)
+    let mut motion = bench::EngineBench::<AvrFast>::new();
+    bench::serve(&mut usart, &dp.PORTA, &BACKENDS, &PRIMS, &mut motion)
 }
 
 #[avr_device::interrupt(atmega2560)]

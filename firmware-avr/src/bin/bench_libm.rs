@@ -32,7 +32,13 @@ fn main() -> ! {
     let mut usart = Usart0::new(dp.USART0, Baud::B1000000);
     // SAFETY: the handler is defined below and touches only its own state.
     unsafe { avr_device::interrupt::enable() };
-    bench::serve(&mut usart, &dp.PORTA, &BACKENDS, &PRIMS)
+    bench::serve(
+        &mut usart,
+        &dp.PORTA,
+        &BACKENDS,
+        &PRIMS,
+        &mut bench::NoMotion,
+    )
 }
 
 #[avr_device::interrupt(atmega2560)]

@@ -1,7 +1,9 @@
 //! `quadctl demo`: the whole chain on an emulated Arduino Mega (or a real one): the firmware
 //! built from `firmware-avr/`, booted in simavr, driven with seed 000's body-pose sweeps; every
 //! readback checked against the host's own kin-core and every pulse on the twelve servo pins
-//! against the readbacks; a short human summary.
+//! against the readbacks; then the device's own motions (stand-up, seed 001's sways and yaw
+//! turn, a trot with a changing velocity, sit), checked against the host's kin-core; a short
+//! human summary.
 
 use crate::args::{self, EXIT_CHECK_FAILED};
 use quad_host::client::AVR_ANGLE_TOLERANCE_RAD;
@@ -23,12 +25,18 @@ at 16 MHz, no hardware needed. --port PATH drives an Arduino Mega 2560 flashed w
 
 Motion: seed 000's pose sweeps on its robot (shahriar2023) at the stance height 0.40 m, rotation
 order zyx — roll +-28 deg, then pitch +-21 deg, then yaw +-21 deg, one sine period each, sampled
-at --poses-per-sweep poses and streamed as fast as the link allows.
+at --poses-per-sweep poses and streamed as fast as the link allows. Then the device's own
+motions (--sweeps-only leaves them out): stand-up, seed 001's roll and pitch sways and yaw turn
+(counter-clockwise), a trot whose velocity command changes, sit.
 
 Checks: every pose is acked with the 12 angles of the host's own kin-core (within 2e-5 rad: the
 AVR's math differs) and the 12 pulses of the device calibration's mapping of those angles; on the
 emulator every pulse measured on the 12 servo pins (Timer1/3/4/5, port L included) must match
-the readback in force within one 0.5 us timer tick. Times are simulated time on the emulator.
+the readback in force within one 0.5 us timer tick (or lie on the joint-speed limiter's way to
+it). The onboard motions: every answer's pulses and (sways, yaw turn) angles against the host's
+kin-core law at the device's motion time, the stance and rest poses at the ends, and on the
+emulator the pins against the host's calibration mapping. Times are simulated time on the
+emulator.
 
 Exit status: 0 every check passed; 2 the firmware could not be built or the link failed; 3 a
 check failed.";
@@ -43,7 +51,7 @@ Examples (from the repository root):
 /// Arguments of `quadctl demo`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
-    about = "Demo: body-pose sweeps on the firmware in an emulated Mega (or --port), all checked",
+    about = "Demo: body-pose sweeps and the onboard motions on the firmware in an emulated Mega (or --port), all checked",
     long_about = LONG_ABOUT,
     after_help = EXAMPLES
 )]
@@ -60,6 +68,11 @@ pub struct Args {
     /// Poses per sweep (three sweeps).
     #[arg(long, value_name = "N", default_value_t = demo::DEFAULT_POSES_PER_SWEEP, value_parser = clap::value_parser!(usize))]
     pub poses_per_sweep: usize,
+    /// Only the pose sweeps: leave out the device's own motions that follow them (stand-up,
+    /// seed 001's roll and pitch sways, the yaw turn, a trot with a changing velocity and sit,
+    /// every answer and, on the emulator, pin checked against the host's kin-core).
+    #[arg(long)]
+    pub sweeps_only: bool,
 }
 
 /// Runs `quadctl demo`.
@@ -71,6 +84,7 @@ pub fn main(args: &Args) -> ExitCode {
         baud: args.baud,
         elf: args.elf.clone(),
         poses_per_sweep: args.poses_per_sweep,
+        motions: !args.sweeps_only,
     };
     let run = match demo::run(&request, &mut out) {
         Ok(run) => run,
@@ -99,7 +113,32 @@ pub fn main(args: &Args) -> ExitCode {
     ) {
         return args::fail("quadctl demo", &e);
     }
-    if run.summary.passed() {
+    if let Some(legs) = &run.motions {
+        for l in legs {
+            let line = format!(
+                "  onboard {}: {} answers, {} angle checks (largest |device − host| {:.1e} rad), \
+                 {} pins, {} errors, {:.1} s of motion",
+                l.motion,
+                l.answers,
+                l.angles_checked,
+                l.max_angle_err_rad,
+                l.pins_checked,
+                l.errors,
+                l.motion_s
+            );
+            if let Err(e) = writeln!(out, "{line}") {
+                return args::fail("quadctl demo", &e);
+            }
+            if let Some(first) = &l.first_error {
+                eprintln!("    first: {first}");
+            }
+        }
+        let verdict = if run.passed() { "PASS" } else { "FAIL" };
+        if let Err(e) = writeln!(out, "  onboard result: {verdict}") {
+            return args::fail("quadctl demo", &e);
+        }
+    }
+    if run.passed() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(EXIT_CHECK_FAILED)

@@ -31,6 +31,19 @@ fn main() {
         println!("{name:<16} {avr:>16.0} {libm:>18}");
     }
     println!(
+        "{:<20} {:>14} {:>15} {:>16}",
+        "onboard motion", "frame max", "frame mean", "share of 20 ms"
+    );
+    for m in &report.motions {
+        println!(
+            "{:<20} {:>14} {:>15.0} {:>15.1}%",
+            m.name,
+            m.max_cycles,
+            m.mean_cycles,
+            100.0 * m.max_cycles as f64 / avr_bench::SERVO_FRAME_CYCLES as f64
+        );
+    }
+    println!(
         "targets: {} body poses + {} leg targets (seed {:#x}); cycles at 16 MHz; bench.elf stack {} B",
         avr_bench::N_TARGETS,
         avr_bench::N_TARGETS,

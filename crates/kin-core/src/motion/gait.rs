@@ -23,8 +23,9 @@ use super::path::{AnyPath, FootPath, PathKind, Stride};
 use super::{
     check_reach, finite, fract01, non_negative, positive, Contact, Error, Frame, Motion, Phase,
 };
+use super::{Expected, Param};
 use crate::body::{BodyConfig, Pose};
-use crate::math::{wrap_pi, Math};
+use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::robot::{LegId, Robot};
 use crate::rotation::RotationOrder;
 use crate::vec::Vec3;
@@ -142,6 +143,47 @@ fn sinc<M: Math>(x: f32) -> f32 {
     }
 }
 
+/// Body displacement `X(s)` of the constant twist `velocity` over a time `s` (s, negative
+/// too), applied to a point `n` of the body frame: `p(s) + Rz(ω·s)·n` with
+/// `p(s) = ∫₀ˢ Rz(ω·u)·v du` (see the module docs). `X(−s)` is the inverse of `X(s)`.
+pub fn displace<M: Math>(velocity: &Velocity, s: f32, n: Vec3) -> Vec3 {
+    let v = velocity;
+    let x = v.yaw_rad_s * s;
+    let (sn, cs) = M::sin_cos(x);
+    let (sh, _) = M::sin_cos(0.5 * x);
+    let a = s * sinc::<M>(x); // ∫ cos
+    let b = s * sh * sinc::<M>(0.5 * x); // ∫ sin = (1 − cos x)/ω
+    Vec3::new(
+        v.forward_m_s * a - v.lateral_m_s * b + cs * n.x - sn * n.y,
+        v.forward_m_s * b + v.lateral_m_s * a + sn * n.x + cs * n.y,
+        n.z,
+    )
+}
+
+/// A swing foot at leg phase `phase` (in `[0, 1 − duty_factor)`) on its way from `lift_off`
+/// to `touch_down` (body frame, m): the [`PathKind`] path over the chord between them (stride =
+/// their horizontal distance, apex `step_height_m` above the chord's middle).
+pub fn swing_foot<M: Math>(
+    swing: PathKind,
+    step_height_m: f32,
+    duty_factor: f32,
+    lift_off: Vec3,
+    touch_down: Vec3,
+    phase: Phase,
+) -> Vec3 {
+    let chord = touch_down - lift_off;
+    let length = M::sqrt(chord.x * chord.x + chord.y * chord.y);
+    let (ux, uy) = if length > 0.0 {
+        (chord.x / length, chord.y / length)
+    } else {
+        (1.0, 0.0)
+    };
+    let mid = (lift_off + touch_down) * 0.5;
+    let path = AnyPath::new(swing, Stride::unchecked(length, step_height_m, duty_factor));
+    let o = path.offset::<M>(phase);
+    Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z)
+}
+
 /// A trot or walk: see the module docs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gait {
@@ -154,45 +196,51 @@ impl Gait {
     /// height ≥ 0 and below the hips; then checks that every foot reaches its neutral foothold
     /// (`stance_height_m`), its lift-off and touch-down points (the velocity command sets the
     /// stride: `velocity`) and its swing apex (`step_height_m`). [`crate::preflight`] sweeps the
-    /// whole motion.
+    /// whole motion. The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: GaitParams) -> Result<Gait, Error> {
+        let gait = Self::without_reach_check(p)?;
+        let cfg = gait.body_config();
+        let zero = Pose::default();
+        let d = p.duty_factor;
+        let reach = |feet: &[Vec3; 4], name| check_reach(&p.robot, &zero, &cfg, feet, name);
+        reach(&gait.neutral, Param::StanceHeightM)?;
+        let at = |phase: f32| LegId::ALL.map(|leg| gait.foot_in_body::<DefaultMath>(leg, phase).0);
+        reach(&at(0.0), Param::Velocity)?;
+        reach(&at(1.0 - 0.5 * d), Param::Velocity)?;
+        reach(&at(0.5 * (1.0 - d)), Param::StepHeightM)?;
+        Ok(gait)
+    }
+
+    /// [`Gait::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself through its own IK (a device's start check).
+    pub fn without_reach_check(p: GaitParams) -> Result<Gait, Error> {
         p.robot.validate()?;
-        positive(p.stance_height_m, "stance_height_m")?;
-        positive(p.cycle_s, "cycle_s")?;
-        let d = finite(p.duty_factor, "duty_factor")?;
+        positive(p.stance_height_m, Param::StanceHeightM)?;
+        positive(p.cycle_s, Param::CycleS)?;
+        let d = finite(p.duty_factor, Param::DutyFactor)?;
         if !(d > 0.0 && d < 1.0) {
             return Err(Error::OutOfRange {
-                parameter: "duty_factor",
-                expected: "in (0, 1)",
+                parameter: Param::DutyFactor,
+                expected: Expected::OpenUnitInterval,
             });
         }
         for o in p.phase_offsets {
-            finite(o, "phase_offsets")?;
+            finite(o, Param::PhaseOffsets)?;
         }
-        non_negative(p.step_height_m, "step_height_m")?;
+        non_negative(p.step_height_m, Param::StepHeightM)?;
         if !(p.step_height_m < p.stance_height_m) {
             return Err(Error::OutOfRange {
-                parameter: "step_height_m",
-                expected: "below the stance height (a lifted foot stays below the hips)",
+                parameter: Param::StepHeightM,
+                expected: Expected::BelowStanceHeight,
             });
         }
-        finite(p.velocity.forward_m_s, "forward_m_s")?;
-        finite(p.velocity.lateral_m_s, "lateral_m_s")?;
-        finite(p.velocity.yaw_rad_s, "yaw_rad_s")?;
-        let gait = Gait {
+        finite(p.velocity.forward_m_s, Param::ForwardMS)?;
+        finite(p.velocity.lateral_m_s, Param::LateralMS)?;
+        finite(p.velocity.yaw_rad_s, Param::YawRadS)?;
+        Ok(Gait {
             p,
             neutral: p.robot.stance_feet(p.stance_height_m),
-        };
-        let cfg = gait.body_config();
-        let zero = Pose::default();
-        check_reach(&p.robot, &zero, &cfg, &gait.neutral, "stance_height_m")?;
-        let at = |phase: f32| {
-            LegId::ALL.map(|leg| gait.foot_in_body::<crate::DefaultMath>(leg, phase).0)
-        };
-        check_reach(&p.robot, &zero, &cfg, &at(0.0), "velocity")?;
-        check_reach(&p.robot, &zero, &cfg, &at(1.0 - 0.5 * d), "velocity")?;
-        check_reach(&p.robot, &zero, &cfg, &at(0.5 * (1.0 - d)), "step_height_m")?;
-        Ok(gait)
+        })
     }
 
     /// The parameters.
@@ -207,17 +255,7 @@ impl Gait {
 
     /// Body displacement `X(s)` applied to a point `n` of the body frame: `p(s) + Rz(ω·s)·n`.
     fn displaced<M: Math>(&self, s: f32, n: Vec3) -> Vec3 {
-        let v = self.p.velocity;
-        let x = v.yaw_rad_s * s;
-        let (sn, cs) = M::sin_cos(x);
-        let (sh, _) = M::sin_cos(0.5 * x);
-        let a = s * sinc::<M>(x); // ∫ cos
-        let b = s * sh * sinc::<M>(0.5 * x); // ∫ sin = (1 − cos x)/ω
-        Vec3::new(
-            v.forward_m_s * a - v.lateral_m_s * b + cs * n.x - sn * n.y,
-            v.forward_m_s * b + v.lateral_m_s * a + sn * n.x + cs * n.y,
-            n.z,
-        )
+        displace::<M>(&self.p.velocity, s, n)
     }
 
     /// Foot of `leg` in the body frame at leg phase `phase` (cycles; wrapped), and its contact.
@@ -234,21 +272,15 @@ impl Gait {
         let half_stance = 0.5 * d * t;
         let lift_off = self.displaced::<M>(-half_stance, n);
         let touch_down = self.displaced::<M>(half_stance, n);
-        let chord = touch_down - lift_off;
-        let length = libm::sqrtf(chord.x * chord.x + chord.y * chord.y);
-        let (ux, uy) = if length > 0.0 {
-            (chord.x / length, chord.y / length)
-        } else {
-            (1.0, 0.0)
-        };
-        let mid = (lift_off + touch_down) * 0.5;
-        let path = AnyPath::new(
-            self.p.swing,
-            Stride::unchecked(length, self.p.step_height_m, d),
-        );
-        let o = path.offset::<M>(phase);
         (
-            Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z),
+            swing_foot::<M>(
+                self.p.swing,
+                self.p.step_height_m,
+                d,
+                lift_off,
+                touch_down,
+                phase,
+            ),
             Contact::Swing,
         )
     }
@@ -263,9 +295,7 @@ impl Gait {
     pub fn step_length_m(&self, leg: LegId) -> f32 {
         let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
         let n = self.neutral[leg.index()];
-        (self.displaced::<crate::DefaultMath>(half, n)
-            - self.displaced::<crate::DefaultMath>(-half, n))
-        .norm()
+        (self.displaced::<DefaultMath>(half, n) - self.displaced::<DefaultMath>(-half, n)).norm()
     }
 }
 
@@ -279,7 +309,7 @@ impl Motion for Gait {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         let body = self.displaced::<M>(t_s, Vec3::ZERO);
         let yaw = wrap_pi(self.p.velocity.yaw_rad_s * t_s);
         let (sn, cs) = M::sin_cos(yaw);

@@ -15,8 +15,9 @@ use super::{
     check_reach, finite, finite_vec, fract01, non_negative, positive, Contact, Error, Frame,
     Motion, Phase,
 };
+use super::{Expected, Param};
 use crate::body::{BodyConfig, Pose};
-use crate::math::{wrap_pi, Math};
+use crate::math::{wrap_pi, DefaultMath, Math};
 use crate::paper;
 use crate::robot::{JointAngles, LegId, Robot};
 use crate::rotation::RotationOrder;
@@ -138,24 +139,16 @@ pub struct Sway {
 impl Sway {
     /// Validates the parameters: finite values, `T > 0`, and the feet reachable at `t = 0` and at
     /// both extremes `angle0 ± A` (a quick check; [`crate::preflight`] sweeps the whole motion).
+    /// The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: SwayParams) -> Result<Sway, Error> {
-        p.robot.validate()?;
-        finite(p.amplitude_rad, "amplitude_rad")?;
-        positive(p.period_s, "period_s")?;
-        finite(p.roll0_rad, "roll0_rad")?;
-        finite(p.pitch0_rad, "pitch0_rad")?;
-        finite(p.yaw0_rad, "yaw0_rad")?;
-        for f in p.feet_in_world {
-            finite_vec(f, "feet_in_world")?;
-        }
-        let s = Sway { p };
+        let s = Self::without_reach_check(p)?;
         let cfg = s.body_config();
         check_reach(
             &p.robot,
             &s.pose_at(0.0),
             &cfg,
             &p.feet_in_world,
-            "feet_in_world",
+            Param::FeetInWorld,
         )?;
         for sign in [1.0, -1.0] {
             check_reach(
@@ -163,10 +156,26 @@ impl Sway {
                 &s.pose_at(sign * p.amplitude_rad),
                 &cfg,
                 &p.feet_in_world,
-                "amplitude_rad",
+                Param::AmplitudeRad,
             )?;
         }
         Ok(s)
+    }
+
+    /// [`Sway::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the motion's frames through its own IK (a device's start
+    /// check).
+    pub fn without_reach_check(p: SwayParams) -> Result<Sway, Error> {
+        p.robot.validate()?;
+        finite(p.amplitude_rad, Param::AmplitudeRad)?;
+        positive(p.period_s, Param::PeriodS)?;
+        finite(p.roll0_rad, Param::Roll0Rad)?;
+        finite(p.pitch0_rad, Param::Pitch0Rad)?;
+        finite(p.yaw0_rad, Param::Yaw0Rad)?;
+        for f in p.feet_in_world {
+            finite_vec(f, Param::FeetInWorld)?;
+        }
+        Ok(Sway { p })
     }
 
     /// The parameters.
@@ -201,7 +210,7 @@ impl Motion for Sway {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         Ok(Frame {
             pose: self.pose_at(self.offset_rad::<M>(t_s)),
             feet_in_world: self.p.feet_in_world,
@@ -214,15 +223,18 @@ impl Motion for Sway {
     }
 }
 
-/// Parameters of seed 001's yaw turn (eq. 9–11): `ψ(t) = ψ0 − ω_z·t` about the fixed body
+/// Parameters of seed 001's yaw turn (eq. 9–11): `ψ(t) = ψ0 + r·t` about the fixed body
 /// centre, the crossed pairs (FL, RR) and (FR, RL) stepping alternately along the circles of
-/// their feet.
+/// their feet. The yaw rate `r` counts counter-clockwise seen from above as positive (REP 103,
+/// as the gaits' velocity command does); the paper's `ω_z` (eq. 9, `ψ = ψ0 − ω_z·t`) counts
+/// clockwise: `r = −ω_z` (`docs/papers.md`, seed 001 errata).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawTurnParams {
     /// The robot.
     pub robot: Robot,
-    /// `ω_z`, rad/s; positive turns clockwise seen from above (ψ decreases, eq. 9).
-    pub omega_rad_s: f32,
+    /// Yaw rate `r = −ω_z`, rad/s; positive turns counter-clockwise seen from above (ψ
+    /// increases).
+    pub yaw_rate_rad_s: f32,
     /// Step period `T1` (one full cycle of both pairs), s.
     pub step_period_s: f32,
     /// Lift height `h_K` of the half-wave sine, m.
@@ -241,13 +253,14 @@ pub struct YawTurnParams {
 }
 
 impl YawTurnParams {
-    /// Seed 001's values: [`Robot::fernando2025`], ω_z = 0.085 rad/s, T1 = 6 s, h_K = 0.3 m,
+    /// Seed 001's values: [`Robot::fernando2025`], ω_z = 0.085 rad/s (clockwise: a yaw rate of
+    /// −0.085 rad/s), T1 = 6 s, h_K = 0.3 m,
     /// ψ0 = θ0 = γ0 = 0, order `zxy`, feet at [`seed001_stance`].
     pub fn seed001() -> YawTurnParams {
         let robot = Robot::fernando2025();
         YawTurnParams {
             robot,
-            omega_rad_s: 0.085,
+            yaw_rate_rad_s: -0.085,
             step_period_s: 6.0,
             lift_height_m: 0.3,
             yaw0_rad: 0.0,
@@ -270,13 +283,13 @@ pub const fn in_pair_13(leg: LegId) -> bool {
 /// With `τ = t mod T1` and `k = ⌊t/T1⌋`:
 /// - `Δ13 = k·T1 + (2τ if τ < T1/2 else T1)`, `Δ24 = k·T1 + (0 if τ < T1/2 else 2(τ − T1/2))`
 ///   (eq. 11 with a floored `mod`);
-/// - foot `i` at `ρ_i·(cos a_i, sin a_i)` with `a_i = α_i + ψ0 − ω_z·Δ_i` and
+/// - foot `i` at `ρ_i·(cos a_i, sin a_i)` with `a_i = α_i + ψ0 + r·Δ_i` (`r = −ω_z`) and
 ///   `α_i = atan2(y_i, x_i)` of its stance position (eq. 10 corrected: atan2, cos/sin, sign);
 /// - lift `h_K·max(0, sin(2πt/T1))` for (FL, RR) and `h_K·max(0, −sin(2πt/T1))` for (FR, RL)
 ///   above the stance height (eq. 10's half-wave).
 ///
-/// A stance foot stays fixed while the body turns by `ω_z·T1/2`; a swing foot moves by
-/// `ω_z·T1` along its circle in `T1/2`. The joint angles repeat with period `T1`.
+/// A stance foot stays fixed while the body turns by `r·T1/2`; a swing foot moves by
+/// `r·T1` along its circle in `T1/2`. The joint angles repeat with period `T1`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawTurn {
     p: YawTurnParams,
@@ -287,42 +300,50 @@ pub struct YawTurn {
 impl YawTurn {
     /// Validates the parameters: finite values, `T1 > 0`, `h_K ≥ 0` and below the hips, and
     /// the feet reachable at `t = 0`, at both apexes and at the end of each swing (a quick check;
-    /// [`crate::preflight`] sweeps the whole motion).
+    /// [`crate::preflight`] sweeps the whole motion). The checks run on the [`DefaultMath`]
+    /// backend.
     pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
-        p.robot.validate()?;
-        finite(p.omega_rad_s, "omega_rad_s")?;
-        positive(p.step_period_s, "step_period_s")?;
-        non_negative(p.lift_height_m, "lift_height_m")?;
-        finite(p.yaw0_rad, "yaw0_rad")?;
-        finite(p.roll0_rad, "roll0_rad")?;
-        finite(p.pitch0_rad, "pitch0_rad")?;
-        for f in p.stance_feet {
-            finite_vec(f, "stance_feet")?;
-            if !(f.z + p.lift_height_m < 0.0) {
-                return Err(Error::OutOfRange {
-                    parameter: "lift_height_m",
-                    expected: "below the stance height (a lifted foot stays below the hips)",
-                });
-            }
-        }
-        let turn = YawTurn {
-            p,
-            rho_m: p.stance_feet.map(|f| libm::sqrtf(f.x * f.x + f.y * f.y)),
-            alpha_rad: p.stance_feet.map(|f| libm::atan2f(f.y, f.x)),
-        };
+        let turn = Self::without_reach_check::<DefaultMath>(p)?;
         let cfg = turn.body_config();
         let t1 = p.step_period_s;
         for (t, name) in [
-            (0.0, "stance_feet"),
-            (0.25 * t1, "lift_height_m"),
-            (0.75 * t1, "lift_height_m"),
-            (0.499 * t1, "omega_rad_s"),
-            (0.999 * t1, "omega_rad_s"),
+            (0.0, Param::StanceFeet),
+            (0.25 * t1, Param::LiftHeightM),
+            (0.75 * t1, Param::LiftHeightM),
+            (0.499 * t1, Param::YawRateRadS),
+            (0.999 * t1, Param::YawRateRadS),
         ] {
-            let f = turn.frame::<crate::DefaultMath>(t)?;
+            let f = turn.frame::<DefaultMath>(t)?;
             check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
         }
         Ok(turn)
+    }
+
+    /// [`YawTurn::new`]'s parameter checks without its reach checks, with the foot radii and
+    /// angles on math backend `M`, for a caller that checks the reach itself by running the
+    /// motion's frames through its own IK (a device's start check).
+    pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
+        p.robot.validate()?;
+        finite(p.yaw_rate_rad_s, Param::YawRateRadS)?;
+        positive(p.step_period_s, Param::StepPeriodS)?;
+        non_negative(p.lift_height_m, Param::LiftHeightM)?;
+        finite(p.yaw0_rad, Param::Yaw0Rad)?;
+        finite(p.roll0_rad, Param::Roll0Rad)?;
+        finite(p.pitch0_rad, Param::Pitch0Rad)?;
+        for f in p.stance_feet {
+            finite_vec(f, Param::StanceFeet)?;
+            if !(f.z + p.lift_height_m < 0.0) {
+                return Err(Error::OutOfRange {
+                    parameter: Param::LiftHeightM,
+                    expected: Expected::BelowStanceHeight,
+                });
+            }
+        }
+        Ok(YawTurn {
+            p,
+            rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
+            alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
+        })
     }
 
     /// The parameters.
@@ -385,13 +406,13 @@ impl Motion for YawTurn {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         let p = &self.p;
         let t1 = p.step_period_s;
         let (k, tau) = self.split(t_s);
         // Yaw at the start of this step period, wrapped once so that body and feet share it.
-        let base = wrap_pi(p.yaw0_rad - p.omega_rad_s * (k * t1));
-        let yaw = wrap_pi(base - p.omega_rad_s * tau);
+        let base = wrap_pi(p.yaw0_rad + p.yaw_rate_rad_s * (k * t1));
+        let yaw = wrap_pi(base + p.yaw_rate_rad_s * tau);
         let (d13, d24) = Self::local_deltas(t1, tau);
         let first_half = tau < 0.5 * t1;
         let wave = M::sin_cos(2.0 * PI * (tau / t1)).0;
@@ -410,7 +431,7 @@ impl Motion for YawTurn {
             } else {
                 (d24, lift24, !first_half)
             };
-            let a = self.alpha_rad[i] + base - p.omega_rad_s * delta;
+            let a = self.alpha_rad[i] + base + p.yaw_rate_rad_s * delta;
             let (s, c) = M::sin_cos(a);
             feet[i] = Vec3::new(
                 self.rho_m[i] * c,
@@ -477,25 +498,33 @@ impl LegPaths {
     const REACH_SAMPLES: u16 = 64;
 
     /// Validates the parameters: finite values, `cycle_s > 0`, and the path reachable by every
-    /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive).
+    /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive), on
+    /// the [`DefaultMath`] backend.
     pub fn new(p: LegPathsParams) -> Result<LegPaths, Error> {
-        p.robot.validate()?;
-        positive(p.cycle_s, "cycle_s")?;
-        for o in p.phase_offsets {
-            finite(o, "phase_offsets")?;
-        }
-        for f in p.stance_feet {
-            finite_vec(f, "stance_feet")?;
-        }
-        let lp = LegPaths { p };
+        let lp = Self::without_reach_check(p)?;
         let cfg = lp.body_config();
         for i in 0..Self::REACH_SAMPLES {
             let phase = Phase::wrap(f32::from(i) / f32::from(Self::REACH_SAMPLES));
             let feet = LegId::ALL
-                .map(|leg| p.stance_feet[leg.index()] + p.path.offset::<crate::DefaultMath>(phase));
-            check_reach(&p.robot, &Pose::default(), &cfg, &feet, "path")?;
+                .map(|leg| p.stance_feet[leg.index()] + p.path.offset::<DefaultMath>(phase));
+            check_reach(&p.robot, &Pose::default(), &cfg, &feet, Param::Path)?;
         }
         Ok(lp)
+    }
+
+    /// [`LegPaths::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the motion's frames through its own IK (a device's start
+    /// check).
+    pub fn without_reach_check(p: LegPathsParams) -> Result<LegPaths, Error> {
+        p.robot.validate()?;
+        positive(p.cycle_s, Param::CycleS)?;
+        for o in p.phase_offsets {
+            finite(o, Param::PhaseOffsets)?;
+        }
+        for f in p.stance_feet {
+            finite_vec(f, Param::StanceFeet)?;
+        }
+        Ok(LegPaths { p })
     }
 
     /// The parameters.
@@ -514,7 +543,7 @@ impl Motion for LegPaths {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, "t_s")?;
+        finite(t_s, Param::TS)?;
         let base = fract01(t_s / self.p.cycle_s);
         let mut feet = self.p.stance_feet;
         let mut contact = [Contact::Stance; 4];

@@ -11,6 +11,8 @@
 //!   with the crossed-pair leg transfer (eq. 9–11, corrected; see `docs/papers.md`) — plus the
 //!   feet following a path under a fixed body (seed 000 §3.2).
 //! - [`gait`]: trot / walk generator driven by a body velocity command.
+//! - [`walker`]: the same gaits as a stateful stepper, for a velocity command that changes
+//!   while walking (footholds planned at lift-off, a stop that ends at the stance).
 //!
 //! ## Frames
 //! The world frame coincides with the body frame in the nominal pose (see the crate docs): the
@@ -32,28 +34,180 @@ use core::fmt;
 pub mod gait;
 pub mod laws;
 pub mod path;
+pub mod walker;
+
+/// A motion parameter, as [`Error`] names it: an enum, not a string, so that a target that
+/// never formats an error holds no parameter names (on the AVR every string literal takes
+/// SRAM as well as flash). [`Param::name`] is the name used in messages and on the command
+/// line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Param {
+    /// `t_s`: The time of a sample, s.
+    TS,
+    /// `dt_s`: A time step, s.
+    DtS,
+    /// `phase`: A phase, cycles.
+    Phase,
+    /// `velocity`: The velocity command as a whole.
+    Velocity,
+    /// `forward_m_s`: The forward velocity, m/s.
+    ForwardMS,
+    /// `lateral_m_s`: The lateral velocity, m/s.
+    LateralMS,
+    /// `yaw_rad_s`: The yaw rate of a velocity command, rad/s (counter-clockwise positive).
+    YawRadS,
+    /// `step_height_m`: The step (swing apex) height, m.
+    StepHeightM,
+    /// `stance_feet`: The feet of the stance, m.
+    StanceFeet,
+    /// `feet_in_world`: The feet in the world frame, m.
+    FeetInWorld,
+    /// `lift_height_m`: The lift height h_K of a yaw turn, m.
+    LiftHeightM,
+    /// `yaw0_rad`: The initial yaw, rad.
+    Yaw0Rad,
+    /// `roll0_rad`: The initial roll, rad.
+    Roll0Rad,
+    /// `pitch0_rad`: The initial pitch, rad.
+    Pitch0Rad,
+    /// `stride_m`: The stride length, m.
+    StrideM,
+    /// `stance_height_m`: The stance (body) height, m.
+    StanceHeightM,
+    /// `phase_offsets`: The legs' phase offsets, cycles.
+    PhaseOffsets,
+    /// `duty_factor`: The duty factor.
+    DutyFactor,
+    /// `duration_s`: A duration, s.
+    DurationS,
+    /// `cycle_s`: A gait or path cycle, s.
+    CycleS,
+    /// `step_period_s`: The step period T1 of a yaw turn, s.
+    StepPeriodS,
+    /// `period_s`: A sway period, s.
+    PeriodS,
+    /// `amplitude_rad`: A sway amplitude, rad.
+    AmplitudeRad,
+    /// `start_s`: A sweep's start time, s.
+    StartS,
+    /// `rate_hz`: A sweep's sample rate, Hz.
+    RateHz,
+    /// `reach_radius_m`: The walker's stride-disc radius, m.
+    ReachRadiusM,
+    /// `path`: A foot path.
+    Path,
+    /// `parked`: A parked foot (a stopped walker).
+    Parked,
+    /// `max_joint_speed_rad_s`: The highest joint speed of a sweep, rad/s.
+    MaxJointSpeedRadS,
+    /// `yaw_rate_rad_s`: The yaw rate of a yaw turn, rad/s (counter-clockwise positive).
+    YawRateRadS,
+    /// `velocity_timeout_ms`: A walk's velocity command timeout, ms.
+    VelocityTimeoutMs,
+    /// `joint_speed_limit_rad_s`: A joint-speed limit, rad/s.
+    JointSpeedLimitRadS,
+}
+
+impl Param {
+    /// The parameter's name (`snake_case`, with its unit).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Param::TS => "t_s",
+            Param::DtS => "dt_s",
+            Param::Phase => "phase",
+            Param::Velocity => "velocity",
+            Param::ForwardMS => "forward_m_s",
+            Param::LateralMS => "lateral_m_s",
+            Param::YawRadS => "yaw_rad_s",
+            Param::StepHeightM => "step_height_m",
+            Param::StanceFeet => "stance_feet",
+            Param::FeetInWorld => "feet_in_world",
+            Param::LiftHeightM => "lift_height_m",
+            Param::Yaw0Rad => "yaw0_rad",
+            Param::Roll0Rad => "roll0_rad",
+            Param::Pitch0Rad => "pitch0_rad",
+            Param::StrideM => "stride_m",
+            Param::StanceHeightM => "stance_height_m",
+            Param::PhaseOffsets => "phase_offsets",
+            Param::DutyFactor => "duty_factor",
+            Param::DurationS => "duration_s",
+            Param::CycleS => "cycle_s",
+            Param::StepPeriodS => "step_period_s",
+            Param::PeriodS => "period_s",
+            Param::AmplitudeRad => "amplitude_rad",
+            Param::StartS => "start_s",
+            Param::RateHz => "rate_hz",
+            Param::ReachRadiusM => "reach_radius_m",
+            Param::Path => "path",
+            Param::Parked => "parked",
+            Param::MaxJointSpeedRadS => "max_joint_speed_rad_s",
+            Param::YawRateRadS => "yaw_rate_rad_s",
+            Param::VelocityTimeoutMs => "velocity_timeout_ms",
+            Param::JointSpeedLimitRadS => "joint_speed_limit_rad_s",
+        }
+    }
+}
+
+impl fmt::Display for Param {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The admissible range an [`Error::OutOfRange`] names (an enum for the reason [`Param`] is).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Expected {
+    /// In the open interval (0, 1).
+    OpenUnitInterval,
+    /// Below the stance height: a lifted foot stays below the hips.
+    BelowStanceHeight,
+    /// At most half a turn per stance (`|ω|·d·T ≤ π`).
+    HalfTurnPerStance,
+    /// Within the gait's reach: footholds inside the stride disc.
+    WithinGaitReach,
+    /// At most 2^24 samples (`duration_s × rate_hz`).
+    SweepSamples,
+}
+
+impl fmt::Display for Expected {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Expected::OpenUnitInterval => "in (0, 1)",
+            Expected::BelowStanceHeight => {
+                "below the stance height (a lifted foot stays below the hips)"
+            }
+            Expected::HalfTurnPerStance => "at most half a turn per stance (|ω|·d·T ≤ π)",
+            Expected::WithinGaitReach => {
+                "within the gait's reach (footholds inside the stride disc)"
+            }
+            Expected::SweepSamples => "at most 2^24 samples (duration_s × rate_hz)",
+        })
+    }
+}
 
 /// Why a motion parameter or a motion sample was refused. Every variant names the parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Error {
     /// The named parameter is NaN or infinite.
-    NonFinite(&'static str),
+    NonFinite(Param),
     /// The named duration, period or rate is zero or negative.
-    NotPositive(&'static str),
+    NotPositive(Param),
     /// The named length or height is negative.
-    Negative(&'static str),
+    Negative(Param),
     /// The named parameter is outside its admissible range (`expected` says which).
     OutOfRange {
         /// The parameter.
-        parameter: &'static str,
-        /// The admissible range, human-readable (e.g. `"in (0, 1)"`).
-        expected: &'static str,
+        parameter: Param,
+        /// The admissible range.
+        expected: Expected,
     },
     /// The named parameter puts a foot of `leg` out of its reach.
     BeyondReach {
         /// The parameter responsible.
-        parameter: &'static str,
+        parameter: Param,
         /// The leg that cannot reach.
         leg: LegId,
         /// Why it cannot.
@@ -95,7 +249,7 @@ impl From<RobotError> for Error {
 }
 
 /// Checks that `v` is finite.
-pub(crate) fn finite(v: f32, name: &'static str) -> Result<f32, Error> {
+pub(crate) fn finite(v: f32, name: Param) -> Result<f32, Error> {
     if v.is_finite() {
         Ok(v)
     } else {
@@ -104,7 +258,7 @@ pub(crate) fn finite(v: f32, name: &'static str) -> Result<f32, Error> {
 }
 
 /// Checks that `v` is finite and `> 0`.
-pub(crate) fn positive(v: f32, name: &'static str) -> Result<f32, Error> {
+pub(crate) fn positive(v: f32, name: Param) -> Result<f32, Error> {
     if finite(v, name)? > 0.0 {
         Ok(v)
     } else {
@@ -113,7 +267,7 @@ pub(crate) fn positive(v: f32, name: &'static str) -> Result<f32, Error> {
 }
 
 /// Checks that `v` is finite and `≥ 0`.
-pub(crate) fn non_negative(v: f32, name: &'static str) -> Result<f32, Error> {
+pub(crate) fn non_negative(v: f32, name: Param) -> Result<f32, Error> {
     if finite(v, name)? >= 0.0 {
         Ok(v)
     } else {
@@ -122,7 +276,7 @@ pub(crate) fn non_negative(v: f32, name: &'static str) -> Result<f32, Error> {
 }
 
 /// Checks that every component of `v` is finite.
-pub(crate) fn finite_vec(v: Vec3, name: &'static str) -> Result<Vec3, Error> {
+pub(crate) fn finite_vec(v: Vec3, name: Param) -> Result<Vec3, Error> {
     if v.is_finite() {
         Ok(v)
     } else {
@@ -152,7 +306,7 @@ impl Phase {
 
     /// Wraps any finite value into `[0, 1)` (`1.25` → `0.25`, `−0.25` → `0.75`).
     pub fn new(value: f32) -> Result<Phase, Error> {
-        Ok(Phase(fract01(finite(value, "phase")?)))
+        Ok(Phase(fract01(finite(value, Param::Phase)?)))
     }
 
     /// Wraps a value already known to be finite.
@@ -301,7 +455,7 @@ pub(crate) fn check_reach(
     pose: &Pose,
     config: &BodyConfig,
     feet_in_world: &[Vec3; 4],
-    parameter: &'static str,
+    parameter: Param,
 ) -> Result<(), Error> {
     let solver = body::Solver::new(robot);
     let local = solver.feet_in_hips(pose, config, feet_in_world);

@@ -21,7 +21,7 @@
 //! | [`Cycloid`] | no (z yes) | zero velocity at the ground, stance moves at `L/d` |
 //! | [`Bezier`] | yes | end control points chosen to match the stance velocity |
 
-use super::{finite, non_negative, Contact, Error, Phase};
+use super::{finite, non_negative, Contact, Error, Expected, Param, Phase};
 use crate::math::Math;
 use crate::vec::Vec3;
 use core::f32::consts::PI;
@@ -62,13 +62,13 @@ impl Stride {
     /// A stride of `length_m` (≥ 0), apex `height_m` (≥ 0) above the ground and stance fraction
     /// `duty_factor` ∈ (0, 1).
     pub fn new(length_m: f32, height_m: f32, duty_factor: f32) -> Result<Stride, Error> {
-        non_negative(length_m, "stride_m")?;
-        non_negative(height_m, "step_height_m")?;
-        let d = finite(duty_factor, "duty_factor")?;
+        non_negative(length_m, Param::StrideM)?;
+        non_negative(height_m, Param::StepHeightM)?;
+        let d = finite(duty_factor, Param::DutyFactor)?;
         if !(d > 0.0 && d < 1.0) {
             return Err(Error::OutOfRange {
-                parameter: "duty_factor",
-                expected: "in (0, 1)",
+                parameter: Param::DutyFactor,
+                expected: Expected::OpenUnitInterval,
             });
         }
         Ok(Stride {
@@ -202,7 +202,7 @@ pub struct Semicircle {
 impl Semicircle {
     /// A semicircle over a stride of `stride_m` (≥ 0) with stance fraction `duty_factor`.
     pub fn new(stride_m: f32, duty_factor: f32) -> Result<Semicircle, Error> {
-        non_negative(stride_m, "stride_m")?;
+        non_negative(stride_m, Param::StrideM)?;
         Ok(Semicircle {
             stride: Stride::new(stride_m, 0.5 * stride_m, duty_factor)?,
         })

@@ -31,7 +31,10 @@
 //! hardware takes them over at the start of the following period. So a pulse that starts at
 //! cycle `t` must be as wide as the pulses of the next readback, of the last one sent before
 //! `t`, or of an earlier one superseded less than [`APPLY_LATENCY`] before `t`, within one timer
-//! tick (0.5 µs). A pulse while all of them say the outputs are off, or at power-on before any
+//! tick (0.5 µs) — or, as every output passes the device's joint-speed limiter, which brings the
+//! pins to a new target over several frames, lie between the channel's previous pulse and one
+//! of those widths (the limiter's bound per frame is checked by the emulator tests of the
+//! motions). A pulse while all of them say the outputs are off, or at power-on before any
 //! answer, is an error too. See [`PulseStats`].
 
 use super::{Faults, LineStats, Link};
@@ -152,6 +155,8 @@ struct PulseCheck {
     expects: VecDeque<Expect>,
     /// Pulses waiting for the next readback.
     pending: VecDeque<Pulse>,
+    /// The last pulse judged on each channel (`None` after a gap: outputs off or a reset).
+    last: [Option<Pulse>; 12],
     stats: PulseStats,
 }
 
@@ -167,6 +172,7 @@ impl PulseCheck {
                 pulses: None,
             }]),
             pending: VecDeque::new(),
+            last: [None; 12],
             stats: PulseStats::default(),
         }
     }
@@ -247,19 +253,52 @@ impl PulseCheck {
     /// (`after`) and the earlier ones still within the apply latency.
     fn judge(&mut self, p: Pulse, k: usize, after: Option<Expect>) {
         self.stats.checked += 1;
-        let fits = |e: &Expect| {
-            e.pulses.is_some_and(|ps| {
-                let want = u64::from(ps[p.channel]) * CYCLES_PER_TICK;
-                want > 0 && p.width_could_be(want, PULSE_TOLERANCE_CYCLES)
-            })
+        // The channel's previous pulse, when it came in the period before this one.
+        let previous = self.last[p.channel].filter(|q| {
+            p.rise_cycle.saturating_sub(q.rise_cycle) <= PERIOD_CYCLES + PERIOD_CYCLES / 2
+        });
+        self.last[p.channel] = Some(p);
+        let width = |e: &Expect| {
+            e.pulses
+                .map(|ps| u64::from(ps[p.channel]) * CYCLES_PER_TICK)
+                .filter(|&w| w > 0)
         };
+        let exact =
+            |e: &Expect| width(e).is_some_and(|w| p.width_could_be(w, PULSE_TOLERANCE_CYCLES));
         let latency = duration_to_cycles(APPLY_LATENCY);
         let mut in_force = (0..=k)
             .rev()
             .take_while(|&j| j == k || self.expects[j + 1].start_cycle + latency > p.rise_cycle);
         let before = self.expects[k];
-        if after.as_ref().is_some_and(fits) || in_force.any(|j| fits(&self.expects[j])) {
+        if after.as_ref().is_some_and(exact) || in_force.any(|j| exact(&self.expects[j])) {
             return;
+        }
+        // On its way from the previous pulse to a target held since: the limiter steps the
+        // outputs toward the target held at each frame, which is written during the period
+        // before its pulse; that target is the one of the last readback sent before the
+        // previous pulse or of a later one (readbacks may come faster than frames).
+        if let Some(q) = previous {
+            let slack = PULSE_TOLERANCE_CYCLES + p.rise_step_cycles + p.fall_step_cycles;
+            let first = self
+                .expects
+                .iter()
+                .rposition(|e| e.start_cycle <= q.rise_cycle)
+                .unwrap_or(0);
+            let between = self
+                .expects
+                .iter()
+                .skip(first)
+                .filter(|e| e.start_cycle <= p.rise_cycle)
+                .chain([&before])
+                .chain(after.as_ref())
+                .filter_map(width)
+                .any(|w| {
+                    let (lo, hi) = (q.high_cycles.min(w), q.high_cycles.max(w));
+                    p.high_cycles + slack >= lo && p.high_cycles <= hi + slack
+                });
+            if between {
+                return;
+            }
         }
         self.stats.errors += 1;
         if self.stats.first_error.is_none() {
@@ -271,13 +310,19 @@ impl PulseCheck {
                 }) => format!("{} µs", f64::from(ps[p.channel]) / 2.0),
             };
             let (port, bit) = SERVO_PINS[p.channel];
-            self.stats.first_error = Some(format!(
-                "channel {} (P{port}{bit}): pulse of {:.2} µs at {:.3} ms; readback before: {}, after: {}",
+            self.stats.first_error =
+                Some(format!(
+                "channel {} (P{port}{bit}): pulse of {:.2} µs at {:.3} ms; readback before: {}, \
+                 after: {}; the channel's previous pulse: {}",
                 p.channel,
                 p.high_us(),
                 p.rise_cycle as f64 / 16_000.0,
                 show(Some(&before)),
                 show(after.as_ref()),
+                previous.map_or_else(
+                    || "-".to_string(),
+                    |q| format!("{:.2} µs at {:.3} ms", q.high_us(), q.rise_cycle as f64 / 16_000.0)
+                ),
             ));
         }
     }

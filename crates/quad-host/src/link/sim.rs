@@ -20,8 +20,9 @@
 //! - **Device → host**: [`Link::recv`] advances the host's clock to the arrival of the next byte
 //!   (or to the timeout) and returns the bytes up to the end of that frame, each no earlier
 //!   than it arrived.
-//! - [`Device::poll`] (the link-loss failsafe) runs before every byte and whenever the host's
-//!   clock advances. The device's millisecond clock is the virtual clock.
+//! - [`Device::poll`] (the link-loss failsafe, the servo frames of the motion engine) runs
+//!   before every byte and whenever the host's clock advances, at every millisecond boundary
+//!   in between. The device's millisecond clock is the virtual clock.
 //!
 //! ## Faults
 //! [`Faults`] apply to both directions, drawn from one seeded generator (the same seed, the
@@ -329,8 +330,7 @@ impl SimLink {
                 continue;
             }
             self.fifo.push_back(t_take);
-            self.set_device_time(t_take);
-            self.device.poll();
+            self.poll_at(t_take);
             let answers = &mut self.answers;
             self.device.receive(&[byte], |f| answers.push(f.to_vec()));
             for answer in std::mem::take(&mut self.answers) {
@@ -349,9 +349,23 @@ impl SimLink {
             }
         }
         if t_ns >= self.dev_free_ns {
-            self.set_device_time(t_ns);
-            self.device.poll();
+            self.poll_at(t_ns);
         }
+    }
+
+    /// Runs the device's main loop up to `t_ns`: a poll at every millisecond boundary since its
+    /// clock's time, then one at `t_ns`, so that its servo frames and its failsafe see the
+    /// time pass as the firmware's loop does, however long the host waits at once.
+    fn poll_at(&mut self, t_ns: u64) {
+        const MS_NS: u64 = 1_000_000;
+        let mut t = (self.clock.get() / MS_NS + 1) * MS_NS;
+        while t < t_ns {
+            self.clock.set(t);
+            self.device.poll();
+            t += MS_NS;
+        }
+        self.set_device_time(t_ns);
+        self.device.poll();
     }
 
     fn set_device_time(&mut self, t_ns: u64) {

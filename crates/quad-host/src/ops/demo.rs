@@ -8,7 +8,7 @@ use crate::client::{
     AVR_ANGLE_TOLERANCE_RAD, DEFAULT_RETRIES,
 };
 use crate::emu::{build, elf};
-use crate::link::emulator::EmulatorConfig;
+use crate::link::emulator::{EmulatorConfig, PulseStats};
 use crate::link::{self, Link, Target};
 use kin_core::motion::laws::{Axis, Sway, SwayParams};
 use kin_core::motion::Motion;
@@ -32,6 +32,8 @@ pub struct Request {
     pub elf: Option<PathBuf>,
     /// Poses per sweep (three sweeps).
     pub poses_per_sweep: usize,
+    /// After the sweeps, the device's own motions ([`crate::ops::demo_motions`]).
+    pub motions: bool,
 }
 
 /// Why the demo could not run.
@@ -62,6 +64,9 @@ pub enum Error {
     /// Writing the log failed.
     #[error("cannot write the output: {0}")]
     Io(#[from] io::Error),
+    /// An onboard motion was refused or stopped early.
+    #[error("the device's own motions: {0}")]
+    Motions(#[from] crate::ops::onboard::Error),
 }
 
 /// What the demo measured.
@@ -201,6 +206,19 @@ pub struct Demo {
     pub wall: Duration,
     /// The poses whose readback disagreed with the host: index and what disagreed.
     pub mismatches: Vec<(usize, Mismatch)>,
+    /// The onboard motions and their checks, when asked for.
+    pub motions: Option<Vec<crate::ops::demo_motions::Leg>>,
+}
+
+impl Demo {
+    /// True when every check passed, the onboard motions' included.
+    pub fn passed(&self) -> bool {
+        self.summary.passed()
+            && self
+                .motions
+                .as_ref()
+                .is_none_or(|legs| legs.iter().all(|l| l.errors == 0))
+    }
 }
 
 /// Runs the demo, writing what it sets up (the firmware build, the target) to `log` as it
@@ -259,17 +277,84 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
     let link = link::open(&target)?;
     let config = ClientConfig::for_target(&target, DEFAULT_RETRIES);
     let mut mismatches = Vec::new();
-    let (mut stream, mut summary) = stream(link, config, &poses, |_, i, result| {
+    let (mut stream, summary) = stream(link, config, &poses, |_, i, result| {
         if let PoseResult::Mismatch(what) = result {
             mismatches.push((i, *what));
         }
     })?;
     let info = *stream.info();
-    let mcu = stream.client_mut().link_mut().emulator().map(|link| {
-        let pulses = link.pulse_stats();
+    // The sweeps' pin check: the readbacks explain every pulse of the sweeps. During the
+    // onboard motions the device moves its outputs at every frame between answers; their pins
+    // are checked against the host's kin-core by the motions' own check.
+    let sweep_pins = stream
+        .client_mut()
+        .link_mut()
+        .emulator()
+        .map(|link| link.pulse_stats());
+    let mut motions = None;
+    if args.motions {
+        writeln!(log, "quadctl demo: the device's own motions")?;
+        let mut session =
+            crate::ops::onboard::Session::connect(stream.into_client(), RobotPreset::Shahriar2023)?;
+        let legs = crate::ops::demo_motions::run(
+            &mut session,
+            &Robot::shahriar2023(),
+            AngleCheck::Within(AVR_ANGLE_TOLERANCE_RAD),
+            |_| {},
+        )?;
+        motions = Some(legs);
+        return finish(
+            session.client_mut(),
+            Sweeps {
+                summary,
+                pins: sweep_pins,
+                mismatches,
+            },
+            info,
+            wall,
+            motions,
+        );
+    }
+    finish(
+        stream.client_mut(),
+        Sweeps {
+            summary,
+            pins: sweep_pins,
+            mismatches,
+        },
+        info,
+        wall,
+        motions,
+    )
+}
+
+/// What the pose sweeps gave: the stream's summary, the pin check at their end and the
+/// readback mismatches.
+struct Sweeps {
+    summary: Summary,
+    pins: Option<PulseStats>,
+    mismatches: Vec<(usize, Mismatch)>,
+}
+
+/// The pin statistics and the MCU of an emulated run, and the result.
+fn finish<L: Link>(
+    client: &mut Client<L>,
+    sweeps: Sweeps,
+    info: DeviceInfo,
+    wall: Instant,
+    motions: Option<Vec<crate::ops::demo_motions::Leg>>,
+) -> Result<Demo, Error> {
+    let Sweeps {
+        mut summary,
+        pins,
+        mismatches,
+    } = sweeps;
+    if let Some(pulses) = pins {
         summary.pulses_checked = Some(pulses.checked);
         summary.pulse_width_errors = Some(pulses.errors);
         summary.first_pulse_error = pulses.first_error;
+    }
+    let mcu = client.link_mut().emulator().map(|link| {
         summary.rx_overruns = Some(link.rx_overruns());
         Mcu {
             resets: link.mcu().resets().count,
@@ -283,6 +368,7 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
         mcu,
         wall: wall.elapsed(),
         mismatches,
+        motions,
     })
 }
 

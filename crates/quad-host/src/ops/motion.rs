@@ -103,8 +103,8 @@ pub struct Params {
     pub amplitude_rad: Option<f32>,
     /// Sways: period T, s.
     pub period_s: Option<f32>,
-    /// yaw-turn: ω_z, rad/s.
-    pub omega_rad_s: Option<f32>,
+    /// yaw-turn: yaw rate, rad/s (counter-clockwise positive).
+    pub yaw_rate_rad_s: Option<f32>,
     /// yaw-turn: step period T1, s.
     pub step_period_s: Option<f32>,
     /// yaw-turn: lift height h_K, m.
@@ -201,9 +201,9 @@ pub fn param_err(e: motion::Error) -> Error {
     let name = match e {
         motion::Error::NonFinite(p)
         | motion::Error::NotPositive(p)
-        | motion::Error::Negative(p) => Some(p),
+        | motion::Error::Negative(p) => Some(p.name()),
         motion::Error::OutOfRange { parameter, .. }
-        | motion::Error::BeyondReach { parameter, .. } => Some(parameter),
+        | motion::Error::BeyondReach { parameter, .. } => Some(parameter.name()),
         _ => None,
     };
     Error::Parameter {
@@ -219,7 +219,7 @@ impl Params {
             ("--stance-height-m", self.stance_height_m.is_some()),
             ("--amplitude-rad", self.amplitude_rad.is_some()),
             ("--period-s", self.period_s.is_some()),
-            ("--omega-rad-s", self.omega_rad_s.is_some()),
+            ("--yaw-rate-rad-s", self.yaw_rate_rad_s.is_some()),
             ("--step-period-s", self.step_period_s.is_some()),
             ("--lift-height-m", self.lift_height_m.is_some()),
             ("--path", self.path.is_some()),
@@ -245,8 +245,8 @@ impl Params {
             ("--amplitude-rad", self.amplitude_rad.is_some(), sway),
             ("--period-s", self.period_s.is_some(), sway),
             (
-                "--omega-rad-s",
-                self.omega_rad_s.is_some(),
+                "--yaw-rate-rad-s",
+                self.yaw_rate_rad_s.is_some(),
                 law == Law::YawTurn,
             ),
             (
@@ -297,10 +297,14 @@ impl Params {
         match self.stance_height_m.or(default_height_m) {
             Some(h) => {
                 if !h.is_finite() {
-                    return Err(param_err(motion::Error::NonFinite("stance_height_m")));
+                    return Err(param_err(motion::Error::NonFinite(
+                        motion::Param::StanceHeightM,
+                    )));
                 }
                 if h <= 0.0 {
-                    return Err(param_err(motion::Error::NotPositive("stance_height_m")));
+                    return Err(param_err(motion::Error::NotPositive(
+                        motion::Param::StanceHeightM,
+                    )));
                 }
                 Ok(robot.stance_feet(h))
             }
@@ -339,8 +343,8 @@ impl Params {
                 p.robot = robot;
                 p.stance_feet = self.stance(&robot, None)?;
                 p.order = order(RotationOrder::Zxy);
-                if let Some(v) = self.omega_rad_s {
-                    p.omega_rad_s = v;
+                if let Some(v) = self.yaw_rate_rad_s {
+                    p.yaw_rate_rad_s = v;
                 }
                 if let Some(v) = self.step_period_s {
                     p.step_period_s = v;
@@ -414,7 +418,7 @@ impl Params {
 pub fn sweep(duration_s: f32, rate_hz: f32) -> Result<Sweep, Error> {
     Sweep::new(0.0, duration_s, rate_hz).map_err(|e| match e {
         motion::Error::OutOfRange {
-            parameter: "duration_s",
+            parameter: motion::Param::DurationS,
             ..
         } if duration_s.is_finite() && rate_hz.is_finite() => {
             let max = MAX_SWEEP_SAMPLES as f32;

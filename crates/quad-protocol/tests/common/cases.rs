@@ -4,11 +4,15 @@
 //! byte, fixed arrays without a length, struct fields in declaration order.
 //! Shared by the golden test, the docs test and the `wire_examples` example.
 
+use kin_core::motion::gait::Pattern;
+use kin_core::motion::laws::Axis;
+use kin_core::motion::path::PathKind;
 use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 use quad_protocol::{
-    servo, DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LinkLossAction,
-    LinkTimeout, NackReason, PoseConfig, ReachFault, Readback, Request, RobotPreset, ServoId,
-    Setting,
+    servo, DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet,
+    LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus,
+    NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request,
+    RobotPreset, ServoId, Setting,
 };
 
 pub fn h2d(seq: u16, request: Request) -> HostToDevice {
@@ -160,6 +164,110 @@ pub fn requests() -> Vec<(&'static str, HostToDevice, &'static str)> {
                 }),
             ),
             "0a 0a 00 00 80 3e 04 01",
+        ),
+        (
+            "StartMotion StandUp",
+            // seq 11 | variant 11 | StandUp = 0
+            h2d(11, Request::StartMotion(MotionCommand::StandUp)),
+            "0b 0b 00",
+        ),
+        (
+            "StartMotion Sway",
+            // seq 12 | variant 11 | Sway = 3 | Pitch = 1 | A 0.25 | T 20 | Some = 1, 40 s
+            h2d(
+                12,
+                Request::StartMotion(MotionCommand::Sway {
+                    axis: Axis::Pitch,
+                    amplitude_rad: 0.25,
+                    period_s: 20.0,
+                    duration_s: Some(40.0),
+                }),
+            ),
+            "0c 0b 03 01 00 00 80 3e 00 00 a0 41 01 00 00 20 42",
+        ),
+        (
+            "StartMotion YawTurn",
+            // seq 13 | variant 11 | YawTurn = 4 | 0.125 rad/s | T1 6 s | lift 0.0625 m | None
+            h2d(
+                13,
+                Request::StartMotion(MotionCommand::YawTurn {
+                    yaw_rate_rad_s: 0.125,
+                    step_period_s: 6.0,
+                    lift_height_m: 0.0625,
+                    duration_s: None,
+                }),
+            ),
+            "0d 0b 04 00 00 00 3e 00 00 c0 40 00 00 80 3d 00",
+        ),
+        (
+            "StartMotion FootPath",
+            // seq 14 | variant 11 | FootPath = 5 | Rectangle = 0 | One = 1, RL = 2 | stride
+            // 0.125 m | lift 0.0625 m | duty 0.75 | cycle 3 s | Some = 1, 6 s
+            h2d(
+                14,
+                Request::StartMotion(MotionCommand::FootPath {
+                    path: PathKind::Rectangle,
+                    legs: LegSet::One(LegId::RL),
+                    stride_m: 0.125,
+                    step_height_m: 0.0625,
+                    duty_factor: 0.75,
+                    cycle_s: 3.0,
+                    duration_s: Some(6.0),
+                }),
+            ),
+            "0e 0b 05 00 01 02 00 00 00 3e 00 00 80 3d 00 00 40 3f 00 00 40 40 01 00 00 c0 40",
+        ),
+        (
+            "StartMotion Walk",
+            // seq 15 | variant 11 | Walk = 6 | Trot = 0 | body 0.25 m | step 0.0625 m | cycle
+            // 0.5 s | timeout 500 ms = f4 03
+            h2d(
+                15,
+                Request::StartMotion(MotionCommand::Walk {
+                    gait: Pattern::Trot,
+                    body_height_m: 0.25,
+                    step_height_m: 0.0625,
+                    cycle_s: 0.5,
+                    velocity_timeout_ms: 500,
+                }),
+            ),
+            "0f 0b 06 00 00 00 80 3e 00 00 80 3d 00 00 00 3f f4 03",
+        ),
+        (
+            "StopMotion",
+            // seq 16 | variant 12
+            h2d(16, Request::StopMotion),
+            "10 0c",
+        ),
+        (
+            "GetMotion",
+            // seq 17 | variant 13
+            h2d(17, Request::GetMotion),
+            "11 0d",
+        ),
+        (
+            "SetVelocity",
+            // seq 18 | variant 14 | forward 0.125 m/s | lateral -0.0625 m/s | yaw 0.25 rad/s
+            h2d(
+                18,
+                Request::SetVelocity {
+                    forward_m_s: 0.125,
+                    lateral_m_s: -0.0625,
+                    yaw_rate_rad_s: 0.25,
+                },
+            ),
+            "12 0e 00 00 00 3e 00 00 80 bd 00 00 80 3e",
+        ),
+        (
+            "SetJointSpeedLimit",
+            // seq 19 | variant 15 | 2.5 rad/s
+            h2d(
+                19,
+                Request::SetJointSpeedLimit {
+                    joint_speed_limit_rad_s: 2.5,
+                },
+            ),
+            "13 0f 00 00 20 40",
         ),
     ]
 }
@@ -334,6 +442,68 @@ pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
              00 00 00 00 00 00 00 00 00 00 00 00 \
              b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 \
              08 07 00",
+        ),
+        (
+            "Nack InvalidParameter",
+            // variant 0 | Some, seq 15 | reason 15 | CycleS = 9 | NotPositive = 1
+            DeviceToHost::Nack {
+                seq: Some(15),
+                reason: NackReason::InvalidParameter {
+                    param: MotionParam::CycleS,
+                    problem: ParamProblem::NotPositive,
+                },
+            },
+            "00 01 0f 0f 09 01",
+        ),
+        (
+            "Nack Preflight",
+            // variant 0 | Some, seq 16 | reason 16 | FR = 1 | JointLimit = 1, knee = 2
+            DeviceToHost::Nack {
+                seq: Some(16),
+                reason: NackReason::Preflight {
+                    leg: LegId::FR,
+                    fault: PreflightFault::JointLimit(Joint::Knee),
+                },
+            },
+            "00 01 10 10 01 01 02",
+        ),
+        (
+            "Nack MotionRunning",
+            // variant 0 | Some, seq 17 | reason 17
+            DeviceToHost::Nack {
+                seq: Some(17),
+                reason: NackReason::MotionRunning,
+            },
+            "00 01 11 11",
+        ),
+        (
+            "MotionAck",
+            // variant 5 | seq 4 | Some = 1, Walk = 6 | Stopping = 2 | t 12.5 s | phase 0.25 |
+            // fault None = 0 | 12 angles 0.5 | pulses 3000 = b8 17 | flags 0x04 | frames_ok 5 |
+            // frames_bad 0
+            DeviceToHost::MotionAck {
+                seq: 4,
+                status: MotionStatus {
+                    kind: Some(MotionKind::Walk),
+                    stage: MotionStage::Stopping,
+                    t_s: 12.5,
+                    phase: 0.25,
+                    fault: None,
+                },
+                readback: Readback {
+                    angles_rad: [0.5; 12],
+                    pulses_half_us: [3000; 12],
+                    flags: Flags(Flags::OUTPUTS_ENABLED),
+                    frames_ok: 5,
+                    frames_bad: 0,
+                },
+            },
+            "05 04 01 06 02 00 00 48 41 00 00 80 3e 00 \
+             00 00 00 3f 00 00 00 3f 00 00 00 3f 00 00 00 3f \
+             00 00 00 3f 00 00 00 3f 00 00 00 3f 00 00 00 3f \
+             00 00 00 3f 00 00 00 3f 00 00 00 3f 00 00 00 3f \
+             b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 \
+             04 05 00",
         ),
     ]
 }

@@ -1,0 +1,499 @@
+//! A stateful trot / walk stepper: the velocity command may change at any time, footholds are
+//! planned at each lift-off, and a stop ends every stride at the neutral stance.
+//!
+//! [`super::gait::Gait`] is a closed form of one constant twist. The [`Walker`] keeps the
+//! state that a changing command needs, and advances by a time step ([`Walker::step`]):
+//!
+//! - **Phases** as in [`super::gait`]: leg `i` has phase `φ_i = frac(φ + o_i)`, swing for
+//!   `φ_i < 1 − d`, stance after; the global phase `φ` advances by `dt/T` per step.
+//! - **Stance**: the foot stays fixed in the world while the body moves by the *current*
+//!   command: over a step `dt` its body-frame position `p` becomes `X(−dt)·p`
+//!   ([`super::gait::displace`]), exact no-slip for any command history.
+//! - **Lift-off**: the foot's touch-down point is planned with the command of that instant,
+//!   `X(d·T/2)·n_i` (the closed form's touch-down, `n_i` the neutral foothold); the swing runs
+//!   from the foot's actual position to it along the [`PathKind`] path
+//!   ([`super::gait::swing_foot`]). Under a constant command the feet follow the closed
+//!   form [`super::gait::Gait`] (to rounding: the stance is integrated step by step).
+//! - **Stop** ([`Walker::stop`]): the command becomes zero; every leg finishes its stride,
+//!   steps once more onto its neutral foothold if it is not there, and then stays down
+//!   ("parked"). [`Walker::is_stopped`] once all four are parked: the nominal stance at the
+//!   walk's height, reached in at most two cycles.
+//!
+//! ## Reach: the stride disc
+//! The feet use a horizontal disc of radius `R` ([`WalkerParams::reach_radius_m`]) around each
+//! neutral foothold, from the ground up to the swing apex. [`Walker::new`] checks that cylinder
+//! by inverse kinematics at [`Walker::ENVELOPE_SAMPLES`] points per leg: the 8 vertices of the
+//! octagon circumscribing the disc (radius `R / cos 22.5°`) at the ground and at the apex, and
+//! the neutral foothold at the apex. The octagon contains the disc, so the outer boundary of the
+//! workspace (a ball, convex) that contains the samples contains the whole cylinder; the inner
+//! boundaries and the joint limits are checked at the samples only (the device's preflight
+//! adds their margins, and its run-time IK remains the last check).
+//!
+//! A velocity command is admitted ([`Walker::check_velocity`]) when every planned lift-off
+//! and touch-down point lies within `R / f` of its neutral foothold, `f = 1 + 2σ/(5d)` for the
+//! Bézier swing (its overshoot beyond the chord, `σ = 1 − d`) and 1 for the other shapes.
+//! The stance between them is an arc of the circle through `n_i` about the instantaneous centre
+//! of rotation (or a segment), whose distance from `n_i` grows with time when `|ω|·d·T ≤ π`,
+//! which is also required; the swing's horizontal path lies on the chord (plus the overshoot).
+//! When the command changes during a stance, the stance feet keep moving with the body and
+//! could leave the disc of `R / f` (from which a swing's overshoot stays within `R`): the
+//! body's displacement of that step is then halved (up to three times, then zero) until every
+//! stance foot stays inside, and [`Walker::saturated`] reports it.
+
+use super::gait::{displace, swing_foot, Gait, GaitParams, Pattern, Velocity};
+use super::path::PathKind;
+use super::{
+    check_reach, finite, fract01, positive, Contact, Error, Expected, Frame, Param, Phase,
+};
+use crate::body::{BodyConfig, Pose};
+use crate::math::Math;
+use crate::robot::{LegId, Robot};
+use crate::rotation::RotationOrder;
+use crate::vec::Vec3;
+
+/// Parameters of a [`Walker`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WalkerParams {
+    /// The robot.
+    pub robot: Robot,
+    /// Stance height `H` (hip plane above the ground), m.
+    pub stance_height_m: f32,
+    /// Gait cycle `T`, s.
+    pub cycle_s: f32,
+    /// Stance fraction `d` ∈ (0, 1).
+    pub duty_factor: f32,
+    /// Phase offsets `o_i` in leg order FL, FR, RL, RR, cycles.
+    pub phase_offsets: [f32; 4],
+    /// Apex of the swing above the ground, m (the semicircle's apex is half its stride).
+    pub step_height_m: f32,
+    /// Swing shape.
+    pub swing: PathKind,
+    /// Rotation order of the pose (the body stays at the zero pose; for consumers).
+    pub order: RotationOrder,
+    /// Radius `R` of the horizontal disc around each neutral foothold that the feet may use, m.
+    pub reach_radius_m: f32,
+}
+
+impl WalkerParams {
+    /// Default [`WalkerParams::reach_radius_m`] as a fraction of the stance height.
+    pub const DEFAULT_REACH_RADIUS_FRACTION: f32 = 0.2;
+
+    /// `pattern` on `robot` at `stance_height_m` with [`GaitParams::new`]'s cycle, step height
+    /// and swing, and a reach radius of [`Self::DEFAULT_REACH_RADIUS_FRACTION`]·H.
+    pub fn new(pattern: Pattern, robot: Robot, stance_height_m: f32) -> WalkerParams {
+        let g = GaitParams::new(pattern, robot, stance_height_m);
+        WalkerParams {
+            robot,
+            stance_height_m,
+            cycle_s: g.cycle_s,
+            duty_factor: g.duty_factor,
+            phase_offsets: g.phase_offsets,
+            step_height_m: g.step_height_m,
+            swing: g.swing,
+            order: g.order,
+            reach_radius_m: Self::DEFAULT_REACH_RADIUS_FRACTION * stance_height_m,
+        }
+    }
+
+    /// The closed-form gait of these parameters at a constant `velocity`.
+    pub fn gait_params(&self, velocity: Velocity) -> GaitParams {
+        GaitParams {
+            robot: self.robot,
+            stance_height_m: self.stance_height_m,
+            cycle_s: self.cycle_s,
+            duty_factor: self.duty_factor,
+            phase_offsets: self.phase_offsets,
+            step_height_m: self.step_height_m,
+            velocity,
+            swing: self.swing,
+            order: self.order,
+        }
+    }
+}
+
+/// One leg's state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Leg {
+    /// Foot, body frame, m.
+    foot: Vec3,
+    /// Where the current (or last) swing started, body frame, m.
+    lift_off: Vec3,
+    /// Where it ends, body frame, m.
+    touch_down: Vec3,
+    /// Stopped at its neutral foothold for good.
+    parked: bool,
+}
+
+/// A trot / walk stepper with a changing velocity command: see the module docs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Walker {
+    p: WalkerParams,
+    neutral: [Vec3; 4],
+    legs: [Leg; 4],
+    phase: f32,
+    velocity: Velocity,
+    stopping: bool,
+    saturated: bool,
+}
+
+impl Walker {
+    /// Number of envelope points per leg ([`Walker::envelope`]).
+    pub const ENVELOPE_SAMPLES: usize = 17;
+
+    /// Validates the parameters (those of [`Gait::new`] at zero velocity, and `R > 0`) and the
+    /// reach of the stride cylinder (module docs; a failure names `reach_radius_m`), and starts
+    /// at phase 0 standing on the neutral footholds with a zero command. The reach checks run
+    /// on the [`DefaultMath`](crate::DefaultMath) backend.
+    pub fn new(p: WalkerParams) -> Result<Walker, Error> {
+        Gait::new(p.gait_params(Velocity::default()))?;
+        let walker = Self::without_reach_check(p)?;
+        let cfg = walker.body_config();
+        for k in 0..Self::ENVELOPE_SAMPLES {
+            check_reach(
+                &p.robot,
+                &Pose::default(),
+                &cfg,
+                &walker.envelope(k),
+                Param::ReachRadiusM,
+            )?;
+        }
+        Ok(walker)
+    }
+
+    /// [`Walker::new`]'s parameter checks without its reach checks, for a caller that checks
+    /// the reach itself by running the envelope's points through its own IK (a device's
+    /// start check).
+    pub fn without_reach_check(p: WalkerParams) -> Result<Walker, Error> {
+        let gait = Gait::without_reach_check(p.gait_params(Velocity::default()))?;
+        positive(p.reach_radius_m, Param::ReachRadiusM)?;
+        let neutral = gait.neutral_feet();
+        let leg = |n: Vec3| Leg {
+            foot: n,
+            lift_off: n,
+            touch_down: n,
+            parked: false,
+        };
+        Ok(Walker {
+            p,
+            neutral,
+            legs: neutral.map(leg),
+            phase: 0.0,
+            velocity: Velocity::default(),
+            stopping: false,
+            saturated: false,
+        })
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> &WalkerParams {
+        &self.p
+    }
+
+    /// Rotation order and pivot of the walker's (zero) pose.
+    pub fn body_config(&self) -> BodyConfig {
+        BodyConfig {
+            order: self.p.order,
+            pivot_m: Vec3::ZERO,
+        }
+    }
+
+    /// Neutral footholds (nominal stance at height `H`), body frame, m.
+    pub const fn neutral_feet(&self) -> [Vec3; 4] {
+        self.neutral
+    }
+
+    /// Envelope point `k` (`< ENVELOPE_SAMPLES`) of the four legs, body frame, m: octagon
+    /// vertices `0..8` at the ground, `8..16` at the apex, `16` the neutral foothold at the
+    /// apex (module docs). Out-of-range `k` gives the neutral footholds.
+    pub fn envelope(&self, k: usize) -> [Vec3; 4] {
+        // cos(22.5°): the octagon of vertex radius R / cos(π/8) circumscribes the disc of R.
+        const COS_PI_8: f32 = 0.923_879_5;
+        let apex = match self.p.swing {
+            PathKind::Semicircle => self.p.reach_radius_m,
+            _ => self.p.step_height_m,
+        };
+        // (cos, sin) of the eight directions k·45°.
+        const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
+        const DIRECTIONS: [(f32, f32); 8] = [
+            (1.0, 0.0),
+            (H, H),
+            (0.0, 1.0),
+            (-H, H),
+            (-1.0, 0.0),
+            (-H, -H),
+            (0.0, -1.0),
+            (H, -H),
+        ];
+        let r = self.p.reach_radius_m / COS_PI_8;
+        let (dx, dy, dz) = match k {
+            0..=15 => {
+                let (c, s) = DIRECTIONS[k % 8];
+                let z = if k < 8 { 0.0 } else { apex };
+                (r * c, r * s, z)
+            }
+            16 => (0.0, 0.0, apex),
+            _ => (0.0, 0.0, 0.0),
+        };
+        self.neutral.map(|n| n + Vec3::new(dx, dy, dz))
+    }
+
+    /// The Bézier swing's overshoot factor `f` (module docs), 1 for the other shapes.
+    fn overshoot_factor(&self) -> f32 {
+        let d = self.p.duty_factor;
+        match self.p.swing {
+            PathKind::Bezier => 1.0 + 2.0 * (1.0 - d) / (5.0 * d),
+            _ => 1.0,
+        }
+    }
+
+    /// Largest horizontal distance of a planned lift-off or touch-down point from its neutral
+    /// foothold under the constant command `v`, m.
+    fn excursion_m<M: Math>(&self, v: &Velocity) -> f32 {
+        let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
+        let mut e: f32 = 0.0;
+        for n in self.neutral {
+            for s in [half, -half] {
+                let q = displace::<M>(v, s, n) - n;
+                e = e.max(M::sqrt(q.x * q.x + q.y * q.y));
+            }
+        }
+        e
+    }
+
+    /// Checks a velocity command: finite components, `|ω|·d·T ≤ π`, and the planned footholds
+    /// within the stride disc (module docs). A component that is too large on its own is named
+    /// (`forward_m_s`, `lateral_m_s`, `yaw_rad_s`); a combination that is, `velocity`.
+    pub fn check_velocity<M: Math>(&self, v: &Velocity) -> Result<(), Error> {
+        finite(v.forward_m_s, Param::ForwardMS)?;
+        finite(v.lateral_m_s, Param::LateralMS)?;
+        finite(v.yaw_rad_s, Param::YawRadS)?;
+        const EXPECTED: Expected = Expected::WithinGaitReach;
+        let stance_s = self.p.duty_factor * self.p.cycle_s;
+        if !(libm::fabsf(v.yaw_rad_s) * stance_s <= core::f32::consts::PI) {
+            return Err(Error::OutOfRange {
+                parameter: Param::YawRadS,
+                expected: Expected::HalfTurnPerStance,
+            });
+        }
+        let limit = self.p.reach_radius_m / self.overshoot_factor();
+        let zero = Velocity::default();
+        for (single, name) in [
+            (
+                Velocity {
+                    forward_m_s: v.forward_m_s,
+                    ..zero
+                },
+                Param::ForwardMS,
+            ),
+            (
+                Velocity {
+                    lateral_m_s: v.lateral_m_s,
+                    ..zero
+                },
+                Param::LateralMS,
+            ),
+            (
+                Velocity {
+                    yaw_rad_s: v.yaw_rad_s,
+                    ..zero
+                },
+                Param::YawRadS,
+            ),
+            (*v, Param::Velocity),
+        ] {
+            if !(self.excursion_m::<M>(&single) <= limit) {
+                return Err(Error::OutOfRange {
+                    parameter: name,
+                    expected: EXPECTED,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The largest forward speed admitted alone, m/s: `2·R / (f·d·T)`.
+    pub fn max_forward_m_s(&self) -> f32 {
+        2.0 * self.p.reach_radius_m
+            / (self.overshoot_factor() * self.p.duty_factor * self.p.cycle_s)
+    }
+
+    /// Sets the velocity command after [`Walker::check_velocity`]; it acts on the stance feet
+    /// from the next step and on each foothold from the leg's next lift-off. Ignored (`Ok`)
+    /// once stopping.
+    pub fn set_velocity<M: Math>(&mut self, v: Velocity) -> Result<(), Error> {
+        self.check_velocity::<M>(&v)?;
+        if !self.stopping {
+            self.velocity = v;
+        }
+        Ok(())
+    }
+
+    /// The velocity command in effect.
+    pub const fn velocity(&self) -> Velocity {
+        self.velocity
+    }
+
+    /// Stops: zero command; each leg finishes its stride and parks on its neutral foothold.
+    pub fn stop(&mut self) {
+        self.stopping = true;
+        self.velocity = Velocity::default();
+    }
+
+    /// True once [`Walker::stop`] was called.
+    pub const fn is_stopping(&self) -> bool {
+        self.stopping
+    }
+
+    /// True when all four legs are parked: the nominal stance at the walk's height.
+    pub fn is_stopped(&self) -> bool {
+        self.legs.iter().all(|l| l.parked)
+    }
+
+    /// True when the last step reduced the body's displacement to keep the stance feet in
+    /// their discs (module docs).
+    pub const fn saturated(&self) -> bool {
+        self.saturated
+    }
+
+    /// Global gait phase `φ`, cycles in `[0, 1)`.
+    pub const fn phase(&self) -> f32 {
+        self.phase
+    }
+
+    /// Phase of `leg` at global phase `phase`.
+    fn leg_phase(&self, leg: usize, phase: f32) -> f32 {
+        fract01(phase + self.p.phase_offsets[leg])
+    }
+
+    /// True when leg phase `q` is in the swing.
+    fn in_swing(&self, q: f32) -> bool {
+        q < 1.0 - self.p.duty_factor
+    }
+
+    /// The touch-down point of `leg` planned now: `X(d·T/2)·n` with the current command.
+    fn plan<M: Math>(&self, leg: usize) -> Vec3 {
+        let n = self.neutral[leg];
+        if self.velocity == Velocity::default() {
+            return n;
+        }
+        let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
+        displace::<M>(&self.velocity, half, n)
+    }
+
+    /// Squared horizontal distance of `p` from the neutral foothold of `leg`, m².
+    fn off_neutral_sq(&self, leg: usize, p: Vec3) -> f32 {
+        let q = p - self.neutral[leg];
+        q.x * q.x + q.y * q.y
+    }
+
+    /// Advances by `dt_s` (> 0, less than the shorter of swing and stance; one servo frame) on
+    /// math backend `M`. A non-finite or non-positive `dt_s` is refused and changes nothing.
+    pub fn step<M: Math>(&mut self, dt_s: f32) -> Result<(), Error> {
+        positive(dt_s, Param::DtS)?;
+        let old = self.phase;
+        let new = fract01(old + dt_s / self.p.cycle_s);
+        // Stance feet within R/f: a swing from there overshoots by at most the factor.
+        let r = self.p.reach_radius_m / self.overshoot_factor();
+        let r_sq = r * r;
+        self.saturated = false;
+        let mut scale = 1.0;
+        let mut next = self.legs;
+        for _ in 0..5 {
+            let mut inside = true;
+            for (i, leg) in next.iter_mut().enumerate() {
+                *leg = self.advance_leg::<M>(i, old, new, dt_s, scale);
+                let l = &self.legs[i];
+                let stance = !self.in_swing(self.leg_phase(i, new));
+                // A foot already outside (it cannot be, by the checks) may stay.
+                if stance
+                    && !leg.parked
+                    && self.off_neutral_sq(i, leg.foot) > r_sq
+                    && self.off_neutral_sq(i, leg.foot) > self.off_neutral_sq(i, l.foot)
+                {
+                    inside = false;
+                }
+            }
+            if inside || scale == 0.0 {
+                break;
+            }
+            self.saturated = true;
+            scale = if scale > 0.2 { 0.5 * scale } else { 0.0 };
+        }
+        self.legs = next;
+        self.phase = new;
+        Ok(())
+    }
+
+    /// Leg `i` after a step from global phase `old` to `new` (`dt_s` long), the body moving by
+    /// `scale` times the command.
+    ///
+    /// Out of line: one copy in the step's retry loop, and a small stack frame on targets
+    /// where large frames are costly (the ATmega2560).
+    #[inline(never)]
+    fn advance_leg<M: Math>(&self, i: usize, old: f32, new: f32, dt_s: f32, scale: f32) -> Leg {
+        let mut l = self.legs[i];
+        if l.parked {
+            return l;
+        }
+        let t = self.p.cycle_s;
+        let swing_end = 1.0 - self.p.duty_factor;
+        let (q0, q1) = (self.leg_phase(i, old), self.leg_phase(i, new));
+        // The foot fixed in the world for `s` seconds of this step.
+        let stance_for = |p: Vec3, s: f32| {
+            if self.velocity == Velocity::default() || !(s > 0.0) {
+                p
+            } else {
+                displace::<M>(&self.velocity, -s * scale, p)
+            }
+        };
+        if q1 < q0 {
+            // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
+            let foot = stance_for(l.foot, ((1.0 - q0) * t).min(dt_s));
+            if self.stopping && foot == self.neutral[i] {
+                l.foot = foot;
+                l.parked = true;
+                return l;
+            }
+            l.lift_off = foot;
+            l.touch_down = self.plan::<M>(i);
+        } else if !self.in_swing(q0) {
+            l.foot = stance_for(l.foot, dt_s);
+            return l;
+        }
+        if self.in_swing(q1) {
+            l.foot = swing_foot::<M>(
+                self.p.swing,
+                self.p.step_height_m,
+                self.p.duty_factor,
+                l.lift_off,
+                l.touch_down,
+                Phase::wrap(q1),
+            );
+        } else {
+            // Touch-down in this step, `(q1 − (1 − d))·T` ago.
+            l.foot = stance_for(l.touch_down, ((q1 - swing_end) * t).min(dt_s));
+        }
+        l
+    }
+
+    /// Feet and contacts now; the body stays at the zero pose, so the world frame is the body
+    /// frame.
+    pub fn frame(&self) -> Frame {
+        let mut contact = [Contact::Stance; 4];
+        for (i, c) in contact.iter_mut().enumerate() {
+            if !self.legs[i].parked && self.in_swing(self.leg_phase(i, self.phase)) {
+                *c = Contact::Swing;
+            }
+        }
+        Frame {
+            pose: Pose::default(),
+            feet_in_world: self.legs.map(|l| l.foot),
+            contact,
+        }
+    }
+
+    /// Foot of `leg` now, body frame, m.
+    pub fn foot(&self, leg: LegId) -> Vec3 {
+        self.legs[leg.index()].foot
+    }
+}

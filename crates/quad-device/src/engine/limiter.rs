@@ -1,0 +1,149 @@
+//! The joint-speed limiter every output of the device passes.
+
+use super::{Error, FRAME_S};
+use kin_core::motion;
+
+/// Default joint-speed limit, rad/s: half of an MG996R-class servo's no-load speed
+/// (0.17 s/60° ≈ 6.2 rad/s at 4.8 V, kin-core's
+/// [`DEFAULT_MAX_JOINT_SPEED_RAD_S`](kin_core::preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S)). A
+/// servo that carries the body is slower than its no-load figure; at half of it a loaded servo
+/// still follows its setpoint, so the commanded pose stays the real one and the servo's own
+/// controller never runs at full current against a step. 0.06 rad (3.4°) per 20 ms frame.
+pub const DEFAULT_JOINT_SPEED_LIMIT_RAD_S: f32 = 3.0;
+
+/// Moves each of twelve outputs toward its target by at most `limit · frame` per frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limiter {
+    speed_rad_s: f32,
+    max_step_rad: f32,
+}
+
+impl Limiter {
+    /// A limiter of `speed_rad_s` (finite, > 0) per joint.
+    ///
+    /// # Errors
+    /// [`Error::Parameter`] naming `joint_speed_limit_rad_s`.
+    pub fn new(speed_rad_s: f32) -> Result<Limiter, Error> {
+        if !speed_rad_s.is_finite() {
+            return Err(Error::Parameter(motion::Error::NonFinite(
+                motion::Param::JointSpeedLimitRadS,
+            )));
+        }
+        if !(speed_rad_s > 0.0) {
+            return Err(Error::Parameter(motion::Error::NotPositive(
+                motion::Param::JointSpeedLimitRadS,
+            )));
+        }
+        Ok(Limiter {
+            speed_rad_s,
+            max_step_rad: speed_rad_s * FRAME_S,
+        })
+    }
+
+    /// The limit, rad/s.
+    pub const fn speed_rad_s(&self) -> f32 {
+        self.speed_rad_s
+    }
+
+    /// The largest change of one output in one frame, rad.
+    pub const fn max_step_rad(&self) -> f32 {
+        self.max_step_rad
+    }
+
+    /// One frame: each of `out` moves to its `target` when that is within
+    /// [`Limiter::max_step_rad`], else by exactly that much toward it. True when some output
+    /// was held back.
+    pub fn step(&self, out: &mut [f32; 12], target: &[f32; 12]) -> bool {
+        let b = self.max_step_rad;
+        let mut limited = false;
+        for (o, &t) in out.iter_mut().zip(target) {
+            let d = t - *o;
+            if d > b {
+                *o += b;
+                limited = true;
+            } else if d < -b {
+                *o -= b;
+                limited = true;
+            } else {
+                *o = t;
+            }
+        }
+        limited
+    }
+}
+
+/// A straight line in joint space from `from` to `to` in whole frames, no joint moving more
+/// than one limiter step per frame: all joints start and arrive together (a synchronised ramp),
+/// and every point lies between the two ends, so within any joint limits and servo travel that
+/// admit both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ramp {
+    from: [f32; 12],
+    to: [f32; 12],
+    frames: u32,
+    done: u32,
+}
+
+impl Ramp {
+    /// A finished ramp at the zero angles (an idle engine's).
+    pub const fn idle() -> Ramp {
+        Ramp {
+            from: [0.0; 12],
+            to: [0.0; 12],
+            frames: 0,
+            done: 0,
+        }
+    }
+
+    /// A ramp at `limiter`'s speed.
+    pub fn new(from: [f32; 12], to: [f32; 12], limiter: &Limiter) -> Ramp {
+        let mut widest = 0.0f32;
+        for (a, b) in from.iter().zip(&to) {
+            widest = widest.max(libm::fabsf(b - a));
+        }
+        // Non-finite input cannot occur (the ends are validated angles); 0 frames if it did.
+        let frames = libm::ceilf(widest / limiter.max_step_rad());
+        let frames = if frames.is_finite() && frames > 0.0 {
+            frames as u32
+        } else {
+            0
+        };
+        Ramp {
+            from,
+            to,
+            frames,
+            done: 0,
+        }
+    }
+
+    /// Advances one frame and returns the new point (`to` exactly at the end).
+    pub fn advance(&mut self) -> [f32; 12] {
+        if self.done < self.frames {
+            self.done += 1;
+        }
+        self.point()
+    }
+
+    /// The current point.
+    pub fn point(&self) -> [f32; 12] {
+        if self.done >= self.frames {
+            return self.to;
+        }
+        let s = self.done as f32 / self.frames as f32;
+        let mut p = self.from;
+        for (p, &b) in p.iter_mut().zip(&self.to) {
+            *p += (b - *p) * s;
+        }
+        p
+    }
+
+    /// True once the end is reached.
+    pub fn finished(&self) -> bool {
+        self.done >= self.frames
+    }
+
+    /// The end point.
+    pub const fn to(&self) -> &[f32; 12] {
+        &self.to
+    }
+}

@@ -1,0 +1,238 @@
+//! The engine's requests, status and errors on the wire (quad-protocol's motion messages).
+
+use super::{Error, Kind, Request, Stage, Status, WalkRequest};
+use kin_core::motion;
+use kin_core::preflight::FailureKind;
+use kin_core::Unreachable;
+use quad_protocol::{
+    LegSet, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
+    ParamProblem, PreflightFault, ReachFault,
+};
+
+impl From<MotionCommand> for Request {
+    fn from(m: MotionCommand) -> Request {
+        match m {
+            MotionCommand::StandUp => Request::StandUp,
+            MotionCommand::Sit => Request::Sit,
+            MotionCommand::Rest => Request::Rest,
+            MotionCommand::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            } => Request::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            },
+            MotionCommand::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            } => Request::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            },
+            MotionCommand::FootPath {
+                path,
+                legs,
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            } => Request::FootPath {
+                path,
+                leg: match legs {
+                    LegSet::All => None,
+                    LegSet::One(leg) => Some(leg),
+                },
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            },
+            MotionCommand::Walk {
+                gait,
+                body_height_m,
+                step_height_m,
+                cycle_s,
+                velocity_timeout_ms,
+            } => Request::Walk(WalkRequest {
+                pattern: gait,
+                body_height_m,
+                step_height_m,
+                cycle_s,
+                velocity_timeout_ms,
+            }),
+        }
+    }
+}
+
+impl From<&Request> for MotionCommand {
+    fn from(r: &Request) -> MotionCommand {
+        match *r {
+            Request::StandUp => MotionCommand::StandUp,
+            Request::Sit => MotionCommand::Sit,
+            Request::Rest => MotionCommand::Rest,
+            Request::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            } => MotionCommand::Sway {
+                axis,
+                amplitude_rad,
+                period_s,
+                duration_s,
+            },
+            Request::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            } => MotionCommand::YawTurn {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                duration_s,
+            },
+            Request::FootPath {
+                path,
+                leg,
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            } => MotionCommand::FootPath {
+                path,
+                legs: leg.map_or(LegSet::All, LegSet::One),
+                stride_m,
+                step_height_m,
+                duty_factor,
+                cycle_s,
+                duration_s,
+            },
+            Request::Walk(w) => MotionCommand::Walk {
+                gait: w.pattern,
+                body_height_m: w.body_height_m,
+                step_height_m: w.step_height_m,
+                cycle_s: w.cycle_s,
+                velocity_timeout_ms: w.velocity_timeout_ms,
+            },
+        }
+    }
+}
+
+impl From<Status> for MotionStatus {
+    fn from(s: Status) -> MotionStatus {
+        MotionStatus {
+            kind: s.kind.map(|k| match k {
+                Kind::StandUp => MotionKind::StandUp,
+                Kind::Sit => MotionKind::Sit,
+                Kind::Rest => MotionKind::Rest,
+                Kind::Sway => MotionKind::Sway,
+                Kind::YawTurn => MotionKind::YawTurn,
+                Kind::FootPath => MotionKind::FootPath,
+                Kind::Walk => MotionKind::Walk,
+            }),
+            stage: match s.stage {
+                Stage::Approach => MotionStage::Approach,
+                Stage::Run => MotionStage::Run,
+                Stage::Stopping => MotionStage::Stopping,
+                Stage::Leave => MotionStage::Leave,
+            },
+            t_s: s.t_s,
+            phase: s.phase,
+            fault: s.fault.map(NackReason::from),
+        }
+    }
+}
+
+/// The wire name of a kin-core or engine parameter.
+pub fn motion_param(param: motion::Param) -> MotionParam {
+    use motion::Param as P;
+    match param {
+        P::AmplitudeRad => MotionParam::AmplitudeRad,
+        P::PeriodS => MotionParam::PeriodS,
+        P::DurationS => MotionParam::DurationS,
+        // The yaw turn's rate and the velocity command's: both counter-clockwise positive.
+        P::YawRateRadS | P::YawRadS => MotionParam::YawRateRadS,
+        P::StepPeriodS => MotionParam::StepPeriodS,
+        P::LiftHeightM => MotionParam::LiftHeightM,
+        P::StrideM => MotionParam::StrideM,
+        P::StepHeightM => MotionParam::StepHeightM,
+        P::DutyFactor => MotionParam::DutyFactor,
+        P::CycleS => MotionParam::CycleS,
+        P::Path => MotionParam::Path,
+        // A walk's body height is its gait's stance height.
+        P::StanceHeightM => MotionParam::BodyHeightM,
+        P::VelocityTimeoutMs => MotionParam::VelocityTimeoutMs,
+        P::ForwardMS => MotionParam::ForwardMS,
+        P::LateralMS => MotionParam::LateralMS,
+        P::Velocity => MotionParam::Velocity,
+        P::JointSpeedLimitRadS => MotionParam::JointSpeedLimitRadS,
+        // The feet a law starts from: the device's stance.
+        P::FeetInWorld | P::StanceFeet => MotionParam::Stance,
+        P::ReachRadiusM => MotionParam::ReachRadiusM,
+        _ => MotionParam::Other,
+    }
+}
+
+fn reach_fault(u: Unreachable) -> PreflightFault {
+    match u {
+        Unreachable::JointLimit(j) => PreflightFault::JointLimit(j),
+        Unreachable::NonFinite => PreflightFault::NonFinite,
+        Unreachable::TooFar => PreflightFault::Reach(ReachFault::TooFar),
+        Unreachable::TooClose => PreflightFault::Reach(ReachFault::TooClose),
+        Unreachable::InsideOffset => PreflightFault::Reach(ReachFault::InsideOffset),
+        _ => PreflightFault::Reach(ReachFault::Other),
+    }
+}
+
+impl From<Error> for NackReason {
+    fn from(e: Error) -> NackReason {
+        let invalid = |name: motion::Param, problem| NackReason::InvalidParameter {
+            param: motion_param(name),
+            problem,
+        };
+        match e {
+            Error::Parameter(p) => match p {
+                motion::Error::NonFinite(n) => invalid(n, ParamProblem::NonFinite),
+                motion::Error::NotPositive(n) => invalid(n, ParamProblem::NotPositive),
+                motion::Error::Negative(n) => invalid(n, ParamProblem::Negative),
+                motion::Error::OutOfRange { parameter, .. } => {
+                    invalid(parameter, ParamProblem::OutOfRange)
+                }
+                motion::Error::BeyondReach { parameter, .. } => {
+                    invalid(parameter, ParamProblem::BeyondReach)
+                }
+                motion::Error::Ik(e) => e.into(),
+                _ => NackReason::InvalidArgument,
+            },
+            Error::Preflight(f) => NackReason::Preflight {
+                leg: f.leg,
+                fault: match f.kind {
+                    FailureKind::Unreachable(u) => reach_fault(u),
+                    FailureKind::Singular { .. } => PreflightFault::Singular,
+                    _ => PreflightFault::Other,
+                },
+            },
+            Error::ServoRange { servo, fault } => NackReason::ServoRange {
+                leg: servo.leg,
+                joint: servo.joint,
+                fault,
+            },
+            Error::OutputsOff => NackReason::OutputsDisabled,
+            Error::Busy => NackReason::MotionRunning,
+            Error::NotWalking => NackReason::NotWalking,
+            Error::Ik(e) => e.into(),
+        }
+    }
+}

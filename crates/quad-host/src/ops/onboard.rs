@@ -1,0 +1,531 @@
+//! The motions the device runs by itself (stand-up, sit, rest, the sways, the yaw turn, the foot
+//! paths, trot and walk): starting them, following them to their end, and the device's
+//! refusals in words. The operations behind `quadctl stand`, `sit`, `rest`, `run` and `drive`.
+//!
+//! A motion's parameters and their defaults are the device's own (`quad_device::engine`'s
+//! requests, sent as `quad_protocol::MotionCommand`): the host adds nothing but the words of a
+//! refusal. Refused requests change nothing on the device.
+
+use crate::client::{self, Client, ClientConfig, Outcome, Verdict};
+use crate::link::{self, Link, Target};
+use quad_device::engine;
+use quad_protocol::servo::Calibration;
+use quad_protocol::{
+    DeviceInfo, DeviceToHost, Flags, MotionCommand, MotionKind, MotionParam, MotionStage,
+    MotionStatus, NackReason, ParamProblem, PreflightFault, Readback, Request, RobotPreset,
+};
+use serde::Serialize;
+use std::time::Duration;
+
+/// How often a running motion is asked for its state while the host waits for its end.
+pub const POLL_PERIOD: Duration = Duration::from_millis(100);
+
+/// Why an onboard motion could not be run.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The robot is not a preset.
+    #[error(
+        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
+         device reports its preset and both sides must run the same geometry"
+    )]
+    NotAPreset(String),
+    /// The link could not be opened.
+    #[error(transparent)]
+    Link(#[from] link::Error),
+    /// The handshake or the link failed.
+    #[error(transparent)]
+    Client(#[from] client::Error),
+    /// The device refused a request.
+    #[error("the device refused {request}: {}{}", words(.reason), reach_hint(.reason, .shaped_by))]
+    Refused {
+        /// The request.
+        request: &'static str,
+        /// Why.
+        reason: NackReason,
+        /// The options that set where a started motion's feet go (empty for other
+        /// requests): named when the device's start check finds a foot it cannot place.
+        shaped_by: &'static str,
+    },
+    /// The motion stopped early on the device.
+    #[error("the motion stopped early on the device: {}", words(.0))]
+    Fault(NackReason),
+    /// The motion did not end within the time allowed.
+    #[error("the motion did not end within {0:?}")]
+    NoEnd(Duration),
+    /// A command-line value the device cannot take in this form.
+    #[error("--{option} {value}: {problem}")]
+    Value {
+        /// The option.
+        option: &'static str,
+        /// The value given.
+        value: f64,
+        /// What is wrong.
+        problem: &'static str,
+    },
+}
+
+/// The command-line option of a motion parameter.
+pub fn option(param: MotionParam) -> &'static str {
+    match param {
+        MotionParam::AmplitudeRad => "--amplitude-rad",
+        MotionParam::PeriodS => "--period-s",
+        MotionParam::DurationS => "--duration-s",
+        MotionParam::YawRateRadS => "--yaw-rate-rad-s",
+        MotionParam::StepPeriodS => "--step-period-s",
+        MotionParam::LiftHeightM => "--lift-height-m",
+        MotionParam::StrideM => "--stride-m",
+        MotionParam::StepHeightM => "--step-height-m",
+        MotionParam::DutyFactor => "--duty-factor",
+        MotionParam::CycleS => "--cycle-s",
+        MotionParam::Path => "--path (with --stride-m, --step-height-m)",
+        MotionParam::BodyHeightM => "--body-height-m",
+        MotionParam::VelocityTimeoutMs => "--velocity-timeout-ms",
+        MotionParam::ForwardMS => "--forward-m-s",
+        MotionParam::LateralMS => "--lateral-m-s",
+        MotionParam::Velocity => "the velocity (--forward-m-s, --lateral-m-s, --yaw-rate-rad-s)",
+        MotionParam::JointSpeedLimitRadS => "--joint-speed-limit-rad-s",
+        MotionParam::Stance => "the device's stance height",
+        MotionParam::ReachRadiusM => "--body-height-m (it sets the stride's reach)",
+        _ => "a parameter",
+    }
+}
+
+/// The options that set where the feet of a started motion go: the device's start check
+/// refuses a sample by the leg that cannot reach it, and these are what to change.
+fn reach_options(request: &Request) -> &'static str {
+    match request {
+        Request::StartMotion(MotionCommand::Sway { .. }) => "--amplitude-rad",
+        Request::StartMotion(MotionCommand::YawTurn { .. }) => {
+            "--yaw-rate-rad-s, --step-period-s, --lift-height-m"
+        }
+        Request::StartMotion(MotionCommand::FootPath { .. }) => "--stride-m, --step-height-m",
+        Request::StartMotion(MotionCommand::Walk { .. }) => "--body-height-m, --step-height-m",
+        _ => "",
+    }
+}
+
+/// " (set by OPTIONS)" after a start check's refusal of a sample, when the motion has such
+/// options.
+fn reach_hint(reason: &NackReason, shaped_by: &str) -> String {
+    let sample = matches!(
+        reason,
+        NackReason::Preflight { .. } | NackReason::ServoRange { .. }
+    );
+    if sample && !shaped_by.is_empty() {
+        format!(" (the motion's feet are set by {shaped_by})")
+    } else {
+        String::new()
+    }
+}
+
+/// A device refusal in words, naming the command-line option of a refused parameter.
+pub fn words(reason: &NackReason) -> String {
+    match reason {
+        NackReason::InvalidParameter { param, problem } => {
+            let what = match problem {
+                ParamProblem::NonFinite => "is not a finite number",
+                ParamProblem::NotPositive => "must be > 0",
+                ParamProblem::Negative => "must be >= 0",
+                ParamProblem::OutOfRange => "is outside its admissible range",
+                ParamProblem::BeyondReach => "puts a foot out of reach",
+            };
+            format!("{} {what}", option(*param))
+        }
+        NackReason::Preflight { leg, fault } => {
+            let what = match fault {
+                PreflightFault::Reach(r) => format!("{leg} cannot reach its foot ({r})"),
+                PreflightFault::JointLimit(j) => format!("{leg} {j:?} leaves its joint limits"),
+                PreflightFault::Singular => {
+                    format!("{leg} comes too close to a singular configuration")
+                }
+                PreflightFault::NonFinite => format!("a sample of {leg} is not finite"),
+                _ => format!("{leg} fails"),
+            };
+            format!("the motion's preflight fails: {what}; nothing moved")
+        }
+        NackReason::ServoRange { leg, joint, fault } => {
+            format!("{leg} {joint:?} would leave its servo's travel ({fault:?}); nothing moved")
+        }
+        NackReason::MotionRunning => {
+            "a motion is running; it keeps running (stop it first)".to_owned()
+        }
+        NackReason::NotWalking => "no walk is running (quadctl run trot or walk first)".to_owned(),
+        NackReason::OutputsDisabled => "the outputs are off (quadctl stand first)".to_owned(),
+        other => other.to_string(),
+    }
+}
+
+/// The device's answer to a motion request.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionAnswer {
+    /// The engine after the request.
+    pub status: MotionStatus,
+    /// The readback after it.
+    pub readback: Readback,
+}
+
+/// A session with the device for onboard motions: handshake, robot check, calibration.
+pub struct Session<L> {
+    client: Client<L>,
+    info: DeviceInfo,
+    calibration: [Calibration; 12],
+}
+
+impl<L: Link> Session<L> {
+    /// Handshake, robot check, calibration read-back.
+    ///
+    /// # Errors
+    /// The handshake's errors, [`client::Error::Robot`] for another robot.
+    pub fn connect(mut client: Client<L>, preset: RobotPreset) -> Result<Session<L>, Error> {
+        let info = client.hello()?;
+        if info.robot != preset {
+            return Err(client::Error::Robot {
+                device: info.robot,
+                host: preset,
+            }
+            .into());
+        }
+        let calibration = client.calibrations()?;
+        Ok(Session {
+            client,
+            info,
+            calibration,
+        })
+    }
+
+    /// The device's `HelloAck`.
+    pub fn info(&self) -> &DeviceInfo {
+        &self.info
+    }
+
+    /// The calibration read at connection.
+    pub fn calibration(&self) -> &[Calibration; 12] {
+        &self.calibration
+    }
+
+    /// The client.
+    pub fn client_mut(&mut self) -> &mut Client<L> {
+        &mut self.client
+    }
+
+    /// The link's clock.
+    pub fn now(&self) -> Duration {
+        self.client.link().now()
+    }
+
+    /// A motion request (`StartMotion`, `StopMotion`, `GetMotion`, `SetVelocity`).
+    ///
+    /// # Errors
+    /// [`Error::Refused`] with the device's reason, or the link's errors.
+    pub fn motion(&mut self, request: Request) -> Result<MotionAnswer, Error> {
+        let name = client::request_name(&request);
+        let retries = self.client.config().retries;
+        let exchange = self
+            .client
+            .exchange_with(request, retries, |_| Verdict::Accept)
+            .map_err(client::Error::from)?;
+        match exchange.outcome {
+            Outcome::Accepted(DeviceToHost::MotionAck {
+                status, readback, ..
+            }) => Ok(MotionAnswer { status, readback }),
+            // A start whose first answer was lost: its retry finds it running.
+            Outcome::Accepted(DeviceToHost::Nack {
+                reason: NackReason::MotionRunning,
+                ..
+            }) if exchange.attempts > 1 && matches!(request, Request::StartMotion(_)) => {
+                self.motion(Request::GetMotion)
+            }
+            Outcome::Accepted(DeviceToHost::Nack { reason, .. }) => Err(Error::Refused {
+                request: name,
+                reason,
+                shaped_by: reach_options(&request),
+            }),
+            Outcome::Accepted(other) | Outcome::Rejected(other) => Err(client::Error::Unexpected {
+                request: name,
+                answer: Box::new(other),
+            }
+            .into()),
+            Outcome::Lost => Err(client::Error::NoAnswer { request: name }.into()),
+        }
+    }
+
+    /// Starts `request` on the device.
+    ///
+    /// # Errors
+    /// As [`Session::motion`].
+    pub fn start(&mut self, request: &engine::Request) -> Result<MotionAnswer, Error> {
+        self.motion(Request::StartMotion(MotionCommand::from(request)))
+    }
+
+    /// The engine's state.
+    ///
+    /// # Errors
+    /// As [`Session::motion`].
+    pub fn get(&mut self) -> Result<MotionAnswer, Error> {
+        self.motion(Request::GetMotion)
+    }
+
+    /// Asks for the state every [`POLL_PERIOD`] until no motion runs, at most `limit`;
+    /// `each` sees every answer.
+    ///
+    /// # Errors
+    /// [`Error::Fault`] when the motion stopped early, [`Error::NoEnd`], the link's errors.
+    pub fn wait_idle(
+        &mut self,
+        limit: Duration,
+        mut each: impl FnMut(&MotionAnswer),
+    ) -> Result<MotionAnswer, Error> {
+        let until = self.now() + limit;
+        loop {
+            let answer = self.get()?;
+            each(&answer);
+            if answer.status.kind.is_none() {
+                if let Some(fault) = answer.status.fault {
+                    return Err(Error::Fault(fault));
+                }
+                return Ok(answer);
+            }
+            let now = self.now();
+            if now >= until {
+                return Err(Error::NoEnd(limit));
+            }
+            self.client
+                .idle_until(now + POLL_PERIOD)
+                .map_err(client::Error::from)?;
+        }
+    }
+
+    /// Stands up when the outputs are off (the motions need them on); returns whether it did.
+    ///
+    /// # Errors
+    /// As [`Session::wait_idle`].
+    pub fn stand_if_off(&mut self, limit: Duration) -> Result<bool, Error> {
+        let now = self.get()?;
+        if now.readback.flags.contains(Flags::OUTPUTS_ENABLED) {
+            return Ok(false);
+        }
+        self.start(&engine::Request::StandUp)?;
+        self.wait_idle(limit, |_| {})?;
+        Ok(true)
+    }
+}
+
+/// Opens `target` and connects a [`Session`] for `robot` (a preset name).
+///
+/// # Errors
+/// [`Error::NotAPreset`], the link's and the handshake's errors.
+pub fn open(robot: &str, target: &Target, retries: u32) -> Result<Session<Box<dyn Link>>, Error> {
+    let preset =
+        RobotPreset::from_name(robot.trim()).ok_or_else(|| Error::NotAPreset(robot.to_owned()))?;
+    let link = link::open(target)?;
+    Session::connect(
+        Client::new(link, ClientConfig::for_target(target, retries)),
+        preset,
+    )
+}
+
+/// What a finished onboard motion reports.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Summary {
+    /// The motion, as the device names it.
+    pub motion: &'static str,
+    /// True when the device stood up first (its outputs were off).
+    pub stood_up_first: bool,
+    /// Motion time the device reported last, s.
+    pub motion_s: f32,
+    /// State requests while waiting.
+    pub polls: u64,
+    /// Velocity commands sent (walks).
+    pub velocity_commands: u64,
+    /// Link time from the start request to the end, s.
+    pub elapsed_s: f64,
+    /// True when the outputs are on at the end.
+    pub outputs_enabled: bool,
+}
+
+/// The name of a motion kind in summaries.
+pub fn kind_name(kind: MotionKind) -> &'static str {
+    match kind {
+        MotionKind::StandUp => "stand_up",
+        MotionKind::Sit => "sit",
+        MotionKind::Rest => "rest",
+        MotionKind::Sway => "sway",
+        MotionKind::YawTurn => "yaw_turn",
+        MotionKind::FootPath => "foot_path",
+        MotionKind::Walk => "walk",
+    }
+}
+
+/// A velocity command held for a time during a walk.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VelocityStep {
+    /// Forward speed, m/s.
+    pub forward_m_s: f32,
+    /// Lateral speed (left positive), m/s.
+    pub lateral_m_s: f32,
+    /// Yaw rate, rad/s, counter-clockwise positive.
+    pub yaw_rate_rad_s: f32,
+    /// How long, s.
+    pub duration_s: f32,
+}
+
+/// Runs `request` to its end: stands up first when the outputs are off (unless the request
+/// is a posture; a sit or rest with the outputs off has nothing to do and returns at once),
+/// starts it, sends the `walk` velocity steps at [`POLL_PERIOD`] (for a walk,
+/// then stops it), and waits until the device is idle. `each` sees every answer.
+///
+/// # Errors
+/// See [`Error`]; a refusal leaves the device as it was (apart from a stand-up first).
+pub fn run<L: Link>(
+    session: &mut Session<L>,
+    request: &engine::Request,
+    walk: &[VelocityStep],
+    limit: Duration,
+    mut each: impl FnMut(&MotionAnswer),
+) -> Result<Summary, Error> {
+    let posture = matches!(
+        request,
+        engine::Request::StandUp | engine::Request::Sit | engine::Request::Rest
+    );
+    let stood_up_first = !posture && session.stand_if_off(limit)?;
+    if posture && !matches!(request, engine::Request::StandUp) {
+        let now = session.get()?;
+        if !now.readback.flags.contains(Flags::OUTPUTS_ENABLED) {
+            return Ok(Summary {
+                motion: "none",
+                stood_up_first: false,
+                motion_s: 0.0,
+                polls: 1,
+                velocity_commands: 0,
+                elapsed_s: 0.0,
+                outputs_enabled: false,
+            });
+        }
+    }
+    let start = session.now();
+    let first = session.start(request)?;
+    each(&first);
+    let mut polls = 0u64;
+    let mut velocity_commands = 0u64;
+    if matches!(request, engine::Request::Walk(_)) {
+        for step in walk {
+            let until = session.now() + Duration::from_secs_f32(step.duration_s);
+            loop {
+                let sent = session.motion(Request::SetVelocity {
+                    forward_m_s: step.forward_m_s,
+                    lateral_m_s: step.lateral_m_s,
+                    yaw_rate_rad_s: step.yaw_rate_rad_s,
+                });
+                let answer = match sent {
+                    Ok(a) => a,
+                    Err(e) => {
+                        // A refused velocity: the walk ends as a stop ends it, then the refusal.
+                        session.motion(Request::StopMotion)?;
+                        session.wait_idle(limit, |_| {})?;
+                        return Err(e);
+                    }
+                };
+                velocity_commands += 1;
+                each(&answer);
+                let now = session.now();
+                if now >= until {
+                    break;
+                }
+                session
+                    .client
+                    .idle_until((now + POLL_PERIOD).min(until))
+                    .map_err(client::Error::from)?;
+            }
+        }
+        each(&session.motion(Request::StopMotion)?);
+    }
+    let last = session.wait_idle(limit, |a| {
+        polls += 1;
+        each(a);
+    })?;
+    Ok(Summary {
+        motion: first.status.kind.map_or("none", kind_name),
+        stood_up_first,
+        motion_s: last.status.t_s.max(first.status.t_s),
+        polls,
+        velocity_commands,
+        elapsed_s: (session.now() - start).as_secs_f64(),
+        outputs_enabled: last.readback.flags.contains(Flags::OUTPUTS_ENABLED),
+    })
+}
+
+/// Whether the device is ramping (approach or leave) rather than running the motion.
+pub fn ramping(status: &MotionStatus) -> bool {
+    matches!(status.stage, MotionStage::Approach | MotionStage::Leave)
+}
+
+/// The teleop's device end ([`crate::ops::drive::Walker`]) on a [`Session`]: a trot or walk
+/// at a body height, velocity commands, stop and sit.
+pub struct SessionWalker<'a, L> {
+    /// The session.
+    pub session: &'a mut Session<L>,
+    /// Trot or walk.
+    pub pattern: kin_core::motion::gait::Pattern,
+    /// How long a stop or a sit may take, link time.
+    pub limit: Duration,
+}
+
+impl<L: Link> crate::ops::drive::Walker for SessionWalker<'_, L> {
+    type State = MotionAnswer;
+    type Error = Error;
+
+    fn start(
+        &mut self,
+        body_height_m: f32,
+    ) -> Result<crate::ops::drive::Answer<MotionAnswer>, Error> {
+        use crate::ops::drive::Answer;
+        self.session.stand_if_off(self.limit)?;
+        let request = engine::Request::Walk(engine::WalkRequest::new(self.pattern, body_height_m));
+        match self.session.start(&request) {
+            Ok(a) => Ok(Answer::Accepted(a)),
+            Err(Error::Refused { reason, .. }) => Ok(Answer::Refused(words(&reason))),
+            Err(e) => Err(e),
+        }
+    }
+
+    fn velocity(
+        &mut self,
+        c: &crate::ops::drive::Command,
+    ) -> Result<crate::ops::drive::Answer<MotionAnswer>, Error> {
+        use crate::ops::drive::Answer;
+        match self.session.motion(Request::SetVelocity {
+            forward_m_s: c.forward_m_s,
+            lateral_m_s: c.lateral_m_s,
+            yaw_rate_rad_s: c.yaw_rate_rad_s,
+        }) {
+            Ok(a) => Ok(Answer::Accepted(a)),
+            Err(Error::Refused { reason, .. }) => Ok(Answer::Refused(words(&reason))),
+            Err(e) => Err(e),
+        }
+    }
+
+    fn stop(&mut self) -> Result<(), Error> {
+        self.session.motion(Request::StopMotion)?;
+        self.session.wait_idle(self.limit, |_| {})?;
+        Ok(())
+    }
+
+    fn sit(&mut self) -> Result<(), Error> {
+        self.stop()?;
+        self.session.start(&engine::Request::Sit)?;
+        self.session.wait_idle(self.limit, |_| {})?;
+        Ok(())
+    }
+
+    fn now(&self) -> Duration {
+        self.session.now()
+    }
+
+    fn idle_until(&mut self, deadline: Duration) -> Result<(), Error> {
+        self.session
+            .client
+            .idle_until(deadline)
+            .map_err(|e| Error::Client(e.into()))
+    }
+}

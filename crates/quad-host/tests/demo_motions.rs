@@ -1,0 +1,44 @@
+//! The onboard tour of `quadctl demo` on the simulated device (the host's own math: every
+//! angle the same bits as the host's kin-core).
+
+use kin_core::Robot;
+use quad_device::Config;
+use quad_host::client::{AngleCheck, Client, ClientConfig};
+use quad_host::link::sim::{SimConfig, SimLink, SimStorage};
+use quad_host::ops::demo_motions;
+use quad_host::ops::onboard::Session;
+use quad_protocol::RobotPreset;
+use std::time::Duration;
+
+#[test]
+fn the_tour_runs_and_every_check_passes_on_the_simulated_device() {
+    let link = SimLink::new(
+        SimConfig::default(),
+        Config::shahriar2023(),
+        SimStorage::erased(),
+    )
+    .unwrap();
+    let client = Client::new(link, ClientConfig::sim(Duration::ZERO));
+    let mut session = Session::connect(client, RobotPreset::Shahriar2023).unwrap();
+    let mut names = Vec::new();
+    let legs = demo_motions::run(
+        &mut session,
+        &Robot::shahriar2023(),
+        AngleCheck::Exact,
+        |n| names.push(n.to_owned()),
+    )
+    .unwrap();
+    assert_eq!(legs.len(), 6, "{names:?}");
+    for leg in &legs {
+        assert_eq!(leg.errors, 0, "{leg:?}");
+        assert!(leg.answers >= 2, "{leg:?}");
+    }
+    // Stand-up and sit end on the host's stance and rest pose; the sways and the turn are
+    // compared at every answer while they run.
+    assert_eq!(legs[0].angles_checked, 1);
+    assert_eq!(legs[5].angles_checked, 1);
+    for leg in &legs[1..4] {
+        assert!(leg.angles_checked >= 30, "{leg:?}");
+        assert_eq!(leg.max_angle_err_rad, 0.0, "{leg:?}");
+    }
+}

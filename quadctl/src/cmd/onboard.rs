@@ -1,0 +1,383 @@
+//! `quadctl stand`, `sit`, `rest` and `run <motion>`: the motions the device runs by itself,
+//! started and followed to their end; a JSON summary as the last line of stdout.
+
+use crate::args::{self, parse_leg, path_kind, RobotArgs, TargetArgs, EXIT_OK};
+use clap::ValueEnum;
+use kin_core::motion::gait::Pattern;
+use kin_core::motion::laws::Axis;
+use kin_core::motion::path::PathKind;
+use kin_core::LegId;
+use quad_device::engine::{self, WalkRequest};
+use quad_host::ops::onboard::{self, Session, VelocityStep};
+use std::io::{self, Write};
+use std::process::ExitCode;
+use std::time::Duration;
+
+/// Longest a command waits for its motion to end, link time.
+const WAIT_LIMIT: Duration = Duration::from_secs(600);
+
+const POSTURE_ABOUT: &str = "\
+The device ramps its joints at its joint-speed limit (3 rad/s by default) and reports when it
+is done. stand: outputs on at the rest pose (legs folded, as a robot lying on the ground),
+then up to the stance; sit: down to the rest pose, held; rest: down to the rest pose, then the
+outputs off. With the outputs off, sit and rest have nothing to do (motion none).
+
+Output: the last line of stdout is one JSON object: motion, stood_up_first, motion_s, polls,
+velocity_commands, elapsed_s, outputs_enabled. Exit status: 0 done; 2 refused (the device's
+reason in words) or the link failed.";
+
+/// `--help`'s examples of `stand`, `sit` and `rest` (run from the repository root).
+pub const STAND_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl stand --robot shahriar2023 --sim
+  quadctl stand --robot shahriar2023 --port /dev/ttyACM0";
+
+/// `quadctl sit --help`'s examples.
+pub const SIT_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl sit --robot shahriar2023 --sim
+  quadctl sit --robot shahriar2023 --port /dev/ttyACM0";
+
+/// `quadctl rest --help`'s examples.
+pub const REST_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl rest --robot shahriar2023 --sim
+  quadctl rest --robot shahriar2023 --port /dev/ttyACM0";
+
+/// Arguments of `quadctl stand`, `sit` and `rest`.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+#[command(long_about = POSTURE_ABOUT)]
+pub struct PostureArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub target: TargetArgs,
+}
+
+/// The onboard motions of `quadctl run`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Motion {
+    /// Seed 001 eq. 6: roll = A·sin(2πt/T), feet fixed.
+    SwayRoll,
+    /// Seed 001 eq. 8: pitch = A·sin(2πt/T), feet fixed.
+    SwayPitch,
+    /// Seed 001 eq. 9-11 (corrected): the crossed pairs step round the body centre.
+    YawTurn,
+    /// Seed 000's foot paths (rectangle by default) on one leg or all four.
+    FootPath,
+    /// Trot: diagonal pairs, from a velocity command.
+    Trot,
+    /// Walk: one leg at a time, from a velocity command.
+    Walk,
+}
+
+const RUN_ABOUT: &str = "\
+Runs one of the device's own motions and waits for its end. When the device's outputs are off
+(a freshly started board), it stands up first.
+
+Parameters (units in the names; every one optional, the defaults are the device's):
+  sway-roll, sway-pitch  --amplitude-rad (0.2) --period-s (20) --duration-s (one period)
+  yaw-turn   --yaw-rate-rad-s (0.085 clockwise = -0.085; counter-clockwise positive, REP 103)
+             --step-period-s (6) --lift-height-m (0.3) --duration-s (one step period)
+  foot-path  --path (rectangle) --leg (all) --stride-m (0.1) --step-height-m (0.05)
+             --duty-factor (1/3) --cycle-s (3) --duration-s (one cycle)
+  trot, walk --body-height-m (the device's stance height) --step-height-m (0.15 x height)
+             --cycle-s (0.8) --velocity-timeout-ms (500) and the velocity --forward-m-s,
+             --lateral-m-s, --yaw-rate-rad-s (0) held for --duration-s (5), then a stop (the
+             strides finish, the feet park on the stance).
+Durations are rounded up to whole periods by the device.
+
+Bad values (NaN, zero or negative periods and durations, amplitudes or heights beyond reach,
+velocities beyond what the gait reaches) are refused by the device before anything moves; the
+refusal names the option. Exit status: 0 done; 2 refused, stopped early or the link failed.";
+
+/// `quadctl run --help`'s examples (run from the repository root).
+pub const RUN_EXAMPLES: &str = "\
+Examples (from the repository root):
+  quadctl run sway-roll --robot shahriar2023 --sim --amplitude-rad 0.1 --period-s 2
+  quadctl run yaw-turn --robot shahriar2023 --sim --yaw-rate-rad-s 0.1 --step-period-s 2 --lift-height-m 0.03
+  quadctl run trot --robot shahriar2023 --sim --forward-m-s 0.02 --duration-s 2
+  quadctl run sway-pitch --robot shahriar2023 --port /dev/ttyACM0";
+
+/// Arguments of `quadctl run`.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+#[command(long_about = RUN_ABOUT, after_help = RUN_EXAMPLES)]
+pub struct RunArgs {
+    /// The motion.
+    #[arg(value_enum)]
+    pub motion: Motion,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub target: TargetArgs,
+    /// Sways: amplitude A, rad.
+    #[arg(long, value_name = "RAD", allow_negative_numbers = true)]
+    pub amplitude_rad: Option<f32>,
+    /// Sways: period T, s.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub period_s: Option<f32>,
+    /// How long, s (sways, yaw-turn, foot-path: rounded up to whole periods; trot, walk: how
+    /// long the velocity is held).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub duration_s: Option<f32>,
+    /// yaw-turn, trot, walk: yaw rate, rad/s, counter-clockwise positive.
+    #[arg(long, value_name = "RAD_S", allow_negative_numbers = true)]
+    pub yaw_rate_rad_s: Option<f32>,
+    /// yaw-turn: step period T1, s.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub step_period_s: Option<f32>,
+    /// yaw-turn: lift h_K, m.
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub lift_height_m: Option<f32>,
+    /// foot-path: the path's shape.
+    #[arg(long, value_parser = path_kind())]
+    pub path: Option<PathKind>,
+    /// foot-path: one leg (FL, FR, RL, RR); default all four.
+    #[arg(long, value_parser = parse_leg)]
+    pub leg: Option<LegId>,
+    /// foot-path: stride, m.
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub stride_m: Option<f32>,
+    /// foot-path, trot, walk: step height, m.
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub step_height_m: Option<f32>,
+    /// foot-path: stance fraction of the loop, in (0, 1).
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
+    pub duty_factor: Option<f32>,
+    /// foot-path, trot, walk: one loop or gait cycle, s.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub cycle_s: Option<f32>,
+    /// trot, walk: body height, m.
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub body_height_m: Option<f32>,
+    /// trot, walk: timeout of the velocity command, ms.
+    #[arg(long, value_name = "MS")]
+    pub velocity_timeout_ms: Option<u16>,
+    /// trot, walk: forward speed, m/s.
+    #[arg(long, value_name = "M_S", allow_negative_numbers = true)]
+    pub forward_m_s: Option<f32>,
+    /// trot, walk: lateral speed (left positive), m/s.
+    #[arg(long, value_name = "M_S", allow_negative_numbers = true)]
+    pub lateral_m_s: Option<f32>,
+}
+
+/// Which options each motion takes.
+fn applies(motion: Motion, option: &str) -> bool {
+    let sway = matches!(motion, Motion::SwayRoll | Motion::SwayPitch);
+    let gait = matches!(motion, Motion::Trot | Motion::Walk);
+    match option {
+        "--amplitude-rad" | "--period-s" => sway,
+        "--duration-s" => true,
+        "--yaw-rate-rad-s" => motion == Motion::YawTurn || gait,
+        "--step-period-s" | "--lift-height-m" => motion == Motion::YawTurn,
+        "--path" | "--leg" | "--stride-m" | "--duty-factor" => motion == Motion::FootPath,
+        "--step-height-m" | "--cycle-s" => motion == Motion::FootPath || gait,
+        _ => gait,
+    }
+}
+
+/// An option given that the motion does not take.
+#[derive(Debug, thiserror::Error)]
+#[error("{option} does not apply to {motion}")]
+struct NotApplicable {
+    option: &'static str,
+    motion: String,
+}
+
+impl RunArgs {
+    fn given(&self) -> Vec<&'static str> {
+        [
+            ("--amplitude-rad", self.amplitude_rad.is_some()),
+            ("--period-s", self.period_s.is_some()),
+            ("--yaw-rate-rad-s", self.yaw_rate_rad_s.is_some()),
+            ("--step-period-s", self.step_period_s.is_some()),
+            ("--lift-height-m", self.lift_height_m.is_some()),
+            ("--path", self.path.is_some()),
+            ("--leg", self.leg.is_some()),
+            ("--stride-m", self.stride_m.is_some()),
+            ("--step-height-m", self.step_height_m.is_some()),
+            ("--duty-factor", self.duty_factor.is_some()),
+            ("--cycle-s", self.cycle_s.is_some()),
+            ("--body-height-m", self.body_height_m.is_some()),
+            ("--velocity-timeout-ms", self.velocity_timeout_ms.is_some()),
+            ("--forward-m-s", self.forward_m_s.is_some()),
+            ("--lateral-m-s", self.lateral_m_s.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(o, g)| g.then_some(o))
+        .collect()
+    }
+
+    /// The device's request with the defaults of `quad_device::engine` and the options given;
+    /// `stance_height_m` is the device's (the walk's default body height).
+    fn request(&self, stance_height_m: f32) -> (engine::Request, Vec<VelocityStep>) {
+        let d = self.duration_s;
+        match self.motion {
+            Motion::SwayRoll | Motion::SwayPitch => {
+                let axis = if self.motion == Motion::SwayRoll {
+                    Axis::Roll
+                } else {
+                    Axis::Pitch
+                };
+                let engine::Request::Sway {
+                    amplitude_rad,
+                    period_s,
+                    ..
+                } = engine::Request::seed001_sway(axis, None)
+                else {
+                    unreachable!("seed001_sway is a sway")
+                };
+                let period_s = self.period_s.unwrap_or(period_s);
+                let request = engine::Request::Sway {
+                    axis,
+                    amplitude_rad: self.amplitude_rad.unwrap_or(amplitude_rad),
+                    period_s,
+                    duration_s: Some(d.unwrap_or(one(period_s))),
+                };
+                (request, Vec::new())
+            }
+            Motion::YawTurn => {
+                let engine::Request::YawTurn {
+                    yaw_rate_rad_s,
+                    step_period_s,
+                    lift_height_m,
+                    ..
+                } = engine::Request::seed001_yaw_turn(None)
+                else {
+                    unreachable!("seed001_yaw_turn is a yaw turn")
+                };
+                let step_period_s = self.step_period_s.unwrap_or(step_period_s);
+                let request = engine::Request::YawTurn {
+                    yaw_rate_rad_s: self.yaw_rate_rad_s.unwrap_or(yaw_rate_rad_s),
+                    step_period_s,
+                    lift_height_m: self.lift_height_m.unwrap_or(lift_height_m),
+                    duration_s: Some(d.unwrap_or(one(step_period_s))),
+                };
+                (request, Vec::new())
+            }
+            Motion::FootPath => {
+                let engine::Request::FootPath {
+                    path,
+                    stride_m,
+                    step_height_m,
+                    duty_factor,
+                    cycle_s,
+                    ..
+                } = engine::Request::seed000_rectangle(None, None)
+                else {
+                    unreachable!("seed000_rectangle is a foot path")
+                };
+                let cycle_s = self.cycle_s.unwrap_or(cycle_s);
+                let request = engine::Request::FootPath {
+                    path: self.path.unwrap_or(path),
+                    leg: self.leg,
+                    stride_m: self.stride_m.unwrap_or(stride_m),
+                    step_height_m: self.step_height_m.unwrap_or(step_height_m),
+                    duty_factor: self.duty_factor.unwrap_or(duty_factor),
+                    cycle_s,
+                    duration_s: Some(d.unwrap_or(one(cycle_s))),
+                };
+                (request, Vec::new())
+            }
+            Motion::Trot | Motion::Walk => {
+                let pattern = if self.motion == Motion::Trot {
+                    Pattern::Trot
+                } else {
+                    Pattern::Walk
+                };
+                let mut w =
+                    WalkRequest::new(pattern, self.body_height_m.unwrap_or(stance_height_m));
+                if let Some(v) = self.step_height_m {
+                    w.step_height_m = v;
+                }
+                if let Some(v) = self.cycle_s {
+                    w.cycle_s = v;
+                }
+                if let Some(v) = self.velocity_timeout_ms {
+                    w.velocity_timeout_ms = v;
+                }
+                let step = VelocityStep {
+                    forward_m_s: self.forward_m_s.unwrap_or(0.0),
+                    lateral_m_s: self.lateral_m_s.unwrap_or(0.0),
+                    yaw_rate_rad_s: self.yaw_rate_rad_s.unwrap_or(0.0),
+                    duration_s: d.unwrap_or(5.0),
+                };
+                (engine::Request::Walk(w), vec![step])
+            }
+        }
+    }
+}
+
+/// The default duration of a periodic motion: one `period_s`, or 1 s when the period itself
+/// is invalid (so that the device's refusal names the period, not the duration).
+fn one(period_s: f32) -> f32 {
+    if period_s.is_finite() && period_s > 0.0 {
+        period_s
+    } else {
+        1.0
+    }
+}
+
+fn finish<L: quad_host::link::Link>(
+    session: &mut Session<L>,
+    request: &engine::Request,
+    walk: &[VelocityStep],
+) -> ExitCode {
+    let summary = match onboard::run(session, request, walk, WAIT_LIMIT, |_| {}) {
+        Ok(s) => s,
+        Err(e) => return args::fail("quadctl", &e),
+    };
+    let json = match serde_json::to_string(&summary) {
+        Ok(j) => j,
+        Err(e) => return args::fail("quadctl", &e),
+    };
+    let mut out = io::stdout().lock();
+    match writeln!(out, "{json}").and_then(|()| out.flush()) {
+        Ok(()) => ExitCode::from(EXIT_OK),
+        Err(e) => args::fail("quadctl", &e),
+    }
+}
+
+fn session(
+    robot: &RobotArgs,
+    target: &TargetArgs,
+) -> Result<Session<Box<dyn quad_host::link::Link>>, onboard::Error> {
+    let preset = quad_protocol::RobotPreset::from_name(robot.robot.trim())
+        .unwrap_or(quad_protocol::RobotPreset::Custom);
+    onboard::open(&robot.robot, &target.target(preset), target.retries)
+}
+
+/// Runs `quadctl stand`, `sit` or `rest` (`request`) and returns its exit status.
+pub fn posture(args: &PostureArgs, request: engine::Request) -> ExitCode {
+    match session(&args.robot, &args.target) {
+        Ok(mut s) => finish(&mut s, &request, &[]),
+        Err(e) => args::fail("quadctl", &e),
+    }
+}
+
+/// Runs `quadctl run` and returns its exit status.
+pub fn run(args: &RunArgs) -> ExitCode {
+    let name = args
+        .motion
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_owned());
+    if let Some(option) = args.given().into_iter().find(|o| !applies(args.motion, o)) {
+        return args::fail(
+            "quadctl",
+            &NotApplicable {
+                option,
+                motion: name,
+            },
+        );
+    }
+    let mut s = match session(&args.robot, &args.target) {
+        Ok(s) => s,
+        Err(e) => return args::fail("quadctl", &e),
+    };
+    let (request, walk) = args.request(s.info().pose_config.stance_height_m);
+    finish(&mut s, &request, &walk)
+}

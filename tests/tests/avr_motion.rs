@@ -1,0 +1,314 @@
+//! The onboard motions of the release firmware in simavr, black box through its UART and its
+//! twelve servo pins: stand-up, a trot with a changing velocity command, seed 001's roll and
+//! pitch sways and yaw turn, and sit. At every servo frame watched: every channel pulses once
+//! per 20 ms period (no missed or late frame), and no joint moves more than the limiter's bound
+//! between two consecutive frames (measured on the pins, through the calibration's gain).
+//!
+//! The trot runs for `QUAD_TROT_S` seconds of emulated time (default [`TROT_S`], bounded for
+//! CI on two cores; `BENCHMARKS.md` has the 60 s figures). All times are simulated.
+
+use kin_core::motion::gait::{GaitParams, Pattern};
+use kin_core::motion::laws::Axis;
+use quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S;
+use quad_host::emu::{build, Pulse, CYCLES_PER_US, PERIOD_CYCLES};
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
+use quad_host::link::Link;
+use quad_protocol::{
+    encode_frame, Accumulator, DeviceToHost, Feed, HostToDevice, MotionCommand, MotionKind,
+    Request, ServoId, MAX_DECODED_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
+};
+use std::time::{Duration, Instant};
+
+/// Default emulated trot, s.
+const TROT_S: f32 = 6.0;
+
+/// A pulse's width is seen up to one simavr step late at each edge; the steps' lengths are
+/// added to the bound, plus one timer tick of rounding of the pulse itself.
+const TICK_US: f64 = 0.5;
+
+/// A servo period may come late by at most this much (the timer runs the frames, the main
+/// loop only updates the compare values), cycles: 50 µs.
+const PERIOD_SLACK_CYCLES: u64 = 50 * CYCLES_PER_US;
+
+struct Rig {
+    link: EmulatorLink,
+    acc: Accumulator<MAX_DECODED_LEN>,
+    seq: u16,
+    answers: Vec<DeviceToHost>,
+    us_per_rad: [f64; 12],
+    /// Last pulse of each channel in the watched run of frames.
+    last: Option<[Pulse; 12]>,
+    frames: u64,
+    late: u64,
+    max_step_rad: f64,
+    max_allowed_rad: f64,
+}
+
+impl Rig {
+    fn boot() -> Rig {
+        let elf = build::firmware_elf(build::FIRMWARE).unwrap_or_else(|e| panic!("{e}"));
+        let link = EmulatorLink::boot(&elf, EmulatorConfig::new(115_200))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut rig = Rig {
+            link,
+            acc: Accumulator::new(),
+            seq: 0,
+            answers: Vec::new(),
+            us_per_rad: [0.0; 12],
+            last: None,
+            frames: 0,
+            late: 0,
+            max_step_rad: 0.0,
+            max_allowed_rad: 0.0,
+        };
+        assert!(matches!(
+            rig.ask(Request::Hello {
+                version: PROTOCOL_VERSION
+            }),
+            DeviceToHost::HelloAck { .. }
+        ));
+        for servo in ServoId::ALL {
+            match rig.ask(Request::GetCalibration { servo }) {
+                DeviceToHost::Calibration { calibration, .. } => {
+                    rig.us_per_rad[servo.index()] = f64::from(calibration.us_per_rad);
+                }
+                other => panic!("{other:?}"),
+            }
+        }
+        rig
+    }
+
+    fn stance_height_m(&mut self) -> f32 {
+        match self.ask(Request::Hello {
+            version: PROTOCOL_VERSION,
+        }) {
+            DeviceToHost::HelloAck { info, .. } => info.pose_config.stance_height_m,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// Sends `request` and watches frames until its answer arrived.
+    fn ask(&mut self, request: Request) -> DeviceToHost {
+        self.seq = self.seq.wrapping_add(1);
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let frame = encode_frame(
+            &HostToDevice {
+                seq: self.seq,
+                request,
+            },
+            &mut buf,
+        )
+        .expect("encodes");
+        self.link.send(frame).expect("send");
+        // A motion start checks its samples (body IK each) before it answers.
+        for _ in 0..250 {
+            self.frame();
+            if let Some(i) = self.answers.iter().position(|a| a.seq() == Some(self.seq)) {
+                return self.answers.remove(i);
+            }
+        }
+        panic!("no answer to {request:?}");
+    }
+
+    /// Watches one servo frame: one pulse per channel, a period after the last, each joint
+    /// within the limiter's bound of its last position; then takes the device's answers.
+    fn frame(&mut self) {
+        let seen = self.link.next_pulses().expect("the MCU runs");
+        let enabled = seen.iter().all(Option::is_some);
+        if enabled {
+            let now: [Pulse; 12] = std::array::from_fn(|c| seen[c].unwrap());
+            if let Some(last) = self.last {
+                self.frames += 1;
+                for c in 0..12 {
+                    let period = now[c].rise_cycle - last[c].rise_cycle;
+                    if period > PERIOD_CYCLES + PERIOD_SLACK_CYCLES {
+                        self.late += 1;
+                    }
+                    let d_us = (now[c].high_cycles as f64 - last[c].high_cycles as f64).abs()
+                        / CYCLES_PER_US as f64;
+                    let slack_us = (now[c].rise_step_cycles
+                        + now[c].fall_step_cycles
+                        + last[c].rise_step_cycles
+                        + last[c].fall_step_cycles) as f64
+                        / CYCLES_PER_US as f64
+                        + TICK_US;
+                    let step = d_us / self.us_per_rad[c];
+                    let allowed = f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02
+                        + slack_us / self.us_per_rad[c];
+                    self.max_step_rad = self.max_step_rad.max(step);
+                    self.max_allowed_rad = self.max_allowed_rad.max(allowed);
+                    assert!(
+                        step <= allowed,
+                        "{:?}: {step} rad in one frame > {allowed}",
+                        ServoId::ALL[c]
+                    );
+                }
+            }
+            self.last = Some(now);
+        } else {
+            self.last = None;
+        }
+        let mut buf = [0u8; 256];
+        let n = self.link.recv(&mut buf, Duration::ZERO).expect("recv");
+        let mut rest = &buf[..n];
+        loop {
+            match self.acc.feed::<DeviceToHost>(rest) {
+                Feed::NeedMore => break,
+                Feed::Frame { msg, remaining } => {
+                    self.answers.push(msg);
+                    rest = remaining;
+                }
+                other => panic!("unreadable answer: {other:?}"),
+            }
+        }
+    }
+
+    fn start(&mut self, m: MotionCommand) {
+        match self.ask(Request::StartMotion(m)) {
+            DeviceToHost::MotionAck { status, .. } => assert!(status.kind.is_some()),
+            other => panic!("{m:?}: {other:?}"),
+        }
+    }
+
+    fn running(&mut self) -> Option<MotionKind> {
+        match self.ask(Request::GetMotion) {
+            DeviceToHost::MotionAck { status, .. } => {
+                assert_eq!(status.fault, None, "the motion stopped early");
+                status.kind
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// Frames until the motion ends (at most `max_s`).
+    fn until_idle(&mut self, max_s: f32) {
+        let max = (max_s * 50.0) as u32;
+        let mut n = 0;
+        while self.running().is_some() {
+            for _ in 0..10 {
+                self.frame();
+            }
+            n += 11;
+            assert!(n < max, "the motion did not end within {max_s} s");
+        }
+    }
+}
+
+#[test]
+fn onboard_stand_up_sways_yaw_turn_and_sit_keep_every_frame_and_the_speed_bound() {
+    let mut rig = Rig::boot();
+    rig.start(MotionCommand::StandUp);
+    rig.until_idle(10.0);
+    for axis in [Axis::Roll, Axis::Pitch] {
+        rig.start(MotionCommand::Sway {
+            axis,
+            amplitude_rad: 0.1,
+            period_s: 2.0,
+            duration_s: Some(2.0),
+        });
+        rig.until_idle(10.0);
+    }
+    rig.start(MotionCommand::YawTurn {
+        yaw_rate_rad_s: 0.085,
+        step_period_s: 2.0,
+        lift_height_m: 0.03,
+        duration_s: Some(2.0),
+    });
+    rig.until_idle(10.0);
+    rig.start(MotionCommand::Sit);
+    rig.until_idle(10.0);
+    eprintln!(
+        "{} frames watched, {} late, max joint step {:.4} rad (bound {:.4} rad + edge slack)",
+        rig.frames,
+        rig.late,
+        rig.max_step_rad,
+        DEFAULT_JOINT_SPEED_LIMIT_RAD_S * 0.02
+    );
+    assert_eq!(rig.late, 0, "late or missed servo frames");
+    assert!(rig.frames > 300);
+    assert!(rig.max_step_rad > 0.5 * f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02);
+}
+
+#[test]
+fn onboard_trot_with_a_changing_velocity_keeps_every_frame_and_the_speed_bound() {
+    let wall = Instant::now();
+    let trot_s: f32 = std::env::var("QUAD_TROT_S")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(TROT_S);
+    let mut rig = Rig::boot();
+    let h = rig.stance_height_m();
+    rig.start(MotionCommand::StandUp);
+    rig.until_idle(10.0);
+
+    rig.start(MotionCommand::Walk {
+        gait: Pattern::Trot,
+        body_height_m: h,
+        step_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * h,
+        cycle_s: GaitParams::DEFAULT_CYCLE_S,
+        velocity_timeout_ms: 500,
+    });
+    let trot_frames_before = rig.frames;
+    let trot_start = rig.link.now();
+    let mut k = 0u32;
+    while (rig.link.now() - trot_start).as_secs_f32() < trot_s {
+        // A velocity command at 10 Hz, changing every second.
+        let phase = (k / 10) % 4;
+        let (vx, wz) = [(0.02, 0.0), (0.03, 0.05), (0.0, -0.08), (-0.02, 0.0)][phase as usize];
+        match rig.ask(Request::SetVelocity {
+            forward_m_s: vx,
+            lateral_m_s: 0.0,
+            yaw_rate_rad_s: wz,
+        }) {
+            DeviceToHost::MotionAck { status, .. } => {
+                assert_eq!(status.kind, Some(MotionKind::Walk))
+            }
+            other => panic!("velocity ({vx}, {wz}): {other:?}"),
+        }
+        for _ in 0..3 {
+            rig.frame();
+        }
+        k += 1;
+    }
+    let trot_frames = rig.frames - trot_frames_before;
+    let trot_late = rig.late;
+    assert!(matches!(
+        rig.ask(Request::StopMotion),
+        DeviceToHost::MotionAck { .. }
+    ));
+    rig.until_idle(10.0);
+
+    for axis in [Axis::Roll, Axis::Pitch] {
+        rig.start(MotionCommand::Sway {
+            axis,
+            amplitude_rad: 0.1,
+            period_s: 2.0,
+            duration_s: Some(2.0),
+        });
+        rig.until_idle(10.0);
+    }
+    rig.start(MotionCommand::YawTurn {
+        yaw_rate_rad_s: 0.085,
+        step_period_s: 2.0,
+        lift_height_m: 0.03,
+        duration_s: Some(2.0),
+    });
+    rig.until_idle(10.0);
+    rig.start(MotionCommand::Sit);
+    rig.until_idle(10.0);
+
+    eprintln!(
+        "trot {trot_s} s emulated: {trot_frames} frames watched, {trot_late} late; all motions: \
+         {} frames watched, {} late, max joint step {:.4} rad (bound {:.4} rad + edge slack, \
+         worst allowed {:.4}); wall {:.1} s",
+        rig.frames,
+        rig.late,
+        rig.max_step_rad,
+        DEFAULT_JOINT_SPEED_LIMIT_RAD_S * 0.02,
+        rig.max_allowed_rad,
+        wall.elapsed().as_secs_f64()
+    );
+    assert_eq!(rig.late, 0, "late or missed servo frames");
+    assert!(trot_frames as f32 >= 0.9 * trot_s * 50.0 * 0.75);
+    assert!(rig.max_step_rad > 0.5 * f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02);
+}
