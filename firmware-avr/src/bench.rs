@@ -143,8 +143,9 @@ impl MotionBench for NoMotion {
 }
 
 /// The device's motion engine on backend `M` with the firmware's configuration.
-pub struct EngineBench<M> {
+pub struct EngineBench<M: Math> {
     config: Config,
+    solver: body::Solver<M>,
     calibration: Table,
     engine: Engine<M>,
     out: [f32; 12],
@@ -162,6 +163,7 @@ impl<M: Math> EngineBench<M> {
         });
         let out = calibration.map(|c| c.zero_rad);
         EngineBench {
+            solver: body::Solver::with_math(&config.robot),
             config,
             calibration,
             engine: Engine::new(limiter),
@@ -173,7 +175,7 @@ impl<M: Math> EngineBench<M> {
 
     fn tick(&mut self) -> Stage {
         self.now_ms += FRAME_MS;
-        let tick = self.engine.tick(1, self.now_ms, &self.out);
+        let tick = self.engine.tick(1, self.now_ms, &self.out, &self.solver);
         if let Some(target) = tick.target {
             self.engine.limiter().step(&mut self.out, &target);
         }
@@ -218,6 +220,7 @@ impl<M: Math> MotionBench for EngineBench<M> {
         };
         let setup = Setup {
             robot: &self.config.robot,
+            solver: &self.solver,
             stance_height_m: h,
             order: self.config.pose_config.order,
             calibration: &self.calibration,

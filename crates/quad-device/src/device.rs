@@ -316,7 +316,7 @@ where
         self.enabling_frame = false;
         let mut disable = false;
         if self.engine.is_active() {
-            let tick = self.engine.tick(frames, now, &self.out_rad);
+            let tick = self.engine.tick(frames, now, &self.out_rad, &self.solver);
             if let Some(q) = tick.target {
                 if let Err(e) = self.hold_motion_target(q) {
                     self.engine.fail(e, self.out_rad);
@@ -363,6 +363,7 @@ where
     pub fn start_motion(&mut self, request: &engine::Request) -> Result<(), engine::Error> {
         let setup = Setup {
             robot: &self.config.robot,
+            solver: &self.solver,
             stance_height_m: self.config.pose_config.stance_height_m,
             order: self.config.pose_config.order,
             calibration: &self.calibration,

@@ -84,7 +84,7 @@ pub use limiter::{Limiter, Ramp, DEFAULT_JOINT_SPEED_LIMIT_RAD_S};
 use crate::store::Table;
 use core::fmt;
 use core::marker::PhantomData;
-use kin_core::body::{BodyConfig, Pose};
+use kin_core::body::{self, BodyConfig, Pose};
 use kin_core::jacobian::SINGULARITY_THRESHOLD;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
@@ -92,9 +92,7 @@ use kin_core::motion::path::{AnyPath, PathKind, Stride};
 use kin_core::motion::walker::{Walker, WalkerParams};
 use kin_core::motion::{self, AnyMotion, Frame, Motion, Param};
 use kin_core::preflight::{Failure, FailureKind};
-use kin_core::{
-    leg, IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3,
-};
+use kin_core::{IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder};
 use quad_protocol::servo;
 use quad_protocol::ServoId;
 
@@ -351,9 +349,12 @@ pub struct Status {
 
 /// What the robot and the device are set up with, for starting a motion.
 #[derive(Debug, Clone, Copy)]
-pub struct Setup<'a> {
+pub struct Setup<'a, M: Math> {
     /// The robot.
     pub robot: &'a Robot,
+    /// The body IK of `robot`: the device's one solver, whose per-leg constants are computed
+    /// once, at boot.
+    pub solver: &'a body::Solver<M>,
     /// Stance height, m.
     pub stance_height_m: f32,
     /// Rotation order of the poses.
@@ -379,9 +380,9 @@ pub struct Tick {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Law {
     motion: AnyMotion,
-    /// Legs that follow the motion; the others stay at their stance point.
+    /// Legs that follow the motion; the others stay at their stance point (the foot paths'
+    /// only: the other laws move every leg).
     legs: [bool; 4],
-    stance_feet: [Vec3; 4],
     period_s: f32,
     end_frame: Option<u32>,
 }
@@ -445,15 +446,15 @@ pub fn rest_angles(robot: &Robot) -> Result<[f32; 12], Error> {
     Ok(out)
 }
 
-/// The body IK of one motion frame (poses in rotation order `order`, about the body centre):
-/// the device's one body IK ([`crate::config`]'s, which `SetBodyPose` and `SetFeet` use), so
-/// the firmware holds one copy of it.
+/// The body IK of one motion frame (poses in rotation order `order`, about the body centre)
+/// through `solver`, the device's one body solver (the one `SetBodyPose` and `SetFeet` use),
+/// so the firmware holds one copy of it and computes its constants once.
 pub fn solve_frame<M: Math>(
-    robot: &Robot,
+    solver: &body::Solver<M>,
     order: RotationOrder,
     frame: &Frame,
 ) -> Result<[f32; 12], IkError> {
-    kin_core::body::Solver::<M>::with_math(robot)
+    solver
         .inverse(
             &frame.pose,
             &BodyConfig::about_centre(order),
@@ -475,13 +476,13 @@ pub fn check_travel(calibration: &Table, angles: &[f32; 12]) -> Result<(), Error
 
 /// The stance angles of a setup: the nominal stance at its height, zero pose.
 #[inline(never)]
-fn stance_angles<M: Math>(s: &Setup<'_>) -> Result<[f32; 12], Error> {
+fn stance_angles<M: Math>(s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
     let frame = Frame {
         pose: Pose::default(),
         feet_in_world: s.robot.stance_feet(s.stance_height_m),
         contact: [motion::Contact::Stance; 4],
     };
-    let q = solve_frame::<M>(s.robot, s.order, &frame).map_err(Error::Ik)?;
+    let q = solve_frame(s.solver, s.order, &frame).map_err(Error::Ik)?;
     check_travel(s.calibration, &q)?;
     Ok(q)
 }
@@ -492,7 +493,7 @@ fn stance_angles<M: Math>(s: &Setup<'_>) -> Result<[f32; 12], Error> {
 /// it passes.
 #[inline(never)]
 fn check_sample<M: Math>(
-    s: &Setup<'_>,
+    s: &Setup<'_, M>,
     sample: u16,
     t_s: f32,
     solved: Result<[f32; 12], IkError>,
@@ -511,7 +512,7 @@ fn check_sample<M: Math>(
     if !singularity {
         return Ok(q);
     }
-    let solver = leg::Solver::<M>::with_math(s.robot);
+    let solver = s.solver.leg();
     for (&leg, a) in LegId::ALL.iter().zip(q.chunks_exact(3)) {
         let ic = solver.inverse_condition(leg, JointAngles::new(a[0], a[1], a[2]));
         if !(ic >= SINGULARITY_THRESHOLD) {
@@ -527,82 +528,99 @@ fn check_sample<M: Math>(
 }
 
 /// The kin-core motion of a law request (its parameters checked, not its reach: the start
-/// check does that), the legs it moves and its duration.
-#[inline(never)]
-fn law_motion<M: Math>(
-    request: &Request,
-    s: &Setup<'_>,
-) -> Result<(AnyMotion, [bool; 4], Option<f32>), Error> {
-    let robot = *s.robot;
-    let stance = robot.stance_feet(s.stance_height_m);
-    let (motion, legs, d) = match *request {
+/// check does that).
+///
+/// One builder per law, each out of line: a law's parameters are a hundred bytes and more,
+/// and the three sets in one stack frame would put most of its accesses beyond the AVR's
+/// 63-byte displacement.
+fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<AnyMotion, Error> {
+    match *request {
         Request::Sway {
             axis,
             amplitude_rad,
             period_s,
-            duration_s,
-        } => {
-            let d = duration(duration_s)?;
-            let sway = laws::Sway::without_reach_check(laws::SwayParams {
-                robot,
-                axis,
-                amplitude_rad,
-                period_s,
-                roll0_rad: 0.0,
-                pitch0_rad: 0.0,
-                yaw0_rad: 0.0,
-                order: s.order,
-                feet_in_world: stance,
-            })?;
-            (AnyMotion::Sway(sway), [true; 4], d)
-        }
+            ..
+        } => sway_motion(axis, amplitude_rad, period_s, s),
         Request::YawTurn {
             yaw_rate_rad_s,
             step_period_s,
             lift_height_m,
-            duration_s,
-        } => {
-            let d = duration(duration_s)?;
-            let turn = laws::YawTurn::without_reach_check::<M>(laws::YawTurnParams {
-                robot,
-                yaw_rate_rad_s,
-                step_period_s,
-                lift_height_m,
-                yaw0_rad: 0.0,
-                roll0_rad: 0.0,
-                pitch0_rad: 0.0,
-                order: s.order,
-                stance_feet: stance,
-            })?;
-            (AnyMotion::YawTurn(turn), [true; 4], d)
-        }
+            ..
+        } => yaw_turn_motion(yaw_rate_rad_s, step_period_s, lift_height_m, s),
         Request::FootPath {
             path,
-            leg,
             stride_m,
             step_height_m,
             duty_factor,
             cycle_s,
-            duration_s,
+            ..
         } => {
-            let d = duration(duration_s)?;
             let stride = Stride::new(stride_m, step_height_m, duty_factor)?;
-            let paths = laws::LegPaths::without_reach_check(laws::LegPathsParams {
-                robot,
-                path: AnyPath::new(path, stride),
-                cycle_s,
-                phase_offsets: [0.0; 4],
-                stance_feet: stance,
-            })?;
-            let legs = match leg {
-                None => [true; 4],
-                Some(l) => LegId::ALL.map(|x| x == l),
-            };
-            (AnyMotion::LegPaths(paths), legs, d)
+            leg_paths_motion(AnyPath::new(path, stride), cycle_s, s)
         }
-        _ => return Err(Error::Busy),
-    };
-    Ok((motion, legs, d))
+        _ => Err(Error::Busy),
+    }
+}
+
+#[inline(never)]
+fn sway_motion<M: Math>(
+    axis: Axis,
+    amplitude_rad: f32,
+    period_s: f32,
+    s: &Setup<'_, M>,
+) -> Result<AnyMotion, Error> {
+    Ok(AnyMotion::Sway(laws::Sway::without_reach_check(
+        laws::SwayParams {
+            robot: *s.robot,
+            axis,
+            amplitude_rad,
+            period_s,
+            roll0_rad: 0.0,
+            pitch0_rad: 0.0,
+            yaw0_rad: 0.0,
+            order: s.order,
+            feet_in_world: s.robot.stance_feet(s.stance_height_m),
+        },
+    )?))
+}
+
+#[inline(never)]
+fn yaw_turn_motion<M: Math>(
+    yaw_rate_rad_s: f32,
+    step_period_s: f32,
+    lift_height_m: f32,
+    s: &Setup<'_, M>,
+) -> Result<AnyMotion, Error> {
+    Ok(AnyMotion::YawTurn(laws::YawTurn::without_reach_check::<M>(
+        laws::YawTurnParams {
+            robot: *s.robot,
+            yaw_rate_rad_s,
+            step_period_s,
+            lift_height_m,
+            yaw0_rad: 0.0,
+            roll0_rad: 0.0,
+            pitch0_rad: 0.0,
+            order: s.order,
+            stance_feet: s.robot.stance_feet(s.stance_height_m),
+        },
+    )?))
+}
+
+#[inline(never)]
+fn leg_paths_motion<M: Math>(
+    path: AnyPath,
+    cycle_s: f32,
+    s: &Setup<'_, M>,
+) -> Result<AnyMotion, Error> {
+    Ok(AnyMotion::LegPaths(laws::LegPaths::without_reach_check(
+        laws::LegPathsParams {
+            robot: *s.robot,
+            path,
+            cycle_s,
+            phase_offsets: [0.0; 4],
+            stance_feet: s.robot.stance_feet(s.stance_height_m),
+        },
+    )?))
 }
 
 /// Whole frames from 0 to the first period boundary at or after `t_s`.
@@ -674,7 +692,7 @@ impl<M: Math> Engine<M> {
     /// every check passed: a program is a few hundred bytes, and each copy of it on the way
     /// would be a stack frame beyond the AVR's 63-byte displacement.
     #[inline(never)]
-    pub fn start(&mut self, request: &Request, setup: &Setup<'_>) -> Result<[f32; 12], Error> {
+    pub fn start(&mut self, request: &Request, setup: &Setup<'_, M>) -> Result<[f32; 12], Error> {
         if self.is_active() {
             return Err(Error::Busy);
         }
@@ -723,7 +741,7 @@ impl<M: Math> Engine<M> {
     /// then start from a small stack frame, not from one that holds the builder's copies of
     /// the motion's parameters.
     #[inline(never)]
-    fn law(request: &Request, s: &Setup<'_>, program: &mut Program) -> Result<[f32; 12], Error> {
+    fn law(request: &Request, s: &Setup<'_, M>, program: &mut Program) -> Result<[f32; 12], Error> {
         Self::build_law(request, s, program)?;
         let checked = match program {
             Program::Law(law) => Self::check_law(law, s),
@@ -736,13 +754,28 @@ impl<M: Math> Engine<M> {
     }
 
     #[inline(never)]
-    fn build_law(request: &Request, s: &Setup<'_>, program: &mut Program) -> Result<(), Error> {
-        let (motion, legs, d) = law_motion::<M>(request, s)?;
+    fn build_law(request: &Request, s: &Setup<'_, M>, program: &mut Program) -> Result<(), Error> {
+        let (legs, d) = match *request {
+            Request::Sway { duration_s, .. } | Request::YawTurn { duration_s, .. } => {
+                ([true; 4], duration_s)
+            }
+            Request::FootPath {
+                leg, duration_s, ..
+            } => (
+                match leg {
+                    None => [true; 4],
+                    Some(l) => LegId::ALL.map(|x| x == l),
+                },
+                duration_s,
+            ),
+            _ => return Err(Error::Busy),
+        };
+        let d = duration(d)?;
+        let motion = law_motion::<M>(request, s)?;
         let period_s = motion.period_s().unwrap_or(1.0);
         *program = Program::Law(Law {
             motion,
             legs,
-            stance_feet: s.robot.stance_feet(s.stance_height_m),
             period_s,
             end_frame: d.map(|d| frames_to_boundary(d, period_s).max(1)),
         });
@@ -750,12 +783,12 @@ impl<M: Math> Engine<M> {
     }
 
     #[inline(never)]
-    fn check_law(law: &Law, s: &Setup<'_>) -> Result<[f32; 12], Error> {
-        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(law, 0.0), true)?;
+    fn check_law(law: &Law, s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
+        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(law, 0.0, s.solver), true)?;
         let n = START_CHECK_SAMPLES;
         for k in 1..n {
             let t = law.period_s * f32::from(k) / f32::from(n);
-            check_sample::<M>(s, k, t, Self::law_setpoint(law, t), true)?;
+            check_sample::<M>(s, k, t, Self::law_setpoint(law, t, s.solver), true)?;
         }
         Ok(first)
     }
@@ -763,7 +796,7 @@ impl<M: Math> Engine<M> {
     /// Builds a walk into `program` and runs its start check there (as [`Engine::law`]); a
     /// refusal leaves `program` idle. Its first setpoint.
     #[inline(never)]
-    fn walk(w: &WalkRequest, s: &Setup<'_>, program: &mut Program) -> Result<[f32; 12], Error> {
+    fn walk(w: &WalkRequest, s: &Setup<'_, M>, program: &mut Program) -> Result<[f32; 12], Error> {
         Self::build_walk(w, s, program)?;
         let checked = match program {
             Program::Walk { walker, .. } => Self::check_walk(walker, s),
@@ -776,7 +809,7 @@ impl<M: Math> Engine<M> {
     }
 
     #[inline(never)]
-    fn build_walk(w: &WalkRequest, s: &Setup<'_>, program: &mut Program) -> Result<(), Error> {
+    fn build_walk(w: &WalkRequest, s: &Setup<'_, M>, program: &mut Program) -> Result<(), Error> {
         if w.velocity_timeout_ms == 0 {
             return Err(motion::Error::NotPositive(Param::VelocityTimeoutMs).into());
         }
@@ -793,15 +826,15 @@ impl<M: Math> Engine<M> {
     }
 
     #[inline(never)]
-    fn check_walk(walker: &Walker, s: &Setup<'_>) -> Result<[f32; 12], Error> {
-        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(walker), true)?;
+    fn check_walk(walker: &Walker, s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
+        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(walker, s.solver), true)?;
         for k in 0..Walker::ENVELOPE_SAMPLES {
             let frame = Frame {
                 pose: Pose::default(),
                 feet_in_world: walker.envelope(k),
                 contact: [motion::Contact::Stance; 4],
             };
-            let solved = solve_frame::<M>(s.robot, s.order, &frame);
+            let solved = solve_frame(s.solver, s.order, &frame);
             // Sample 0 is the first frame; the envelope's points follow, without the
             // singularity measure (see the module docs).
             check_sample::<M>(s, k as u16 + 1, 0.0, solved, false)?;
@@ -809,42 +842,39 @@ impl<M: Math> Engine<M> {
         Ok(first)
     }
 
-    /// The law's frame at `t_s`: the motion's frame with the legs it does not move at their
-    /// stance points.
+    /// The law's joint setpoint at `t_s`: the motion's frame, with the legs it does not move
+    /// at their stance points, through the body IK.
     #[inline(never)]
-    fn law_frame(law: &Law, t_s: f32) -> Result<Frame, Error> {
+    fn law_setpoint(law: &Law, t_s: f32, solver: &body::Solver<M>) -> Result<[f32; 12], IkError> {
         // The engine's law motions only: matching them keeps the gait's frame code out of the
         // firmware.
-        let mut f = match &law.motion {
+        let frame = match &law.motion {
             AnyMotion::Sway(m) => m.frame::<M>(t_s),
             AnyMotion::YawTurn(m) => m.frame::<M>(t_s),
-            AnyMotion::LegPaths(m) => m.frame::<M>(t_s),
+            AnyMotion::LegPaths(m) => m.frame::<M>(t_s).map(|mut f| {
+                let stance = &m.params().stance_feet;
+                for (i, moves) in law.legs.iter().enumerate() {
+                    if !moves {
+                        f.feet_in_world[i] = stance[i];
+                        f.contact[i] = motion::Contact::Stance;
+                    }
+                }
+                f
+            }),
             _ => Err(motion::Error::NonFinite(Param::TS)),
-        }?;
-        for (i, moves) in law.legs.iter().enumerate() {
-            if !moves {
-                f.feet_in_world[i] = law.stance_feet[i];
-                f.contact[i] = motion::Contact::Stance;
-            }
-        }
-        Ok(f)
-    }
-
-    /// The law's joint setpoint at `t_s`.
-    #[inline(never)]
-    fn law_setpoint(law: &Law, t_s: f32) -> Result<[f32; 12], IkError> {
-        let frame = Self::law_frame(law, t_s).map_err(|_| IkError {
+        };
+        let frame = frame.map_err(|_| IkError {
             leg: LegId::FL,
             kind: kin_core::Unreachable::NonFinite,
         })?;
-        solve_frame::<M>(law.motion.robot(), law.motion.body_config().order, &frame)
+        solve_frame(solver, law.motion.body_config().order, &frame)
     }
 
     /// The walk's joint setpoint at its current frame.
     #[inline(never)]
-    fn walk_setpoint(walker: &Walker) -> Result<[f32; 12], IkError> {
+    fn walk_setpoint(walker: &Walker, solver: &body::Solver<M>) -> Result<[f32; 12], IkError> {
         let p = walker.params();
-        solve_frame::<M>(&p.robot, p.order, &walker.frame())
+        solve_frame(solver, p.order, &walker.frame())
     }
 
     /// Sets a walk's velocity command at `now_ms`.
@@ -929,13 +959,20 @@ impl<M: Math> Engine<M> {
         }
     }
 
-    /// One tick after `frames` (≥ 1) frame boundaries, at `now_ms`, with the outputs at `out`:
-    /// the new target, if any.
+    /// One tick after `frames` (≥ 1) frame boundaries, at `now_ms`, with the outputs at `out`,
+    /// the motion's frames solved by `solver` (the [`Setup::solver`] it started with): the new
+    /// target, if any.
     ///
     /// Out of line, as are the law's frame and setpoint and the walker's steps: each keeps its
     /// own small stack frame (see `Device`'s notes on AVR stack frames).
     #[inline(never)]
-    pub fn tick(&mut self, frames: u32, now_ms: u32, out: &[f32; 12]) -> Tick {
+    pub fn tick(
+        &mut self,
+        frames: u32,
+        now_ms: u32,
+        out: &[f32; 12],
+        solver: &body::Solver<M>,
+    ) -> Tick {
         let mut tick = Tick {
             target: None,
             disable_outputs: false,
@@ -976,7 +1013,7 @@ impl<M: Math> Engine<M> {
                             frame = e;
                         }
                         self.frame = frame;
-                        let q = Self::law_setpoint(law, frame as f32 * FRAME_S);
+                        let q = Self::law_setpoint(law, frame as f32 * FRAME_S, solver);
                         (q, end.is_some())
                     }
                     Program::Walk {
@@ -993,7 +1030,7 @@ impl<M: Math> Engine<M> {
                             let _ = walker.step::<M>(FRAME_S);
                         }
                         self.frame = self.frame.saturating_add(frames);
-                        (Self::walk_setpoint(walker), walker.is_stopped())
+                        (Self::walk_setpoint(walker, solver), walker.is_stopped())
                     }
                     _ => {
                         self.cancel();
