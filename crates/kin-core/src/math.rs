@@ -39,6 +39,13 @@ pub trait Math {
     /// The results are the same, bit for bit.
     const STAGE_LEGS: bool = true;
 
+    /// Whether code that can take either shape keeps one copy of its float operations, with
+    /// run-time indices, rather than a copy specialised to each case (the rotation matrix of
+    /// the six orders: [`crate::rotation::matrix`]): true where every float operation is a
+    /// library call and its code counts (a soft-float target's flash), false where the
+    /// specialised copies run faster. The results are the same, bit for bit.
+    const SHARE_FLOAT_CODE: bool = false;
+
     /// Square root; the argument is never negative when called from this crate.
     fn sqrt(x: f32) -> f32;
     /// Four-quadrant arctangent of `y / x`, in `[-π, π]`; `atan2(0, 0)` must be finite.
@@ -233,6 +240,7 @@ impl Math for Fast {
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
 /// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false);
+/// - one copy of the float code where the crate has the choice ([`Math::SHARE_FLOAT_CODE`]);
 /// - the kernels' tables read by `S` ([`Math::read_table_cell`]): a
 ///   plain load for `Libm`; from flash for the firmware's `AvrLibm`, on the AVR, where the
 ///   tables are linked into flash ([`TABLES_IN_PROGRAM_MEMORY`]).
@@ -244,6 +252,7 @@ pub struct SoftFloat<S: Math = Libm>(PhantomData<S>);
 
 impl<S: Math> Math for SoftFloat<S> {
     const STAGE_LEGS: bool = false;
+    const SHARE_FLOAT_CODE: bool = true;
 
     #[inline]
     fn sqrt(x: f32) -> f32 {

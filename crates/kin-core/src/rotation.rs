@@ -52,6 +52,14 @@ impl RotationOrder {
         }
     }
 
+    /// True for the cyclic orders (`xyz`, `yzx`, `zxy`): the even permutations of the axes.
+    const fn is_even(self) -> bool {
+        matches!(
+            self,
+            RotationOrder::Xyz | RotationOrder::Yzx | RotationOrder::Zxy
+        )
+    }
+
     /// Lower-case name: `xyz`, …, `zyx`.
     pub const fn name(self) -> &'static str {
         match self {
@@ -125,7 +133,9 @@ fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32)
 /// Body rotation matrix for `roll`, `pitch`, `yaw` (rad) in `order`, on backend `M`
 /// (`rotation::matrix::<kin_core::DefaultMath>(…)` on a host): three `sin_cos`, then the
 /// closed form of the order — written out entry by entry for the papers' orders ([`zyx`],
-/// [`zxy`]), from the general Tait–Bryan closed form for the other four.
+/// [`zxy`]), from the general Tait–Bryan closed form for the other four; on a backend that
+/// shares its float code ([`Math::SHARE_FLOAT_CODE`]), the general closed form with the
+/// order's axes at run time for all six. The same matrix either way, bit for bit.
 ///
 /// ```
 /// use kin_core::{rotation::{self, RotationOrder}, DefaultMath, Mat3};
@@ -140,8 +150,19 @@ fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32)
 pub fn matrix<M: Math>(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
     // The three `sin_cos` once, ahead of the order's arm: one copy of the kernels, not one per
     // arm. One arm per order with the axes as constants, so that each compiles to its own
-    // closed form without index arithmetic.
+    // closed form without index arithmetic; where float operations are library calls, one
+    // closed form instead, whose index arithmetic costs less than five more copies of them.
     let sc = sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
+    if M::SHARE_FLOAT_CODE {
+        let [i, j, k] = order.axes();
+        return closed_form(
+            usize::from(i),
+            usize::from(j),
+            usize::from(k),
+            order.is_even(),
+            &sc,
+        );
+    }
     match order {
         RotationOrder::Zyx => zyx_of(&sc),
         RotationOrder::Zxy => zxy_of(&sc),
