@@ -119,6 +119,24 @@ impl Stride {
     fn stance(&self, u: f32) -> Vec3 {
         Vec3::new(self.length_m * (0.5 - u), 0.0, 0.0)
     }
+
+    /// The offset at `phase`: the stance, or the swing shape `swing` at swing progress `s`.
+    /// One copy of the split and the stance for every shape (a path chosen at run time
+    /// matches only its swing).
+    #[inline(always)]
+    fn offset(&self, phase: Phase, swing: impl FnOnce(f32) -> Vec3) -> Vec3 {
+        match self.split(phase) {
+            Part::Stance(u) => self.stance(u),
+            Part::Swing(s) => swing(s),
+        }
+    }
+}
+
+/// Half-ellipse swing at progress `s`: `(−a·cos πs, 0, b·sin πs)` (the semicircle is `a = b`).
+#[inline(always)]
+fn half_ellipse<M: Math>(a: f32, b: f32, s: f32) -> Vec3 {
+    let (sn, cs) = M::sin_cos(PI * s);
+    Vec3::new(-(a * cs), 0.0, b * sn)
 }
 
 enum Part {
@@ -163,24 +181,25 @@ impl Rectangle {
     }
 }
 
+impl Rectangle {
+    fn swing(&self, s: f32) -> Vec3 {
+        let (l, h) = (self.stride.length_m, self.stride.height_m);
+        let total = 2.0 * h + l;
+        let a = s * total;
+        if a < h {
+            Vec3::new(-0.5 * l, 0.0, a)
+        } else if a < h + l {
+            Vec3::new(-0.5 * l + (a - h), 0.0, h)
+        } else {
+            let down = a - h - l;
+            Vec3::new(0.5 * l, 0.0, if down < h { h - down } else { 0.0 })
+        }
+    }
+}
+
 impl FootPath for Rectangle {
     fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
-        let (l, h) = (self.stride.length_m, self.stride.height_m);
-        match self.stride.split(phase) {
-            Part::Stance(u) => self.stride.stance(u),
-            Part::Swing(s) => {
-                let total = 2.0 * h + l;
-                let a = s * total;
-                if a < h {
-                    Vec3::new(-0.5 * l, 0.0, a)
-                } else if a < h + l {
-                    Vec3::new(-0.5 * l + (a - h), 0.0, h)
-                } else {
-                    let down = a - h - l;
-                    Vec3::new(0.5 * l, 0.0, if down < h { h - down } else { 0.0 })
-                }
-            }
-        }
+        self.stride.offset(phase, |s| self.swing(s))
     }
 
     fn duty_factor(&self) -> f32 {
@@ -214,16 +233,16 @@ impl Semicircle {
     }
 }
 
+impl Semicircle {
+    fn swing<M: Math>(&self, s: f32) -> Vec3 {
+        let r = 0.5 * self.stride.length_m;
+        half_ellipse::<M>(r, r, s)
+    }
+}
+
 impl FootPath for Semicircle {
     fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
-        match self.stride.split(phase) {
-            Part::Stance(u) => self.stride.stance(u),
-            Part::Swing(s) => {
-                let r = 0.5 * self.stride.length_m;
-                let (sn, cs) = M::sin_cos(PI * s);
-                Vec3::new(-r * cs, 0.0, r * sn)
-            }
-        }
+        self.stride.offset(phase, |s| self.swing::<M>(s))
     }
 
     fn duty_factor(&self) -> f32 {
@@ -254,19 +273,15 @@ impl Ellipse {
     }
 }
 
+impl Ellipse {
+    fn swing<M: Math>(&self, s: f32) -> Vec3 {
+        half_ellipse::<M>(0.5 * self.stride.length_m, self.stride.height_m, s)
+    }
+}
+
 impl FootPath for Ellipse {
     fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
-        match self.stride.split(phase) {
-            Part::Stance(u) => self.stride.stance(u),
-            Part::Swing(s) => {
-                let (sn, cs) = M::sin_cos(PI * s);
-                Vec3::new(
-                    -0.5 * self.stride.length_m * cs,
-                    0.0,
-                    self.stride.height_m * sn,
-                )
-            }
-        }
+        self.stride.offset(phase, |s| self.swing::<M>(s))
     }
 
     fn duty_factor(&self) -> f32 {
@@ -298,20 +313,21 @@ impl Cycloid {
     }
 }
 
+impl Cycloid {
+    fn swing<M: Math>(&self, s: f32) -> Vec3 {
+        let (sn, cs) = M::sin_cos(2.0 * PI * s);
+        let l = self.stride.length_m;
+        Vec3::new(
+            l * (s - sn / (2.0 * PI)) - 0.5 * l,
+            0.0,
+            0.5 * self.stride.height_m * (1.0 - cs),
+        )
+    }
+}
+
 impl FootPath for Cycloid {
     fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
-        match self.stride.split(phase) {
-            Part::Stance(u) => self.stride.stance(u),
-            Part::Swing(s) => {
-                let (sn, cs) = M::sin_cos(2.0 * PI * s);
-                let l = self.stride.length_m;
-                Vec3::new(
-                    l * (s - sn / (2.0 * PI)) - 0.5 * l,
-                    0.0,
-                    0.5 * self.stride.height_m * (1.0 - cs),
-                )
-            }
-        }
+        self.stride.offset(phase, |s| self.swing::<M>(s))
     }
 
     fn duty_factor(&self) -> f32 {
@@ -368,30 +384,31 @@ impl Bezier {
     }
 }
 
+impl Bezier {
+    fn swing(&self, s: f32) -> Vec3 {
+        let r = 1.0 - s;
+        let (s2, r2) = (s * s, r * r);
+        let b = [
+            r2 * r2 * r,
+            5.0 * s * r2 * r2,
+            10.0 * s2 * r2 * r,
+            10.0 * s2 * s * r2,
+            5.0 * s2 * s2 * r,
+            s2 * s2 * s,
+        ];
+        let p = self.control_points();
+        let (mut x, mut z) = (0.0, 0.0);
+        for (w, (px, pz)) in b.iter().zip(p) {
+            x += w * px;
+            z += w * pz;
+        }
+        Vec3::new(x, 0.0, z)
+    }
+}
+
 impl FootPath for Bezier {
     fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
-        match self.stride.split(phase) {
-            Part::Stance(u) => self.stride.stance(u),
-            Part::Swing(s) => {
-                let r = 1.0 - s;
-                let (s2, r2) = (s * s, r * r);
-                let b = [
-                    r2 * r2 * r,
-                    5.0 * s * r2 * r2,
-                    10.0 * s2 * r2 * r,
-                    10.0 * s2 * s * r2,
-                    5.0 * s2 * s2 * r,
-                    s2 * s2 * s,
-                ];
-                let p = self.control_points();
-                let (mut x, mut z) = (0.0, 0.0);
-                for (w, (px, pz)) in b.iter().zip(p) {
-                    x += w * px;
-                    z += w * pz;
-                }
-                Vec3::new(x, 0.0, z)
-            }
-        }
+        self.stride.offset(phase, |s| self.swing(s))
     }
 
     fn duty_factor(&self) -> f32 {
@@ -507,13 +524,13 @@ impl AnyPath {
 
 impl FootPath for AnyPath {
     fn offset<M: Math>(&self, phase: Phase) -> Vec3 {
-        match self {
-            AnyPath::Rectangle(p) => p.offset::<M>(phase),
-            AnyPath::Semicircle(p) => p.offset::<M>(phase),
-            AnyPath::Ellipse(p) => p.offset::<M>(phase),
-            AnyPath::Cycloid(p) => p.offset::<M>(phase),
-            AnyPath::Bezier(p) => p.offset::<M>(phase),
-        }
+        self.stride().offset(phase, |s| match self {
+            AnyPath::Rectangle(p) => p.swing(s),
+            AnyPath::Semicircle(p) => p.swing::<M>(s),
+            AnyPath::Ellipse(p) => p.swing::<M>(s),
+            AnyPath::Cycloid(p) => p.swing::<M>(s),
+            AnyPath::Bezier(p) => p.swing(s),
+        })
     }
 
     fn duty_factor(&self) -> f32 {
