@@ -394,26 +394,21 @@ impl Robot {
     /// Checks lengths and limits: femur and tibia > 0, offsets ≥ 0, body sizes ≥ 0, limits
     /// finite with min ≤ max.
     pub fn validate(&self) -> Result<(), RobotError> {
-        let pos = |v: f32, name| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(RobotError::BadLength(name))
+        // One check over a table of the lengths (`true`: zero allowed), not one inlined copy
+        // per length: on a soft-float target each copy is its own library calls.
+        let lengths = [
+            (self.leg.femur_m, "femur_m", false),
+            (self.leg.tibia_m, "tibia_m", false),
+            (self.leg.d_lat_m, "d_lat_m", true),
+            (self.leg.d_ax_m, "d_ax_m", true),
+            (self.body_length_m, "body_length_m", true),
+            (self.body_width_m, "body_width_m", true),
+        ];
+        for (v, name, zero_allowed) in lengths {
+            if !(v.is_finite() && (v > 0.0 || (zero_allowed && v >= 0.0))) {
+                return Err(RobotError::BadLength(name));
             }
-        };
-        let nonneg = |v: f32, name| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(RobotError::BadLength(name))
-            }
-        };
-        pos(self.leg.femur_m, "femur_m")?;
-        pos(self.leg.tibia_m, "tibia_m")?;
-        nonneg(self.leg.d_lat_m, "d_lat_m")?;
-        nonneg(self.leg.d_ax_m, "d_ax_m")?;
-        nonneg(self.body_length_m, "body_length_m")?;
-        nonneg(self.body_width_m, "body_width_m")?;
+        }
         for j in Joint::ALL {
             let (lo, hi) = (
                 self.limits.min_rad[j as usize],

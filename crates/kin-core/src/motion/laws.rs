@@ -189,6 +189,16 @@ impl Sway {
         self.p.amplitude_rad * M::sin_cos(2.0 * PI * phase).0
     }
 
+    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite): no frame
+    /// passed by value, for a caller that keeps one.
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        finite(t_s, Param::TS)?;
+        frame.pose = self.pose_at(self.offset_rad::<M>(t_s));
+        frame.feet_in_world = self.p.feet_in_world;
+        frame.contact = [Contact::Stance; 4];
+        Ok(())
+    }
+
     fn pose_at(&self, offset_rad: f32) -> Pose {
         let (mut r, mut p, mut y) = (self.p.roll0_rad, self.p.pitch0_rad, self.p.yaw0_rad);
         match self.p.axis {
@@ -210,12 +220,9 @@ impl Motion for Sway {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, Param::TS)?;
-        Ok(Frame {
-            pose: self.pose_at(self.offset_rad::<M>(t_s)),
-            feet_in_world: self.p.feet_in_world,
-            contact: [Contact::Stance; 4],
-        })
+        let mut frame = Frame::ZERO;
+        self.frame_into::<M>(t_s, &mut frame)?;
+        Ok(frame)
     }
 
     fn period_s(&self) -> Option<f32> {
@@ -386,6 +393,49 @@ impl YawTurn {
         Self::local_deltas(self.p.step_period_s, tau)
     }
 
+    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite): no frame
+    /// passed by value, for a caller that keeps one.
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        finite(t_s, Param::TS)?;
+        let p = &self.p;
+        let t1 = p.step_period_s;
+        let (k, tau) = self.split(t_s);
+        // Yaw at the start of this step period, wrapped once so that body and feet share it.
+        let base = wrap_pi(p.yaw0_rad + p.yaw_rate_rad_s * (k * t1));
+        let yaw = wrap_pi(base + p.yaw_rate_rad_s * tau);
+        let (d13, d24) = Self::local_deltas(t1, tau);
+        let first_half = tau < 0.5 * t1;
+        let wave = M::sin_cos(2.0 * PI * (tau / t1)).0;
+        let lift13 = if first_half && wave > 0.0 { wave } else { 0.0 };
+        let lift24 = if !first_half && wave < 0.0 {
+            -wave
+        } else {
+            0.0
+        };
+        for leg in LegId::ALL {
+            let i = leg.index();
+            let (delta, lift, swing) = if in_pair_13(leg) {
+                (d13, lift13, first_half)
+            } else {
+                (d24, lift24, !first_half)
+            };
+            let a = self.alpha_rad[i] + base + p.yaw_rate_rad_s * delta;
+            let (s, c) = M::sin_cos(a);
+            frame.feet_in_world[i] = Vec3::new(
+                self.rho_m[i] * c,
+                self.rho_m[i] * s,
+                p.stance_feet[i].z + p.lift_height_m * lift,
+            );
+            frame.contact[i] = if swing {
+                Contact::Swing
+            } else {
+                Contact::Stance
+            };
+        }
+        frame.pose = Pose::rotation(p.roll0_rad, p.pitch0_rad, yaw);
+        Ok(())
+    }
+
     fn local_deltas(t1: f32, tau: f32) -> (f32, f32) {
         let half = 0.5 * t1;
         if tau < half {
@@ -406,49 +456,9 @@ impl Motion for YawTurn {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, Param::TS)?;
-        let p = &self.p;
-        let t1 = p.step_period_s;
-        let (k, tau) = self.split(t_s);
-        // Yaw at the start of this step period, wrapped once so that body and feet share it.
-        let base = wrap_pi(p.yaw0_rad + p.yaw_rate_rad_s * (k * t1));
-        let yaw = wrap_pi(base + p.yaw_rate_rad_s * tau);
-        let (d13, d24) = Self::local_deltas(t1, tau);
-        let first_half = tau < 0.5 * t1;
-        let wave = M::sin_cos(2.0 * PI * (tau / t1)).0;
-        let lift13 = if first_half && wave > 0.0 { wave } else { 0.0 };
-        let lift24 = if !first_half && wave < 0.0 {
-            -wave
-        } else {
-            0.0
-        };
-        let mut feet = [Vec3::ZERO; 4];
-        let mut contact = [Contact::Stance; 4];
-        for leg in LegId::ALL {
-            let i = leg.index();
-            let (delta, lift, swing) = if in_pair_13(leg) {
-                (d13, lift13, first_half)
-            } else {
-                (d24, lift24, !first_half)
-            };
-            let a = self.alpha_rad[i] + base + p.yaw_rate_rad_s * delta;
-            let (s, c) = M::sin_cos(a);
-            feet[i] = Vec3::new(
-                self.rho_m[i] * c,
-                self.rho_m[i] * s,
-                p.stance_feet[i].z + p.lift_height_m * lift,
-            );
-            contact[i] = if swing {
-                Contact::Swing
-            } else {
-                Contact::Stance
-            };
-        }
-        Ok(Frame {
-            pose: Pose::rotation(p.roll0_rad, p.pitch0_rad, yaw),
-            feet_in_world: feet,
-            contact,
-        })
+        let mut frame = Frame::ZERO;
+        self.frame_into::<M>(t_s, &mut frame)?;
+        Ok(frame)
     }
 
     fn period_s(&self) -> Option<f32> {
@@ -531,6 +541,21 @@ impl LegPaths {
     pub const fn params(&self) -> &LegPathsParams {
         &self.p
     }
+
+    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite): no frame
+    /// passed by value, for a caller that keeps one.
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        finite(t_s, Param::TS)?;
+        let base = fract01(t_s / self.p.cycle_s);
+        frame.pose = Pose::default();
+        for leg in LegId::ALL {
+            let i = leg.index();
+            let phase = Phase::wrap(base + self.p.phase_offsets[i]);
+            frame.feet_in_world[i] = self.p.stance_feet[i] + self.p.path.offset::<M>(phase);
+            frame.contact[i] = self.p.path.contact(phase);
+        }
+        Ok(())
+    }
 }
 
 impl Motion for LegPaths {
@@ -543,21 +568,9 @@ impl Motion for LegPaths {
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
-        finite(t_s, Param::TS)?;
-        let base = fract01(t_s / self.p.cycle_s);
-        let mut feet = self.p.stance_feet;
-        let mut contact = [Contact::Stance; 4];
-        for leg in LegId::ALL {
-            let i = leg.index();
-            let phase = Phase::wrap(base + self.p.phase_offsets[i]);
-            feet[i] = feet[i] + self.p.path.offset::<M>(phase);
-            contact[i] = self.p.path.contact(phase);
-        }
-        Ok(Frame {
-            pose: Pose::default(),
-            feet_in_world: feet,
-            contact,
-        })
+        let mut frame = Frame::ZERO;
+        self.frame_into::<M>(t_s, &mut frame)?;
+        Ok(frame)
     }
 
     fn period_s(&self) -> Option<f32> {

@@ -358,6 +358,15 @@ pub struct Frame {
     pub contact: [Contact; 4],
 }
 
+impl Frame {
+    /// The zero pose, the four feet at the origin, in stance.
+    pub const ZERO: Frame = Frame {
+        pose: Pose::rotation(0.0, 0.0, 0.0),
+        feet_in_world: [Vec3::ZERO; 4],
+        contact: [Contact::Stance; 4],
+    };
+}
+
 /// A motion: body pose and feet as a pure function of time.
 pub trait Motion {
     /// The robot the motion was built (and validated) for.

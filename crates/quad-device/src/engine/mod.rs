@@ -842,28 +842,38 @@ impl<M: Math> Engine<M> {
         Ok(first)
     }
 
-    /// The law's joint setpoint at `t_s`: the motion's frame, with the legs it does not move
-    /// at their stance points, through the body IK.
+    /// The law's frame at `t_s`, written into `frame`: the motion's frame with the legs it
+    /// does not move at their stance points.
+    ///
+    /// Out of line, the frame in the caller's storage: the laws' frame code then reaches it
+    /// through a pointer, not through a stack frame beyond the AVR's 63-byte displacement.
     #[inline(never)]
-    fn law_setpoint(law: &Law, t_s: f32, solver: &body::Solver<M>) -> Result<[f32; 12], IkError> {
+    fn law_frame(law: &Law, t_s: f32, frame: &mut Frame) -> Result<(), motion::Error> {
         // The engine's law motions only: matching them keeps the gait's frame code out of the
         // firmware.
-        let frame = match &law.motion {
-            AnyMotion::Sway(m) => m.frame::<M>(t_s),
-            AnyMotion::YawTurn(m) => m.frame::<M>(t_s),
-            AnyMotion::LegPaths(m) => m.frame::<M>(t_s).map(|mut f| {
+        match &law.motion {
+            AnyMotion::Sway(m) => m.frame_into::<M>(t_s, frame),
+            AnyMotion::YawTurn(m) => m.frame_into::<M>(t_s, frame),
+            AnyMotion::LegPaths(m) => {
+                m.frame_into::<M>(t_s, frame)?;
                 let stance = &m.params().stance_feet;
                 for (i, moves) in law.legs.iter().enumerate() {
                     if !moves {
-                        f.feet_in_world[i] = stance[i];
-                        f.contact[i] = motion::Contact::Stance;
+                        frame.feet_in_world[i] = stance[i];
+                        frame.contact[i] = motion::Contact::Stance;
                     }
                 }
-                f
-            }),
+                Ok(())
+            }
             _ => Err(motion::Error::NonFinite(Param::TS)),
-        };
-        let frame = frame.map_err(|_| IkError {
+        }
+    }
+
+    /// The law's joint setpoint at `t_s`: its frame through the body IK.
+    #[inline(never)]
+    fn law_setpoint(law: &Law, t_s: f32, solver: &body::Solver<M>) -> Result<[f32; 12], IkError> {
+        let mut frame = Frame::ZERO;
+        Self::law_frame(law, t_s, &mut frame).map_err(|_| IkError {
             leg: LegId::FL,
             kind: kin_core::Unreachable::NonFinite,
         })?;
