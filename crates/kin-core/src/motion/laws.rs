@@ -166,16 +166,25 @@ impl Sway {
     /// the reach itself by running the motion's frames through its own IK (a device's start
     /// check).
     pub fn without_reach_check(p: SwayParams) -> Result<Sway, Error> {
+        Self::check(&p)?;
+        Ok(Sway { p })
+    }
+
+    /// The parameter checks of [`Sway::without_reach_check`]. Out of line, on a reference:
+    /// the parameters are a hundred bytes and more, and the checks' reads then stay close to
+    /// one pointer (on the AVR, within its 63-byte displacement) wherever they are built.
+    #[inline(never)]
+    fn check(p: &SwayParams) -> Result<(), Error> {
         p.robot.validate()?;
         finite(p.amplitude_rad, Param::AmplitudeRad)?;
         positive(p.period_s, Param::PeriodS)?;
         finite(p.roll0_rad, Param::Roll0Rad)?;
         finite(p.pitch0_rad, Param::Pitch0Rad)?;
         finite(p.yaw0_rad, Param::Yaw0Rad)?;
-        for f in p.feet_in_world {
-            finite_vec(f, Param::FeetInWorld)?;
+        for f in &p.feet_in_world {
+            finite_vec(*f, Param::FeetInWorld)?;
         }
-        Ok(Sway { p })
+        Ok(())
     }
 
     /// The parameters.
@@ -330,6 +339,18 @@ impl YawTurn {
     /// angles on math backend `M`, for a caller that checks the reach itself by running the
     /// motion's frames through its own IK (a device's start check).
     pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
+        Self::check(&p)?;
+        Ok(YawTurn {
+            p,
+            rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
+            alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
+        })
+    }
+
+    /// The parameter checks of [`YawTurn::without_reach_check`], out of line on a reference
+    /// as [`Sway`]'s.
+    #[inline(never)]
+    fn check(p: &YawTurnParams) -> Result<(), Error> {
         p.robot.validate()?;
         finite(p.yaw_rate_rad_s, Param::YawRateRadS)?;
         positive(p.step_period_s, Param::StepPeriodS)?;
@@ -337,8 +358,8 @@ impl YawTurn {
         finite(p.yaw0_rad, Param::Yaw0Rad)?;
         finite(p.roll0_rad, Param::Roll0Rad)?;
         finite(p.pitch0_rad, Param::Pitch0Rad)?;
-        for f in p.stance_feet {
-            finite_vec(f, Param::StanceFeet)?;
+        for f in &p.stance_feet {
+            finite_vec(*f, Param::StanceFeet)?;
             if !(f.z + p.lift_height_m < 0.0) {
                 return Err(Error::OutOfRange {
                     parameter: Param::LiftHeightM,
@@ -346,11 +367,7 @@ impl YawTurn {
                 });
             }
         }
-        Ok(YawTurn {
-            p,
-            rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
-            alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
-        })
+        Ok(())
     }
 
     /// The parameters.
@@ -526,15 +543,23 @@ impl LegPaths {
     /// the reach itself by running the motion's frames through its own IK (a device's start
     /// check).
     pub fn without_reach_check(p: LegPathsParams) -> Result<LegPaths, Error> {
+        Self::check(&p)?;
+        Ok(LegPaths { p })
+    }
+
+    /// The parameter checks of [`LegPaths::without_reach_check`], out of line on a reference
+    /// as [`Sway`]'s.
+    #[inline(never)]
+    fn check(p: &LegPathsParams) -> Result<(), Error> {
         p.robot.validate()?;
         positive(p.cycle_s, Param::CycleS)?;
-        for o in p.phase_offsets {
-            finite(o, Param::PhaseOffsets)?;
+        for o in &p.phase_offsets {
+            finite(*o, Param::PhaseOffsets)?;
         }
-        for f in p.stance_feet {
-            finite_vec(f, Param::StanceFeet)?;
+        for f in &p.stance_feet {
+            finite_vec(*f, Param::StanceFeet)?;
         }
-        Ok(LegPaths { p })
+        Ok(())
     }
 
     /// The parameters.

@@ -771,14 +771,24 @@ impl<M: Math> Engine<M> {
             _ => return Err(Error::Busy),
         };
         let d = duration(d)?;
-        let motion = law_motion::<M>(request, s)?;
-        let period_s = motion.period_s().unwrap_or(1.0);
+        // The motion written where it stays, then the fields that follow from it.
         *program = Program::Law(Law {
-            motion,
+            motion: law_motion::<M>(request, s)?,
             legs,
-            period_s,
-            end_frame: d.map(|d| frames_to_boundary(d, period_s).max(1)),
+            period_s: 1.0,
+            end_frame: None,
         });
+        if let Program::Law(law) = program {
+            let period_s = match &law.motion {
+                AnyMotion::Sway(m) => m.period_s(),
+                AnyMotion::YawTurn(m) => m.period_s(),
+                AnyMotion::LegPaths(m) => m.period_s(),
+                _ => None,
+            }
+            .unwrap_or(1.0);
+            law.period_s = period_s;
+            law.end_frame = d.map(|d| frames_to_boundary(d, period_s).max(1));
+        }
         Ok(())
     }
 
