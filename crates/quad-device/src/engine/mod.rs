@@ -700,31 +700,31 @@ impl<M: Math> Engine<M> {
         }
         let kind = request.kind();
         let (first, home, start) = match request {
-            Request::StandUp => {
+            Request::StandUp | Request::Sit | Request::Rest => {
+                // Sit and rest ramp from the outputs, which must be on; stand-up enables them at
+                // the rest pose when they are off.
+                let out = match setup.outputs {
+                    Some(o) => Some(*o),
+                    None if kind == Kind::StandUp => None,
+                    None => return Err(Error::OutputsOff),
+                };
                 let rest = rest_angles(setup.robot)?;
                 check_travel(setup.calibration, &rest)?;
-                let stance = stance_angles::<M>(setup)?;
-                let start = setup.outputs.copied().unwrap_or(rest);
+                let target = if kind == Kind::StandUp {
+                    stance_angles::<M>(setup)?
+                } else {
+                    rest
+                };
                 self.program = Program::Pose { kind };
-                (stance, stance, start)
-            }
-            Request::Sit | Request::Rest => {
-                let out = *setup.outputs.ok_or(Error::OutputsOff)?;
-                let rest = rest_angles(setup.robot)?;
-                check_travel(setup.calibration, &rest)?;
-                self.program = Program::Pose { kind };
-                (rest, rest, out)
-            }
-            Request::Walk(w) => {
-                let out = *setup.outputs.ok_or(Error::OutputsOff)?;
-                let home = stance_angles::<M>(setup)?;
-                let first = Self::walk(w, setup, &mut self.program)?;
-                (first, home, out)
+                (target, target, out.unwrap_or(rest))
             }
             _ => {
                 let out = *setup.outputs.ok_or(Error::OutputsOff)?;
                 let home = stance_angles::<M>(setup)?;
-                let first = Self::law(request, setup, &mut self.program)?;
+                let first = match request {
+                    Request::Walk(w) => Self::walk(w, setup, &mut self.program)?,
+                    _ => Self::law(request, setup, &mut self.program)?,
+                };
                 (first, home, out)
             }
         };
@@ -796,11 +796,14 @@ impl<M: Math> Engine<M> {
 
     #[inline(never)]
     fn check_law(law: &Law, s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
-        let first = check_sample::<M>(s, 0, 0.0, Self::law_setpoint(law, 0.0, s.solver), true)?;
         let n = START_CHECK_SAMPLES;
-        for k in 1..n {
+        let mut first = [0.0; 12];
+        for k in 0..n {
             let t = law.period_s * f32::from(k) / f32::from(n);
-            check_sample::<M>(s, k, t, Self::law_setpoint(law, t, s.solver), true)?;
+            let q = check_sample::<M>(s, k, t, Self::law_setpoint(law, t, s.solver), true)?;
+            if k == 0 {
+                first = q;
+            }
         }
         Ok(first)
     }
