@@ -896,7 +896,10 @@ mod bits {
 }
 
 /// Wraps an angle into `(-π, π]`.
-#[inline]
+///
+/// Out of line: its callers wrap once or twice per frame, and on a soft-float target each
+/// inlined copy is its own library calls.
+#[inline(never)]
 pub fn wrap_pi(angle_rad: f32) -> f32 {
     let two_pi = 2.0 * PI;
     let mut a = angle_rad - two_pi * libm::roundf(angle_rad / two_pi);
