@@ -435,8 +435,14 @@ impl Robot {
     /// plane of the zero-abduction leg: `hip_in_body + (0, s·d_lat, −H)` (world = body frame).
     #[inline]
     pub fn stance_feet(&self, height_m: f32) -> [Vec3; 4] {
-        LegId::ALL.map(|leg| {
-            self.hip_in_body(leg) + Vec3::new(0.0, leg.side() * self.leg.d_lat_m, -height_m)
-        })
+        // The front left foot, then the others by their corner's signs: the sums are the same
+        // for every leg up to sign, so one computes them all (fewer float operations, each a
+        // library call on a soft-float target).
+        let fl = self.hip_in_body(LegId::FL) + Vec3::new(0.0, self.leg.d_lat_m, -height_m);
+        let mut feet = [fl; 4];
+        for (foot, leg) in feet.iter_mut().zip(LegId::ALL) {
+            *foot = leg.at_corner(fl);
+        }
+        feet
     }
 }

@@ -492,15 +492,15 @@ fn stance_angles<M: Math>(s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
 /// One sample of a start check (module docs): `solved` is what the per-frame path (the
 /// frame's body IK, [`solve_frame`]) gave at sample `sample`, time `t_s`; then the servo
 /// travel and, when `singularity`, each leg's singularity measure. The sample's setpoint when
-/// it passes.
+/// it passes (borrowed from `solved`: the angles are not copied on the way).
 #[inline(never)]
-fn check_sample<M: Math>(
+fn check_sample<'r, M: Math>(
     s: &Setup<'_, M>,
     sample: u16,
     t_s: f32,
-    solved: Result<[f32; 12], IkError>,
+    solved: &'r Result<[f32; 12], IkError>,
     singularity: bool,
-) -> Result<[f32; 12], Error> {
+) -> Result<&'r [f32; 12], Error> {
     let failure = |leg, kind| {
         Error::Preflight(Failure {
             sample: u32::from(sample),
@@ -509,8 +509,10 @@ fn check_sample<M: Math>(
             kind,
         })
     };
-    let q = solved.map_err(|e| failure(e.leg, FailureKind::Unreachable(e.kind)))?;
-    check_travel(s.calibration, &q)?;
+    let q = solved
+        .as_ref()
+        .map_err(|e| failure(e.leg, FailureKind::Unreachable(e.kind)))?;
+    check_travel(s.calibration, q)?;
     if !singularity {
         return Ok(q);
     }
@@ -800,9 +802,10 @@ impl<M: Math> Engine<M> {
         let mut first = [0.0; 12];
         for k in 0..n {
             let t = law.period_s * f32::from(k) / f32::from(n);
-            let q = check_sample::<M>(s, k, t, Self::law_setpoint(law, t, s.solver), true)?;
+            let solved = Self::law_setpoint(law, t, s.solver);
+            let q = check_sample::<M>(s, k, t, &solved, true)?;
             if k == 0 {
-                first = q;
+                first = *q;
             }
         }
         Ok(first)
@@ -842,7 +845,8 @@ impl<M: Math> Engine<M> {
 
     #[inline(never)]
     fn check_walk(walker: &Walker, s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
-        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(walker, s.solver), true)?;
+        let solved = Self::walk_setpoint(walker, s.solver);
+        let first = *check_sample::<M>(s, 0, 0.0, &solved, true)?;
         for k in 0..Walker::ENVELOPE_SAMPLES {
             let frame = Frame {
                 pose: Pose::default(),
@@ -852,7 +856,7 @@ impl<M: Math> Engine<M> {
             let solved = solve_frame(s.solver, s.order, &frame);
             // Sample 0 is the first frame; the envelope's points follow, without the
             // singularity measure (see the module docs).
-            check_sample::<M>(s, k as u16 + 1, 0.0, solved, false)?;
+            check_sample::<M>(s, k as u16 + 1, 0.0, &solved, false)?;
         }
         Ok(first)
     }
