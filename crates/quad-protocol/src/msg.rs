@@ -54,13 +54,13 @@ wire_enum! {
         /// → [`DeviceToHost::Ack`] or a nack.
         3 => SetFeet {
             /// The four feet in the body frame, m.
-            feet_in_body_m: [[f32; 3]; 4],
+            feet_in_body_m: [[f32; 3]; 4] as wire::array,
         },
         /// Twelve joint angles, rad, canonical order; bypasses the IK (joint limits and servo
         /// calibration still apply). → [`DeviceToHost::Ack`] or a nack.
         4 => SetJoints {
             /// The twelve joint angles, rad.
-            angles_rad: [f32; 12],
+            angles_rad: [f32; 12] as wire::array,
         },
         /// Switch the servo outputs on or off (off at power-on). → [`DeviceToHost::Ack`].
         5 => SetOutputs {
@@ -540,9 +540,11 @@ impl Flags {
 pub struct Readback {
     /// The twelve joint angles the device holds (computed by its IK, or as set), rad;
     /// canonical order. Always finite.
+    #[serde(with = "wire::array")]
     pub angles_rad: [f32; 12],
     /// The twelve pulse widths on the outputs, half-µs (one 0.5 µs timer tick each; 3000 =
     /// 1500 µs); 0 = that output is off. Canonical order.
+    #[serde(with = "wire::array")]
     pub pulses_half_us: [u16; 12],
     /// Status bits.
     pub flags: Flags,

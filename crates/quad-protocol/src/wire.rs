@@ -372,6 +372,62 @@ macro_rules! wire_de_newtype {
 
 pub(crate) use {wire_de_newtype, wire_enum, wire_next_field, wire_ser_field};
 
+/// Arrays on the wire, for serde's `with` and `wire_enum!`'s `as`: a tuple of `N` elements,
+/// the data model of serde's own `[T; N]` implementations (postcard: the elements one after
+/// the other, no length), so the bytes are the same. serde reads an array with one unrolled
+/// copy of the element code per element; here one loop serves all elements, which on the
+/// ATmega2560 is a fraction of the flash for the twelve-value arrays.
+pub mod array {
+    use core::fmt;
+    use core::marker::PhantomData;
+    use serde::de::{self, Deserializer, SeqAccess, Visitor};
+    use serde::ser::{SerializeTuple, Serializer};
+    use serde::{Deserialize, Serialize};
+
+    /// Serializes `value` as a tuple of its `N` elements (serde's `with`).
+    ///
+    /// # Errors
+    /// The serializer's.
+    pub fn serialize<S: Serializer, T: Serialize, const N: usize>(
+        value: &[T; N],
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        let mut tuple = s.serialize_tuple(N)?;
+        for element in value {
+            tuple.serialize_element(element)?;
+        }
+        tuple.end()
+    }
+
+    /// Deserializes a tuple of `N` elements (serde's `with`).
+    ///
+    /// # Errors
+    /// The deserializer's, or an invalid length when the input ends early.
+    pub fn deserialize<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
+    where
+        D: Deserializer<'de>,
+        T: Deserialize<'de> + Copy + Default,
+    {
+        struct Elements<T, const N: usize>(PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Visitor<'de> for Elements<T, N> {
+            type Value = [T; N];
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                write!(f, "an array of length {N}")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<[T; N], A::Error> {
+                let mut out = [T::default(); N];
+                for (i, slot) in out.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_tuple(N, Elements::<T, N>(PhantomData))
+    }
+}
+
 wire_index! {
     /// [`LegId`] on the wire.
     pub mod leg_id for LegId { 0 => FL, 1 => FR, 2 => RL, 3 => RR }
