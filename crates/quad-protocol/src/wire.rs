@@ -150,8 +150,12 @@ macro_rules! wire_enum {
                     fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
                         f.write_str(concat!("the fields of ", stringify!($var)))
                     }
-                    // The count after the last field is not read.
+                    // The count after the last field is not read. Out of line, as is the
+                    // enum's `visit_enum`: inlined into one another (as LTO does), a message's
+                    // variants and their fields made one function whose stack frame held all
+                    // of them, beyond the AVR's 63-byte displacement (see `variant_index`).
                     #[allow(unused_assignments)]
+                    #[inline(never)]
                     fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
                         self,
                         mut seq: A,
@@ -203,12 +207,12 @@ macro_rules! wire_enum {
                         ) -> ::core::fmt::Result {
                             f.write_str(concat!("enum ", stringify!($name)))
                         }
+                        #[inline(never)]
                         fn visit_enum<A: ::serde::de::EnumAccess<'de>>(
                             self,
                             data: A,
                         ) -> Result<$name, A::Error> {
-                            let (index, $var_access) =
-                                ::serde::de::EnumAccess::variant::<u32>(data)?;
+                            let (index, $var_access) = $crate::wire::variant_index(data)?;
                             match index {
                                 $($de_arms)*
                                 other => Err(::serde::de::Error::invalid_value(
@@ -281,7 +285,7 @@ macro_rules! wire_index {
                         self,
                         data: A,
                     ) -> Result<$ty, A::Error> {
-                        let (i, variant) = ::serde::de::EnumAccess::variant::<u32>(data)?;
+                        let (i, variant) = $crate::wire::variant_index(data)?;
                         ::serde::de::VariantAccess::unit_variant(variant)?;
                         from_index(i).ok_or_else(|| {
                             ::serde::de::Error::invalid_value(
@@ -371,6 +375,17 @@ macro_rules! wire_de_newtype {
 }
 
 pub(crate) use {wire_de_newtype, wire_enum, wire_next_field, wire_ser_field};
+
+/// [`serde::de::EnumAccess::variant`] with a `u32` index, out of line: inlined, every enum's
+/// decoder carried its own copy of the format's index code (postcard's varint). With that
+/// code shared, LTO inlines the decoders into one another; `wire_enum!` keeps each enum's
+/// `visit_enum` and each variant's `visit_seq` out of line for that reason.
+#[inline(never)]
+pub(crate) fn variant_index<'de, A: serde::de::EnumAccess<'de>>(
+    data: A,
+) -> Result<(u32, A::Variant), A::Error> {
+    data.variant::<u32>()
+}
 
 /// Arrays on the wire, for serde's `with` and `wire_enum!`'s `as`: a tuple of `N` elements,
 /// the data model of serde's own `[T; N]` implementations (postcard: the elements one after
