@@ -435,7 +435,7 @@ where
     pub fn handle(&mut self, msg: HostToDevice) -> DeviceToHost {
         self.last_valid_ms = self.clock.now_ms();
         self.failsafe_armed = true;
-        let answer = self.answer(msg);
+        let answer = self.answer(&msg);
         // Latched until an answer reports it (only the readback carries the flags).
         if answer.readback().is_some() {
             self.failsafe = false;
@@ -444,10 +444,10 @@ where
     }
 
     #[inline(never)]
-    fn answer(&mut self, msg: HostToDevice) -> DeviceToHost {
+    fn answer(&mut self, msg: &HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
         // The host's own check (`Ok` for the requests answered before the handshake).
-        let in_range = check_request(&msg.request, &self.config.robot);
+        let in_range = check_range(&msg.request, &self.config.robot);
         let result = match msg.request {
             Request::Hello { version } => {
                 return if is_compatible(version) {
@@ -851,6 +851,13 @@ pub fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<
 #[inline(never)]
 pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
     encode_frame(answer, out).map_or(0, <[u8]>::len)
+}
+
+/// [`check_request`], out of line: inlined into [`Device::answer`], its copies of the request's
+/// values took the dispatcher's stack frame beyond the AVR's 63-byte displacement.
+#[inline(never)]
+fn check_range(request: &Request, robot: &kin_core::Robot) -> Result<(), NackReason> {
+    check_request(request, robot)
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {
