@@ -135,7 +135,7 @@ macro_rules! wire_enum {
                 let mut fields = ::serde::Serializer::serialize_struct_variant(
                     $ser, NAME, $idx, stringify!($var), <[&str]>::len(&[$(stringify!($field)),*]))?;
                 $(
-                    ::serde::ser::SerializeStructVariant::serialize_field(
+                    $crate::wire::variant_field(
                         &mut fields,
                         stringify!($field),
                         $crate::wire::wire_ser_field!($field, $fty $(, $($with)::+)?),
@@ -385,6 +385,20 @@ pub(crate) fn variant_index<'de, A: serde::de::EnumAccess<'de>>(
     data: A,
 ) -> Result<(u32, A::Variant), A::Error> {
     data.variant::<u32>()
+}
+
+/// [`serde::ser::SerializeStructVariant::serialize_field`], out of line: one instance per
+/// field type and format serves every variant that has such a field (the sequence number of
+/// every answer, the readback of three of them); inlined, each variant carried its own copy.
+/// (The reading side gains nothing from the same: its fields are read in out-of-line
+/// `visit_seq`s already, and wrapped they grew.)
+#[inline(never)]
+pub(crate) fn variant_field<S: serde::ser::SerializeStructVariant, T: serde::Serialize + ?Sized>(
+    fields: &mut S,
+    key: &'static str,
+    value: &T,
+) -> Result<(), S::Error> {
+    fields.serialize_field(key, value)
 }
 
 /// Arrays on the wire, for serde's `with` and `wire_enum!`'s `as`: a tuple of `N` elements,
