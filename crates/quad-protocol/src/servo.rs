@@ -83,10 +83,13 @@ pub struct Calibration {
     /// Gain, µs of pulse per rad of joint angle (> 0; the direction is `reversed`).
     pub us_per_rad: f32,
     /// Pulse at `zero_rad`, µs.
+    #[serde(with = "crate::wire::shared")]
     pub center_us: u16,
     /// Shortest admissible pulse, µs (mechanical stop or servo limit).
+    #[serde(with = "crate::wire::shared")]
     pub min_us: u16,
     /// Longest admissible pulse, µs.
+    #[serde(with = "crate::wire::shared")]
     pub max_us: u16,
 }
 

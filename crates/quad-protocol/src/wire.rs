@@ -401,6 +401,34 @@ pub(crate) fn variant_field<S: serde::ser::SerializeStructVariant, T: serde::Ser
     fields.serialize_field(key, value)
 }
 
+/// A field's serde code out of line, for serde's `with` and `wire_enum!`'s `as`: the bytes are
+/// the field type's own. For the varint integers (`u16`): postcard's varint reader inlined
+/// into every struct that has such a field was the larger part of its decoder on the AVR; out
+/// of line one copy per type serves them all.
+pub mod shared {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// `value`'s own serialization, out of line (serde's `with`).
+    ///
+    /// # Errors
+    /// The serializer's.
+    #[inline(never)]
+    pub fn serialize<S: Serializer, T: Serialize>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+        value.serialize(s)
+    }
+
+    /// `T`'s own deserialization, out of line (serde's `with`).
+    ///
+    /// # Errors
+    /// The deserializer's.
+    #[inline(never)]
+    pub fn deserialize<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<T, D::Error> {
+        T::deserialize(d)
+    }
+}
+
 /// Arrays on the wire, for serde's `with` and `wire_enum!`'s `as`: a tuple of `N` elements,
 /// the data model of serde's own `[T; N]` implementations (postcard: the elements one after
 /// the other, no length), so the bytes are the same. serde reads an array with one unrolled
