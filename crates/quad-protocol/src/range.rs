@@ -110,19 +110,17 @@ pub fn check_pose(pose: &Pose, robot: &Robot) -> Result<(), NackReason> {
     } = *pose;
     let values = [roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m];
     let span = reach_limit_m(robot);
-    const FIELDS: [Field; 6] = [
-        Field::BodyRoll,
-        Field::BodyPitch,
-        Field::BodyYaw,
-        Field::BodyX,
-        Field::BodyY,
-        Field::BodyZ,
-    ];
     // An angle in `[−π, π]` is one of magnitude ≤ π.
-    match first_beyond(&values, &[PI, PI, PI, span, span, span])? {
-        None => Ok(()),
-        Some(i) => Err(NackReason::OutOfRange { field: FIELDS[i] }),
-    }
+    let field = match first_beyond(&values, &[PI, PI, PI, span, span, span])? {
+        None => return Ok(()),
+        Some(0) => Field::BodyRoll,
+        Some(1) => Field::BodyPitch,
+        Some(2) => Field::BodyYaw,
+        Some(3) => Field::BodyX,
+        Some(4) => Field::BodyY,
+        Some(_) => Field::BodyZ,
+    };
+    Err(NackReason::OutOfRange { field })
 }
 
 /// Four feet in the body frame: finite, each within the body's half size plus
