@@ -325,10 +325,11 @@ where
             disable = tick.disable_outputs;
         }
         if let Some(held) = &self.held {
-            let mut out = self.out_rad;
-            self.engine.limiter().step(&mut out, &held.angles_rad);
-            if out != self.out_rad {
-                self.out_rad = out;
+            if self
+                .engine
+                .limiter()
+                .step(&mut self.out_rad, &held.angles_rad)
+            {
                 self.write_out();
             }
         }
