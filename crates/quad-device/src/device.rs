@@ -578,10 +578,6 @@ where
     /// outputs (zeros while stopped), flags and frame counters.
     #[inline(never)]
     pub fn readback(&self) -> Readback {
-        let (angles_rad, pulses) = match &self.held {
-            Some(h) => (h.angles_rad, h.pulses_half_us),
-            None => ([0.0; 12], [0; 12]),
-        };
         let flags = Flags::EMPTY
             .with(Flags::CLAMPED, self.clamped)
             .with(Flags::LIMITED, self.limited)
@@ -589,17 +585,21 @@ where
             .with(Flags::FAILSAFE_ACTIVE, self.failsafe)
             .with(Flags::CALIBRATION_UNSAVED, self.calibration_unsaved)
             .with(Flags::CALIBRATION_DEFAULT, self.calibration_default);
-        Readback {
-            angles_rad,
-            pulses_half_us: if self.outputs_enabled {
-                pulses
-            } else {
-                [0; 12]
-            },
+        // Built in place: each array is copied once, from the held target when there is one.
+        let mut readback = Readback {
+            angles_rad: [0.0; 12],
+            pulses_half_us: [0; 12],
             flags,
             frames_ok: self.acc.frames_ok(),
             frames_bad: self.acc.frames_bad(),
+        };
+        if let Some(h) = &self.held {
+            readback.angles_rad = h.angles_rad;
+            if self.outputs_enabled {
+                readback.pulses_half_us = h.pulses_half_us;
+            }
         }
+        readback
     }
 
     /// The twelve calibrations in RAM.
