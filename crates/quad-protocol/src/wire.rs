@@ -150,12 +150,8 @@ macro_rules! wire_enum {
                     fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
                         f.write_str(concat!("the fields of ", stringify!($var)))
                     }
-                    // The count after the last field is not read. Out of line, as is the
-                    // enum's `visit_enum`: inlined into one another (as LTO does), a message's
-                    // variants and their fields made one function whose stack frame held all
-                    // of them, beyond the AVR's 63-byte displacement (see `variant_index`).
+                    // The count after the last field is not read.
                     #[allow(unused_assignments)]
-                    #[inline(never)]
                     fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
                         self,
                         mut seq: A,
@@ -207,6 +203,7 @@ macro_rules! wire_enum {
                         ) -> ::core::fmt::Result {
                             f.write_str(concat!("enum ", stringify!($name)))
                         }
+                        // Out of line: see `variant_index`.
                         #[inline(never)]
                         fn visit_enum<A: ::serde::de::EnumAccess<'de>>(
                             self,
@@ -378,8 +375,11 @@ pub(crate) use {wire_de_newtype, wire_enum, wire_next_field, wire_ser_field};
 
 /// [`serde::de::EnumAccess::variant`] with a `u32` index, out of line: inlined, every enum's
 /// decoder carried its own copy of the format's index code (postcard's varint). With that
-/// code shared, LTO inlines the decoders into one another; `wire_enum!` keeps each enum's
-/// `visit_enum` and each variant's `visit_seq` out of line for that reason.
+/// code shared, LTO inlines the decoders into one another, and a message's variants, their
+/// fields and the enums within them made one function whose stack frame held all of them,
+/// beyond the AVR's 63-byte displacement; `wire_enum!` keeps each enum's `visit_enum` out of
+/// line for that reason (its variants' fields inlined into it: smaller than each variant out
+/// of line, whose field count the callee no longer knows).
 #[inline(never)]
 pub(crate) fn variant_index<'de, A: serde::de::EnumAccess<'de>>(
     data: A,
