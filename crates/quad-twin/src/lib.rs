@@ -79,6 +79,11 @@ pub enum Error {
     },
     /// The rendered picture could not be copied to its file (nothing is left at its path).
     Picture(quad_model::Error),
+    /// The motion has no onboard form (the device's engine does not run it as the plan does).
+    NotOnboard {
+        /// The motion's name.
+        motion: &'static str,
+    },
 }
 
 impl fmt::Display for Error {
@@ -104,6 +109,11 @@ impl fmt::Display for Error {
                 write!(f, "frame {frame}: no pulse on servo {servo}'s pin")
             }
             Error::Picture(e) => write!(f, "picture: {e}"),
+            Error::NotOnboard { motion } => write!(
+                f,
+                "{motion} has no onboard form (the device's stand-up starts from its own rest \
+                 pose); run it host-driven"
+            ),
         }
     }
 }
@@ -271,6 +281,9 @@ pub struct RunOptions {
     pub picture: Option<PathBuf>,
     /// Where the frames come from.
     pub driver: Driver,
+    /// The device runs the motion itself (its motion engine, started once; a walk's velocity
+    /// sent every frame) instead of getting every frame's feet from the host.
+    pub onboard: bool,
 }
 
 /// Time the first frame is held before the motion starts, s: the robot, placed with its feet
@@ -394,16 +407,34 @@ pub fn run_plan(
     options: &RunOptions,
 ) -> Result<Run, Error> {
     let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
+    // The device's joint-speed limiter set for the twin's servos, by the rule of its default
+    // (half the no-load speed): the default is for MG996R-class servos, and a faster servo
+    // would otherwise be held back to their speed.
+    let config = &quad_device::Config {
+        joint_speed_limit_rad_s: quad_device::engine::limit_for_servo(
+            physical.servo.no_load_speed_rad_s,
+        ),
+        ..*config
+    };
     let plan = *plan;
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {
             let device = device::SimDevice::start(*config)
                 .map_err(|error| Error::Device { frame: 0, error })?;
-            Box::new(source::HostDriven::new(plan, device))
+            if options.onboard {
+                Box::new(source::Onboard::new(plan, device).ok_or(Error::NotOnboard {
+                    motion: plan.kind().name(),
+                })?)
+            } else {
+                Box::new(source::HostDriven::new(plan, device))
+            }
         }
-        Driver::Emulator { elf } => {
-            Box::new(emulated::Emulated::boot(plan, config, elf.as_deref())?)
-        }
+        Driver::Emulator { elf } => Box::new(emulated::Emulated::boot(
+            plan,
+            config,
+            elf.as_deref(),
+            options.onboard,
+        )?),
     };
     let tmp = tempfile::tempdir().map_err(Error::Io)?;
     let out_dir = match (&options.out_dir, &options.picture) {
