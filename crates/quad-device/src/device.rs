@@ -680,12 +680,10 @@ where
         self.apply(angles, clamped, limited)
     }
 
+    /// `SetJoints`, on angles the range check has found finite (`check_request`).
     fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
         for s in ServoId::ALL {
             let a = angles[s.index()];
-            if !a.is_finite() {
-                return Err(NackReason::NonFinite);
-            }
             if !self.config.robot.limits.admits(s.joint, a) {
                 return Err(NackReason::JointLimit {
                     leg: s.leg,
