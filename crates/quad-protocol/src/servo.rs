@@ -267,7 +267,7 @@ mod tests {
                 us_per_rad: v,
                 ..Calibration::STANDARD
             };
-            let gain_ok = v >= US_PER_RAD_MIN && v <= US_PER_RAD_MAX;
+            let gain_ok = (US_PER_RAD_MIN..=US_PER_RAD_MAX).contains(&v);
             assert_eq!(gain.validate().is_ok(), gain_ok, "us_per_rad {v:?}");
             let zero = Calibration {
                 zero_rad: v,
