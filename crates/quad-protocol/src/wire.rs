@@ -11,9 +11,9 @@
 //! - `wire_index!` writes the table of a foreign field-less enum as a module with `index`,
 //!   `from_index` and serde's `with` functions ([`leg_id`], [`joint`], [`rotation_order`],
 //!   [`reach_policy`]); `wire_fields!` fixes the field order of a foreign struct ([`pose`]).
-//! - [`array`](mod@array) and [`shared`] change no byte, only the code that writes and reads them: the
-//!   twelve-value arrays in a loop, the varint integers through one out-of-line call (sizes on
-//!   the ATmega2560 in BENCHMARKS.md).
+//! - [`array`](mod@array) and [`shared`] change no byte, only the code that writes and reads
+//!   them: the twelve-value arrays in a loop, the varint integers through one out-of-line call
+//!   (sizes on the ATmega2560 in BENCHMARKS.md).
 //!
 //! Every table is an exhaustive `match`: a variant or field added to kin-core does not compile
 //! until it has its place on the wire. The implementations follow serde's data model as the
