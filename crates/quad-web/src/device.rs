@@ -21,7 +21,14 @@
 //! While the server runs it reads the device's state several times a second, so the device's
 //! own link-loss failsafe never fires. When the controlling page goes away, the server applies
 //! the same rule the device applies to a silent link ([`quad_protocol::LinkLossAction`] of its
-//! configuration): `Disable` switches the outputs off, `Hold` keeps the last pose.
+//! configuration): `Disable` switches the outputs off (which cancels a running motion), `Hold`
+//! keeps the last pose and stops a running motion cleanly ([`motion::on_control_lost`]).
+//!
+//! ## Motions and the device's clock
+//! Motion requests go through [`motion::request`]; their `MotionAck` carries the engine's state,
+//! which the thread also reads between commands (`GetMotion` instead of `GetState`). A
+//! simulated or emulated device's clock runs only while its link is read, so the thread idles
+//! the link up to the wall clock before each event: its motions run in real time.
 
 use crate::motion;
 use crate::msg::{self, FlagsMsg, LinkMsg, State};
