@@ -374,7 +374,8 @@ function buildRobotMeshes(robot) {
 
 function setGhost(pose, p) {
   if (!ghost) return;
-  drawRobot(ghost, panel.kin.points(pose, p.angles, panel.order));
+  panel.ghostPoints = panel.kin.points(pose, p.angles, panel.order);
+  drawRobot(ghost, panel.ghostPoints);
   p.legs.forEach((l, i) => ghost.legs[i].mat.color.copy(legColour(l)));
   viewDirty = true;
 }
@@ -384,10 +385,60 @@ let readbackSeen = null;
 let dirty = false; // a new readback to draw
 let viewDirty = true; // the camera, the preview or the size changed
 
+// The rigid motion that best puts the points `from` onto `to` (least squares; Horn's unit
+// quaternion method): the quaternion is the dominant eigenvector of a symmetric 4x4 matrix of
+// the cross-covariance, found by power iteration (three.js has no eigen-solver; four points
+// need nothing larger). Returns p -> R (p - cFrom) + cTo.
+function rigidFit(from, to) {
+  const n = from.length;
+  const cf = new THREE.Vector3(); const ct = new THREE.Vector3();
+  from.forEach((p) => cf.addScaledVector(p, 1 / n));
+  to.forEach((p) => ct.addScaledVector(p, 1 / n));
+  const S = [[0, 0, 0], [0, 0, 0], [0, 0, 0]];
+  for (let i = 0; i < n; i++) {
+    const a = from[i].clone().sub(cf).toArray();
+    const b = to[i].clone().sub(ct).toArray();
+    for (let r = 0; r < 3; r++) for (let c = 0; c < 3; c++) S[r][c] += a[r] * b[c];
+  }
+  const [[xx, xy, xz], [yx, yy, yz], [zx, zy, zz]] = S;
+  const N = [
+    [xx + yy + zz, yz - zy, zx - xz, xy - yx],
+    [yz - zy, xx - yy - zz, xy + yx, zx + xz],
+    [zx - xz, xy + yx, -xx + yy - zz, yz + zy],
+    [xy - yx, zx + xz, yz + zy, -xx - yy + zz],
+  ];
+  // Shifted by Gershgorin's bound so that every eigenvalue is >= 0: the largest then dominates.
+  const shift = Math.max(0, ...N.map((row, r) => row.reduce((m, v, c) => m + (c === r ? -v : Math.abs(v)), 0)));
+  let q = [1, 0, 0, 0];
+  for (let k = 0; k < 100; k++) {
+    const next = N.map((row, r) => row.reduce((acc, v, c) => acc + v * q[c], 0) + shift * q[r]);
+    const len = Math.hypot(...next);
+    q = next.map((v) => v / len);
+  }
+  const rot = new THREE.Quaternion(q[1], q[2], q[3], q[0]);
+  return (p) => p.clone().sub(cf).applyQuaternion(rot).add(ct);
+}
+
+// During a sway the device holds the feet on their stance points and rotates the body over
+// them; the readback has the joints but not the body's pose. The body is placed where the
+// readback's feet land on the stance points: the view shows the body swaying over still feet.
+function placeOnHeldFeet(pts, stanceHeightM) {
+  const stance = panel.kin.preview(NEUTRAL, stanceHeightM, panel.order);
+  if (!stance.reachable) return pts;
+  const held = panel.kin.points(NEUTRAL, stance.angles, panel.order);
+  const foot = (a, leg) => new THREE.Vector3(a[12 * leg + 9], a[12 * leg + 10], a[12 * leg + 11]);
+  const place = rigidFit([0, 1, 2, 3].map((i) => foot(pts, i)), [0, 1, 2, 3].map((i) => foot(held, i)));
+  const out = [];
+  for (let k = 0; k < pts.length; k += 3) out.push(...place(new THREE.Vector3(pts[k], pts[k + 1], pts[k + 2])).toArray());
+  return out;
+}
+
 function updateReadback(s) {
   if (!actual) return;
-  // The body is placed by the pose the device acked; every joint comes from its readback.
-  const pts = panel.kin.points(s.pose ?? NEUTRAL, s.angles_rad, panel.order);
+  // The body is placed by the pose the device acked (none while a motion runs: level at the
+  // origin, or on the held feet during a sway); every joint comes from its readback.
+  let pts = panel.kin.points(s.pose ?? NEUTRAL, s.angles_rad, panel.order);
+  if (s.motion.kind === 'sway') pts = placeOnHeldFeet(pts, s.stance_height_m);
   drawRobot(actual, pts);
   panel.renderedAngles = s.angles_rad;
   panel.renderedPoints = pts;

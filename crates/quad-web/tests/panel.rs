@@ -359,18 +359,14 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str, walk: bool) 
 
     motion_form(b, "stand", &[]).await;
     b.click("motion-start").await;
-    b.wait(
-        "panel.done.filter((c) => c === 'start_motion').length >= 1",
-        WAIT,
-    )
-    .await;
+    // The stand-up's first readback drawn (its state follows the command's answer), then its end.
+    b.wait("panel.motionLatencies.length >= 1", WAIT).await;
     b.wait(
         "panel.state.flags.outputs_enabled && panel.motionStatus.kind === null",
         WAIT,
     )
     .await;
     let stance = f64s(&b.js("panel.state.angles_rad").await);
-    b.wait("panel.motionLatencies.length >= 1", WAIT).await;
 
     // A roll sway: the device's status in the page, the readback moving the view.
     let shot0 = b.screenshot().await;
@@ -397,7 +393,7 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str, walk: bool) 
     )
     .await;
     b.wait(
-        "panel.motionStatus.kind === 'sway' && panel.motionStatus.stage === 'run' && panel.motionStatus.phase > 0.1",
+        "panel.motionStatus.kind === 'sway' && panel.motionStatus.stage === 'run' && panel.motionStatus.phase > 0.1 && panel.motionStatus.phase < 0.4",
         WAIT,
     )
     .await;
@@ -418,6 +414,26 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str, walk: bool) 
     assert!(
         moved > 0.01,
         "the sway's readback is drawn (moved {moved} rad)"
+    );
+    // Drawn on its held feet: the feet on the stance's, the body rolled over them.
+    let pts = f64s(&b.js("panel.renderedPoints").await);
+    let held = f64s(
+        &b.js("panel.kin.points(NEUTRAL_POSE, panel.kin.preview(NEUTRAL_POSE, panel.state.stance_height_m, panel.order).angles, panel.order)"
+            .replace("NEUTRAL_POSE", "{roll_rad: 0, pitch_rad: 0, yaw_rad: 0, x_m: 0, y_m: 0, z_m: 0}")
+            .as_str())
+        .await,
+    );
+    for leg in 0..4 {
+        for k in 9..12 {
+            let (d, h) = (pts[12 * leg + k], held[12 * leg + k]);
+            assert!((d - h).abs() < 1e-3, "foot {leg} drawn at {d}, held at {h}");
+        }
+    }
+    // The FL and FR hip mounts' heights differ by the body's roll.
+    let tilt = (pts[2] - pts[14]).abs();
+    assert!(
+        tilt > 0.005,
+        "the body is drawn rolled ({tilt} m between the front hips)"
     );
     let shot1 = b.screenshot().await;
     assert_ne!(shot0, shot1, "the view changed");
@@ -462,14 +478,9 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str, walk: bool) 
             .await,
         true
     );
-    keep_screenshot(
-        &b.screenshot().await,
-        &format!(
-            "panel-{}motion-refused.png",
-            if what == "sim" { "" } else { "emulator-" }
-        ),
-        dir,
-    );
+    if what == "sim" {
+        keep_screenshot(&b.screenshot().await, "panel-motion-refused.png", dir);
+    }
     assert!(b.js("panel.state.link.frames_sent").await.as_u64().unwrap() > frames);
     motion_form(b, "sway", &[("amplitude_deg", "10"), ("period_s", "0")]).await;
     let refusal = refused_start(b).await;
