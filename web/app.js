@@ -162,12 +162,26 @@ function pump() {
 // ---------------------------------------------------------------- WebSocket
 let socket = null;
 
+// The server answers every message with one `done` or `error`, in order: the commands awaiting
+// their answer, oldest first.
+let awaiting = [];
+
 function send(msg) {
-  if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify(msg));
+  if (socket && socket.readyState === WebSocket.OPEN) {
+    socket.send(JSON.stringify(msg));
+    awaiting.push(msg.type);
+  }
 }
 panel.send = send;
 // A raw text message, for the tests of the server's validation.
-panel.sendRaw = (text) => socket.send(text);
+panel.sendRaw = (text) => { socket.send(text); awaiting.push('raw'); };
+
+// An answer came: the command it answers.
+function answered() {
+  const cmd = awaiting.shift();
+  if (cmd === 'set_velocity') velocitiesInFlight = Math.max(0, velocitiesInFlight - 1);
+  return cmd;
+}
 
 // Leaving the page closes its socket at once (the server also drops a silent page).
 window.addEventListener('pagehide', () => { if (socket) socket.close(); });
@@ -179,7 +193,8 @@ function connect() {
     $('conn').textContent = 'disconnected';
     $('conn').className = 'badge bad';
     panel.controller = null;
-    velocityInFlight = false;
+    awaiting = [];
+    velocitiesInFlight = 0;
     updateControl();
     setTimeout(connect, 1000);
   };
@@ -189,6 +204,7 @@ function connect() {
       case 'welcome': onWelcome(msg); break;
       case 'state': onState(msg); break;
       case 'done':
+        answered();
         panel.done.push(msg.command);
         if (msg.command === 'start_motion' && motionClick !== null) {
           // The next state carries the started motion's first readback (the server sends a
@@ -196,18 +212,18 @@ function connect() {
           motionStarted = motionClick;
           motionClick = null;
         }
-        if (msg.command === 'set_velocity') velocityInFlight = false;
         if (['set_pose', 'set_stance_height'].includes(msg.command)) { inFlight = false; pump(); }
         break;
-      case 'error':
+      case 'error': {
+        const cmd = answered();
         panel.errors.push(msg.message);
         message(msg.message);
         if (msg.field) showRefusal(msg.message, msg.field);
-        motionClick = null;
+        if (cmd === 'start_motion') motionClick = null;
         inFlight = false;
-        velocityInFlight = false;
         pump();
         break;
+      }
       default: break;
     }
   };
@@ -663,21 +679,24 @@ const keys = new Set();
 const MAX_V = 0.2; // m/s
 const MAX_YAW = 0.5; // rad/s
 // At least 10 Hz with room to spare: the device stops a walk whose velocity is not refreshed
-// within its timeout (500 ms by default). One command in flight at a time, so that a slow
-// device gets the latest velocity rather than a queue of old ones.
+// within its timeout (500 ms by default). At most a few commands awaiting their answer, so that
+// a slow server or device gets recent velocities rather than a growing queue of old ones, while
+// a round trip longer than the period (a busy machine) does not lower the rate.
 const VELOCITY_PERIOD_MS = 50;
+const VELOCITIES_IN_FLIGHT = 4;
 let lastVelocitySent = 0;
-let velocityInFlight = false;
+let velocitiesInFlight = 0;
 
 // The walk's velocity goes to the device only while the device reports a walk running, and
-// often enough for its velocity timeout: on its own timer and as soon as the last one is
-// answered, not at the drawing's pace (a software-rendered view on a busy machine draws slowly).
+// often enough for its velocity timeout: on its own timer, not at the drawing's pace (a
+// software-rendered view on a busy machine draws slowly).
 function sendVelocity() {
   const now = performance.now();
-  if (!panel.controlling || !panel.walking || velocityInFlight || now - lastVelocitySent < VELOCITY_PERIOD_MS) return;
+  if (!panel.controlling || !panel.walking || velocitiesInFlight >= VELOCITIES_IN_FLIGHT
+    || now - lastVelocitySent < VELOCITY_PERIOD_MS) return;
   const v = panel.velocity;
   lastVelocitySent = now;
-  velocityInFlight = true;
+  velocitiesInFlight += 1;
   panel.velocitiesSent += 1;
   send({ type: 'set_velocity', velocity: { forward_m_s: v.vx, lateral_m_s: v.vy, yaw_rate_rad_s: v.yaw } });
 }
