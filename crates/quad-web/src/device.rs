@@ -28,7 +28,7 @@
 //! Motion requests go through [`motion::request`]; their `MotionAck` carries the engine's state,
 //! which the thread also reads between commands (`GetMotion` instead of `GetState`). A
 //! simulated or emulated device's clock runs only while its link is read, so the thread idles
-//! the link up to the wall clock before each event: its motions run in real time.
+//! the link up to the wall clock while it waits for events: its motions run in real time.
 
 use crate::motion;
 use crate::msg::{self, FlagsMsg, LinkMsg, State};
@@ -618,6 +618,56 @@ pub struct Ready {
     pub info: DeviceInfo,
 }
 
+/// The device's clock runs this much at a time while it is behind the wall clock: a command
+/// that arrives meanwhile waits for at most one slice (an emulated device may need several
+/// times its length of wall time).
+const IDLE_SLICE: Duration = Duration::from_millis(2);
+
+/// Longest wait for an event while the device's clock is up to the wall clock.
+const WAIT_SLICE: Duration = Duration::from_millis(10);
+
+/// The device thread's next event: a job, a lost page, the server's end, or (as a timeout) a
+/// state read due at `poll_due`.
+///
+/// The device's clock follows the server's meanwhile: a simulated or emulated device's time
+/// (and its motion) runs only while its link is read, so the link idles in [`IDLE_SLICE`]s up
+/// to the wall clock, checking for events and a due state read between slices. A device slower
+/// than real time (simavr on a busy machine) thus runs its motions slower rather than delaying
+/// the pages' commands.
+fn next_event<L: Link>(
+    events: &std::sync::mpsc::Receiver<Event>,
+    session: &mut Session<L>,
+    link_up: &mut bool,
+    wall_epoch: Instant,
+    poll_due: Instant,
+) -> Result<Event, std::sync::mpsc::RecvTimeoutError> {
+    use std::sync::mpsc::{RecvTimeoutError, TryRecvError};
+    loop {
+        match events.try_recv() {
+            Ok(e) => return Ok(e),
+            Err(TryRecvError::Disconnected) => return Err(RecvTimeoutError::Disconnected),
+            Err(TryRecvError::Empty) => {}
+        }
+        let now = Instant::now();
+        if now >= poll_due {
+            return Err(RecvTimeoutError::Timeout);
+        }
+        let behind = wall_epoch.elapsed().saturating_sub(session.link_elapsed());
+        if *link_up && behind >= IDLE_SLICE {
+            if let Err(e) = session.idle(IDLE_SLICE) {
+                eprintln!("quadctl serve: device link failed: {e}");
+                *link_up = false;
+            }
+            continue;
+        }
+        match events.recv_timeout((poll_due - now).min(WAIT_SLICE)) {
+            Ok(e) => return Ok(e),
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => return Err(RecvTimeoutError::Disconnected),
+        }
+    }
+}
+
 /// Runs the device thread: opens the link, connects, then serves `events` and publishes the
 /// state to `state` until `events` closes. The result of the connection goes to `ready` first.
 pub fn run(
@@ -662,23 +712,17 @@ pub fn run(
     };
     publish(&session, true);
     let mut link_up = true;
-    // The device's clock follows the server's: a simulated or emulated device's time (and its
-    // motion) runs only while the link is read, so the link idles up to the wall clock before
-    // each event; at most a few poll periods at a time, so that a device slower than real
-    // time (simavr on a busy machine) runs slower instead of holding up the pages.
     let wall_epoch = Instant::now();
-    let max_idle = setup.poll * 4;
+    let mut last_state = Instant::now();
     loop {
-        let event = events.recv_timeout(setup.poll);
-        if link_up {
-            let behind = wall_epoch.elapsed().saturating_sub(session.link_elapsed());
-            if !behind.is_zero() {
-                if let Err(e) = session.idle(behind.min(max_idle)) {
-                    eprintln!("quadctl serve: device link failed: {e}");
-                    link_up = false;
-                }
-            }
-        }
+        let event = next_event(
+            &events,
+            &mut session,
+            &mut link_up,
+            wall_epoch,
+            last_state + setup.poll,
+        );
+        last_state = Instant::now();
         match event {
             Ok(Event::Job(job)) => {
                 let result = if link_up {

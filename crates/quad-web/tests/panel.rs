@@ -167,7 +167,7 @@ async fn sim_panel() {
     println!("body IK in the page: {ik_per_s:.0} per s; kin.wasm {wasm} bytes");
     assert!(ik_per_s > 1000.0);
 
-    motion_tab(&b, &dir, "sim", true).await;
+    motion_tab(&b, &dir, "sim").await;
     server.stop().unwrap();
 
     // Calibration: jog, save, read back, and power on again from the saved EEPROM.
@@ -290,7 +290,7 @@ async fn emulator_pose_and_calibration() {
         }
         report_latency(&b, "emulator").await;
         keep_screenshot(&b.screenshot().await, "panel-emulator.png", &dir);
-        motion_tab(&b, &dir, "emulator", false).await;
+        motion_tab(&b, &dir, "emulator").await;
         b.client.goto("about:blank").await.unwrap();
         server.stop().unwrap();
     }
@@ -351,9 +351,9 @@ async fn refused_start(b: &Browser) -> String {
 
 /// The Motion tab on the device, the page in control: stand, a roll sway whose readback moves
 /// the 3D view and whose status the page shows, Stop and the end of the motion; refusals named
-/// by their field, nothing moved; with `walk`, a trot steered by the keyboard whose velocity
+/// by their field, nothing moved; a trot steered by the keyboard whose velocity
 /// keeps it going. Prints the Start → first readback drawn latencies.
-async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str, walk: bool) {
+async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str) {
     b.click("tab-motion").await;
     b.js("(panel.motionLatencies.length = 0, 1)").await;
 
@@ -415,26 +415,36 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str, walk: bool) 
         moved > 0.01,
         "the sway's readback is drawn (moved {moved} rad)"
     );
-    // Drawn on its held feet: the feet on the stance's, the body rolled over them.
-    let pts = f64s(&b.js("panel.renderedPoints").await);
+    // Drawn on its held feet: the feet on the stance's, the body rolled over them (sampled
+    // until the roll shows: the sway passes through level twice a period).
     let held = f64s(
         &b.js("panel.kin.points(NEUTRAL_POSE, panel.kin.preview(NEUTRAL_POSE, panel.state.stance_height_m, panel.order).angles, panel.order)"
             .replace("NEUTRAL_POSE", "{roll_rad: 0, pitch_rad: 0, yaw_rad: 0, x_m: 0, y_m: 0, z_m: 0}")
             .as_str())
         .await,
     );
-    for leg in 0..4 {
-        for k in 9..12 {
-            let (d, h) = (pts[12 * leg + k], held[12 * leg + k]);
-            assert!((d - h).abs() < 1e-3, "foot {leg} drawn at {d}, held at {h}");
+    let t0 = std::time::Instant::now();
+    let mut max_tilt = 0.0f64;
+    loop {
+        let pts = f64s(&b.js("panel.renderedPoints").await);
+        for leg in 0..4 {
+            for k in 9..12 {
+                let (d, h) = (pts[12 * leg + k], held[12 * leg + k]);
+                assert!((d - h).abs() < 1e-3, "foot {leg} drawn at {d}, held at {h}");
+            }
         }
+        // The FL and FR hip mounts' heights differ by the body's roll.
+        let tilt = (pts[2] - pts[14]).abs();
+        max_tilt = max_tilt.max(tilt);
+        if tilt > 0.01 {
+            break;
+        }
+        assert!(
+            t0.elapsed() < WAIT,
+            "the body is never drawn rolled (at most {max_tilt} m between the front hips)"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
     }
-    // The FL and FR hip mounts' heights differ by the body's roll.
-    let tilt = (pts[2] - pts[14]).abs();
-    assert!(
-        tilt > 0.005,
-        "the body is drawn rolled ({tilt} m between the front hips)"
-    );
     let shot1 = b.screenshot().await;
     assert_ne!(shot0, shot1, "the view changed");
     if what == "sim" {
@@ -495,29 +505,27 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str, walk: bool) 
     assert_eq!(b.js("panel.motionStatus.kind").await, Value::Null);
     assert_eq!(f64s(&b.js("panel.state.angles_rad").await), back);
 
-    if walk {
-        // A trot held by the keyboard: the page refreshes the velocity well within the walk's
-        // timeout, so the device keeps walking; Stop ends it.
-        motion_form(b, "walk", &[("gait", "Trot")]).await;
-        b.click("motion-start").await;
-        b.wait("panel.walking", WAIT).await;
-        b.js("(window.dispatchEvent(new KeyboardEvent('keydown', {key: 'w'})), 1)")
-            .await;
-        let sent0 = b.js("panel.velocitiesSent").await.as_u64().unwrap();
-        let t0 = std::time::Instant::now();
-        tokio::time::sleep(Duration::from_millis(1500)).await;
-        let sent = b.js("panel.velocitiesSent").await.as_u64().unwrap() - sent0;
-        let rate_hz = sent as f64 / t0.elapsed().as_secs_f64();
-        assert!(rate_hz >= 10.0, "velocity refreshed at {rate_hz:.1} Hz");
-        assert_eq!(b.js("panel.motionStatus.kind").await, "walk");
-        assert_eq!(b.js("panel.motionStatus.stage").await, "run");
-        b.js("(window.dispatchEvent(new KeyboardEvent('keyup', {key: 'w'})), 1)")
-            .await;
-        b.click("motion-stop").await;
-        b.wait("panel.motionStatus.kind === null", WAIT).await;
-        assert_eq!(b.js("panel.motionStatus.fault").await, Value::Null);
-        println!("{what}: trot velocity refreshed at {rate_hz:.1} Hz");
-    }
+    // A trot held by the keyboard: the page refreshes the velocity well within the walk's
+    // timeout, so the device keeps walking; Stop ends it.
+    motion_form(b, "walk", &[("gait", "Trot")]).await;
+    b.click("motion-start").await;
+    b.wait("panel.walking", WAIT).await;
+    b.js("(window.dispatchEvent(new KeyboardEvent('keydown', {key: 'w'})), 1)")
+        .await;
+    let sent0 = b.js("panel.velocitiesSent").await.as_u64().unwrap();
+    let t0 = std::time::Instant::now();
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    let sent = b.js("panel.velocitiesSent").await.as_u64().unwrap() - sent0;
+    let rate_hz = sent as f64 / t0.elapsed().as_secs_f64();
+    assert!(rate_hz >= 10.0, "velocity refreshed at {rate_hz:.1} Hz");
+    assert_eq!(b.js("panel.motionStatus.kind").await, "walk");
+    assert_eq!(b.js("panel.motionStatus.stage").await, "run");
+    b.js("(window.dispatchEvent(new KeyboardEvent('keyup', {key: 'w'})), 1)")
+        .await;
+    b.click("motion-stop").await;
+    b.wait("panel.motionStatus.kind === null", WAIT).await;
+    assert_eq!(b.js("panel.motionStatus.fault").await, Value::Null);
+    println!("{what}: trot velocity refreshed at {rate_hz:.1} Hz");
 
     let latencies = f64s(&b.js("panel.motionLatencies").await);
     let mean = latencies.iter().sum::<f64>() / latencies.len().max(1) as f64;
