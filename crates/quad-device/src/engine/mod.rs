@@ -537,6 +537,7 @@ fn check_sample<'r, M: Math>(
 /// One builder per law, each out of line: a law's parameters are a hundred bytes and more,
 /// and the three sets in one stack frame would put most of its accesses beyond the AVR's
 /// 63-byte displacement.
+#[inline(never)]
 fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<AnyMotion, Error> {
     match *request {
         Request::Sway {
