@@ -12,8 +12,8 @@
 
 use super::path::{AnyPath, FootPath};
 use super::{
-    check_reach, finite, finite_vec, fract01, non_negative, positive, Contact, Error, Frame,
-    Motion, Phase,
+    check_reach, finite, finite_feet, finite_vec, fract01, non_negative, positive, Contact, Error,
+    Frame, Motion, Phase,
 };
 use super::{Expected, Param};
 use crate::body::{BodyConfig, Pose};
@@ -181,9 +181,7 @@ impl Sway {
         finite(p.roll0_rad, Param::Roll0Rad)?;
         finite(p.pitch0_rad, Param::Pitch0Rad)?;
         finite(p.yaw0_rad, Param::Yaw0Rad)?;
-        for f in &p.feet_in_world {
-            finite_vec(*f, Param::FeetInWorld)?;
-        }
+        finite_feet(&p.feet_in_world, Param::FeetInWorld)?;
         Ok(())
     }
 
@@ -556,9 +554,7 @@ impl LegPaths {
         for o in &p.phase_offsets {
             finite(*o, Param::PhaseOffsets)?;
         }
-        for f in &p.stance_feet {
-            finite_vec(*f, Param::StanceFeet)?;
-        }
+        finite_feet(&p.stance_feet, Param::StanceFeet)?;
         Ok(())
     }
 

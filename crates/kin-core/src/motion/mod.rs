@@ -284,6 +284,16 @@ pub(crate) fn finite_vec(v: Vec3, name: Param) -> Result<Vec3, Error> {
     }
 }
 
+/// Checks that every component of the four feet is finite. Out of line: one copy for the
+/// laws that check their feet.
+#[inline(never)]
+pub(crate) fn finite_feet(feet: &[Vec3; 4], name: Param) -> Result<(), Error> {
+    for f in feet {
+        finite_vec(*f, name)?;
+    }
+    Ok(())
+}
+
 /// `x − floor(x)` in `[0, 1)` for finite `x` (guards the rounding of tiny negative values to 1).
 #[inline]
 pub(crate) fn fract01(x: f32) -> f32 {
