@@ -173,7 +173,9 @@ impl<M: Math> EngineBench<M> {
 
     fn tick(&mut self) -> Stage {
         self.now_ms += FRAME_MS;
-        let tick = self.engine.tick(1, self.now_ms, &self.out);
+        let tick = self
+            .engine
+            .tick(1, self.now_ms, &self.out, &self.config.robot);
         if let Some(target) = tick.target {
             self.engine.limiter().step(&mut self.out, &target);
         }

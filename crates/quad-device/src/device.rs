@@ -316,7 +316,9 @@ where
         self.enabling_frame = false;
         let mut disable = false;
         if self.engine.is_active() {
-            let tick = self.engine.tick(frames, now, &self.out_rad);
+            let tick = self
+                .engine
+                .tick(frames, now, &self.out_rad, &self.config.robot);
             if let Some(q) = tick.target {
                 if let Err(e) = self.hold_motion_target(q) {
                     self.engine.fail(e, self.out_rad);

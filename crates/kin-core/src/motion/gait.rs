@@ -114,10 +114,12 @@ impl GaitParams {
     pub const DEFAULT_CYCLE_S: f32 = 1.0;
     /// Default step height as a fraction of the stance height.
     pub const DEFAULT_STEP_HEIGHT_FRACTION: f32 = 0.15;
+    /// Default swing shape: the Bézier swing, which joins a straight stance with C1 continuity.
+    pub const DEFAULT_SWING: PathKind = PathKind::Bezier;
 
     /// `pattern` on `robot` at `stance_height_m`, standing still (zero velocity), with a cycle
     /// of [`Self::DEFAULT_CYCLE_S`], a step height of [`Self::DEFAULT_STEP_HEIGHT_FRACTION`]·H
-    /// and the Bézier swing.
+    /// and the [`Self::DEFAULT_SWING`].
     pub fn new(pattern: Pattern, robot: Robot, stance_height_m: f32) -> GaitParams {
         GaitParams {
             robot,
@@ -127,7 +129,7 @@ impl GaitParams {
             phase_offsets: pattern.phase_offsets(),
             step_height_m: Self::DEFAULT_STEP_HEIGHT_FRACTION * stance_height_m,
             velocity: Velocity::default(),
-            swing: PathKind::Bezier,
+            swing: Self::DEFAULT_SWING,
             order: RotationOrder::default(),
         }
     }
@@ -184,6 +186,37 @@ pub fn swing_foot<M: Math>(
     Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z)
 }
 
+/// The gait's checks that need no robot: finite values, `H > 0`, `T > 0`, `d ∈ (0, 1)`, the
+/// step height ≥ 0 and below the hips (the [`Gait`]'s and the walker's).
+pub(crate) fn check_timing(
+    stance_height_m: f32,
+    cycle_s: f32,
+    duty_factor: f32,
+    phase_offsets: &[f32; 4],
+    step_height_m: f32,
+) -> Result<(), Error> {
+    positive(stance_height_m, Param::StanceHeightM)?;
+    positive(cycle_s, Param::CycleS)?;
+    let d = finite(duty_factor, Param::DutyFactor)?;
+    if !(d > 0.0 && d < 1.0) {
+        return Err(Error::OutOfRange {
+            parameter: Param::DutyFactor,
+            expected: Expected::OpenUnitInterval,
+        });
+    }
+    for &o in phase_offsets {
+        finite(o, Param::PhaseOffsets)?;
+    }
+    non_negative(step_height_m, Param::StepHeightM)?;
+    if !(step_height_m < stance_height_m) {
+        return Err(Error::OutOfRange {
+            parameter: Param::StepHeightM,
+            expected: Expected::BelowStanceHeight,
+        });
+    }
+    Ok(())
+}
+
 /// A trot or walk: see the module docs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gait {
@@ -215,25 +248,13 @@ impl Gait {
     /// the reach itself through its own IK (a device's start check).
     pub fn without_reach_check(p: GaitParams) -> Result<Gait, Error> {
         p.robot.validate()?;
-        positive(p.stance_height_m, Param::StanceHeightM)?;
-        positive(p.cycle_s, Param::CycleS)?;
-        let d = finite(p.duty_factor, Param::DutyFactor)?;
-        if !(d > 0.0 && d < 1.0) {
-            return Err(Error::OutOfRange {
-                parameter: Param::DutyFactor,
-                expected: Expected::OpenUnitInterval,
-            });
-        }
-        for o in p.phase_offsets {
-            finite(o, Param::PhaseOffsets)?;
-        }
-        non_negative(p.step_height_m, Param::StepHeightM)?;
-        if !(p.step_height_m < p.stance_height_m) {
-            return Err(Error::OutOfRange {
-                parameter: Param::StepHeightM,
-                expected: Expected::BelowStanceHeight,
-            });
-        }
+        check_timing(
+            p.stance_height_m,
+            p.cycle_s,
+            p.duty_factor,
+            &p.phase_offsets,
+            p.step_height_m,
+        )?;
         finite(p.velocity.forward_m_s, Param::ForwardMS)?;
         finite(p.velocity.lateral_m_s, Param::LateralMS)?;
         finite(p.velocity.yaw_rad_s, Param::YawRadS)?;

@@ -40,7 +40,7 @@
 //! body's displacement of that step is then halved (up to three times, then zero) until every
 //! stance foot stays inside, and [`Walker::saturated`] reports it.
 
-use super::gait::{displace, swing_foot, Gait, GaitParams, Pattern, Velocity};
+use super::gait::{check_timing, displace, swing_foot, Gait, GaitParams, Pattern, Velocity};
 use super::path::PathKind;
 use super::{
     check_reach, finite, fract01, positive, Contact, Error, Expected, Frame, Param, Phase,
@@ -51,11 +51,10 @@ use crate::robot::{LegId, Robot};
 use crate::rotation::RotationOrder;
 use crate::vec::Vec3;
 
-/// Parameters of a [`Walker`].
+/// Parameters of a [`Walker`] (the robot is given apart: the walker keeps its neutral
+/// footholds, not the robot).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WalkerParams {
-    /// The robot.
-    pub robot: Robot,
     /// Stance height `H` (hip plane above the ground), m.
     pub stance_height_m: f32,
     /// Gait cycle `T`, s.
@@ -78,27 +77,25 @@ impl WalkerParams {
     /// Default [`WalkerParams::reach_radius_m`] as a fraction of the stance height.
     pub const DEFAULT_REACH_RADIUS_FRACTION: f32 = 0.2;
 
-    /// `pattern` on `robot` at `stance_height_m` with [`GaitParams::new`]'s cycle, step height
-    /// and swing, and a reach radius of [`Self::DEFAULT_REACH_RADIUS_FRACTION`]·H.
-    pub fn new(pattern: Pattern, robot: Robot, stance_height_m: f32) -> WalkerParams {
-        let g = GaitParams::new(pattern, robot, stance_height_m);
+    /// `pattern` at `stance_height_m` with [`GaitParams::new`]'s cycle, step height, swing and
+    /// rotation order, and a reach radius of [`Self::DEFAULT_REACH_RADIUS_FRACTION`]·H.
+    pub fn new(pattern: Pattern, stance_height_m: f32) -> WalkerParams {
         WalkerParams {
-            robot,
             stance_height_m,
-            cycle_s: g.cycle_s,
-            duty_factor: g.duty_factor,
-            phase_offsets: g.phase_offsets,
-            step_height_m: g.step_height_m,
-            swing: g.swing,
-            order: g.order,
+            cycle_s: GaitParams::DEFAULT_CYCLE_S,
+            duty_factor: pattern.duty_factor(),
+            phase_offsets: pattern.phase_offsets(),
+            step_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * stance_height_m,
+            swing: GaitParams::DEFAULT_SWING,
+            order: RotationOrder::default(),
             reach_radius_m: Self::DEFAULT_REACH_RADIUS_FRACTION * stance_height_m,
         }
     }
 
-    /// The closed-form gait of these parameters at a constant `velocity`.
-    pub fn gait_params(&self, velocity: Velocity) -> GaitParams {
+    /// The closed-form gait of these parameters on `robot` at a constant `velocity`.
+    pub fn gait_params(&self, robot: Robot, velocity: Velocity) -> GaitParams {
         GaitParams {
-            robot: self.robot,
+            robot,
             stance_height_m: self.stance_height_m,
             cycle_s: self.cycle_s,
             duty_factor: self.duty_factor,
@@ -140,17 +137,18 @@ impl Walker {
     /// Number of envelope points per leg ([`Walker::envelope`]).
     pub const ENVELOPE_SAMPLES: usize = 17;
 
-    /// Validates the parameters (those of [`Gait::new`] at zero velocity, and `R > 0`) and the
-    /// reach of the stride cylinder (module docs; a failure names `reach_radius_m`), and starts
-    /// at phase 0 standing on the neutral footholds with a zero command. The reach checks run
-    /// on the [`DefaultMath`](crate::DefaultMath) backend.
-    pub fn new(p: WalkerParams) -> Result<Walker, Error> {
-        Gait::new(p.gait_params(Velocity::default()))?;
-        let walker = Self::without_reach_check(p)?;
+    /// Validates the parameters (those of [`Gait::new`] on `robot` at zero velocity, and
+    /// `R > 0`) and the reach of the stride cylinder (module docs; a failure names
+    /// `reach_radius_m`), and starts at phase 0 standing on the neutral footholds (`robot`'s
+    /// [`Robot::stance_feet`] at `H`) with a zero command. The reach checks run on the
+    /// [`DefaultMath`](crate::DefaultMath) backend.
+    pub fn new(robot: &Robot, p: WalkerParams) -> Result<Walker, Error> {
+        Gait::new(p.gait_params(*robot, Velocity::default()))?;
+        let walker = Self::on_stance(p, robot.stance_feet(p.stance_height_m))?;
         let cfg = walker.body_config();
         for k in 0..Self::ENVELOPE_SAMPLES {
             check_reach(
-                &p.robot,
+                robot,
                 &Pose::default(),
                 &cfg,
                 &walker.envelope(k),
@@ -160,13 +158,20 @@ impl Walker {
         Ok(walker)
     }
 
-    /// [`Walker::new`]'s parameter checks without its reach checks, for a caller that checks
-    /// the reach itself by running the envelope's points through its own IK (a device's
-    /// start check).
-    pub fn without_reach_check(p: WalkerParams) -> Result<Walker, Error> {
-        let gait = Gait::without_reach_check(p.gait_params(Velocity::default()))?;
+    /// [`Walker::new`]'s parameter checks without the robot's validation and the reach checks,
+    /// standing on `neutral_feet` (the robot's [`Robot::stance_feet`] at `H`): for a caller
+    /// that validated its robot already and checks the reach itself by running the envelope's
+    /// points through its own IK (a device's start check).
+    pub fn on_stance(p: WalkerParams, neutral_feet: [Vec3; 4]) -> Result<Walker, Error> {
+        check_timing(
+            p.stance_height_m,
+            p.cycle_s,
+            p.duty_factor,
+            &p.phase_offsets,
+            p.step_height_m,
+        )?;
         positive(p.reach_radius_m, Param::ReachRadiusM)?;
-        let neutral = gait.neutral_feet();
+        let neutral = neutral_feet;
         let leg = |n: Vec3| Leg {
             foot: n,
             lift_off: n,

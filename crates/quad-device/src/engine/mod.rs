@@ -780,12 +780,14 @@ impl<M: Math> Engine<M> {
         if w.velocity_timeout_ms == 0 {
             return Err(motion::Error::NotPositive(Param::VelocityTimeoutMs).into());
         }
-        let mut p = WalkerParams::new(w.pattern, *s.robot, w.body_height_m);
+        let mut p = WalkerParams::new(w.pattern, w.body_height_m);
         p.step_height_m = w.step_height_m;
         p.cycle_s = w.cycle_s;
         p.order = s.order;
+        // The device validated its robot at boot.
+        let stance = s.robot.stance_feet(w.body_height_m);
         *program = Program::Walk {
-            walker: Walker::without_reach_check(p)?,
+            walker: Walker::on_stance(p, stance)?,
             timeout_ms: w.velocity_timeout_ms,
             last_command_ms: s.now_ms,
         };
@@ -794,7 +796,7 @@ impl<M: Math> Engine<M> {
 
     #[inline(never)]
     fn check_walk(walker: &Walker, s: &Setup<'_>) -> Result<[f32; 12], Error> {
-        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(walker), true)?;
+        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(walker, s.robot), true)?;
         for k in 0..Walker::ENVELOPE_SAMPLES {
             let frame = Frame {
                 pose: Pose::default(),
@@ -840,11 +842,10 @@ impl<M: Math> Engine<M> {
         solve_frame::<M>(law.motion.robot(), law.motion.body_config().order, &frame)
     }
 
-    /// The walk's joint setpoint at its current frame.
+    /// The walk's joint setpoint at its current frame, on `robot`.
     #[inline(never)]
-    fn walk_setpoint(walker: &Walker) -> Result<[f32; 12], IkError> {
-        let p = walker.params();
-        solve_frame::<M>(&p.robot, p.order, &walker.frame())
+    fn walk_setpoint(walker: &Walker, robot: &Robot) -> Result<[f32; 12], IkError> {
+        solve_frame::<M>(robot, walker.params().order, &walker.frame())
     }
 
     /// Sets a walk's velocity command at `now_ms`.
@@ -929,13 +930,13 @@ impl<M: Math> Engine<M> {
         }
     }
 
-    /// One tick after `frames` (≥ 1) frame boundaries, at `now_ms`, with the outputs at `out`:
-    /// the new target, if any.
+    /// One tick after `frames` (≥ 1) frame boundaries, at `now_ms`, with the outputs at `out`,
+    /// on `robot` (the one the motion was started with): the new target, if any.
     ///
     /// Out of line, as are the law's frame and setpoint and the walker's steps: each keeps its
     /// own small stack frame (see `Device`'s notes on AVR stack frames).
     #[inline(never)]
-    pub fn tick(&mut self, frames: u32, now_ms: u32, out: &[f32; 12]) -> Tick {
+    pub fn tick(&mut self, frames: u32, now_ms: u32, out: &[f32; 12], robot: &Robot) -> Tick {
         let mut tick = Tick {
             target: None,
             disable_outputs: false,
@@ -993,7 +994,7 @@ impl<M: Math> Engine<M> {
                             let _ = walker.step::<M>(FRAME_S);
                         }
                         self.frame = self.frame.saturating_add(frames);
-                        (Self::walk_setpoint(walker), walker.is_stopped())
+                        (Self::walk_setpoint(walker, robot), walker.is_stopped())
                     }
                     _ => {
                         self.cancel();
