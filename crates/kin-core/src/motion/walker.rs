@@ -251,28 +251,41 @@ impl Walker {
         }
     }
 
-    /// Largest horizontal distance of a planned lift-off or touch-down point from its neutral
-    /// foothold under the constant command `v`, m.
-    fn excursion_m<M: Math>(&self, v: &Velocity) -> f32 {
+    /// `R / f`: the radius within which the planned footholds lie and the stance feet stay
+    /// (module docs), m.
+    fn stance_radius_m(&self) -> f32 {
+        self.p.reach_radius_m / self.overshoot_factor()
+    }
+
+    /// True when every lift-off and touch-down point planned under the constant command `v`
+    /// lies within `sqrt(radius_sq)` of its neutral foothold, horizontally.
+    fn footholds_within<M: Math>(&self, v: &Velocity, radius_sq: f32) -> bool {
         let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
-        let mut e: f32 = 0.0;
-        for n in self.neutral {
+        for (i, &n) in self.neutral.iter().enumerate() {
             for s in [half, -half] {
-                let q = displace::<M>(v, s, n) - n;
-                e = e.max(M::sqrt(q.x * q.x + q.y * q.y));
+                if !(self.off_neutral_sq(i, displace::<M>(v, s, n)) <= radius_sq) {
+                    return false;
+                }
             }
         }
-        e
+        true
     }
 
     /// Checks a velocity command: finite components, `|ω|·d·T ≤ π`, and the planned footholds
     /// within the stride disc (module docs). A component that is too large on its own is named
     /// (`forward_m_s`, `lateral_m_s`, `yaw_rad_s`); a combination that is, `velocity`.
     pub fn check_velocity<M: Math>(&self, v: &Velocity) -> Result<(), Error> {
-        finite(v.forward_m_s, Param::ForwardMS)?;
-        finite(v.lateral_m_s, Param::LateralMS)?;
-        finite(v.yaw_rad_s, Param::YawRadS)?;
-        const EXPECTED: Expected = Expected::WithinGaitReach;
+        // Each component alone, then all three together.
+        const NAMES: [Param; 4] = [
+            Param::ForwardMS,
+            Param::LateralMS,
+            Param::YawRadS,
+            Param::Velocity,
+        ];
+        let c = [v.forward_m_s, v.lateral_m_s, v.yaw_rad_s];
+        for (&x, &name) in c.iter().zip(&NAMES) {
+            finite(x, name)?;
+        }
         let stance_s = self.p.duty_factor * self.p.cycle_s;
         if !(libm::fabsf(v.yaw_rad_s) * stance_s <= core::f32::consts::PI) {
             return Err(Error::OutOfRange {
@@ -280,36 +293,18 @@ impl Walker {
                 expected: Expected::HalfTurnPerStance,
             });
         }
-        let limit = self.p.reach_radius_m / self.overshoot_factor();
-        let zero = Velocity::default();
-        for (single, name) in [
-            (
-                Velocity {
-                    forward_m_s: v.forward_m_s,
-                    ..zero
-                },
-                Param::ForwardMS,
-            ),
-            (
-                Velocity {
-                    lateral_m_s: v.lateral_m_s,
-                    ..zero
-                },
-                Param::LateralMS,
-            ),
-            (
-                Velocity {
-                    yaw_rad_s: v.yaw_rad_s,
-                    ..zero
-                },
-                Param::YawRadS,
-            ),
-            (*v, Param::Velocity),
-        ] {
-            if !(self.excursion_m::<M>(&single) <= limit) {
+        let r = self.stance_radius_m();
+        for (k, &name) in NAMES.iter().enumerate() {
+            let part = |j: usize| if k == j || k == 3 { c[j] } else { 0.0 };
+            let single = Velocity {
+                forward_m_s: part(0),
+                lateral_m_s: part(1),
+                yaw_rad_s: part(2),
+            };
+            if !self.footholds_within::<M>(&single, r * r) {
                 return Err(Error::OutOfRange {
                     parameter: name,
-                    expected: EXPECTED,
+                    expected: Expected::WithinGaitReach,
                 });
             }
         }
@@ -398,7 +393,7 @@ impl Walker {
         let old = self.phase;
         let new = fract01(old + dt_s / self.p.cycle_s);
         // Stance feet within R/f: a swing from there overshoots by at most the factor.
-        let r = self.p.reach_radius_m / self.overshoot_factor();
+        let r = self.stance_radius_m();
         let r_sq = r * r;
         self.saturated = false;
         let mut scale = 1.0;
