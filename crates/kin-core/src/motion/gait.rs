@@ -135,13 +135,13 @@ impl GaitParams {
     }
 }
 
-/// `sin(x)/x`, exact at 0.
+/// `sin(x)/x` from `sin_x` = `sin(x)`, exact at 0.
 #[inline]
-fn sinc<M: Math>(x: f32) -> f32 {
+fn sinc(sin_x: f32, x: f32) -> f32 {
     if libm::fabsf(x) < 1e-3 {
         1.0 - x * x / 6.0
     } else {
-        M::sin_cos(x).0 / x
+        sin_x / x
     }
 }
 
@@ -151,10 +151,11 @@ fn sinc<M: Math>(x: f32) -> f32 {
 pub fn displace<M: Math>(velocity: &Velocity, s: f32, n: Vec3) -> Vec3 {
     let v = velocity;
     let x = v.yaw_rad_s * s;
+    // Two sines, each used twice: on a soft-float target each evaluation is costly.
     let (sn, cs) = M::sin_cos(x);
     let (sh, _) = M::sin_cos(0.5 * x);
-    let a = s * sinc::<M>(x); // ∫ cos
-    let b = s * sh * sinc::<M>(0.5 * x); // ∫ sin = (1 − cos x)/ω
+    let a = s * sinc(sn, x); // ∫ cos
+    let b = s * sh * sinc(sh, 0.5 * x); // ∫ sin = (1 − cos x)/ω
     Vec3::new(
         v.forward_m_s * a - v.lateral_m_s * b + cs * n.x - sn * n.y,
         v.forward_m_s * b + v.lateral_m_s * a + sn * n.x + cs * n.y,

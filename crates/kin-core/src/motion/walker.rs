@@ -370,14 +370,17 @@ impl Walker {
         q < 1.0 - self.p.duty_factor
     }
 
-    /// The touch-down point of `leg` planned now: `X(d·T/2)·n` with the current command.
-    fn plan<M: Math>(&self, leg: usize) -> Vec3 {
-        let n = self.neutral[leg];
-        if self.velocity == Velocity::default() {
-            return n;
+    /// Moves `p` by the body displacement `X(rate·s)` of the current command, when there is a
+    /// command and `s > 0`: a stance foot over `s` seconds of the body moving by `scale` times
+    /// the command is `rate = −scale`, a touch-down point planned `s = d·T/2` ahead `rate = 1`.
+    /// A zero command leaves `p` exactly where it is (a stop parks on the neutral foothold).
+    ///
+    /// Out of line: one copy of the displacement's call for the three uses of a step.
+    #[inline(never)]
+    fn carry<M: Math>(&self, p: &mut Vec3, s: f32, rate: f32) {
+        if self.velocity != Velocity::default() && s > 0.0 {
+            *p = displace::<M>(&self.velocity, rate * s, *p);
         }
-        let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
-        displace::<M>(&self.velocity, half, n)
     }
 
     /// Squared horizontal distance of `p` from the neutral foothold of `leg`, m².
@@ -401,14 +404,13 @@ impl Walker {
         for _ in 0..5 {
             let mut inside = true;
             for (i, leg) in next.iter_mut().enumerate() {
-                *leg = self.advance_leg::<M>(i, old, new, dt_s, scale);
                 let l = &self.legs[i];
+                *leg = *l;
+                self.advance_leg::<M>(i, leg, old, new, dt_s, scale);
                 let stance = !self.in_swing(self.leg_phase(i, new));
                 // A foot already outside (it cannot be, by the checks) may stay.
-                if stance
-                    && !leg.parked
-                    && self.off_neutral_sq(i, leg.foot) > r_sq
-                    && self.off_neutral_sq(i, leg.foot) > self.off_neutral_sq(i, l.foot)
+                let off_sq = self.off_neutral_sq(i, leg.foot);
+                if stance && !leg.parked && off_sq > r_sq && off_sq > self.off_neutral_sq(i, l.foot)
                 {
                     inside = false;
                 }
@@ -424,41 +426,48 @@ impl Walker {
         Ok(())
     }
 
-    /// Leg `i` after a step from global phase `old` to `new` (`dt_s` long), the body moving by
-    /// `scale` times the command.
+    /// Advances leg `i`'s state `l` over a step from global phase `old` to `new` (`dt_s` long),
+    /// the body moving by `scale` times the command.
     ///
     /// Out of line: one copy in the step's retry loop, and a small stack frame on targets
     /// where large frames are costly (the ATmega2560).
     #[inline(never)]
-    fn advance_leg<M: Math>(&self, i: usize, old: f32, new: f32, dt_s: f32, scale: f32) -> Leg {
-        let mut l = self.legs[i];
+    fn advance_leg<M: Math>(
+        &self,
+        i: usize,
+        l: &mut Leg,
+        old: f32,
+        new: f32,
+        dt_s: f32,
+        scale: f32,
+    ) {
         if l.parked {
-            return l;
+            return;
         }
         let t = self.p.cycle_s;
         let swing_end = 1.0 - self.p.duty_factor;
         let (q0, q1) = (self.leg_phase(i, old), self.leg_phase(i, new));
-        // The foot fixed in the world for `s` seconds of this step.
-        let stance_for = |p: Vec3, s: f32| {
-            if self.velocity == Velocity::default() || !(s > 0.0) {
-                p
+        // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
+        let lift_off = q1 < q0;
+        if lift_off || !self.in_swing(q0) {
+            // The foot fixed in the world up to the lift-off or the step's end.
+            let s = if lift_off {
+                ((1.0 - q0) * t).min(dt_s)
             } else {
-                displace::<M>(&self.velocity, -s * scale, p)
+                dt_s
+            };
+            self.carry::<M>(&mut l.foot, s, -scale);
+            if !lift_off {
+                return;
             }
-        };
-        if q1 < q0 {
-            // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
-            let foot = stance_for(l.foot, ((1.0 - q0) * t).min(dt_s));
-            if self.stopping && foot == self.neutral[i] {
-                l.foot = foot;
+            if self.stopping && l.foot == self.neutral[i] {
                 l.parked = true;
-                return l;
+                return;
             }
-            l.lift_off = foot;
-            l.touch_down = self.plan::<M>(i);
-        } else if !self.in_swing(q0) {
-            l.foot = stance_for(l.foot, dt_s);
-            return l;
+            l.lift_off = l.foot;
+            // The touch-down point planned now: `X(d·T/2)·n` with the current command.
+            l.touch_down = self.neutral[i];
+            self.carry::<M>(&mut l.touch_down, 0.5 * self.p.duty_factor * t, 1.0);
         }
         if self.in_swing(q1) {
             l.foot = swing_foot::<M>(
@@ -471,9 +480,9 @@ impl Walker {
             );
         } else {
             // Touch-down in this step, `(q1 − (1 − d))·T` ago.
-            l.foot = stance_for(l.touch_down, ((q1 - swing_end) * t).min(dt_s));
+            l.foot = l.touch_down;
+            self.carry::<M>(&mut l.foot, ((q1 - swing_end) * t).min(dt_s), -scale);
         }
-        l
     }
 
     /// Feet and contacts now; the body stays at the zero pose, so the world frame is the body
