@@ -121,6 +121,20 @@ struct Leg {
     parked: bool,
 }
 
+/// One step of [`Walker::step`], as its legs see it.
+struct Span {
+    /// Global phase before the step, cycles.
+    old: f32,
+    /// After the step, cycles.
+    new: f32,
+    /// The step's duration, s.
+    dt_s: f32,
+    /// Fraction of the command by which the body moves over the step.
+    scale: f32,
+    /// `(R/f)²`, m².
+    r_sq: f32,
+}
+
 /// A trot / walk stepper with a changing velocity command: see the module docs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Walker {
@@ -295,11 +309,17 @@ impl Walker {
         }
         let r = self.stance_radius_m();
         for (k, &name) in NAMES.iter().enumerate() {
-            let part = |j: usize| if k == j || k == 3 { c[j] } else { 0.0 };
+            let mut part = c;
+            for (j, x) in part.iter_mut().enumerate() {
+                if k != j && k != 3 {
+                    *x = 0.0;
+                }
+            }
+            let [forward_m_s, lateral_m_s, yaw_rad_s] = part;
             let single = Velocity {
-                forward_m_s: part(0),
-                lateral_m_s: part(1),
-                yaw_rad_s: part(2),
+                forward_m_s,
+                lateral_m_s,
+                yaw_rad_s,
             };
             if !self.footholds_within::<M>(&single, r * r) {
                 return Err(Error::OutOfRange {
@@ -394,95 +414,97 @@ impl Walker {
     pub fn step<M: Math>(&mut self, dt_s: f32) -> Result<(), Error> {
         positive(dt_s, Param::DtS)?;
         let old = self.phase;
-        let new = fract01(old + dt_s / self.p.cycle_s);
         // Stance feet within R/f: a swing from there overshoots by at most the factor.
         let r = self.stance_radius_m();
-        let r_sq = r * r;
+        let mut span = Span {
+            old,
+            new: fract01(old + dt_s / self.p.cycle_s),
+            dt_s,
+            scale: 1.0,
+            r_sq: r * r,
+        };
         self.saturated = false;
-        let mut scale = 1.0;
         let mut next = self.legs;
         for _ in 0..5 {
             let mut inside = true;
             for (i, leg) in next.iter_mut().enumerate() {
-                let l = &self.legs[i];
-                *leg = *l;
-                self.advance_leg::<M>(i, leg, old, new, dt_s, scale);
-                let stance = !self.in_swing(self.leg_phase(i, new));
-                // A foot already outside (it cannot be, by the checks) may stay.
-                let off_sq = self.off_neutral_sq(i, leg.foot);
-                if stance && !leg.parked && off_sq > r_sq && off_sq > self.off_neutral_sq(i, l.foot)
-                {
-                    inside = false;
-                }
+                *leg = self.legs[i];
+                inside &= self.advance_leg::<M>(i, leg, &span);
             }
-            if inside || scale == 0.0 {
+            if inside || span.scale == 0.0 {
                 break;
             }
             self.saturated = true;
-            scale = if scale > 0.2 { 0.5 * scale } else { 0.0 };
+            span.scale = if span.scale > 0.2 {
+                0.5 * span.scale
+            } else {
+                0.0
+            };
         }
         self.legs = next;
-        self.phase = new;
+        self.phase = span.new;
         Ok(())
     }
 
-    /// Advances leg `i`'s state `l` over a step from global phase `old` to `new` (`dt_s` long),
-    /// the body moving by `scale` times the command.
+    /// Advances leg `i`'s state `l` over `span`. False when the leg ends the step in stance
+    /// with its foot moved farther out, beyond `R/f` (the step must move the body less). A
+    /// foot already outside (it cannot be, by the checks) may stay.
     ///
     /// Out of line: one copy in the step's retry loop, and a small stack frame on targets
     /// where large frames are costly (the ATmega2560).
     #[inline(never)]
-    fn advance_leg<M: Math>(
-        &self,
-        i: usize,
-        l: &mut Leg,
-        old: f32,
-        new: f32,
-        dt_s: f32,
-        scale: f32,
-    ) {
+    fn advance_leg<M: Math>(&self, i: usize, l: &mut Leg, span: &Span) -> bool {
         if l.parked {
-            return;
+            return true;
         }
+        let before_sq = self.off_neutral_sq(i, l.foot);
         let t = self.p.cycle_s;
         let swing_end = 1.0 - self.p.duty_factor;
-        let (q0, q1) = (self.leg_phase(i, old), self.leg_phase(i, new));
+        let (q0, q1) = (self.leg_phase(i, span.old), self.leg_phase(i, span.new));
         // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
         let lift_off = q1 < q0;
-        if lift_off || !self.in_swing(q0) {
+        let stance_only = !lift_off && !self.in_swing(q0);
+        if lift_off || stance_only {
             // The foot fixed in the world up to the lift-off or the step's end.
             let s = if lift_off {
-                ((1.0 - q0) * t).min(dt_s)
+                ((1.0 - q0) * t).min(span.dt_s)
             } else {
-                dt_s
+                span.dt_s
             };
-            self.carry::<M>(&mut l.foot, s, -scale);
-            if !lift_off {
-                return;
-            }
+            self.carry::<M>(&mut l.foot, s, -span.scale);
+        }
+        if lift_off {
             if self.stopping && l.foot == self.neutral[i] {
                 l.parked = true;
-                return;
+                return true;
             }
             l.lift_off = l.foot;
             // The touch-down point planned now: `X(d·T/2)·n` with the current command.
             l.touch_down = self.neutral[i];
             self.carry::<M>(&mut l.touch_down, 0.5 * self.p.duty_factor * t, 1.0);
         }
-        if self.in_swing(q1) {
-            l.foot = swing_foot::<M>(
-                self.p.swing,
-                self.p.step_height_m,
-                self.p.duty_factor,
-                l.lift_off,
-                l.touch_down,
-                Phase::wrap(q1),
-            );
-        } else {
+        if !stance_only {
+            if self.in_swing(q1) {
+                l.foot = swing_foot::<M>(
+                    self.p.swing,
+                    self.p.step_height_m,
+                    self.p.duty_factor,
+                    l.lift_off,
+                    l.touch_down,
+                    Phase::wrap(q1),
+                );
+                return true;
+            }
             // Touch-down in this step, `(q1 − (1 − d))·T` ago.
             l.foot = l.touch_down;
-            self.carry::<M>(&mut l.foot, ((q1 - swing_end) * t).min(dt_s), -scale);
+            self.carry::<M>(
+                &mut l.foot,
+                ((q1 - swing_end) * t).min(span.dt_s),
+                -span.scale,
+            );
         }
+        let off_sq = self.off_neutral_sq(i, l.foot);
+        !(off_sq > span.r_sq && off_sq > before_sq)
     }
 
     /// Feet and contacts now; the body stays at the zero pose, so the world frame is the body
