@@ -411,6 +411,7 @@ impl Walker {
 
     /// Advances by `dt_s` (> 0, less than the shorter of swing and stance; one servo frame) on
     /// math backend `M`. A non-finite or non-positive `dt_s` is refused and changes nothing.
+    #[inline(never)]
     pub fn step<M: Math>(&mut self, dt_s: f32) -> Result<(), Error> {
         positive(dt_s, Param::DtS)?;
         let old = self.phase;
@@ -518,9 +519,14 @@ impl Walker {
         }
         Frame {
             pose: Pose::default(),
-            feet_in_world: self.legs.map(|l| l.foot),
+            feet_in_world: self.feet(),
             contact,
         }
+    }
+
+    /// The four feet now, body frame, m ([`Walker::frame`]'s without the contacts).
+    pub fn feet(&self) -> [Vec3; 4] {
+        self.legs.map(|l| l.foot)
     }
 
     /// Foot of `leg` now, body frame, m.

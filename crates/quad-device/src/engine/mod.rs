@@ -796,14 +796,11 @@ impl<M: Math> Engine<M> {
 
     #[inline(never)]
     fn check_walk(walker: &Walker, s: &Setup<'_>) -> Result<[f32; 12], Error> {
-        let first = check_sample::<M>(s, 0, 0.0, Self::walk_setpoint(walker, s.robot), true)?;
+        let order = walker.params().order;
+        let first = Self::walk_setpoint(s.robot, order, &walker.feet());
+        let first = check_sample::<M>(s, 0, 0.0, first, true)?;
         for k in 0..Walker::ENVELOPE_SAMPLES {
-            let frame = Frame {
-                pose: Pose::default(),
-                feet_in_world: walker.envelope(k),
-                contact: [motion::Contact::Stance; 4],
-            };
-            let solved = solve_frame::<M>(s.robot, s.order, &frame);
+            let solved = Self::walk_setpoint(s.robot, order, &walker.envelope(k));
             // Sample 0 is the first frame; the envelope's points follow, without the
             // singularity measure (see the module docs).
             check_sample::<M>(s, k as u16 + 1, 0.0, solved, false)?;
@@ -842,10 +839,20 @@ impl<M: Math> Engine<M> {
         solve_frame::<M>(law.motion.robot(), law.motion.body_config().order, &frame)
     }
 
-    /// The walk's joint setpoint at its current frame, on `robot`.
+    /// The walk's joint setpoint with its feet at `feet` (body frame, the body at the zero pose;
+    /// the contacts do not enter the IK), on `robot`.
     #[inline(never)]
-    fn walk_setpoint(walker: &Walker, robot: &Robot) -> Result<[f32; 12], IkError> {
-        solve_frame::<M>(robot, walker.params().order, &walker.frame())
+    fn walk_setpoint(
+        robot: &Robot,
+        order: RotationOrder,
+        feet: &[Vec3; 4],
+    ) -> Result<[f32; 12], IkError> {
+        let frame = Frame {
+            pose: Pose::default(),
+            feet_in_world: *feet,
+            contact: [motion::Contact::Stance; 4],
+        };
+        solve_frame::<M>(robot, order, &frame)
     }
 
     /// Sets a walk's velocity command at `now_ms`.
@@ -994,7 +1001,10 @@ impl<M: Math> Engine<M> {
                             let _ = walker.step::<M>(FRAME_S);
                         }
                         self.frame = self.frame.saturating_add(frames);
-                        (Self::walk_setpoint(walker, robot), walker.is_stopped())
+                        (
+                            Self::walk_setpoint(robot, walker.params().order, &walker.feet()),
+                            walker.is_stopped(),
+                        )
                     }
                     _ => {
                         self.cancel();
