@@ -15,11 +15,9 @@ fn every_command_of_first_steps_runs_on_the_emulator() {
     let dir = std::env::temp_dir().join(format!("quadctl-first-steps-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("a scratch directory");
     std::fs::create_dir_all(dir.join("examples")).expect("examples");
-    std::fs::copy(
-        root.join("examples/stance.csv"),
-        dir.join("examples/stance.csv"),
-    )
-    .expect("the stance file");
+    for file in ["examples/stance.csv", "examples/drive.keys"] {
+        std::fs::copy(root.join(file), dir.join(file)).expect(file);
+    }
     let mut in_block = false;
     let mut ran = 0;
     for line in doc.lines() {
@@ -51,6 +49,6 @@ fn every_command_of_first_steps_runs_on_the_emulator() {
         }
         ran += 1;
     }
-    assert!(ran >= 11, "{ran} commands found");
+    assert!(ran >= 15, "{ran} commands found");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -97,6 +97,11 @@ fn coord(half: f64) -> impl Strategy<Value = f32> {
     ]
 }
 
+/// How close to the abduction offset's circle (`|w|`, m) an in-limit foot may be refused as
+/// `InsideOffset`: the solver tests `A² ≥ La²` where `A² − La² = w²`, and the f32 foot carries
+/// `A²` (about 2e-3 m²) only to about 1e-7 of itself, i.e. `w` to a few 1e-5 m.
+const OFFSET_CIRCLE_BAND_M: f64 = 1.0e-4;
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(ROUND_TRIP_CASES))]
 
@@ -124,9 +129,10 @@ proptest! {
                 prop_assert!(ang_diff(*a, b) <= ANGLE_TOL_RAD, "joint {j}: {a} -> {b}");
             }
         }
-        if r == 0 && interior {
+        if r == 0 && interior && w.abs() > OFFSET_CIRCLE_BAND_M {
             // shahriar2023 limits abduction and hip only to a full turn: the other abduction
-            // branch (w > 0) is always admissible, so every in-limit foot solves.
+            // branch (w > 0) is always admissible, so every in-limit foot solves. Not next to
+            // the abduction offset's circle (w = 0, see `OFFSET_CIRCLE_BAND_M`).
             prop_assert!(got.is_some(), "shahriar2023 foot {target:?} from {q32:?} unsolved");
         }
     }

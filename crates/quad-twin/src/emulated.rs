@@ -32,7 +32,8 @@ pub struct Emulated {
 
 impl Emulated {
     /// Boots `elf` (none: the firmware built from `firmware-avr/` at [`FIRMWARE_BAUD`]), says
-    /// hello, reads its calibration and enables its outputs.
+    /// hello, reads its calibration, sets its joint-speed limit to `config`'s and enables its
+    /// outputs.
     ///
     /// # Errors
     /// [`crate::Error::Emulator`] when the emulator or the link fails,
@@ -53,6 +54,11 @@ impl Emulated {
             });
         }
         let calibration = client.calibrations().map_err(crate::Error::Emulator)?;
+        client
+            .ack(Request::SetJointSpeedLimit {
+                joint_speed_limit_rad_s: config.joint_speed_limit_rad_s,
+            })
+            .map_err(crate::Error::Emulator)?;
         client
             .ack(Request::SetOutputs { enabled: true })
             .map_err(crate::Error::Emulator)?;

@@ -394,6 +394,15 @@ pub fn run_plan(
     options: &RunOptions,
 ) -> Result<Run, Error> {
     let model = Model::new(config.robot, *physical).map_err(Error::Model)?;
+    // The device's joint-speed limiter set for the twin's servos, by the rule of its default
+    // (half the no-load speed): the default is for MG996R-class servos, and a faster servo
+    // would otherwise be held back to their speed.
+    let config = &quad_device::Config {
+        joint_speed_limit_rad_s: quad_device::engine::limit_for_servo(
+            physical.servo.no_load_speed_rad_s,
+        ),
+        ..*config
+    };
     let plan = *plan;
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {

@@ -11,6 +11,17 @@ use kin_core::motion;
 /// controller never runs at full current against a step. 0.06 rad (3.4°) per 20 ms frame.
 pub const DEFAULT_JOINT_SPEED_LIMIT_RAD_S: f32 = 3.0;
 
+/// The share of a servo's no-load speed that the limiter allows: the rule behind
+/// [`DEFAULT_JOINT_SPEED_LIMIT_RAD_S`] (for MG996R-class servos), for other servos.
+pub const NO_LOAD_SPEED_SHARE: f32 = 0.5;
+
+/// The joint-speed limit, rad/s, for servos whose no-load speed is `no_load_speed_rad_s`:
+/// [`NO_LOAD_SPEED_SHARE`] of it (what `SetJointSpeedLimit` or
+/// [`crate::Config::joint_speed_limit_rad_s`] should be set to for such servos).
+pub fn limit_for_servo(no_load_speed_rad_s: f32) -> f32 {
+    NO_LOAD_SPEED_SHARE * no_load_speed_rad_s
+}
+
 /// Moves each of twelve outputs toward its target by at most `limit · frame` per frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limiter {

@@ -79,7 +79,9 @@
 pub mod limiter;
 pub mod protocol;
 
-pub use limiter::{Limiter, Ramp, DEFAULT_JOINT_SPEED_LIMIT_RAD_S};
+pub use limiter::{
+    limit_for_servo, Limiter, Ramp, DEFAULT_JOINT_SPEED_LIMIT_RAD_S, NO_LOAD_SPEED_SHARE,
+};
 
 use crate::store::Table;
 use core::fmt;
