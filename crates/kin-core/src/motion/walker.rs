@@ -92,6 +92,20 @@ impl WalkerParams {
         }
     }
 
+    /// Checks the parameters: those of [`Gait::new`] that need no robot (finite values,
+    /// `H > 0`, `T > 0`, `d ∈ (0, 1)`, the step height ≥ 0 and below the hips) and `R > 0`.
+    pub fn checked(self) -> Result<CheckedWalkerParams, Error> {
+        check_timing(
+            self.stance_height_m,
+            self.cycle_s,
+            self.duty_factor,
+            &self.phase_offsets,
+            self.step_height_m,
+        )?;
+        positive(self.reach_radius_m, Param::ReachRadiusM)?;
+        Ok(CheckedWalkerParams(self))
+    }
+
     /// The closed-form gait of these parameters on `robot` at a constant `velocity`.
     pub fn gait_params(&self, robot: Robot, velocity: Velocity) -> GaitParams {
         GaitParams {
@@ -107,6 +121,12 @@ impl WalkerParams {
         }
     }
 }
+
+/// [`WalkerParams`] that passed their checks ([`WalkerParams::checked`]): a walker built from
+/// them ([`Walker::standing`]) needs no fallible step, so a caller can build it where it is
+/// stored instead of moving it out of a `Result`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckedWalkerParams(WalkerParams);
 
 /// One leg's state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -177,30 +197,27 @@ impl Walker {
     /// that validated its robot already and checks the reach itself by running the envelope's
     /// points through its own IK (a device's start check).
     pub fn on_stance(p: WalkerParams, neutral_feet: [Vec3; 4]) -> Result<Walker, Error> {
-        check_timing(
-            p.stance_height_m,
-            p.cycle_s,
-            p.duty_factor,
-            &p.phase_offsets,
-            p.step_height_m,
-        )?;
-        positive(p.reach_radius_m, Param::ReachRadiusM)?;
-        let neutral = neutral_feet;
+        Ok(Self::standing(p.checked()?, &neutral_feet))
+    }
+
+    /// [`Walker::on_stance`] with parameters checked already: at phase 0 standing on
+    /// `neutral_feet` (the robot's [`Robot::stance_feet`] at `H`) with a zero command.
+    pub fn standing(p: CheckedWalkerParams, neutral_feet: &[Vec3; 4]) -> Walker {
         let leg = |n: Vec3| Leg {
             foot: n,
             lift_off: n,
             touch_down: n,
             parked: false,
         };
-        Ok(Walker {
-            p,
-            neutral,
-            legs: neutral.map(leg),
+        Walker {
+            p: p.0,
+            neutral: *neutral_feet,
+            legs: neutral_feet.map(leg),
             phase: 0.0,
             velocity: Velocity::default(),
             stopping: false,
             saturated: false,
-        })
+        }
     }
 
     /// The parameters.

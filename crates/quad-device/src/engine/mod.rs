@@ -786,10 +786,11 @@ impl<M: Math> Engine<M> {
         p.step_height_m = w.step_height_m;
         p.cycle_s = w.cycle_s;
         p.order = s.order;
+        let p = p.checked()?;
         // The device validated its robot at boot.
         let stance = s.robot.stance_feet(w.body_height_m);
         *program = Program::Walk {
-            walker: Walker::on_stance(p, stance)?,
+            walker: Walker::standing(p, &stance),
             timeout_ms: w.velocity_timeout_ms,
             last_command_ms: s.now_ms,
         };
