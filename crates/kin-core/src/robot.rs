@@ -438,10 +438,16 @@ impl Robot {
 
     /// Nominal stance for stance height `height_m`: each foot straight below its hip, in the
     /// plane of the zero-abduction leg: `hip_in_body + (0, s·d_lat, −H)` (world = body frame).
-    #[inline]
+    #[inline(never)]
     pub fn stance_feet(&self, height_m: f32) -> [Vec3; 4] {
-        LegId::ALL.map(|leg| {
-            self.hip_in_body(leg) + Vec3::new(0.0, leg.side() * self.leg.d_lat_m, -height_m)
-        })
+        // The front left foot moved to each corner: the same sums as hip plus offset, one set
+        // of float operations instead of one per leg. Out of line: callers on a soft-float
+        // target would each hold a copy of them.
+        let front_left = Vec3::new(
+            0.5 * self.body_length_m,
+            0.5 * self.body_width_m + self.leg.d_lat_m,
+            -height_m,
+        );
+        LegId::ALL.map(|leg| leg.at_corner(front_left))
     }
 }
