@@ -509,7 +509,8 @@ impl Walker {
                     self.p.duty_factor,
                     l.lift_off,
                     l.touch_down,
-                    Phase::wrap(q1),
+                    // A leg phase is in [0, 1) already.
+                    Phase(q1),
                 );
                 return true;
             }
