@@ -248,24 +248,26 @@ impl Walker {
             PathKind::Semicircle => self.p.reach_radius_m,
             _ => self.p.step_height_m,
         };
-        // (cos, sin) of the eight directions k·45°.
-        const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
-        const DIRECTIONS: [(f32, f32); 8] = [
-            (1.0, 0.0),
-            (H, H),
-            (0.0, 1.0),
-            (-H, H),
-            (-1.0, 0.0),
-            (-H, -H),
-            (0.0, -1.0),
-            (H, -H),
-        ];
         let r = self.p.reach_radius_m / COS_PI_8;
         let (dx, dy, dz) = match k {
             0..=15 => {
-                let (c, s) = DIRECTIONS[k % 8];
+                // The vertex in direction k·45°: the one at 0° or 45°, turned by quarter turns
+                // (swaps and sign changes: exact, and no table, which the AVR would hold in
+                // SRAM).
+                let (a, b) = if k % 2 == 0 {
+                    (r, 0.0)
+                } else {
+                    let h = r * core::f32::consts::FRAC_1_SQRT_2;
+                    (h, h)
+                };
+                let (x, y) = match (k / 2) % 4 {
+                    0 => (a, b),
+                    1 => (-b, a),
+                    2 => (-a, -b),
+                    _ => (b, -a),
+                };
                 let z = if k < 8 { 0.0 } else { apex };
-                (r * c, r * s, z)
+                (x, y, z)
             }
             16 => (0.0, 0.0, apex),
             _ => (0.0, 0.0, 0.0),
