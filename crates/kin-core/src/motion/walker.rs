@@ -156,15 +156,20 @@ struct Span {
 }
 
 /// A trot / walk stepper with a changing velocity command: see the module docs.
+///
+/// The fields are laid out in declaration order, those the step reads most first: on the AVR a
+/// field within 63 bytes of the walker's address is one load instruction, one beyond costs a
+/// pointer adjustment at each access.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub struct Walker {
-    p: WalkerParams,
-    neutral: [Vec3; 4],
-    legs: [Leg; 4],
     phase: f32,
     velocity: Velocity,
+    p: WalkerParams,
     stopping: bool,
     saturated: bool,
+    neutral: [Vec3; 4],
+    legs: [Leg; 4],
 }
 
 impl Walker {
