@@ -404,17 +404,22 @@ enum Program {
 }
 
 /// The motion engine (module docs), on kin-core math backend `M`.
+///
+/// The fields are laid out in declaration order, the small ones first: on the AVR a field
+/// within 63 bytes of the engine's address is one load instruction, one beyond costs a pointer
+/// adjustment at each access.
 #[derive(Debug, Clone, Copy)]
+#[repr(C)]
 pub struct Engine<M> {
-    program: Program,
     stage: Stage,
+    /// Frames run since [`Stage::Run`] began.
+    frame: u32,
+    limiter: Limiter,
+    fault: Option<Error>,
+    program: Program,
     ramp: Ramp,
     /// Where the motion ends (stance or rest angles).
     home: [f32; 12],
-    /// Frames run since [`Stage::Run`] began.
-    frame: u32,
-    fault: Option<Error>,
-    limiter: Limiter,
     _math: PhantomData<fn() -> M>,
 }
 
