@@ -253,31 +253,26 @@ impl Walker {
             PathKind::Semicircle => self.p.reach_radius_m,
             _ => self.p.step_height_m,
         };
-        let r = self.p.reach_radius_m / COS_PI_8;
-        let (dx, dy, dz) = match k {
-            0..=15 => {
-                // The vertex in direction k·45°: the one at 0° or 45°, turned by quarter turns
-                // (swaps and sign changes: exact, and no table, which the AVR would hold in
-                // SRAM).
-                let (a, b) = if k % 2 == 0 {
-                    (r, 0.0)
-                } else {
-                    let h = r * core::f32::consts::FRAC_1_SQRT_2;
-                    (h, h)
-                };
-                let (x, y) = match (k / 2) % 4 {
-                    0 => (a, b),
-                    1 => (-b, a),
-                    2 => (-a, -b),
-                    _ => (b, -a),
-                };
-                let z = if k < 8 { 0.0 } else { apex };
-                (x, y, z)
+        let mut d = Vec3::ZERO;
+        if k < 16 {
+            // The vertex in direction k·45°: the one at 0° or 45°, turned by quarter turns
+            // (a swap and a sign change each: exact, and no table, which the AVR would hold in
+            // SRAM).
+            let r = self.p.reach_radius_m / COS_PI_8;
+            let (mut x, mut y) = if k % 2 == 0 {
+                (r, 0.0)
+            } else {
+                let h = r * core::f32::consts::FRAC_1_SQRT_2;
+                (h, h)
+            };
+            for _ in 0..(k / 2) % 4 {
+                (x, y) = (-y, x);
             }
-            16 => (0.0, 0.0, apex),
-            _ => (0.0, 0.0, 0.0),
-        };
-        self.neutral.map(|n| n + Vec3::new(dx, dy, dz))
+            d = Vec3::new(x, y, if k < 8 { 0.0 } else { apex });
+        } else if k == 16 {
+            d.z = apex;
+        }
+        self.neutral.map(|n| n + d)
     }
 
     /// The Bézier swing's overshoot factor `f` (module docs), 1 for the other shapes.
