@@ -546,7 +546,8 @@ impl Walker {
 
     /// The four feet now, body frame, m ([`Walker::frame`]'s without the contacts).
     pub fn feet(&self) -> [Vec3; 4] {
-        self.legs.map(|l| l.foot)
+        // Borrowed, not `map`ped: the legs' whole states would be copied first.
+        core::array::from_fn(|i| self.legs[i].foot)
     }
 
     /// Foot of `leg` now, body frame, m.
