@@ -106,6 +106,15 @@ impl WalkerParams {
         Ok(CheckedWalkerParams(self))
     }
 
+    /// The Bézier swing's overshoot factor `f` (module docs), 1 for the other shapes.
+    fn overshoot_factor(&self) -> f32 {
+        let d = self.duty_factor;
+        match self.swing {
+            PathKind::Bezier => 1.0 + 2.0 * (1.0 - d) / (5.0 * d),
+            _ => 1.0,
+        }
+    }
+
     /// The closed-form gait of these parameters on `robot` at a constant `velocity`.
     pub fn gait_params(&self, robot: Robot, velocity: Velocity) -> GaitParams {
         GaitParams {
@@ -165,6 +174,9 @@ struct Span {
 pub struct Walker {
     phase: f32,
     velocity: Velocity,
+    /// `R / f`: the radius within which the planned footholds lie and the stance feet stay
+    /// (module docs), m; computed once.
+    stance_radius_m: f32,
     p: WalkerParams,
     stopping: bool,
     saturated: bool,
@@ -215,6 +227,7 @@ impl Walker {
             parked: false,
         };
         Walker {
+            stance_radius_m: p.0.reach_radius_m / p.0.overshoot_factor(),
             p: p.0,
             neutral: *neutral_feet,
             legs: neutral_feet.map(leg),
@@ -275,21 +288,6 @@ impl Walker {
         self.neutral.map(|n| n + d)
     }
 
-    /// The Bézier swing's overshoot factor `f` (module docs), 1 for the other shapes.
-    fn overshoot_factor(&self) -> f32 {
-        let d = self.p.duty_factor;
-        match self.p.swing {
-            PathKind::Bezier => 1.0 + 2.0 * (1.0 - d) / (5.0 * d),
-            _ => 1.0,
-        }
-    }
-
-    /// `R / f`: the radius within which the planned footholds lie and the stance feet stay
-    /// (module docs), m.
-    fn stance_radius_m(&self) -> f32 {
-        self.p.reach_radius_m / self.overshoot_factor()
-    }
-
     /// True when every lift-off and touch-down point planned under the constant command `v`
     /// lies within `sqrt(radius_sq)` of its neutral foothold, horizontally.
     fn footholds_within<M: Math>(&self, v: &Velocity, radius_sq: f32) -> bool {
@@ -326,7 +324,7 @@ impl Walker {
                 expected: Expected::HalfTurnPerStance,
             });
         }
-        let r = self.stance_radius_m();
+        let r = self.stance_radius_m;
         for (k, &name) in NAMES.iter().enumerate() {
             let mut part = c;
             for (j, x) in part.iter_mut().enumerate() {
@@ -353,7 +351,7 @@ impl Walker {
     /// The largest forward speed admitted alone, m/s: `2·R / (f·d·T)`.
     pub fn max_forward_m_s(&self) -> f32 {
         2.0 * self.p.reach_radius_m
-            / (self.overshoot_factor() * self.p.duty_factor * self.p.cycle_s)
+            / (self.p.overshoot_factor() * self.p.duty_factor * self.p.cycle_s)
     }
 
     /// Sets the velocity command after [`Walker::check_velocity`]; it acts on the stance feet
@@ -435,7 +433,7 @@ impl Walker {
         positive(dt_s, Param::DtS)?;
         let old = self.phase;
         // Stance feet within R/f: a swing from there overshoots by at most the factor.
-        let r = self.stance_radius_m();
+        let r = self.stance_radius_m;
         let mut span = Span {
             old,
             new: fract01(old + dt_s / self.p.cycle_s),
