@@ -175,8 +175,12 @@ pub struct Walker {
     phase: f32,
     velocity: Velocity,
     /// `R / f`: the radius within which the planned footholds lie and the stance feet stay
-    /// (module docs), m; computed once.
+    /// (module docs), m; computed once, as are the next two.
     stance_radius_m: f32,
+    /// `1 − d`: the leg phase at which the swing ends, cycles.
+    swing_end: f32,
+    /// `d·T/2`: half a stance, s.
+    half_stance_s: f32,
     p: WalkerParams,
     stopping: bool,
     saturated: bool,
@@ -228,6 +232,8 @@ impl Walker {
         };
         Walker {
             stance_radius_m: p.0.reach_radius_m / p.0.overshoot_factor(),
+            swing_end: 1.0 - p.0.duty_factor,
+            half_stance_s: 0.5 * p.0.duty_factor * p.0.cycle_s,
             p: p.0,
             neutral: *neutral_feet,
             legs: neutral_feet.map(leg),
@@ -291,7 +297,7 @@ impl Walker {
     /// True when every lift-off and touch-down point planned under the constant command `v`
     /// lies within `sqrt(radius_sq)` of its neutral foothold, horizontally.
     fn footholds_within<M: Math>(&self, v: &Velocity, radius_sq: f32) -> bool {
-        let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
+        let half = self.half_stance_s;
         for (i, &n) in self.neutral.iter().enumerate() {
             for s in [half, -half] {
                 if !(self.off_neutral_sq(i, displace::<M>(v, s, n)) <= radius_sq) {
@@ -404,7 +410,7 @@ impl Walker {
 
     /// True when leg phase `q` is in the swing.
     fn in_swing(&self, q: f32) -> bool {
-        q < 1.0 - self.p.duty_factor
+        q < self.swing_end
     }
 
     /// Moves `p` by the body displacement `X(rate·s)` of the current command, when there is a
@@ -477,7 +483,6 @@ impl Walker {
         }
         let before_sq = self.off_neutral_sq(i, l.foot);
         let t = self.p.cycle_s;
-        let swing_end = 1.0 - self.p.duty_factor;
         let (q0, q1) = (self.leg_phase(i, span.old), self.leg_phase(i, span.new));
         // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
         let lift_off = q1 < q0;
@@ -499,7 +504,7 @@ impl Walker {
             l.lift_off = l.foot;
             // The touch-down point planned now: `X(d·T/2)·n` with the current command.
             l.touch_down = self.neutral[i];
-            self.carry::<M>(&mut l.touch_down, 0.5 * self.p.duty_factor * t, 1.0);
+            self.carry::<M>(&mut l.touch_down, self.half_stance_s, 1.0);
         }
         if !stance_only {
             if self.in_swing(q1) {
@@ -518,7 +523,7 @@ impl Walker {
             l.foot = l.touch_down;
             self.carry::<M>(
                 &mut l.foot,
-                ((q1 - swing_end) * t).min(span.dt_s),
+                ((q1 - self.swing_end) * t).min(span.dt_s),
                 -span.scale,
             );
         }
