@@ -298,9 +298,9 @@ impl Walker {
     /// lies within `sqrt(radius_sq)` of its neutral foothold, horizontally.
     fn footholds_within<M: Math>(&self, v: &Velocity, radius_sq: f32) -> bool {
         let half = self.half_stance_s;
-        for (i, &n) in self.neutral.iter().enumerate() {
+        for &n in &self.neutral {
             for s in [half, -half] {
-                if !(self.off_neutral_sq(i, displace::<M>(v, s, n)) <= radius_sq) {
+                if !(off_sq(&displace::<M>(v, s, n), &n) <= radius_sq) {
                     return false;
                 }
             }
@@ -426,12 +426,6 @@ impl Walker {
         }
     }
 
-    /// Squared horizontal distance of `p` from the neutral foothold of `leg`, m².
-    fn off_neutral_sq(&self, leg: usize, p: Vec3) -> f32 {
-        let q = p - self.neutral[leg];
-        q.x * q.x + q.y * q.y
-    }
-
     /// Advances by `dt_s` (> 0, less than the shorter of swing and stance; one servo frame) on
     /// math backend `M`. A non-finite or non-positive `dt_s` is refused and changes nothing.
     #[inline(never)]
@@ -481,7 +475,8 @@ impl Walker {
         if l.parked {
             return true;
         }
-        let before_sq = self.off_neutral_sq(i, l.foot);
+        let n = &self.neutral[i];
+        let before_sq = off_sq(&l.foot, n);
         let t = self.p.cycle_s;
         let (q0, q1) = (self.leg_phase(i, span.old), self.leg_phase(i, span.new));
         // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
@@ -497,13 +492,13 @@ impl Walker {
             self.carry::<M>(&mut l.foot, s, -span.scale);
         }
         if lift_off {
-            if self.stopping && l.foot == self.neutral[i] {
+            if self.stopping && l.foot == *n {
                 l.parked = true;
                 return true;
             }
             l.lift_off = l.foot;
             // The touch-down point planned now: `X(d·T/2)·n` with the current command.
-            l.touch_down = self.neutral[i];
+            l.touch_down = *n;
             self.carry::<M>(&mut l.touch_down, self.half_stance_s, 1.0);
         }
         if !stance_only {
@@ -527,8 +522,8 @@ impl Walker {
                 -span.scale,
             );
         }
-        let off_sq = self.off_neutral_sq(i, l.foot);
-        !(off_sq > span.r_sq && off_sq > before_sq)
+        let after_sq = off_sq(&l.foot, n);
+        !(after_sq > span.r_sq && after_sq > before_sq)
     }
 
     /// Feet and contacts now; the body stays at the zero pose, so the world frame is the body
@@ -557,4 +552,14 @@ impl Walker {
     pub fn foot(&self, leg: LegId) -> Vec3 {
         self.legs[leg.index()].foot
     }
+}
+
+/// Squared horizontal distance of `p` from `n`, m².
+///
+/// Out of line and by reference: the step and the velocity check use it at three places, each
+/// then a call with two pointers.
+#[inline(never)]
+fn off_sq(p: &Vec3, n: &Vec3) -> f32 {
+    let q = *p - *n;
+    q.x * q.x + q.y * q.y
 }
