@@ -296,6 +296,10 @@ impl Walker {
 
     /// True when every lift-off and touch-down point planned under the constant command `v`
     /// lies within `sqrt(radius_sq)` of its neutral foothold, horizontally.
+    ///
+    /// Inline in its one caller: out of line, LLVM passes the command through memory and the
+    /// velocity check grows on the AVR.
+    #[inline(always)]
     fn footholds_within<M: Math>(&self, v: &Velocity, radius_sq: f32) -> bool {
         let half = self.half_stance_s;
         for &n in &self.neutral {
@@ -319,10 +323,9 @@ impl Walker {
             Param::YawRadS,
             Param::Velocity,
         ];
-        let c = [v.forward_m_s, v.lateral_m_s, v.yaw_rad_s];
-        for (&x, &name) in c.iter().zip(&NAMES) {
-            finite(x, name)?;
-        }
+        finite(v.forward_m_s, Param::ForwardMS)?;
+        finite(v.lateral_m_s, Param::LateralMS)?;
+        finite(v.yaw_rad_s, Param::YawRadS)?;
         let stance_s = self.p.duty_factor * self.p.cycle_s;
         if !(libm::fabsf(v.yaw_rad_s) * stance_s <= core::f32::consts::PI) {
             return Err(Error::OutOfRange {
@@ -332,18 +335,16 @@ impl Walker {
         }
         let r = self.stance_radius_m;
         for (k, &name) in NAMES.iter().enumerate() {
-            let mut part = c;
-            for (j, x) in part.iter_mut().enumerate() {
-                if k != j && k != 3 {
-                    *x = 0.0;
-                }
+            let mut single = *v;
+            if k != 0 && k != 3 {
+                single.forward_m_s = 0.0;
             }
-            let [forward_m_s, lateral_m_s, yaw_rad_s] = part;
-            let single = Velocity {
-                forward_m_s,
-                lateral_m_s,
-                yaw_rad_s,
-            };
+            if k != 1 && k != 3 {
+                single.lateral_m_s = 0.0;
+            }
+            if k != 2 && k != 3 {
+                single.yaw_rad_s = 0.0;
+            }
             if !self.footholds_within::<M>(&single, r * r) {
                 return Err(Error::OutOfRange {
                     parameter: name,
