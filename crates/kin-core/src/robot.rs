@@ -448,6 +448,6 @@ impl Robot {
             0.5 * self.body_width_m + self.leg.d_lat_m,
             -height_m,
         );
-        LegId::ALL.map(|leg| leg.at_corner(front_left))
+        core::array::from_fn(|i| LegId::ALL[i].at_corner(front_left))
     }
 }
