@@ -291,7 +291,7 @@ impl Walker {
         } else if k == 16 {
             d.z = apex;
         }
-        self.neutral.map(|n| n + d)
+        core::array::from_fn(|i| self.neutral[i] + d)
     }
 
     /// True when every lift-off and touch-down point planned under the constant command `v`
