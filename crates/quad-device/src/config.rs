@@ -171,18 +171,24 @@ pub(crate) const UNBOOTED_CALIBRATION: Table = [Calibration {
 /// reversed (mounted mirrored). When the stance is unreachable the centres sit at angle 0.
 pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> Table {
     let mut table = UNBOOTED_CALIBRATION;
-    write_default_calibration::<M>(robot, pose_config, &mut table);
+    write_default_calibration(
+        &body::Solver::<M>::with_math(robot),
+        pose_config,
+        &mut table,
+    );
     table
 }
 
-/// [`default_calibration`] written in place (no table-sized temporary on the stack).
+/// [`default_calibration`] written in place (no table-sized temporary on the stack), with the
+/// robot's body solver (the device's own: building a second one repeated its per-leg
+/// constants' code).
 #[inline(never)]
 pub(crate) fn write_default_calibration<M: Math>(
-    robot: &Robot,
+    solver: &body::Solver<M>,
     pose_config: &PoseConfig,
     table: &mut Table,
 ) {
-    let stance = stance_angles::<M>(robot, pose_config);
+    let stance = stance_angles(solver, pose_config);
     for ((c, servo), zero_rad) in table.iter_mut().zip(ServoId::ALL).zip(stance) {
         let right = matches!(servo.leg, LegId::FR | LegId::RR);
         *c = Calibration {
@@ -198,8 +204,8 @@ pub(crate) fn write_default_calibration<M: Math>(
 
 /// The twelve joint angles of the nominal stance of `pose_config` (zeros when unreachable).
 #[inline(always)]
-fn stance_angles<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> [f32; 12] {
-    body::Solver::<M>::with_math(robot)
+fn stance_angles<M: Math>(solver: &body::Solver<M>, pose_config: &PoseConfig) -> [f32; 12] {
+    solver
         .inverse_at_stance(
             &body::Pose::default(),
             &BodyConfig::about_centre(pose_config.order),
