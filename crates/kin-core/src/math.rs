@@ -833,6 +833,26 @@ pub(crate) fn finite(x: f32) -> bool {
     x.to_bits() & bits::INF != bits::INF
 }
 
+/// `x.is_finite() && x > 0.0` from the bits: the patterns of the positive subnormals to the
+/// largest finite float.
+#[inline(always)]
+pub(crate) fn positive_finite(x: f32) -> bool {
+    x.to_bits().wrapping_sub(1) < bits::INF - 1
+}
+
+/// `x.is_finite() && x >= 0.0` from the bits: +0 to the largest finite float, or −0.
+#[inline(always)]
+pub(crate) fn nonneg_finite(x: f32) -> bool {
+    let b = x.to_bits();
+    b < bits::INF || b == 0x8000_0000
+}
+
+/// `lo.is_finite() && hi.is_finite() && lo <= hi` from the bits.
+#[inline(always)]
+pub(crate) fn finite_ordered(lo: f32, hi: f32) -> bool {
+    finite(lo) && finite(hi) && bits::key(lo) <= bits::key(hi)
+}
+
 /// Float comparisons as integer comparisons of the bit patterns, with the semantics of the
 /// float operators (NaN included): [`SoftFloat`]'s comparisons.
 mod bits {
@@ -857,7 +877,7 @@ mod bits {
     /// A key that orders non-NaN floats as `<` does, with −0 = +0 (sign–magnitude to
     /// two's complement); positive NaNs sort above +∞, negative NaNs below −∞.
     #[inline(always)]
-    fn key(x: f32) -> i32 {
+    pub(super) fn key(x: f32) -> i32 {
         let b = x.to_bits() as i32;
         if b < 0 {
             i32::MIN.wrapping_sub(b)
@@ -1290,8 +1310,15 @@ mod tests {
         for &a in &vals {
             assert_eq!(bits::gt_zero(a), a > 0.0, "{a:e} > 0");
             assert_eq!(finite(a), a.is_finite(), "finite {a:e}");
+            assert_eq!(positive_finite(a), a.is_finite() && a > 0.0, "0 < {a:e} < inf");
+            assert_eq!(nonneg_finite(a), a.is_finite() && a >= 0.0, "0 <= {a:e} < inf");
             for &b in &vals {
                 let nonneg = |v: f32| v.is_sign_positive() || v.is_nan();
+                assert_eq!(
+                    finite_ordered(a, b),
+                    a.is_finite() && b.is_finite() && a <= b,
+                    "{a:e} <= {b:e}, finite"
+                );
                 if nonneg(a) && nonneg(b) {
                     assert_eq!(bits::lt_nonneg(a, b), a < b, "{a:e} < {b:e}");
                 }
