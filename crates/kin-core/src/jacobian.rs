@@ -103,12 +103,8 @@ pub(crate) fn leg_inverse_condition_on<M: Math>(
     let w = hx - g.d_ax_m;
     let y0 = leg.side() * g.d_lat_m;
     gram_inverse_condition::<M>(&Gram {
-        diagonal: [
-            M::mul_add2(w, w, y0, y0),
-            M::mul_add2(hx, hx, hz, hz),
-            M::mul_add2(kx, kx, kz, kz),
-        ],
-        off: [y0 * hz, y0 * kz, M::mul_add2(hx, kx, hz, kz)],
+        diagonal: [w * w + y0 * y0, hx * hx + hz * hz, kx * kx + kz * kz],
+        off: [y0 * hz, y0 * kz, hx * kx + hz * kz],
     })
 }
 

@@ -156,12 +156,8 @@ fn planar<M: Math>(g: &LegGeometry, hip_rad: f32, knee_rad: f32) -> (f32, f32, f
 }
 
 #[inline]
-fn abduct<M: Math>(s_a: f32, c_a: f32, v: Vec3) -> Vec3 {
-    Vec3::new(
-        v.x,
-        M::mul_add2(c_a, v.y, -s_a, v.z),
-        M::mul_add2(s_a, v.y, c_a, v.z),
-    )
+fn abduct(s_a: f32, c_a: f32, v: Vec3) -> Vec3 {
+    Vec3::new(v.x, c_a * v.y - s_a * v.z, s_a * v.y + c_a * v.z)
 }
 
 /// Forward kinematics on backend `M`, closed form.
@@ -169,7 +165,7 @@ fn abduct<M: Math>(s_a: f32, c_a: f32, v: Vec3) -> Vec3 {
 fn forward_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
     let (_, _, u, w) = planar::<M>(g, q.hip_rad, q.knee_rad);
     let (sa, ca) = M::sin_cos(q.abduction_rad);
-    abduct::<M>(sa, ca, Vec3::new(u, leg.side() * g.d_lat_m, w))
+    abduct(sa, ca, Vec3::new(u, leg.side() * g.d_lat_m, w))
 }
 
 /// Forward kinematics, closed form:
@@ -186,9 +182,9 @@ pub fn joint_points(g: &LegGeometry, leg: LegId, q: JointAngles) -> LegPoints {
     let y = leg.side() * g.d_lat_m;
     LegPoints {
         hip_mount: Vec3::ZERO,
-        hip_joint: abduct::<DefaultMath>(sa, ca, Vec3::new(0.0, y, -g.d_ax_m)),
-        knee: abduct::<DefaultMath>(sa, ca, Vec3::new(ku, y, kw)),
-        foot: abduct::<DefaultMath>(sa, ca, Vec3::new(u, y, w)),
+        hip_joint: abduct(sa, ca, Vec3::new(0.0, y, -g.d_ax_m)),
+        knee: abduct(sa, ca, Vec3::new(ku, y, kw)),
+        foot: abduct(sa, ca, Vec3::new(u, y, w)),
     }
 }
 
@@ -356,8 +352,8 @@ fn depth<M: Math>(d_lat_sq: f32, r_sq: f32) -> (f32, f32) {
 /// [`depth`]), as the arguments `(y, x)` of one `atan2` of their cross and dot products: every
 /// quadrant of the abduction circle in one formula, in `(−π, π]`.
 #[inline(always)]
-fn abduction_yx<M: Math>(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
-    (M::mul_add2(sd, z, -w, y), M::mul_add2(sd, y, w, z))
+fn abduction_yx(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
+    (sd * z - w * y, sd * y + w * z)
 }
 
 impl Consts {
@@ -412,10 +408,10 @@ impl Consts {
 /// the law of cosines; the second vector scaled by `2·L1` is `(R² + L1² − L2², 2·L1·L2·sin k)`
 /// (`diff_sq` = `L1² − L2²`, `s` from [`Consts::knee_yx`]).
 #[inline(always)]
-fn hip_yx<M: Math>(u: f32, v: f32, dist2: f32, diff_sq: f32, s: f32) -> (f32, f32) {
+fn hip_yx(u: f32, v: f32, dist2: f32, diff_sq: f32, s: f32) -> (f32, f32) {
     let (bx, by) = (dist2 + diff_sq, s);
     let (ax, ay) = (-v, -u);
-    (M::mul_add2(bx, ay, -by, ax), M::mul_add2(bx, ax, by, ay))
+    (bx * ay - by * ax, bx * ax + by * ay)
 }
 
 impl Solver<DefaultMath> {
@@ -579,7 +575,7 @@ impl<M: Math> Solver<M> {
         let mut first: Option<Unreachable> = None;
 
         // Eq. 4.1: the foot must lie at A ≥ La from the abduction axis (A² < La²: inside).
-        let mut r_sq = M::mul_add2(y, y, z, z);
+        let mut r_sq = y * y + z * z;
         if M::lt_nonneg(r_sq, self.c.d_lat_sq) {
             if policy == ReachPolicy::Reject {
                 return Err(Unreachable::InsideOffset);
@@ -594,7 +590,7 @@ impl<M: Math> Solver<M> {
                 y = sd;
                 z = 0.0;
             }
-            r_sq = M::mul_add2(y, y, z, z);
+            r_sq = y * y + z * z;
         }
         let depth = depth::<M>(self.c.d_lat_sq, r_sq);
         let w = depth.0;
@@ -628,18 +624,18 @@ impl<M: Math> Solver<M> {
                 u = 0.0;
                 v = -radius;
             }
-            dist2 = M::mul_add2(u, u, v, v);
+            dist2 = u * u + v * v;
         }
-        let (abd_y, abd_x) = abduction_yx::<M>(sd, y, z, w);
+        let (abd_y, abd_x) = abduction_yx(sd, y, z, w);
         let (knee_y, knee_x) = self.c.knee_yx::<M>(g, self.knee_bend, dist2, moved);
-        let (hip_y, hip_x) = hip_yx::<M>(u, v, dist2, self.c.diff_sq, knee_y);
+        let (hip_y, hip_x) = hip_yx(u, v, dist2, self.c.diff_sq, knee_y);
         let [abduction, knee, hip] = M::atan2_3([abd_y, knee_y, hip_y], [abd_x, knee_x, hip_x]);
         let angles = JointAngles::new(abduction, hip, knee);
         let reached = if moved {
             let (sa, ca) = M::sin_cos(abduction);
             Some((
                 first.unwrap_or(Unreachable::TooFar),
-                abduct::<M>(sa, ca, Vec3::new(u, sd, v - g.d_ax_m)),
+                abduct(sa, ca, Vec3::new(u, sd, v - g.d_ax_m)),
             ))
         } else {
             None
@@ -674,7 +670,7 @@ impl<M: Math> Solver<M> {
         }
         for (i, p) in feet_in_hip.iter().enumerate() {
             let sd = self.side_d_lat(LegId::ALL[i]);
-            let (abd_y, abd_x) = abduction_yx::<M>(sd, p.y, p.z, w[i]);
+            let (abd_y, abd_x) = abduction_yx(sd, p.y, p.z, w[i]);
             abduction[i] = M::atan2(abd_y, abd_x);
             let v_sq;
             (v[i], v_sq) = self.c.leg_plane(g.d_ax_m, (w[i], w_sq[i]));
@@ -692,7 +688,7 @@ impl<M: Math> Solver<M> {
         let mut planar = [([0.0f32; 2], [0.0f32; 2]); 4];
         for (i, p) in feet_in_hip.iter().enumerate() {
             let (knee_y, knee_x) = self.c.knee_yx::<M>(g, self.knee_bend, dist2[i], false);
-            let (hip_y, hip_x) = hip_yx::<M>(p.x, v[i], dist2[i], self.c.diff_sq, knee_y);
+            let (hip_y, hip_x) = hip_yx(p.x, v[i], dist2[i], self.c.diff_sq, knee_y);
             planar[i] = ([knee_y, hip_y], [knee_x, hip_x]);
         }
         let mut out = [JointAngles::default(); 4];

@@ -58,15 +58,6 @@ pub trait Math {
             Self::atan2(y[2], x[2]),
         ]
     }
-    /// `a·b + c·d`, rounded as written (each product rounded, then the sum; no fused
-    /// operation), so that every backend returns the same bits. The default is the
-    /// expression inline; a backend whose float operations are library calls may keep one
-    /// copy out of line ([`SoftFloat`]), the kinematics' most frequent pattern (dot products,
-    /// rotations, cross products with a negated operand: `a·b − c·d = a·b + (−c)·d` exactly).
-    #[inline(always)]
-    fn mul_add2(a: f32, b: f32, c: f32, d: f32) -> f32 {
-        a * b + c * d
-    }
     /// `x > 0.0`.
     #[inline(always)]
     fn gt_zero(x: f32) -> bool {
@@ -270,11 +261,6 @@ impl<S: Math> Math for SoftFloat<S> {
     }
 
     #[inline(always)]
-    fn mul_add2(a: f32, b: f32, c: f32, d: f32) -> f32 {
-        mul_add2_out_of_line(a, b, c, d)
-    }
-
-    #[inline(always)]
     fn gt_zero(x: f32) -> bool {
         bits::gt_zero(x)
     }
@@ -293,15 +279,6 @@ impl<S: Math> Math for SoftFloat<S> {
     fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
         S::read_table_cell(entry)
     }
-}
-
-/// [`SoftFloat`]'s [`Math::mul_add2`]: one copy of the two multiplications and the addition
-/// (each a library call with its register moves on CPUs without floating-point hardware), in a
-/// function of its own whose four arguments arrive in registers; the caller keeps fewer
-/// values alive across calls.
-#[inline(never)]
-fn mul_add2_out_of_line(a: f32, b: f32, c: f32, d: f32) -> f32 {
-    a * b + c * d
 }
 
 const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
