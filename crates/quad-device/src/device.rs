@@ -189,8 +189,8 @@ where
     /// the nominal stance (zero body pose) when it maps within that calibration.
     #[inline(never)]
     pub fn boot(&mut self) {
-        write_default_calibration::<M>(
-            &self.config.robot,
+        write_default_calibration(
+            &self.solver,
             &self.config.pose_config,
             &mut self.calibration,
         );
