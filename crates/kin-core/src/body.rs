@@ -266,7 +266,7 @@ impl<M: Math> Solver<M> {
     /// `foot_in_hip = sx·(L/2·r₀ − (L/2, 0, 0)) + s·((W/2 + d_lat)·r₁ − (0, W/2, 0)) − K` for the
     /// front/rear sign `sx`, the side sign `s` and `K = Rᵀ·(t + c + (0, 0, H)) − c`: fewer
     /// operations than the general transform (counted in `BENCHMARKS.md`).
-    #[inline]
+    #[inline(never)]
     fn stance_feet_in_hips(
         &self,
         pose: &Pose,
