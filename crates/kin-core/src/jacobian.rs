@@ -120,7 +120,8 @@ struct Gram {
 /// inverse condition number of a matrix whose Gram matrix `a` is. Eigenvalues in the
 /// trigonometric closed form: with `q = tr(a)/3`, `p = √(tr((a − qI)²)/6)` and
 /// `r = det(a − qI)/(2p³)`, `φ = acos(r)/3`, the largest is `q + 2p·cos φ` and the smallest
-/// `q + 2p·cos(φ + 2π/3) = q − p·(cos φ + √3·sin φ)` (one sine and cosine).
+/// `q + 2p·cos(φ + 2π/3) = q − p·(cos φ + √3·sin φ)` (one sine and cosine); `p = 0` is
+/// `a = q·I`.
 #[inline(never)]
 fn gram_inverse_condition<M: Math>(a: &Gram) -> f32 {
     let [a00, a11, a22] = a.diagonal;
@@ -128,22 +129,21 @@ fn gram_inverse_condition<M: Math>(a: &Gram) -> f32 {
     let p1 = a01 * a01 + a02 * a02 + a12 * a12;
     let tr = a00 + a11 + a22;
     let q = tr / 3.0;
-    let (lo, hi) = if p1 <= f32::EPSILON * (q * q) {
-        // Diagonal: its entries are the eigenvalues.
-        (a00.min(a11).min(a22), a00.max(a11).max(a22))
-    } else {
-        let (d0, d1, d2) = (a00 - q, a11 - q, a22 - q);
-        let p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * p1;
-        let p = M::sqrt(p2 / 6.0);
-        let det = d0 * (d1 * d2 - a12 * a12) - a01 * (a01 * d2 - a12 * a02)
-            + a02 * (a01 * a12 - d1 * a02);
-        let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
-        // acos r = atan2(√(1 − r²), r) for r in [−1, 1]: the backend's own functions.
-        let phi = M::atan2(M::sqrt((1.0 - r) * (1.0 + r)), r) / 3.0;
-        let (sin, cos) = M::sin_cos(phi);
-        const SQRT_3: f32 = 1.732_050_8;
-        (q - p * (cos + SQRT_3 * sin), q + 2.0 * p * cos)
-    };
+    let (d0, d1, d2) = (a00 - q, a11 - q, a22 - q);
+    let p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * p1;
+    if !M::gt_zero(p2) {
+        // a = q·I: isotropic when q > 0 (else zero, or not finite).
+        return if M::gt_zero(q) { 1.0 } else { 0.0 };
+    }
+    let p = M::sqrt(p2 / 6.0);
+    let det =
+        d0 * (d1 * d2 - a12 * a12) - a01 * (a01 * d2 - a12 * a02) + a02 * (a01 * a12 - d1 * a02);
+    let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
+    // acos r = atan2(√(1 − r²), r) for r in [−1, 1]: the backend's own functions.
+    let phi = M::atan2(M::sqrt((1.0 - r) * (1.0 + r)), r) / 3.0;
+    let (sin, cos) = M::sin_cos(phi);
+    const SQRT_3: f32 = 1.732_050_8;
+    let (lo, hi) = (q - p * (cos + SQRT_3 * sin), q + 2.0 * p * cos);
     let (lo, hi) = (lo.max(0.0), hi.max(0.0));
     if hi <= 0.0 {
         return 0.0;

@@ -501,7 +501,7 @@ impl<M: Math> Solver<M> {
         let target = match policy {
             ReachPolicy::Clamp => {
                 let m = max_abs(foot_in_hip);
-                if m > FAR_M {
+                if M::lt_nonneg(FAR_M, m) {
                     foot_in_hip * (FAR_M / m)
                 } else {
                     foot_in_hip
@@ -715,13 +715,18 @@ impl<M: Math> Solver<M> {
 const FAR_M: f32 = 1.0e6;
 
 /// The largest absolute coordinate of `v` (its maximum norm): what decides whether squaring
-/// `v`'s coordinates could overflow.
+/// `v`'s coordinates could overflow. From the bits, which order as the magnitudes do (no
+/// software-float comparison on CPUs without floating-point hardware); a NaN coordinate
+/// (never passed here: the targets are checked finite first) would count as the largest.
 #[inline(always)]
 fn max_abs(v: Vec3) -> f32 {
-    libm::fmaxf(
-        libm::fabsf(v.x),
-        libm::fmaxf(libm::fabsf(v.y), libm::fabsf(v.z)),
-    )
+    const ABS: u32 = 0x7fff_ffff;
+    let (x, y, z) = (
+        v.x.to_bits() & ABS,
+        v.y.to_bits() & ABS,
+        v.z.to_bits() & ABS,
+    );
+    f32::from_bits(x.max(y).max(z))
 }
 
 /// `|a − b|` without overflowing the squares of far targets, with the backend's square root
@@ -730,7 +735,7 @@ fn max_abs(v: Vec3) -> f32 {
 fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     let d = a - b;
     let m = max_abs(d);
-    if m > FAR_M {
+    if M::lt_nonneg(FAR_M, m) {
         m * M::sqrt((d * (1.0 / m)).norm_squared())
     } else {
         M::sqrt(d.norm_squared())
