@@ -1,5 +1,6 @@
 // The control panel: WebSocket to `quadctl serve`, the 3D view from the device's readback,
-// the pose sliders previewed by kin-core in WebAssembly, plots, calibration.
+// the pose sliders previewed by kin-core in WebAssembly, the device's onboard motions and the
+// walk's joystick, plots, calibration.
 //
 // Units: SI on the wire (rad, m); degrees and millimetres only on the sliders.
 // `window.panel` exposes the page's state for the browser tests and for debugging.
@@ -29,6 +30,10 @@ const panel = {
   done: [],
   latencies: [], // slider input -> the device's readback of that pose drawn, ms
   arrivals: [], // slider input -> the device's readback of that pose received, ms
+  motionLatencies: [], // Start clicked -> the first readback of the started motion drawn, ms
+  motionStatus: null, // the device's motion engine, from the last state
+  walking: false,
+  velocitiesSent: 0,
   renderedPoseId: 0,
   renderedAngles: null,
   velocity: { vx: 0, vy: 0, yaw: 0 },
@@ -157,12 +162,26 @@ function pump() {
 // ---------------------------------------------------------------- WebSocket
 let socket = null;
 
+// The server answers every message with one `done` or `error`, in order: the commands awaiting
+// their answer, oldest first.
+let awaiting = [];
+
 function send(msg) {
-  if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify(msg));
+  if (socket && socket.readyState === WebSocket.OPEN) {
+    socket.send(JSON.stringify(msg));
+    awaiting.push(msg.type);
+  }
 }
 panel.send = send;
 // A raw text message, for the tests of the server's validation.
-panel.sendRaw = (text) => socket.send(text);
+panel.sendRaw = (text) => { socket.send(text); awaiting.push('raw'); };
+
+// An answer came: the command it answers.
+function answered() {
+  const cmd = awaiting.shift();
+  if (cmd === 'set_velocity') velocitiesInFlight = Math.max(0, velocitiesInFlight - 1);
+  return cmd;
+}
 
 // Leaving the page closes its socket at once (the server also drops a silent page).
 window.addEventListener('pagehide', () => { if (socket) socket.close(); });
@@ -174,6 +193,8 @@ function connect() {
     $('conn').textContent = 'disconnected';
     $('conn').className = 'badge bad';
     panel.controller = null;
+    awaiting = [];
+    velocitiesInFlight = 0;
     updateControl();
     setTimeout(connect, 1000);
   };
@@ -183,17 +204,26 @@ function connect() {
       case 'welcome': onWelcome(msg); break;
       case 'state': onState(msg); break;
       case 'done':
+        answered();
         panel.done.push(msg.command);
-        if (msg.command === 'start_motion') panel.walking = panel.lastMotion?.kind === 'walk';
-        if (msg.command === 'stop_motion') panel.walking = false;
+        if (msg.command === 'start_motion' && motionClick !== null) {
+          // The next state carries the started motion's first readback (the server sends a
+          // command's state after its answer).
+          motionStarted = motionClick;
+          motionClick = null;
+        }
         if (['set_pose', 'set_stance_height'].includes(msg.command)) { inFlight = false; pump(); }
         break;
-      case 'error':
+      case 'error': {
+        const cmd = answered();
         panel.errors.push(msg.message);
         message(msg.message);
+        if (msg.field) showRefusal(msg.message, msg.field);
+        if (cmd === 'start_motion') motionClick = null;
         inFlight = false;
         pump();
         break;
+      }
       default: break;
     }
   };
@@ -224,6 +254,11 @@ function onState(msg) {
     sliders.stance.value = Math.round(msg.stance_height_m * 1000);
     onSlider(false);
   }
+  if (motionStarted !== null && msg.motion.kind !== null) {
+    motionSeen = motionStarted;
+    motionStarted = null;
+  }
+  showMotion(msg.motion);
   if (msg.pose_id && sentAt.has(msg.pose_id)) {
     readbackSeen = { id: msg.pose_id, t0: sentAt.get(msg.pose_id) };
     panel.arrivals.push(performance.now() - readbackSeen.t0);
@@ -243,7 +278,7 @@ function updateControl() {
   $('control-badge').className = `badge ${mine ? 'mine' : ''}`;
   $('take-control').disabled = mine;
   $('release-control').disabled = !mine;
-  for (const id of ['outputs-on', 'outputs-off', 'cal-save', 'cal-read', 'cal-set-center', 'cal-set-direction']) {
+  for (const id of ['outputs-on', 'outputs-off', 'cal-save', 'cal-read', 'cal-set-center', 'cal-set-direction', 'motion-start', 'motion-stop']) {
     $(id).disabled = !mine;
   }
   for (const b of document.querySelectorAll('[data-jog]')) b.disabled = !mine;
@@ -355,7 +390,8 @@ function buildRobotMeshes(robot) {
 
 function setGhost(pose, p) {
   if (!ghost) return;
-  drawRobot(ghost, panel.kin.points(pose, p.angles, panel.order));
+  panel.ghostPoints = panel.kin.points(pose, p.angles, panel.order);
+  drawRobot(ghost, panel.ghostPoints);
   p.legs.forEach((l, i) => ghost.legs[i].mat.color.copy(legColour(l)));
   viewDirty = true;
 }
@@ -365,10 +401,60 @@ let readbackSeen = null;
 let dirty = false; // a new readback to draw
 let viewDirty = true; // the camera, the preview or the size changed
 
+// The rigid motion that best puts the points `from` onto `to` (least squares; Horn's unit
+// quaternion method): the quaternion is the dominant eigenvector of a symmetric 4x4 matrix of
+// the cross-covariance, found by power iteration (three.js has no eigen-solver; four points
+// need nothing larger). Returns p -> R (p - cFrom) + cTo.
+function rigidFit(from, to) {
+  const n = from.length;
+  const cf = new THREE.Vector3(); const ct = new THREE.Vector3();
+  from.forEach((p) => cf.addScaledVector(p, 1 / n));
+  to.forEach((p) => ct.addScaledVector(p, 1 / n));
+  const S = [[0, 0, 0], [0, 0, 0], [0, 0, 0]];
+  for (let i = 0; i < n; i++) {
+    const a = from[i].clone().sub(cf).toArray();
+    const b = to[i].clone().sub(ct).toArray();
+    for (let r = 0; r < 3; r++) for (let c = 0; c < 3; c++) S[r][c] += a[r] * b[c];
+  }
+  const [[xx, xy, xz], [yx, yy, yz], [zx, zy, zz]] = S;
+  const N = [
+    [xx + yy + zz, yz - zy, zx - xz, xy - yx],
+    [yz - zy, xx - yy - zz, xy + yx, zx + xz],
+    [zx - xz, xy + yx, -xx + yy - zz, yz + zy],
+    [xy - yx, zx + xz, yz + zy, -xx - yy + zz],
+  ];
+  // Shifted by Gershgorin's bound so that every eigenvalue is >= 0: the largest then dominates.
+  const shift = Math.max(0, ...N.map((row, r) => row.reduce((m, v, c) => m + (c === r ? -v : Math.abs(v)), 0)));
+  let q = [1, 0, 0, 0];
+  for (let k = 0; k < 100; k++) {
+    const next = N.map((row, r) => row.reduce((acc, v, c) => acc + v * q[c], 0) + shift * q[r]);
+    const len = Math.hypot(...next);
+    q = next.map((v) => v / len);
+  }
+  const rot = new THREE.Quaternion(q[1], q[2], q[3], q[0]);
+  return (p) => p.clone().sub(cf).applyQuaternion(rot).add(ct);
+}
+
+// During a sway the device holds the feet on their stance points and rotates the body over
+// them; the readback has the joints but not the body's pose. The body is placed where the
+// readback's feet land on the stance points: the view shows the body swaying over still feet.
+function placeOnHeldFeet(pts, stanceHeightM) {
+  const stance = panel.kin.preview(NEUTRAL, stanceHeightM, panel.order);
+  if (!stance.reachable) return pts;
+  const held = panel.kin.points(NEUTRAL, stance.angles, panel.order);
+  const foot = (a, leg) => new THREE.Vector3(a[12 * leg + 9], a[12 * leg + 10], a[12 * leg + 11]);
+  const place = rigidFit([0, 1, 2, 3].map((i) => foot(pts, i)), [0, 1, 2, 3].map((i) => foot(held, i)));
+  const out = [];
+  for (let k = 0; k < pts.length; k += 3) out.push(...place(new THREE.Vector3(pts[k], pts[k + 1], pts[k + 2])).toArray());
+  return out;
+}
+
 function updateReadback(s) {
   if (!actual) return;
-  // The body is placed by the pose the device acked; every joint comes from its readback.
-  const pts = panel.kin.points(s.pose ?? NEUTRAL, s.angles_rad, panel.order);
+  // The body is placed by the pose the device acked (none while a motion runs: level at the
+  // origin, or on the held feet during a sway); every joint comes from its readback.
+  let pts = panel.kin.points(s.pose ?? NEUTRAL, s.angles_rad, panel.order);
+  if (s.motion.kind === 'sway') pts = placeOnHeldFeet(pts, s.stance_height_m);
   drawRobot(actual, pts);
   panel.renderedAngles = s.angles_rad;
   panel.renderedPoints = pts;
@@ -405,6 +491,10 @@ function frame() {
     if (readbackSeen) {
       panel.latencies.push(performance.now() - readbackSeen.t0);
       readbackSeen = null;
+    }
+    if (motionSeen !== null) {
+      panel.motionLatencies.push(performance.now() - motionSeen);
+      motionSeen = null;
     }
   }
   pollInputs();
@@ -451,7 +541,7 @@ function showHealth(s) {
   $('health').innerHTML = `link ${s.link_up ? 'up' : '<span class="unreachable">down</span>'} · acked ${l.acked} · nacked ${l.nacked} · lost ${l.lost} · retries ${l.retries} · timeouts ${l.timeouts} · bad frames ${l.bad_frames}<br>
     round trip ${l.rtt_ms.toFixed(2)} ms (max ${l.rtt_max_ms.toFixed(2)}) · device frames ok ${l.device_frames_ok}, bad ${l.device_frames_bad}`;
   const f = s.flags;
-  $('device').innerHTML = `outputs <b>${f.outputs_enabled ? 'ON' : 'off'}</b> · failsafe ${f.failsafe_active ? 'ACTIVE' : 'idle'} · calibration ${f.calibration_unsaved ? 'unsaved' : f.calibration_default ? 'defaults' : 'saved'} · motion: none<br>
+  $('device').innerHTML = `outputs <b>${f.outputs_enabled ? 'ON' : 'off'}</b> · failsafe ${f.failsafe_active ? 'ACTIVE' : 'idle'} · calibration ${f.calibration_unsaved ? 'unsaved' : f.calibration_default ? 'defaults' : 'saved'} · motion: ${s.motion.kind ?? 'none'}<br>
     stance ${(s.stance_height_m * 1000).toFixed(0)} mm · poses sent ${s.poses_sent} · pages ${s.pages}`;
 }
 
@@ -462,6 +552,7 @@ const LEGS = ['all', 'FL', 'FR', 'RL', 'RR'];
 const MOTION_FORMS = {
   stand: { label: 'stand', fields: [] },
   sit: { label: 'sit', fields: [] },
+  rest: { label: 'rest (then outputs off)', fields: [] },
   sway: {
     label: 'sway',
     fields: [['axis', ['Roll', 'Pitch', 'Yaw']], ['amplitude_deg', 8], ['period_s', 2], ['duration_s', 0]],
@@ -480,6 +571,12 @@ const MOTION_FORMS = {
     fields: [['gait', ['Trot', 'Walk']], ['body_height_mm', 400], ['step_height_mm', 40], ['cycle_s', 0.8],
       ['velocity_timeout_ms', 500]],
   },
+};
+
+// The message's field of each form input whose unit differs on the page.
+const FIELD_OF_INPUT = {
+  amplitude_deg: 'amplitude_rad', yaw_rate_deg_s: 'yaw_rate_rad_s', lift_height_mm: 'lift_height_m',
+  stride_mm: 'stride_m', step_height_mm: 'step_height_m', body_height_mm: 'body_height_m',
 };
 
 // The `start_motion` message of the form's values.
@@ -534,6 +631,8 @@ function buildMotion() {
     for (const i of document.querySelectorAll('#motion-params [data-param]')) values[i.dataset.param] = i.value;
     const motion = motionMessage(sel.value, values);
     panel.lastMotion = motion;
+    showRefusal('', null);
+    motionClick = performance.now();
     send({ type: 'start_motion', motion });
   });
   $('motion-stop').addEventListener('click', () => send({ type: 'stop_motion' }));
@@ -551,12 +650,57 @@ function buildMotion() {
   window.addEventListener('keydown', (ev) => { if (!(ev.target instanceof HTMLInputElement)) keys.add(ev.key.toLowerCase()); });
   window.addEventListener('keyup', (ev) => keys.delete(ev.key.toLowerCase()));
 }
+let motionClick = null; // Start clicked, its answer not yet in
+let motionStarted = null; // Start acked, its first state not yet in
+let motionSeen = null; // the started motion's first readback received, not yet drawn
+
+// The device's motion engine in words: kind, stage, motion time, phase, and why the last
+// motion stopped early.
+function showMotion(m) {
+  panel.motionStatus = m;
+  panel.walking = m.kind === 'walk' && (m.stage === 'approach' || m.stage === 'run');
+  const fault = m.fault ? ` · <span class="unreachable">stopped early: ${m.fault}</span>` : '';
+  $('motion-status').innerHTML = m.kind === null
+    ? `motion: idle${fault}`
+    : `motion: <b>${m.kind}</b> · ${m.stage} · t ${m.t_s.toFixed(2)} s · phase ${m.phase.toFixed(2)}${fault}`;
+}
+
+// A refusal naming a field: the message under the form, the field's input marked.
+function showRefusal(text, field) {
+  $('motion-error').textContent = text;
+  for (const i of document.querySelectorAll('#motion-params [data-param]')) {
+    const name = FIELD_OF_INPUT[i.dataset.param] ?? i.dataset.param;
+    i.classList.toggle('invalid', field !== null && name === field);
+  }
+}
+
 const stick = { active: false, x: 0, y: 0 };
 const keys = new Set();
 const MAX_V = 0.2; // m/s
 const MAX_YAW = 0.5; // rad/s
-const VELOCITY_PERIOD_MS = 200;
+// At least 10 Hz with room to spare: the device stops a walk whose velocity is not refreshed
+// within its timeout (500 ms by default). At most a few commands awaiting their answer, so that
+// a slow server or device gets recent velocities rather than a growing queue of old ones, while
+// a round trip longer than the period (a busy machine) does not lower the rate.
+const VELOCITY_PERIOD_MS = 50;
+const VELOCITIES_IN_FLIGHT = 4;
 let lastVelocitySent = 0;
+let velocitiesInFlight = 0;
+
+// The walk's velocity goes to the device only while the device reports a walk running, and
+// often enough for its velocity timeout: on its own timer, not at the drawing's pace (a
+// software-rendered view on a busy machine draws slowly).
+function sendVelocity() {
+  const now = performance.now();
+  if (!panel.controlling || !panel.walking || velocitiesInFlight >= VELOCITIES_IN_FLIGHT
+    || now - lastVelocitySent < VELOCITY_PERIOD_MS) return;
+  const v = panel.velocity;
+  lastVelocitySent = now;
+  velocitiesInFlight += 1;
+  panel.velocitiesSent += 1;
+  send({ type: 'set_velocity', velocity: { forward_m_s: v.vx, lateral_m_s: v.vy, yaw_rate_rad_s: v.yaw } });
+}
+setInterval(sendVelocity, VELOCITY_PERIOD_MS / 5);
 
 function pollInputs() {
   let vx = -stick.y; let vy = -stick.x; let yaw = 0;
@@ -572,13 +716,7 @@ function pollInputs() {
   }
   const v = { vx: vx * MAX_V, vy: vy * MAX_V, yaw: yaw * MAX_YAW };
   panel.velocity = v;
-  // The walk's velocity goes to the device only while a walk runs (its start was done), and
-  // often enough for its velocity timeout.
-  const now = performance.now();
-  if (panel.controlling && panel.walking && now - lastVelocitySent > VELOCITY_PERIOD_MS) {
-    lastVelocitySent = now;
-    send({ type: 'set_velocity', velocity: { forward_m_s: v.vx, lateral_m_s: v.vy, yaw_rate_rad_s: v.yaw } });
-  }
+  sendVelocity();
   $('velocity').textContent = `vx ${v.vx.toFixed(3)} m/s · vy ${v.vy.toFixed(3)} m/s · yaw ${v.yaw.toFixed(3)} rad/s`;
   const pad = $('joystick');
   const g = pad.getContext('2d');

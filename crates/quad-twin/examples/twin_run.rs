@@ -73,6 +73,7 @@ fn main() -> ExitCode {
         } else {
             quad_twin::Driver::Device
         },
+        onboard: args.iter().any(|a| a == "--onboard"),
         ..RunOptions::default()
     };
     let number = |flag: &str| -> Result<Option<f32>, String> {

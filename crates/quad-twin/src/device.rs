@@ -134,7 +134,8 @@ impl SimDevice {
         Ok(d)
     }
 
-    /// Sends one request at message level and checks it is acknowledged.
+    /// Sends one request at message level and checks it is acknowledged (`Ack`, `HelloAck`,
+    /// or `MotionAck` for the motion engine's requests).
     ///
     /// # Errors
     /// [`DeviceError::Nack`] or [`DeviceError::Unexpected`].
@@ -144,7 +145,9 @@ impl SimDevice {
             seq: self.seq,
             request,
         }) {
-            DeviceToHost::Ack { .. } | DeviceToHost::HelloAck { .. } => Ok(()),
+            DeviceToHost::Ack { .. }
+            | DeviceToHost::HelloAck { .. }
+            | DeviceToHost::MotionAck { .. } => Ok(()),
             DeviceToHost::Nack { reason, .. } => Err(DeviceError::Nack(reason)),
             _ => Err(DeviceError::Unexpected),
         }

@@ -7,17 +7,24 @@
 //! pulse that started afterwards (the hardware takes new compare values over at the start of a
 //! period, so these pulses carry the request). The firmware's own IK, pulse mapping and timer
 //! code make the frame.
+//!
+//! Onboard ([`Emulated::boot`] with `onboard`), the firmware runs the motion itself: it gets
+//! `StartMotion` once and, for a walk, the velocity command at 10 Hz
+//! ([`crate::source::onboard_request`]). Its engine keeps time by the MCU's clock, so the
+//! emulator runs exactly one PWM period of MCU time per frame (a request's exchange included)
+//! and the frame is the last complete pulse of each pin.
 
 use crate::device::DeviceError;
 use crate::link::BodyState;
 use crate::motions::Plan;
-use crate::source::{DeviceFrame, FrameSource};
+use crate::source::{onboard_request, DeviceFrame, FrameSource};
+use kin_core::motion::gait::Velocity;
 use quad_device::Config;
 use quad_host::client::{Client, ClientConfig};
-use quad_host::emu::CYCLES_PER_TICK;
+use quad_host::emu::{CYCLES_PER_TICK, F_CPU_HZ, PERIOD_CYCLES};
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::servo::Calibration;
-use quad_protocol::{Request, ServoId};
+use quad_protocol::{MotionCommand, Request, ServoId};
 use std::path::Path;
 
 /// The line rate of the firmware the emulated source boots (`firmware.elf`), bit/s.
@@ -28,6 +35,10 @@ pub struct Emulated {
     plan: Plan,
     client: Client<EmulatorLink>,
     calibration: [Calibration; 12],
+    /// The onboard motion and a walk's velocity; `None`: `SetFeet` every frame.
+    onboard: Option<(MotionCommand, Option<Velocity>)>,
+    /// The MCU cycle at which an onboard run's frame 0 began.
+    start_cycle: Option<u64>,
 }
 
 impl Emulated {
@@ -38,8 +49,20 @@ impl Emulated {
     /// # Errors
     /// [`crate::Error::Emulator`] when the emulator or the link fails,
     /// [`crate::Error::FirmwareConfig`] when the firmware runs another robot or stance than
-    /// `config`.
-    pub fn boot(plan: Plan, config: &Config, elf: Option<&Path>) -> Result<Emulated, crate::Error> {
+    /// `config`, [`crate::Error::NotOnboard`] when `onboard` asks for a plan without an
+    /// onboard form.
+    pub fn boot(
+        plan: Plan,
+        config: &Config,
+        elf: Option<&Path>,
+        onboard: bool,
+    ) -> Result<Emulated, crate::Error> {
+        let onboard = match onboard {
+            false => None,
+            true => Some(plan.onboard().ok_or(crate::Error::NotOnboard {
+                motion: plan.kind().name(),
+            })?),
+        };
         let emulator = EmulatorConfig::new(FIRMWARE_BAUD);
         let link = match elf {
             Some(path) => EmulatorLink::boot(path, emulator),
@@ -66,6 +89,8 @@ impl Emulated {
             plan,
             client,
             calibration,
+            onboard,
+            start_cycle: None,
         })
     }
 }
@@ -78,16 +103,41 @@ impl FrameSource for Emulated {
     fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
         let t_s = k as f32 * crate::source::FRAME_S;
         let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
-        self.client
-            .ack(Request::SetFeet {
-                feet_in_body_m: target.feet_in_body_m,
-            })
-            .map_err(crate::Error::Emulator)?;
-        let pulses = self
-            .client
-            .link_mut()
-            .next_pulses()
-            .map_err(|e| crate::Error::Emulator(e.into()))?;
+        let pulses = match self.onboard {
+            None => {
+                self.client
+                    .ack(Request::SetFeet {
+                        feet_in_body_m: target.feet_in_body_m,
+                    })
+                    .map_err(crate::Error::Emulator)?;
+                self.client
+                    .link_mut()
+                    .next_pulses()
+                    .map_err(|e| crate::Error::Emulator(e.into()))?
+            }
+            Some((command, velocity)) => {
+                let start = *self
+                    .start_cycle
+                    .get_or_insert(self.client.link().mcu().cycle());
+                if let Some(request) = onboard_request(k, command, velocity) {
+                    self.client
+                        .request(request)
+                        .map_err(crate::Error::Emulator)?;
+                }
+                let end = start + (u64::from(k) + 1) * PERIOD_CYCLES;
+                let now = self.client.link().mcu().cycle();
+                if now < end {
+                    let idle = std::time::Duration::from_nanos(
+                        (end - now) * 1_000_000_000 / u64::from(F_CPU_HZ),
+                    );
+                    self.client
+                        .link_mut()
+                        .idle(idle)
+                        .map_err(|e| crate::Error::Emulator(e.into()))?;
+                }
+                self.client.link().last_pulses()
+            }
+        };
         let mut pulses_half_us = [0; 12];
         let mut angles_rad = [0.0; 12];
         for s in ServoId::ALL {

@@ -79,6 +79,11 @@ pub enum Error {
     },
     /// The rendered picture could not be copied to its file (nothing is left at its path).
     Picture(quad_model::Error),
+    /// The motion has no onboard form (the device's engine does not run it as the plan does).
+    NotOnboard {
+        /// The motion's name.
+        motion: &'static str,
+    },
 }
 
 impl fmt::Display for Error {
@@ -104,6 +109,11 @@ impl fmt::Display for Error {
                 write!(f, "frame {frame}: no pulse on servo {servo}'s pin")
             }
             Error::Picture(e) => write!(f, "picture: {e}"),
+            Error::NotOnboard { motion } => write!(
+                f,
+                "{motion} has no onboard form (the device's stand-up starts from its own rest \
+                 pose); run it host-driven"
+            ),
         }
     }
 }
@@ -271,6 +281,9 @@ pub struct RunOptions {
     pub picture: Option<PathBuf>,
     /// Where the frames come from.
     pub driver: Driver,
+    /// The device runs the motion itself (its motion engine, started once; a walk's velocity
+    /// sent every frame) instead of getting every frame's feet from the host.
+    pub onboard: bool,
 }
 
 /// Time the first frame is held before the motion starts, s: the robot, placed with its feet
@@ -408,11 +421,20 @@ pub fn run_plan(
         Driver::Device => {
             let device = device::SimDevice::start(*config)
                 .map_err(|error| Error::Device { frame: 0, error })?;
-            Box::new(source::HostDriven::new(plan, device))
+            if options.onboard {
+                Box::new(source::Onboard::new(plan, device).ok_or(Error::NotOnboard {
+                    motion: plan.kind().name(),
+                })?)
+            } else {
+                Box::new(source::HostDriven::new(plan, device))
+            }
         }
-        Driver::Emulator { elf } => {
-            Box::new(emulated::Emulated::boot(plan, config, elf.as_deref())?)
-        }
+        Driver::Emulator { elf } => Box::new(emulated::Emulated::boot(
+            plan,
+            config,
+            elf.as_deref(),
+            options.onboard,
+        )?),
     };
     let tmp = tempfile::tempdir().map_err(Error::Io)?;
     let out_dir = match (&options.out_dir, &options.picture) {

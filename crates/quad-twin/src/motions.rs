@@ -1,16 +1,20 @@
 //! The motions the twin runs, built from kin-core's motion laws for the device's robot and
 //! stance, and turned into the requests a host would send the device at every servo frame.
 //!
-//! Until the device runs motions itself, each frame's target is the kin-core motion's frame at
-//! that time, sent as `SetFeet` (the feet in the body frame): the device solves the IK and maps
-//! the angles to pulses with its own code, exactly as it would for a host.
+//! Driven by the host, each frame's target is the kin-core motion's frame at that time, sent as
+//! `SetFeet` (the feet in the body frame): the device solves the IK and maps the angles to
+//! pulses with its own code, exactly as it would for a host. Run onboard ([`Plan::onboard`]),
+//! the device's motion engine runs the same kin-core law (or its walker for the trots) by
+//! itself.
 
 use core::fmt;
 use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{Axis, Sway, SwayParams, YawTurn, YawTurnParams};
 use kin_core::motion::{AnyMotion, Contact, Motion};
 use kin_core::{rotation, Pose, Robot, RotationOrder};
+use quad_device::engine::DEFAULT_VELOCITY_TIMEOUT_MS;
 use quad_device::Config;
+use quad_protocol::MotionCommand;
 
 /// Rest height of the stand-up, as a fraction of the stance height: low enough to be a
 /// crouch, high enough that the body clears the floor on both presets.
@@ -342,6 +346,50 @@ impl Plan {
             script: Script::Law(AnyMotion::Gait(Gait::new(p)?)),
             law_start_s: shape.four_feet_start() * shape.cycle_s,
         })
+    }
+
+    /// The plan as the device's motion engine runs it: the `StartMotion` command with the
+    /// plan's parameters and, for the trots, the velocity to keep commanding. `None` for the
+    /// stand-up, whose crouch-to-stance ramp the device does from its own rest pose instead.
+    /// The trots' walker takes its duty factor from the gait pattern, not from the plan's
+    /// shape.
+    pub fn onboard(&self) -> Option<(MotionCommand, Option<Velocity>)> {
+        let duration_s = Some(self.duration_s);
+        let command = match self.script {
+            Script::StandUp { .. } => return None,
+            Script::Law(AnyMotion::Sway(m)) => {
+                let p = m.params();
+                MotionCommand::Sway {
+                    axis: p.axis,
+                    amplitude_rad: p.amplitude_rad,
+                    period_s: p.period_s,
+                    duration_s,
+                }
+            }
+            Script::Law(AnyMotion::YawTurn(m)) => {
+                let p = m.params();
+                MotionCommand::YawTurn {
+                    yaw_rate_rad_s: p.yaw_rate_rad_s,
+                    step_period_s: p.step_period_s,
+                    lift_height_m: p.lift_height_m,
+                    duration_s,
+                }
+            }
+            Script::Law(AnyMotion::Gait(g)) => {
+                let p = g.params();
+                // The catalogue's gaits are trots (`Plan::gait`).
+                let command = MotionCommand::Walk {
+                    gait: Pattern::Trot,
+                    body_height_m: self.stance_height_m,
+                    step_height_m: p.step_height_m,
+                    cycle_s: p.cycle_s,
+                    velocity_timeout_ms: DEFAULT_VELOCITY_TIMEOUT_MS,
+                };
+                return Some((command, Some(p.velocity)));
+            }
+            Script::Law(_) => return None,
+        };
+        Some((command, None))
     }
 
     /// The motion.

@@ -1,11 +1,12 @@
-//! Where the frames come from: the one place to change when the device runs the motions
-//! itself (then the source starts the onboard motion once and only steps the device).
+//! Where the frames come from: a host sending every frame's feet ([`HostDriven`]), or the
+//! device running the motion itself ([`Onboard`]).
 
 use crate::device::{DeviceError, SimDevice};
 use crate::link::BodyState;
 use crate::motions::Plan;
+use kin_core::motion::gait::Velocity;
 use kin_core::Pose;
-use quad_protocol::Request;
+use quad_protocol::{MotionCommand, Request};
 
 /// The device's servo period, s (50 Hz hobby-servo frames).
 pub const FRAME_S: f32 = 0.02;
@@ -75,6 +76,80 @@ impl FrameSource for HostDriven {
                 feet_in_body_m: target.feet_in_body_m,
             })
             .map_err(device_error)?;
+        self.device.tick(FRAME_MS);
+        let outputs = self.device.outputs();
+        Ok(DeviceFrame {
+            t_s,
+            enabled: outputs.enabled,
+            pulses_half_us: outputs.pulses_half_us,
+            angles_rad: self.device.output_angles_rad().map_err(device_error)?,
+            commanded_pose: target.pose,
+            stance: target.stance,
+        })
+    }
+}
+
+/// The device running the motion itself: `StartMotion` once (the plan's motion as the device's
+/// engine runs it, [`Plan::onboard`]), a walk's velocity command at 10 Hz (as a teleoperating
+/// host refreshes it, [`onboard_request`]), and otherwise only the device's clock advancing. The
+/// commanded pose and the feet on the ground are the plan's, for the metrics.
+pub struct Onboard {
+    plan: Plan,
+    device: SimDevice,
+    command: MotionCommand,
+    velocity: Option<Velocity>,
+}
+
+impl Onboard {
+    /// Runs `plan` on `device` (started, outputs enabled); `None` when the plan has no onboard
+    /// form ([`Plan::onboard`]).
+    pub fn new(plan: Plan, device: SimDevice) -> Option<Onboard> {
+        let (command, velocity) = plan.onboard()?;
+        Some(Onboard {
+            plan,
+            device,
+            command,
+            velocity,
+        })
+    }
+}
+
+/// Frames between two velocity commands of an onboard walk: 10 Hz, as a teleoperating host
+/// sends them (the device's timeout is five of them).
+pub const VELOCITY_EVERY_FRAMES: u32 = 5;
+
+/// The request of frame `k` of an onboard run: the start at frame 0, then a walk's velocity
+/// every [`VELOCITY_EVERY_FRAMES`].
+pub fn onboard_request(
+    k: u32,
+    command: MotionCommand,
+    velocity: Option<Velocity>,
+) -> Option<Request> {
+    if k == 0 {
+        return Some(Request::StartMotion(command));
+    }
+    if k % VELOCITY_EVERY_FRAMES != 0 {
+        return None;
+    }
+    velocity.map(|v| Request::SetVelocity {
+        forward_m_s: v.forward_m_s,
+        lateral_m_s: v.lateral_m_s,
+        yaw_rate_rad_s: v.yaw_rad_s,
+    })
+}
+
+impl FrameSource for Onboard {
+    fn frame_count(&self) -> u32 {
+        frame_count(&self.plan)
+    }
+
+    fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
+        let t_s = k as f32 * FRAME_S;
+        let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
+        let device_error = |error: DeviceError| crate::Error::Device { frame: k, error };
+        if let Some(request) = onboard_request(k, self.command, self.velocity) {
+            self.device.request(request).map_err(device_error)?;
+        }
         self.device.tick(FRAME_MS);
         let outputs = self.device.outputs();
         Ok(DeviceFrame {

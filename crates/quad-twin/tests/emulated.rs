@@ -25,7 +25,7 @@ fn the_firmwares_pulses_equal_the_device_controllers() {
     let config = Config::shahriar2023();
     let plan = Plan::new(MotionKind::Trot, &config).unwrap();
     let mut device = HostDriven::new(plan, SimDevice::start(config).unwrap());
-    let mut firmware = Emulated::boot(plan, &config, None).unwrap_or_else(|e| panic!("{e}"));
+    let mut firmware = Emulated::boot(plan, &config, None, false).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(firmware.frame_count(), device.frame_count());
     let mut worst = 0;
     let mut previous: Option<[u16; 12]> = None;
@@ -49,4 +49,22 @@ fn the_firmwares_pulses_equal_the_device_controllers() {
         }
     }
     eprintln!("largest pulse difference over {FRAMES} frames: {worst} half-µs");
+}
+
+#[test]
+fn the_firmwares_own_trot_walks_in_the_twin() {
+    // The firmware's motion engine runs the trot (one PWM period of MCU time per frame);
+    // the twin's physics carries the robot forward.
+    let (config, physical) = (Config::shahriar2023(), quad_model::Physical::shahriar2023());
+    let options = quad_twin::RunOptions {
+        driver: quad_twin::Driver::Emulator { elf: None },
+        onboard: true,
+        ..quad_twin::RunOptions::default()
+    };
+    let s = quad_twin::run(&config, &physical, MotionKind::Trot, &options)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .summary;
+    assert!(!s.fell, "{:?}", s.fall_reason);
+    let travel = s.travel.expect("a travelling motion");
+    assert!(travel.ratio >= 0.5, "{travel:?}");
 }

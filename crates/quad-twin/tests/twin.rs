@@ -199,3 +199,50 @@ fn a_motion_out_of_reach_is_refused_naming_the_parameter() {
     let err = Plan::new(MotionKind::Roll, &config).unwrap_err();
     assert!(err.to_string().contains("feet_in_world"), "{err}");
 }
+
+/// Upright, and no servo at full duty for more than [`STEPPING_SATURATED_MAX`] of the steps.
+/// (The peak may touch the stall torque: the onboard trot's knees do, docs/twin.md.)
+fn assert_steps_within_saturation(name: &str, s: &Summary) {
+    assert!(!s.fell, "{name} {}: fell: {:?}", s.motion, s.fall_reason);
+    assert!(
+        s.torque.saturated_fraction < STEPPING_SATURATED_MAX,
+        "{name} {}: {:?}",
+        s.motion,
+        s.torque
+    );
+}
+
+#[test]
+fn the_devices_own_trot_walks_and_turns_both_presets() {
+    // The device's motion engine runs the trots itself (its walker, a velocity command at
+    // 10 Hz), the host only watches: the host-driven trots' travel and yaw bounds.
+    let onboard = RunOptions {
+        onboard: true,
+        ..RunOptions::default()
+    };
+    for (name, config, physical) in presets() {
+        let trot = run(&config, &physical, MotionKind::Trot, &onboard)
+            .unwrap_or_else(|e| panic!("{name} onboard trot: {e}"))
+            .summary;
+        assert_steps_within_saturation(name, &trot);
+        let travel = trot.travel.expect("a travelling motion");
+        assert!(travel.ratio >= TRAVEL_RATIO_MIN, "{name}: {travel:?}");
+        let turn = run(&config, &physical, MotionKind::TrotTurn, &onboard)
+            .unwrap_or_else(|e| panic!("{name} onboard trot-turn: {e}"))
+            .summary;
+        assert_steps_within_saturation(name, &turn);
+        let yaw = turn.yaw.expect("a turning motion");
+        assert!(yaw.ratio >= YAW_RATIO_MIN, "{name}: {yaw:?}");
+    }
+}
+
+#[test]
+fn the_stand_up_has_no_onboard_form() {
+    let (_, config, physical) = &presets()[0];
+    let onboard = RunOptions {
+        onboard: true,
+        ..RunOptions::default()
+    };
+    let e = run(config, physical, MotionKind::Stand, &onboard).expect_err("refused");
+    assert!(matches!(e, quad_twin::Error::NotOnboard { .. }), "{e}");
+}

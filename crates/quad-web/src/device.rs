@@ -21,7 +21,14 @@
 //! While the server runs it reads the device's state several times a second, so the device's
 //! own link-loss failsafe never fires. When the controlling page goes away, the server applies
 //! the same rule the device applies to a silent link ([`quad_protocol::LinkLossAction`] of its
-//! configuration): `Disable` switches the outputs off, `Hold` keeps the last pose.
+//! configuration): `Disable` switches the outputs off (which cancels a running motion), `Hold`
+//! keeps the last pose and stops a running motion cleanly ([`motion::on_control_lost`]).
+//!
+//! ## Motions and the device's clock
+//! Motion requests go through [`motion::request`]; their `MotionAck` carries the engine's state,
+//! which the thread also reads between commands (`GetMotion` instead of `GetState`). A
+//! simulated or emulated device's clock runs only while its link is read, so the thread idles
+//! the link up to the wall clock while it waits for events: its motions run in real time.
 
 use crate::motion;
 use crate::msg::{self, FlagsMsg, LinkMsg, State};
@@ -33,8 +40,8 @@ use quad_host::client::{
 use quad_host::link::{self, Link, Target};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    DeviceInfo, DeviceToHost, Flags, LinkLossAction, NackReason, PoseConfig, Readback, Request,
-    RobotPreset, ServoId,
+    DeviceInfo, DeviceToHost, Flags, LinkLossAction, MotionStage, MotionStatus, NackReason,
+    PoseConfig, Readback, Request, RobotPreset, ServoId,
 };
 use std::time::{Duration, Instant};
 
@@ -112,9 +119,28 @@ pub enum Error {
     /// The link is down; the server keeps serving pages.
     #[error("the device link is down")]
     LinkDown,
-    /// A motion command the device protocol cannot carry: not sent.
-    #[error(transparent)]
-    Motion(motion::Unsupported),
+    /// A motion command out of range: not sent.
+    #[error("not sent: {0}")]
+    Motion(motion::Invalid),
+    /// The device refused a motion request; a running motion keeps running.
+    #[error("the device refused {}: {}", client::request_name(.request), motion::words(.reason, .request))]
+    MotionRefused {
+        /// The request.
+        request: Request,
+        /// Why.
+        reason: NackReason,
+    },
+}
+
+impl Error {
+    /// The page's field a refusal names, if it names one.
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            Error::MotionRefused { reason, request } => motion::refused_field(reason, request),
+            Error::Motion(invalid) => Some(invalid.field()),
+            _ => None,
+        }
+    }
 }
 
 /// A session with the device: what the server knows of it and the requests the panel makes.
@@ -126,6 +152,13 @@ pub struct Session<L> {
     calibration: [Calibration; 12],
     check: AngleCheck,
     readback: Readback,
+    motion: MotionStatus,
+    /// The device speaks protocol 2.1 or later: it has the motion requests.
+    motions: bool,
+    /// Attempts of the last exchange.
+    attempts: u32,
+    /// The link's clock when the session connected.
+    link_epoch: Duration,
     pose: Option<(Pose, u32)>,
     poses_sent: u64,
     link: LinkMsg,
@@ -152,7 +185,19 @@ impl<L: Link> Session<L> {
         }
         let calibration = client.calibrations()?;
         let readback = client.ack(Request::GetState)?;
+        let motions = quad_protocol::version_minor(info.version) >= 1;
+        let link_epoch = client.link().now();
         Ok(Session {
+            link_epoch,
+            motion: MotionStatus {
+                kind: None,
+                stage: MotionStage::Run,
+                t_s: 0.0,
+                phase: 0.0,
+                fault: None,
+            },
+            motions,
+            attempts: 0,
             client,
             robot,
             info,
@@ -176,6 +221,21 @@ impl<L: Link> Session<L> {
         &self.readback
     }
 
+    /// Link time since the session connected.
+    pub fn link_elapsed(&self) -> Duration {
+        self.client.link().now().saturating_sub(self.link_epoch)
+    }
+
+    /// Lets `d` of link time pass with nothing sent: a simulated or emulated device's clock
+    /// runs only while its link is read, and its motions with it; a serial link just waits.
+    ///
+    /// # Errors
+    /// Link failures.
+    pub fn idle(&mut self, d: Duration) -> Result<(), Error> {
+        let until = self.client.link().now() + d;
+        self.client.idle_until(until).map_err(Error::Link)
+    }
+
     /// One request through [`Client::exchange`] with `check`, timed and counted.
     fn exchange(
         &mut self,
@@ -184,6 +244,7 @@ impl<L: Link> Session<L> {
     ) -> Result<DeviceToHost, Error> {
         let t0 = self.client.link().now();
         let ex = self.client.exchange(request, check)?;
+        self.attempts = ex.attempts;
         let rtt_ms = (self.client.link().now() - t0).as_secs_f64() * 1e3;
         self.link.rtt_ms = rtt_ms;
         self.link.rtt_max_ms = self.link.rtt_max_ms.max(rtt_ms);
@@ -226,12 +287,17 @@ impl<L: Link> Session<L> {
         }
     }
 
-    /// Reads the device's state.
+    /// Reads the device's state: its motion engine's with the readback (`GetMotion`) when it
+    /// has one, else the readback (`GetState`).
     ///
     /// # Errors
     /// Link failures, no answer.
     pub fn poll(&mut self) -> Result<(), Error> {
-        self.ack(Request::GetState).map(|_| ())
+        if self.motions {
+            self.motion(Request::GetMotion)
+        } else {
+            self.ack(Request::GetState).map(|_| ())
+        }
     }
 
     /// Sends `pose` (page id `id`) when the host's kin-core and calibration accept it; the
@@ -402,8 +468,10 @@ impl<L: Link> Session<L> {
     /// # Errors
     /// Link failures, no answer.
     pub fn control_lost(&mut self) -> Result<(), Error> {
-        if let Some(stop) = motion::on_control_lost() {
-            self.motion(stop)?;
+        if let Some(stop) = motion::on_control_lost(self.info.link_timeout.action) {
+            if self.motions {
+                self.motion(stop)?;
+            }
         }
         match self.info.link_timeout.action {
             LinkLossAction::Disable => self.set_outputs(false),
@@ -411,11 +479,47 @@ impl<L: Link> Session<L> {
         }
     }
 
-    /// Sends a motion request ([`motion::request`]) and takes the device's answer: an ack or
-    /// a nack (reported to the page) for now; the answer the protocol's motion requests will
-    /// carry (the engine's state) is to be accepted here as well.
+    /// Sends a motion request (`StartMotion`, `StopMotion`, `GetMotion`, `SetVelocity`) and
+    /// keeps the engine's state of its `MotionAck`; a refusal is [`Error::MotionRefused`].
     fn motion(&mut self, request: Request) -> Result<(), Error> {
-        self.ack(request).map(|_| ())
+        match self.exchange(request, |_| client::Verdict::Accept) {
+            Ok(DeviceToHost::MotionAck { status, .. }) => {
+                self.motion = status;
+                Ok(())
+            }
+            Ok(other) => Err(Error::Client(client::Error::Unexpected {
+                request: client::request_name(&request),
+                answer: Box::new(other),
+            })),
+            // A start whose first answer was lost: its retry finds it running.
+            Err(Error::Refused {
+                reason: NackReason::MotionRunning,
+                ..
+            }) if self.attempts > 1 && matches!(request, Request::StartMotion(_)) => {
+                self.motion(Request::GetMotion)
+            }
+            Err(Error::Refused { reason, .. }) => Err(Error::MotionRefused { request, reason }),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The motion engine's state, as last reported.
+    pub fn motion_status(&self) -> &MotionStatus {
+        &self.motion
+    }
+
+    /// Starts, stops or steers a motion ([`motion::request`]). A started motion replaces the
+    /// held body pose: the state reports none until the next pose.
+    ///
+    /// # Errors
+    /// [`Error::Motion`] (nothing sent), [`Error::MotionRefused`], link failures.
+    pub fn motion_command(&mut self, cmd: &motion::MotionCommand) -> Result<(), Error> {
+        let request = motion::request(cmd).map_err(Error::Motion)?;
+        self.motion(request)?;
+        if matches!(cmd, motion::MotionCommand::Start(_)) {
+            self.pose = None;
+        }
+        Ok(())
     }
 
     /// The state for the pages.
@@ -444,6 +548,7 @@ impl<L: Link> Session<L> {
             controller: None,
             pages: 0,
             link_up: true,
+            motion: motion::MotionState::from(&self.motion),
         }
     }
 
@@ -466,14 +571,10 @@ impl<L: Link> Session<L> {
             M::SetDirection { servo: s, reversed } => self.set_direction(servo(s)?, reversed),
             M::SaveCalibration => self.save_calibration(),
             M::ReadCalibration => self.read_calibration(),
-            M::StartMotion { .. } | M::StopMotion | M::SetVelocity { .. } => {
-                let request = cmd.motion().map(|m| motion::request(&m));
-                match request {
-                    Some(Ok(r)) => self.motion(r),
-                    Some(Err(e)) => Err(Error::Motion(e)),
-                    None => Ok(()),
-                }
-            }
+            M::StartMotion { .. } | M::StopMotion | M::SetVelocity { .. } => match cmd.motion() {
+                Some(m) => self.motion_command(&m),
+                None => Ok(()),
+            },
             M::TakeControl | M::ReleaseControl => Ok(()),
         }
     }
@@ -515,6 +616,56 @@ pub enum Event {
 pub struct Ready {
     /// The device's `HelloAck`.
     pub info: DeviceInfo,
+}
+
+/// The device's clock runs this much at a time while it is behind the wall clock: a command
+/// that arrives meanwhile waits for at most one slice (an emulated device may need several
+/// times its length of wall time).
+const IDLE_SLICE: Duration = Duration::from_millis(2);
+
+/// Longest wait for an event while the device's clock is up to the wall clock.
+const WAIT_SLICE: Duration = Duration::from_millis(10);
+
+/// The device thread's next event: a job, a lost page, the server's end, or (as a timeout) a
+/// state read due at `poll_due`.
+///
+/// The device's clock follows the server's meanwhile: a simulated or emulated device's time
+/// (and its motion) runs only while its link is read, so the link idles in [`IDLE_SLICE`]s up
+/// to the wall clock, checking for events and a due state read between slices. A device slower
+/// than real time (simavr on a busy machine) thus runs its motions slower rather than delaying
+/// the pages' commands.
+fn next_event<L: Link>(
+    events: &std::sync::mpsc::Receiver<Event>,
+    session: &mut Session<L>,
+    link_up: &mut bool,
+    wall_epoch: Instant,
+    poll_due: Instant,
+) -> Result<Event, std::sync::mpsc::RecvTimeoutError> {
+    use std::sync::mpsc::{RecvTimeoutError, TryRecvError};
+    loop {
+        match events.try_recv() {
+            Ok(e) => return Ok(e),
+            Err(TryRecvError::Disconnected) => return Err(RecvTimeoutError::Disconnected),
+            Err(TryRecvError::Empty) => {}
+        }
+        let now = Instant::now();
+        if now >= poll_due {
+            return Err(RecvTimeoutError::Timeout);
+        }
+        let behind = wall_epoch.elapsed().saturating_sub(session.link_elapsed());
+        if *link_up && behind >= IDLE_SLICE {
+            if let Err(e) = session.idle(IDLE_SLICE) {
+                eprintln!("quadctl serve: device link failed: {e}");
+                *link_up = false;
+            }
+            continue;
+        }
+        match events.recv_timeout((poll_due - now).min(WAIT_SLICE)) {
+            Ok(e) => return Ok(e),
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => return Err(RecvTimeoutError::Disconnected),
+        }
+    }
 }
 
 /// Runs the device thread: opens the link, connects, then serves `events` and publishes the
@@ -561,8 +712,18 @@ pub fn run(
     };
     publish(&session, true);
     let mut link_up = true;
+    let wall_epoch = Instant::now();
+    let mut last_state = Instant::now();
     loop {
-        match events.recv_timeout(setup.poll) {
+        let event = next_event(
+            &events,
+            &mut session,
+            &mut link_up,
+            wall_epoch,
+            last_state + setup.poll,
+        );
+        last_state = Instant::now();
+        match event {
             Ok(Event::Job(job)) => {
                 let result = if link_up {
                     session.command(&job.cmd)

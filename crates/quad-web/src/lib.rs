@@ -8,6 +8,8 @@
 //! - sliders for the body pose and the stance height, previewed at once by kin-core compiled
 //!   to WebAssembly (`crates/kin-wasm`), each leg coloured by its reachability and joint-limit
 //!   margin; an unreachable position is drawn, not sent;
+//! - the device's onboard motions (its motion engine): start, stop, a walk's velocity from a
+//!   joystick, the engine's status live, its refusals named by field;
 //! - live plots of the twelve joints and pulses, link health and device state;
 //! - a calibration tab: pick a servo, jog its pulse, set its centre and direction, save.
 //!

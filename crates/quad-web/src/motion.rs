@@ -1,18 +1,19 @@
 //! The Motion tab's commands: the onboard motions its buttons start, the velocity its joystick
-//! sets, and the one place ([`request`]) that turns them into device requests.
+//! sets, and the one place ([`request`]) that turns them into the device's motion requests
+//! (protocol 2.1: `StartMotion`, `StopMotion`, `SetVelocity`), plus the stop a lost page owes
+//! ([`on_control_lost`]) and the device's refusals in the page's words ([`words`]).
 //!
-//! The device protocol of this build has no motion requests: [`request`] answers
-//! [`Unsupported`] for every command, the device thread reports it to the page as an error
-//! ("not sent"), and nothing is sent. The page, its messages, their validation and the server's
-//! path to the device are complete; carrying motions is [`request`]'s job alone (one `match`
-//! arm per [`MotionMsg`] onto the protocol's motion requests, the device thread sends what it
-//! returns like any other request and reports the device's nack), plus [`on_control_lost`]
-//! for the stop a lost page owes.
+//! A motion's parameters are the device's to check against the robot (reach, travel, the
+//! gait's limits): the page's values go to it as they are, after the message checks of
+//! [`MotionCommand::validate`], and its typed refusal comes back naming the page's field.
 
 use kin_core::motion::gait::Pattern;
 use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
-use quad_protocol::Request;
+use kin_core::LegId;
+use quad_device::engine::{self, WalkRequest};
+use quad_host::ops::onboard::{self, Naming};
+use quad_protocol::{LinkLossAction, MotionParam, MotionStage, MotionStatus, NackReason, Request};
 use serde::{Deserialize, Serialize};
 
 /// A motion the device runs by itself, as the page asks it. Durations: `None` runs until
@@ -24,6 +25,8 @@ pub enum MotionMsg {
     Stand,
     /// A ramp to the rest pose, held.
     Sit,
+    /// A ramp to the rest pose, then the outputs off.
+    Rest,
     /// Seed 001's sway about `axis`, `angle = A·sin(2πt/T)`, feet fixed.
     Sway {
         /// Roll, pitch or yaw.
@@ -128,6 +131,18 @@ pub enum Invalid {
     Timeout,
 }
 
+impl Invalid {
+    /// The field out of range.
+    pub fn field(&self) -> &'static str {
+        match *self {
+            Invalid::NonFinite(name) | Invalid::NotPositive { name, .. } => name,
+            Invalid::DutyFactor(_) => "duty_factor",
+            Invalid::Leg(_) => "leg",
+            Invalid::Timeout => "velocity_timeout_ms",
+        }
+    }
+}
+
 fn finite(name: &'static str, v: f32) -> Result<(), Invalid> {
     if v.is_finite() {
         Ok(())
@@ -164,7 +179,7 @@ impl MotionCommand {
                 finite("yaw_rate_rad_s", v.yaw_rate_rad_s)
             }
             MotionCommand::Start(m) => match m {
-                MotionMsg::Stand | MotionMsg::Sit => Ok(()),
+                MotionMsg::Stand | MotionMsg::Sit | MotionMsg::Rest => Ok(()),
                 MotionMsg::Sway {
                     amplitude_rad,
                     period_s,
@@ -227,25 +242,203 @@ impl MotionCommand {
     }
 }
 
-/// The device protocol of this build cannot carry the command.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[error("not sent: the device protocol of this build has no motion requests")]
-pub struct Unsupported;
-
-/// The device request that carries `cmd` (validated).
+/// The device's motion of a page's: the engine's request, which the host's onboard
+/// operations send as well ([`quad_protocol::MotionCommand`]'s one conversion from it).
 ///
 /// # Errors
-/// [`Unsupported`] for every command: the protocol has no motion requests yet.
-pub fn request(cmd: &MotionCommand) -> Result<Request, Unsupported> {
-    match cmd {
-        MotionCommand::Start(_) | MotionCommand::Stop | MotionCommand::Velocity(_) => {
-            Err(Unsupported)
+/// [`Invalid::Leg`] for a foot path's leg index beyond 3.
+pub fn engine_request(m: &MotionMsg) -> Result<engine::Request, Invalid> {
+    Ok(match *m {
+        MotionMsg::Stand => engine::Request::StandUp,
+        MotionMsg::Sit => engine::Request::Sit,
+        MotionMsg::Rest => engine::Request::Rest,
+        MotionMsg::Sway {
+            axis,
+            amplitude_rad,
+            period_s,
+            duration_s,
+        } => engine::Request::Sway {
+            axis,
+            amplitude_rad,
+            period_s,
+            duration_s,
+        },
+        MotionMsg::YawTurn {
+            yaw_rate_rad_s,
+            step_period_s,
+            lift_height_m,
+            duration_s,
+        } => engine::Request::YawTurn {
+            yaw_rate_rad_s,
+            step_period_s,
+            lift_height_m,
+            duration_s,
+        },
+        MotionMsg::FootPath {
+            path,
+            leg,
+            stride_m,
+            step_height_m,
+            duty_factor,
+            cycle_s,
+            duration_s,
+        } => engine::Request::FootPath {
+            path,
+            leg: match leg {
+                None => None,
+                Some(l) => Some(*LegId::ALL.get(usize::from(l)).ok_or(Invalid::Leg(l))?),
+            },
+            stride_m,
+            step_height_m,
+            duty_factor,
+            cycle_s,
+            duration_s,
+        },
+        MotionMsg::Walk {
+            gait,
+            body_height_m,
+            step_height_m,
+            cycle_s,
+            velocity_timeout_ms,
+        } => engine::Request::Walk(WalkRequest {
+            pattern: gait,
+            body_height_m,
+            step_height_m,
+            cycle_s,
+            velocity_timeout_ms,
+        }),
+    })
+}
+
+/// The device request that carries `cmd`.
+///
+/// # Errors
+/// `cmd`'s first field out of range ([`MotionCommand::validate`]): nothing to send.
+pub fn request(cmd: &MotionCommand) -> Result<Request, Invalid> {
+    cmd.validate()?;
+    Ok(match cmd {
+        MotionCommand::Start(m) => {
+            Request::StartMotion(quad_protocol::MotionCommand::from(&engine_request(m)?))
+        }
+        MotionCommand::Stop => Request::StopMotion,
+        MotionCommand::Velocity(v) => Request::SetVelocity {
+            forward_m_s: v.forward_m_s,
+            lateral_m_s: v.lateral_m_s,
+            yaw_rate_rad_s: v.yaw_rate_rad_s,
+        },
+    })
+}
+
+/// The request that stops a running motion when the controlling page goes away, as the
+/// device's own link-loss rule stops it: with [`LinkLossAction::Hold`] a running motion ends
+/// cleanly (`StopMotion`: the end of its period or strides, then a ramp to the stance); with
+/// [`LinkLossAction::Disable`] nothing here, the outputs going off cancels it.
+pub fn on_control_lost(action: LinkLossAction) -> Option<Request> {
+    match action {
+        LinkLossAction::Hold => Some(Request::StopMotion),
+        LinkLossAction::Disable => None,
+    }
+}
+
+/// The page's field of a motion parameter (the field of its `start_motion` and
+/// `set_velocity` messages; the form shows it in degrees or millimetres where its unit says
+/// so).
+pub fn field(param: MotionParam) -> &'static str {
+    match param {
+        MotionParam::AmplitudeRad => "amplitude_rad",
+        MotionParam::PeriodS => "period_s",
+        MotionParam::DurationS => "duration_s",
+        MotionParam::YawRateRadS => "yaw_rate_rad_s",
+        MotionParam::StepPeriodS => "step_period_s",
+        MotionParam::LiftHeightM => "lift_height_m",
+        MotionParam::StrideM => "stride_m",
+        MotionParam::StepHeightM => "step_height_m",
+        MotionParam::DutyFactor => "duty_factor",
+        MotionParam::CycleS => "cycle_s",
+        MotionParam::Path => "path (with stride_m, step_height_m)",
+        MotionParam::BodyHeightM => "body_height_m",
+        MotionParam::VelocityTimeoutMs => "velocity_timeout_ms",
+        MotionParam::ForwardMS => "forward_m_s",
+        MotionParam::LateralMS => "lateral_m_s",
+        MotionParam::Velocity => "the velocity (forward_m_s, lateral_m_s, yaw_rate_rad_s)",
+        MotionParam::JointSpeedLimitRadS => "joint_speed_limit_rad_s",
+        MotionParam::Stance => "the device's stance height",
+        MotionParam::ReachRadiusM => "body_height_m (it sets the stride's reach)",
+        _ => "a parameter",
+    }
+}
+
+/// The page's names for the device's refusals ([`onboard::words_in`]).
+pub const PANEL: Naming = Naming {
+    param: field,
+    start_walk: "start a trot / walk",
+    stand: "start stand",
+};
+
+/// A device refusal in the page's words: the host's sentences ([`onboard::words_in`]) with
+/// the page's field names, and for a refused sample of a started motion the fields that set
+/// its feet.
+pub fn words(reason: &NackReason, request: &Request) -> String {
+    format!(
+        "{}{}",
+        onboard::words_in(reason, &PANEL),
+        onboard::reach_hint(reason, onboard::shaping_params(request), &PANEL)
+    )
+}
+
+/// The page's field a refusal of `request` names, when it names one: the refused parameter,
+/// or for a refused sample of a started motion the first field that sets its feet.
+pub fn refused_field(reason: &NackReason, request: &Request) -> Option<&'static str> {
+    match reason {
+        NackReason::InvalidParameter { param, .. } => Some(field(*param)),
+        NackReason::Preflight { .. } | NackReason::ServoRange { .. } => {
+            onboard::shaping_params(request).first().map(|&p| field(p))
+        }
+        _ => None,
+    }
+}
+
+/// The motion engine's state for the pages.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MotionState {
+    /// The motion running (`stand_up`, `sit`, `rest`, `sway`, `yaw_turn`, `foot_path`,
+    /// `walk`); `None` when idle.
+    pub kind: Option<&'static str>,
+    /// Its stage: `approach`, `run`, `stopping`, `leave` (`run` when idle).
+    pub stage: &'static str,
+    /// Motion time since the run began, s.
+    pub t_s: f32,
+    /// Phase within the motion's period (the walk's gait phase), in `[0, 1)`.
+    pub phase: f32,
+    /// Why the last motion stopped early, in words, if it did.
+    pub fault: Option<String>,
+}
+
+impl Default for MotionState {
+    fn default() -> MotionState {
+        MotionState {
+            kind: None,
+            stage: "run",
+            t_s: 0.0,
+            phase: 0.0,
+            fault: None,
         }
     }
 }
 
-/// The request that stops a running motion when the controlling page goes away, before the
-/// device's link-loss rule is applied; `None` while the protocol has no motion requests.
-pub fn on_control_lost() -> Option<Request> {
-    None
+impl From<&MotionStatus> for MotionState {
+    fn from(s: &MotionStatus) -> MotionState {
+        MotionState {
+            kind: s.kind.map(onboard::kind_name),
+            stage: match s.stage {
+                MotionStage::Approach => "approach",
+                MotionStage::Run => "run",
+                MotionStage::Stopping => "stopping",
+                MotionStage::Leave => "leave",
+            },
+            t_s: s.t_s,
+            phase: s.phase,
+            fault: s.fault.map(|f| onboard::words_in(&f, &PANEL)),
+        }
+    }
 }

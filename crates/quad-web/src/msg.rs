@@ -120,6 +120,16 @@ pub enum Error {
     Motion(#[from] motion::Invalid),
 }
 
+impl Error {
+    /// The field of the command the refusal names, if it names one (a motion parameter).
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            Error::Motion(invalid) => Some(invalid.field()),
+            _ => None,
+        }
+    }
+}
+
 fn finite(name: &'static str, v: f32) -> Result<(), Error> {
     if v.is_finite() {
         Ok(())
@@ -295,6 +305,8 @@ pub struct State {
     pub pages: u32,
     /// The device link is up (false after a link failure; the server keeps serving the page).
     pub link_up: bool,
+    /// The device's motion engine, from its last `MotionAck`.
+    pub motion: motion::MotionState,
 }
 
 /// What the server tells a page.
@@ -330,6 +342,9 @@ pub enum ServerMsg {
     Error {
         /// What went wrong.
         message: String,
+        /// The field of the command the refusal names, if it names one (a motion parameter).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        field: Option<&'static str>,
     },
 }
 

@@ -140,6 +140,7 @@ fn initial_state() -> State {
         controller: None,
         pages: 0,
         link_up: false,
+        motion: crate::motion::MotionState::default(),
     }
 }
 
@@ -377,7 +378,7 @@ async fn serve_page(
                     Some(Ok(Message::Binary(_))) => {
                         let e = msg::Error::Binary;
                         log(id, &format!("refused: {e}"));
-                        if !send(socket, &ServerMsg::Error { message: e.to_string() }).await {
+                        if !send(socket, &ServerMsg::Error { message: e.to_string(), field: None }).await {
                             return;
                         }
                         continue;
@@ -387,7 +388,7 @@ async fn serve_page(
                 let reply = match ClientMsg::parse(text.as_str()) {
                     Err(e) => {
                         log(id, &format!("refused: {e}"));
-                        ServerMsg::Error { message: e.to_string() }
+                        ServerMsg::Error { message: e.to_string(), field: e.field() }
                     }
                     Ok(cmd) => {
                         let reply = command(shared, id, cmd).await;
@@ -406,10 +407,11 @@ async fn serve_page(
 }
 
 async fn command(shared: &Shared, id: u64, cmd: ClientMsg) -> ServerMsg {
-    let refuse = |message: String| {
+    let refuse_field = |message: String, field: Option<&'static str>| {
         log(id, &format!("{}: {message}", cmd.name()));
-        ServerMsg::Error { message }
+        ServerMsg::Error { message, field }
     };
+    let refuse = |message: String| refuse_field(message, None);
     let done = ServerMsg::Done {
         command: cmd.name(),
     };
@@ -460,7 +462,7 @@ async fn command(shared: &Shared, id: u64, cmd: ClientMsg) -> ServerMsg {
     }
     match result.await {
         Ok(Ok(())) => done,
-        Ok(Err(e)) => refuse(e.to_string()),
+        Ok(Err(e)) => refuse_field(e.to_string(), e.field()),
         Err(_) => refuse("the device thread has stopped".to_owned()),
     }
 }

@@ -1,6 +1,6 @@
 //! The control panel in a real browser: headless Debian Chromium driven through chromedriver
 //! against the server in-process — the simulated device (`--sim`) for the page's behaviour,
-//! the firmware in simavr (`--emulator`) for the end-to-end path.
+//! the firmware in simavr (`--emulator`) for the end-to-end path, the onboard motions on both.
 
 mod browser;
 
@@ -114,42 +114,6 @@ async fn sim_panel() {
     b.wait(&format!("panel.states > {states} + 3"), WAIT).await;
     assert_eq!(b.js("panel.state.angles_rad").await, angles_before);
 
-    // The Motion tab: Start and Stop reach the server, which answers "not sent" (the device
-    // protocol has no motion requests yet) and moves nothing.
-    b.click("tab-motion").await;
-    b.client
-        .find(fantoccini::Locator::Css(
-            "#motion-kind option[value='sway']",
-        ))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
-    for (button, command) in [
-        ("motion-start", "start_motion"),
-        ("motion-stop", "stop_motion"),
-    ] {
-        let n = b.js("panel.errors.length").await.as_u64().unwrap();
-        b.click(button).await;
-        let got = b
-            .wait(
-                &format!("panel.errors.length > {n} && panel.errors[{n}]"),
-                WAIT,
-            )
-            .await;
-        assert!(
-            got.as_str().unwrap().contains("no motion requests"),
-            "{command}: {got}"
-        );
-    }
-    assert_eq!(b.js("panel.lastMotion.kind").await, "sway");
-    assert_eq!(b.js("panel.lastMotion.axis").await, "Roll");
-    assert_eq!(b.js("panel.walking === true").await, false);
-    keep_screenshot(&b.screenshot().await, "panel-motion.png", &dir);
-    b.click("tab-pose").await;
-    assert_eq!(b.js("panel.state.angles_rad").await, angles_before);
-
     // A second page is refused control while this one controls.
     b.js("(panel.second = [], (() => { const ws = new WebSocket(`ws://${location.host}/ws`); \
           ws.onmessage = (e) => panel.second.push(JSON.parse(e.data)); \
@@ -202,6 +166,8 @@ async fn sim_panel() {
     let wasm = b.js("panel.wasmBytes").await;
     println!("body IK in the page: {ik_per_s:.0} per s; kin.wasm {wasm} bytes");
     assert!(ik_per_s > 1000.0);
+
+    motion_tab(&b, &dir, "sim").await;
     server.stop().unwrap();
 
     // Calibration: jog, save, read back, and power on again from the saved EEPROM.
@@ -324,6 +290,7 @@ async fn emulator_pose_and_calibration() {
         }
         report_latency(&b, "emulator").await;
         keep_screenshot(&b.screenshot().await, "panel-emulator.png", &dir);
+        motion_tab(&b, &dir, "emulator").await;
         b.client.goto("about:blank").await.unwrap();
         server.stop().unwrap();
     }
@@ -352,4 +319,220 @@ async fn report_latency(b: &Browser, what: &str) -> usize {
         drawn.len()
     );
     drawn.len()
+}
+
+/// Picks `kind` in the Motion tab's form and sets its inputs (`data-param` → value).
+async fn motion_form(b: &Browser, kind: &str, values: &[(&str, &str)]) {
+    b.js(&format!(
+        "(document.getElementById('motion-kind').value = '{kind}', \
+          document.getElementById('motion-kind').dispatchEvent(new Event('change')), 1)"
+    ))
+    .await;
+    for (param, value) in values {
+        b.js(&format!(
+            "(document.querySelector(\"#motion-params [data-param='{param}']\").value = '{value}', 1)"
+        ))
+        .await;
+    }
+}
+
+/// Clicks Start and waits for the page's error that follows; returns it.
+async fn refused_start(b: &Browser) -> String {
+    let n = b.js("panel.errors.length").await.as_u64().unwrap();
+    b.click("motion-start").await;
+    let got = b
+        .wait(
+            &format!("panel.errors.length > {n} && panel.errors[{n}]"),
+            WAIT,
+        )
+        .await;
+    got.as_str().unwrap().to_owned()
+}
+
+/// The Motion tab on the device, the page in control: stand, a roll sway whose readback moves
+/// the 3D view and whose status the page shows, Stop and the end of the motion; refusals named
+/// by their field, nothing moved; a trot steered by the keyboard whose velocity
+/// keeps it going. Prints the Start → first readback drawn latencies.
+async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str) {
+    b.click("tab-motion").await;
+    b.js("(panel.motionLatencies.length = 0, 1)").await;
+
+    motion_form(b, "stand", &[]).await;
+    b.click("motion-start").await;
+    // The stand-up's first readback drawn (its state follows the command's answer), then its end.
+    b.wait("panel.motionLatencies.length >= 1", WAIT).await;
+    b.wait(
+        "panel.state.flags.outputs_enabled && panel.motionStatus.kind === null",
+        WAIT,
+    )
+    .await;
+    let stance = f64s(&b.js("panel.state.angles_rad").await);
+
+    // A roll sway: the device's status in the page, the readback moving the view.
+    let shot0 = b.screenshot().await;
+    motion_form(
+        b,
+        "sway",
+        &[
+            ("axis", "Roll"),
+            ("amplitude_deg", "10"),
+            ("period_s", "2"),
+            ("duration_s", "0"),
+        ],
+    )
+    .await;
+    let starts = b
+        .js("panel.done.filter((c) => c === 'start_motion').length")
+        .await
+        .as_u64()
+        .unwrap();
+    b.click("motion-start").await;
+    b.wait(
+        &format!("panel.done.filter((c) => c === 'start_motion').length > {starts}"),
+        WAIT,
+    )
+    .await;
+    b.wait(
+        "panel.motionStatus.kind === 'sway' && panel.motionStatus.stage === 'run' && panel.motionStatus.phase > 0.1 && panel.motionStatus.phase < 0.4",
+        WAIT,
+    )
+    .await;
+    let status = b
+        .js("document.getElementById('motion-status').textContent")
+        .await;
+    let status = status.as_str().unwrap();
+    assert!(
+        status.contains("sway") && status.contains("run"),
+        "{status}"
+    );
+    let drawn = f64s(&b.js("panel.renderedAngles").await);
+    let moved = drawn
+        .iter()
+        .zip(&stance)
+        .map(|(a, s)| (a - s).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        moved > 0.01,
+        "the sway's readback is drawn (moved {moved} rad)"
+    );
+    // Drawn on its held feet: the feet on the stance's, the body rolled over them (sampled
+    // until the roll shows: the sway passes through level twice a period).
+    let held = f64s(
+        &b.js("panel.kin.points(NEUTRAL_POSE, panel.kin.preview(NEUTRAL_POSE, panel.state.stance_height_m, panel.order).angles, panel.order)"
+            .replace("NEUTRAL_POSE", "{roll_rad: 0, pitch_rad: 0, yaw_rad: 0, x_m: 0, y_m: 0, z_m: 0}")
+            .as_str())
+        .await,
+    );
+    let t0 = std::time::Instant::now();
+    let mut max_tilt = 0.0f64;
+    loop {
+        let pts = f64s(&b.js("panel.renderedPoints").await);
+        for leg in 0..4 {
+            for k in 9..12 {
+                let (d, h) = (pts[12 * leg + k], held[12 * leg + k]);
+                assert!((d - h).abs() < 1e-3, "foot {leg} drawn at {d}, held at {h}");
+            }
+        }
+        // The FL and FR hip mounts' heights differ by the body's roll.
+        let tilt = (pts[2] - pts[14]).abs();
+        max_tilt = max_tilt.max(tilt);
+        if tilt > 0.01 {
+            break;
+        }
+        assert!(
+            t0.elapsed() < WAIT,
+            "the body is never drawn rolled (at most {max_tilt} m between the front hips)"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let shot1 = b.screenshot().await;
+    assert_ne!(shot0, shot1, "the view changed");
+    if what == "sim" {
+        keep_screenshot(&shot1, "panel-motion.png", dir);
+    } else {
+        keep_screenshot(&shot1, "panel-emulator-motion.png", dir);
+    }
+
+    // Stop: the period ends, the ramp back to the stance, the motion ends.
+    b.click("motion-stop").await;
+    b.wait(
+        "['stopping', 'leave'].includes(panel.motionStatus.stage) || panel.motionStatus.kind === null",
+        WAIT,
+    )
+    .await;
+    b.wait("panel.motionStatus.kind === null", WAIT).await;
+    let status = b
+        .js("document.getElementById('motion-status').textContent")
+        .await;
+    assert_eq!(status, "motion: idle");
+    let back = f64s(&b.js("panel.state.angles_rad").await);
+    for (a, s) in back.iter().zip(&stance) {
+        assert!((a - s).abs() < 1e-4, "back at the stance: {a} vs {s}");
+    }
+
+    // Refusals name the field and move nothing: the device's (an amplitude beyond reach, its
+    // preflight) and the message check's (a period of 0, never sent).
+    let frames = b.js("panel.state.link.frames_sent").await.as_u64().unwrap();
+    motion_form(b, "sway", &[("amplitude_deg", "90"), ("period_s", "2")]).await;
+    let refusal = refused_start(b).await;
+    assert!(
+        refusal.contains("the device refused StartMotion") && refusal.contains("amplitude_rad"),
+        "{refusal}"
+    );
+    let shown = b
+        .js("document.getElementById('motion-error').textContent")
+        .await;
+    assert_eq!(shown.as_str(), Some(refusal.as_str()));
+    assert_eq!(
+        b.js("document.querySelector(\"[data-param='amplitude_deg']\").classList.contains('invalid')")
+            .await,
+        true
+    );
+    if what == "sim" {
+        keep_screenshot(&b.screenshot().await, "panel-motion-refused.png", dir);
+    }
+    assert!(b.js("panel.state.link.frames_sent").await.as_u64().unwrap() > frames);
+    motion_form(b, "sway", &[("amplitude_deg", "10"), ("period_s", "0")]).await;
+    let refusal = refused_start(b).await;
+    assert!(refusal.contains("`period_s` must be > 0"), "{refusal}");
+    assert_eq!(
+        b.js("document.querySelector(\"[data-param='period_s']\").classList.contains('invalid')")
+            .await,
+        true
+    );
+    let states = b.js("panel.states").await.as_u64().unwrap();
+    b.wait(&format!("panel.states > {states} + 3"), WAIT).await;
+    assert_eq!(b.js("panel.motionStatus.kind").await, Value::Null);
+    assert_eq!(f64s(&b.js("panel.state.angles_rad").await), back);
+
+    // A trot held by the keyboard: the page refreshes the velocity well within the walk's
+    // timeout, so the device keeps walking; Stop ends it.
+    motion_form(b, "walk", &[("gait", "Trot")]).await;
+    b.click("motion-start").await;
+    b.wait("panel.walking", WAIT).await;
+    b.js("(window.dispatchEvent(new KeyboardEvent('keydown', {key: 'w'})), 1)")
+        .await;
+    let sent0 = b.js("panel.velocitiesSent").await.as_u64().unwrap();
+    let t0 = std::time::Instant::now();
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    let sent = b.js("panel.velocitiesSent").await.as_u64().unwrap() - sent0;
+    let rate_hz = sent as f64 / t0.elapsed().as_secs_f64();
+    assert!(rate_hz >= 10.0, "velocity refreshed at {rate_hz:.1} Hz");
+    assert_eq!(b.js("panel.motionStatus.kind").await, "walk");
+    assert_eq!(b.js("panel.motionStatus.stage").await, "run");
+    b.js("(window.dispatchEvent(new KeyboardEvent('keyup', {key: 'w'})), 1)")
+        .await;
+    b.click("motion-stop").await;
+    b.wait("panel.motionStatus.kind === null", WAIT).await;
+    assert_eq!(b.js("panel.motionStatus.fault").await, Value::Null);
+    println!("{what}: trot velocity refreshed at {rate_hz:.1} Hz");
+
+    let latencies = f64s(&b.js("panel.motionLatencies").await);
+    let mean = latencies.iter().sum::<f64>() / latencies.len().max(1) as f64;
+    let max = latencies.iter().copied().fold(0.0, f64::max);
+    println!(
+        "{what}: motion Start → first readback drawn: mean {mean:.1} ms, max {max:.1} ms ({} starts)",
+        latencies.len()
+    );
+    b.click("tab-pose").await;
 }

@@ -1,12 +1,16 @@
 //! The panel's device session on the simulated device, without a browser: the checks before
-//! sending, the jog, and the link-loss rule when the controlling page goes away.
+//! sending, the jog, the onboard motions, and the link-loss rule when the controlling page
+//! goes away.
 
 use kin_core::body::Pose;
+use kin_core::motion::laws::Axis;
 use kin_core::Robot;
 use quad_host::client::{AngleCheck, Client, ClientConfig};
 use quad_host::link::{self, sim::SimConfig, Link, Target};
-use quad_protocol::{LinkLossAction, LinkTimeout, Request, RobotPreset, ServoId};
+use quad_protocol::{LinkLossAction, LinkTimeout, NackReason, Request, RobotPreset, ServoId};
 use quad_web::device::{Error, Session};
+use quad_web::motion::{MotionMsg, VelocityMsg};
+use quad_web::msg::ClientMsg;
 use std::time::Duration;
 
 fn session(action: LinkLossAction) -> Session<Box<dyn Link>> {
@@ -80,36 +84,169 @@ fn losing_the_controlling_page_applies_the_link_loss_rule() {
     assert!(s.state(0.0).flags.outputs_enabled);
 }
 
-#[test]
-fn a_motion_the_protocol_cannot_carry_is_not_sent() {
-    use quad_web::motion::{MotionMsg, VelocityMsg};
-    use quad_web::msg::ClientMsg;
-    let mut s = session(LinkLossAction::Hold);
-    s.set_outputs(true).unwrap();
-    let before = s.state(0.0);
-    for cmd in [
-        ClientMsg::StartMotion {
-            motion: MotionMsg::Stand,
+/// Lets the device run (link time) until no motion runs; at most `limit`.
+fn run_to_idle(s: &mut Session<Box<dyn Link>>, limit: Duration) {
+    let t0 = s.link_elapsed();
+    loop {
+        s.idle(Duration::from_millis(50)).unwrap();
+        s.poll().unwrap();
+        if s.state(0.0).motion.kind.is_none() {
+            return;
+        }
+        assert!(
+            s.link_elapsed() - t0 < limit,
+            "still running: {:?}",
+            s.state(0.0).motion
+        );
+    }
+}
+
+fn sway(amplitude_rad: f32, period_s: f32) -> ClientMsg {
+    ClientMsg::StartMotion {
+        motion: MotionMsg::Sway {
+            axis: Axis::Roll,
+            amplitude_rad,
+            period_s,
+            duration_s: None,
         },
-        ClientMsg::SetVelocity {
+    }
+}
+
+#[test]
+fn motions_run_on_the_device_and_report_its_engine() {
+    let mut s = session(LinkLossAction::Hold);
+    let stand = ClientMsg::StartMotion {
+        motion: MotionMsg::Stand,
+    };
+    s.command(&stand).unwrap();
+    let m = s.state(0.0).motion;
+    assert_eq!(m.kind, Some("stand_up"));
+    assert!(
+        s.state(0.0).flags.outputs_enabled,
+        "a stand-up switches them on"
+    );
+    run_to_idle(&mut s, Duration::from_secs(10));
+    let stance = s.state(0.0).angles_rad;
+
+    // A roll sway: the readback follows the device's motion, its status the engine's.
+    s.command(&sway(0.1, 1.0)).unwrap();
+    assert_eq!(s.state(0.0).motion.kind, Some("sway"));
+    assert_eq!(s.state(0.0).pose, None, "a motion replaces the held pose");
+    let mut moved = false;
+    let mut phases = Vec::new();
+    for _ in 0..30 {
+        s.idle(Duration::from_millis(50)).unwrap();
+        s.poll().unwrap();
+        let st = s.state(0.0);
+        moved |= st.angles_rad != stance;
+        phases.push(st.motion.phase);
+    }
+    assert!(moved, "the sway moved the joints");
+    assert!(phases.iter().all(|p| (0.0..1.0).contains(p)), "{phases:?}");
+    assert!(phases.windows(2).any(|w| w[1] > w[0]), "{phases:?}");
+    // A second start is refused while it runs: the device's typed nack, in words.
+    let err = s.command(&stand).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::MotionRefused {
+                reason: NackReason::MotionRunning,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("stop it first"), "{err}");
+    // Stop: the period ends, the ramp back to the stance, idle.
+    s.command(&ClientMsg::StopMotion).unwrap();
+    let stage = s.state(0.0).motion.stage;
+    assert!(["stopping", "leave"].contains(&stage), "{stage}");
+    run_to_idle(&mut s, Duration::from_secs(10));
+    let m = s.state(0.0).motion;
+    assert_eq!((m.kind, m.fault), (None, None));
+    for (a, b) in s.state(0.0).angles_rad.iter().zip(&stance) {
+        assert!((a - b).abs() < 1e-4, "back at the stance: {a} vs {b}");
+    }
+}
+
+#[test]
+fn a_parameter_the_device_refuses_is_named_and_moves_nothing() {
+    let mut s = session(LinkLossAction::Hold);
+    s.command(&ClientMsg::StartMotion {
+        motion: MotionMsg::Stand,
+    })
+    .unwrap();
+    run_to_idle(&mut s, Duration::from_secs(10));
+    let before = s.state(0.0);
+    // An amplitude no leg reaches: the device's nack, naming the page's field.
+    let err = s.command(&sway(1.5, 2.0)).unwrap_err();
+    assert!(matches!(err, Error::MotionRefused { .. }), "{err}");
+    assert!(err.to_string().contains("amplitude_rad"), "{err}");
+    assert_eq!(err.field(), Some("amplitude_rad"));
+    let after = s.state(0.0);
+    assert!(
+        after.link.frames_sent > before.link.frames_sent,
+        "it was sent"
+    );
+    assert_eq!(after.angles_rad, before.angles_rad);
+    assert_eq!(after.motion.kind, None);
+    // A velocity without a walk.
+    let err = s
+        .command(&ClientMsg::SetVelocity {
             velocity: VelocityMsg {
-                forward_m_s: 0.1,
+                forward_m_s: 0.05,
                 lateral_m_s: 0.0,
                 yaw_rate_rad_s: 0.0,
             },
-        },
-        ClientMsg::StopMotion,
-    ] {
-        let err = s.command(&cmd).unwrap_err();
-        assert!(matches!(err, Error::Motion(_)), "{err}");
-        assert!(err.to_string().contains("not sent"), "{err}");
-    }
-    let after = s.state(0.0);
-    assert_eq!(after.link.frames_sent, before.link.frames_sent);
-    assert_eq!(after.angles_rad, before.angles_rad);
+        })
+        .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::MotionRefused {
+                reason: NackReason::NotWalking,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    // A period of 0 is the page message's own check: nothing sent.
+    let frames = s.state(0.0).link.frames_sent;
+    let err = s.command(&sway(0.1, 0.0)).unwrap_err();
+    assert!(matches!(err, Error::Motion(_)), "{err}");
+    assert_eq!(err.field(), Some("period_s"));
+    assert_eq!(s.state(0.0).link.frames_sent, frames);
+}
+
+#[test]
+fn losing_the_controlling_page_stops_a_running_motion_cleanly() {
+    let mut s = session(LinkLossAction::Hold);
+    s.command(&ClientMsg::StartMotion {
+        motion: MotionMsg::Stand,
+    })
+    .unwrap();
+    run_to_idle(&mut s, Duration::from_secs(10));
+    s.command(&sway(0.1, 1.0)).unwrap();
+    s.idle(Duration::from_millis(300)).unwrap();
     s.control_lost().unwrap();
+    let stage = s.state(0.0).motion.stage;
+    assert!(["stopping", "leave"].contains(&stage), "{stage}");
+    run_to_idle(&mut s, Duration::from_secs(10));
     assert!(
         s.state(0.0).flags.outputs_enabled,
         "hold keeps the outputs on"
     );
+
+    // `disable`: the outputs go off, which cancels the motion.
+    let mut s = session(LinkLossAction::Disable);
+    s.command(&ClientMsg::StartMotion {
+        motion: MotionMsg::Stand,
+    })
+    .unwrap();
+    run_to_idle(&mut s, Duration::from_secs(10));
+    s.command(&sway(0.1, 1.0)).unwrap();
+    s.control_lost().unwrap();
+    s.poll().unwrap();
+    assert!(!s.state(0.0).flags.outputs_enabled);
+    assert_eq!(s.state(0.0).motion.kind, None);
 }

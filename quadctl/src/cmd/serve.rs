@@ -25,14 +25,16 @@ height (millimetres on the page, metres on the wire), previewed at once by kin-c
 WebAssembly; each leg is coloured by its reachability and joint-limit margin, and an unreachable
 position is drawn, never sent. Live plots of the twelve joint angles and pulses, link health
 and device state; a calibration tab jogs a servo's pulse (by moving its centre_us), sets its
-centre and direction and saves to EEPROM. The Motion tab's forms and joystick reach the server,
-which answers \"not sent\": the device protocol has no motion requests yet.
+centre and direction and saves to EEPROM. The Motion tab starts and stops the device's own
+motions (stand, sit, rest, sways, yaw turn, foot paths, trot/walk) and shows the device's motion
+status; while a walk runs, its joystick (keys W/S A/D Q/E, a gamepad) sends the velocity every
+50 ms. The device checks a motion's parameters and its refusal names the field.
 
 Several pages may watch; one controls at a time (`Take control` on the page). The outputs are
 switched on only by the page's `Outputs on` button. Every command passes the same checks as the
 command line's: a pose the host's kin-core or the device's calibration rejects is not sent, and
 every answer passes stream's readback check. When the controlling page goes away, the server
-applies the device's link-loss rule (hold, or outputs off).
+applies the device's link-loss rule (hold: a running motion stops cleanly; or outputs off).
 
 --listen sets the address (default 127.0.0.1:8080; port 0 picks a free one). Binding to
 another interface exposes the robot to that network: there is no authentication.
@@ -50,7 +52,7 @@ Examples (from the repository root):
 /// Arguments of `quadctl serve`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
-    about = "Serve the browser control panel (3D view, pose sliders, calibration) of the device",
+    about = "Serve the browser control panel (3D view, pose sliders, onboard motions, calibration) of the device",
     long_about = LONG_ABOUT,
     after_help = EXAMPLES
 )]

@@ -19,6 +19,9 @@ The servo frames (50 Hz) come from the device's own code: --sim (the default) st
 controller in-process, a host sending the motion's feet as SetFeet every frame; --emulator runs
 the firmware ELF in simavr and measures the pulses on its twelve servo pins (seed 000's robot
 only, the firmware's). The pulses map back to joint angles through the device's calibration.
+With --onboard the device runs the motion itself: its motion engine gets the motion once
+(StartMotion; the trots are its walker with the velocity command sent every frame), and the
+host only watches (all but stand).
 
 --render FILE writes an animation of the run (GIF; a strip of frames when FILE ends in .png);
 --out-dir DIR keeps the model, summary.json, plots.png, and with --render, motion.gif and
@@ -35,7 +38,8 @@ pub const EXAMPLES: &str = "\
 Examples (from the repository root):
   quadctl sim stand --robot fernando2025
   quadctl sim trot --robot shahriar2023 --out-dir trot
-  quadctl sim stand --emulator --out-dir stand --render stand.gif";
+  quadctl sim stand --emulator --out-dir stand --render stand.gif
+  quadctl sim trot --onboard";
 
 /// Arguments of `quadctl sim`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -60,6 +64,10 @@ pub struct Args {
     /// Firmware ELF for --emulator [default: firmware.elf built from firmware-avr/].
     #[arg(long, value_name = "PATH", requires = "emulator")]
     pub elf: Option<PathBuf>,
+    /// The device runs the motion itself (its motion engine: started once, a trot's velocity
+    /// sent every frame) instead of getting every frame's feet from the host.
+    #[arg(long)]
+    pub onboard: bool,
     /// Write an animation of the run to FILE (.gif; .png: a strip of frames).
     #[arg(long, value_name = "FILE")]
     pub render: Option<PathBuf>,
@@ -99,6 +107,7 @@ pub fn run(args: &Args) -> ExitCode {
             } else {
                 Driver::Device
             },
+            onboard: args.onboard,
         },
     };
     match command::sim(&request) {

@@ -37,15 +37,19 @@ pub enum Error {
     #[error(transparent)]
     Client(#[from] client::Error),
     /// The device refused a request.
-    #[error("the device refused {request}: {}{}", words(.reason), reach_hint(.reason, .shaped_by))]
+    #[error(
+        "the device refused {request}: {}{}",
+        words(.reason),
+        reach_hint(.reason, .shaped_by, &COMMAND_LINE)
+    )]
     Refused {
         /// The request.
         request: &'static str,
         /// Why.
         reason: NackReason,
-        /// The options that set where a started motion's feet go (empty for other
+        /// The parameters that set where a started motion's feet go (empty for other
         /// requests): named when the device's start check finds a foot it cannot place.
-        shaped_by: &'static str,
+        shaped_by: &'static [MotionParam],
     },
     /// The motion stopped early on the device.
     #[error("the motion stopped early on the device: {}", words(.0))]
@@ -91,36 +95,62 @@ pub fn option(param: MotionParam) -> &'static str {
     }
 }
 
-/// The options that set where the feet of a started motion go: the device's start check
+/// The parameters that set where the feet of a started motion go: the device's start check
 /// refuses a sample by the leg that cannot reach it, and these are what to change.
-fn reach_options(request: &Request) -> &'static str {
+pub fn shaping_params(request: &Request) -> &'static [MotionParam] {
+    use MotionParam as P;
     match request {
-        Request::StartMotion(MotionCommand::Sway { .. }) => "--amplitude-rad",
+        Request::StartMotion(MotionCommand::Sway { .. }) => &[P::AmplitudeRad],
         Request::StartMotion(MotionCommand::YawTurn { .. }) => {
-            "--yaw-rate-rad-s, --step-period-s, --lift-height-m"
+            &[P::YawRateRadS, P::StepPeriodS, P::LiftHeightM]
         }
-        Request::StartMotion(MotionCommand::FootPath { .. }) => "--stride-m, --step-height-m",
-        Request::StartMotion(MotionCommand::Walk { .. }) => "--body-height-m, --step-height-m",
-        _ => "",
+        Request::StartMotion(MotionCommand::FootPath { .. }) => &[P::StrideM, P::StepHeightM],
+        Request::StartMotion(MotionCommand::Walk { .. }) => &[P::BodyHeightM, P::StepHeightM],
+        _ => &[],
     }
 }
 
-/// " (set by OPTIONS)" after a start check's refusal of a sample, when the motion has such
-/// options.
-fn reach_hint(reason: &NackReason, shaped_by: &str) -> String {
+/// " (the motion's feet are set by …)" after a start check's refusal of a sample, when the
+/// motion has such parameters ([`shaping_params`]), named by `naming`.
+pub fn reach_hint(reason: &NackReason, shaped_by: &[MotionParam], naming: &Naming) -> String {
     let sample = matches!(
         reason,
         NackReason::Preflight { .. } | NackReason::ServoRange { .. }
     );
     if sample && !shaped_by.is_empty() {
-        format!(" (the motion's feet are set by {shaped_by})")
+        let names: Vec<&str> = shaped_by.iter().map(|&p| (naming.param)(p)).collect();
+        format!(" (the motion's feet are set by {})", names.join(", "))
     } else {
         String::new()
     }
 }
 
+/// How a front end names what the device's refusals point at: the place where a motion
+/// parameter is set, and what to do first when a request needs a walk or the outputs on.
+#[derive(Debug, Clone, Copy)]
+pub struct Naming {
+    /// Where a motion parameter is set (a command-line option, a form field).
+    pub param: fn(MotionParam) -> &'static str,
+    /// How a walk is started.
+    pub start_walk: &'static str,
+    /// How the outputs are switched on by a stand-up.
+    pub stand: &'static str,
+}
+
+/// The command line's names: options, `quadctl run`, `quadctl stand`.
+pub const COMMAND_LINE: Naming = Naming {
+    param: option,
+    start_walk: "quadctl run trot or walk",
+    stand: "quadctl stand",
+};
+
 /// A device refusal in words, naming the command-line option of a refused parameter.
 pub fn words(reason: &NackReason) -> String {
+    words_in(reason, &COMMAND_LINE)
+}
+
+/// A device refusal in words, with a front end's names (see [`Naming`]).
+pub fn words_in(reason: &NackReason, naming: &Naming) -> String {
     match reason {
         NackReason::InvalidParameter { param, problem } => {
             let what = match problem {
@@ -130,7 +160,7 @@ pub fn words(reason: &NackReason) -> String {
                 ParamProblem::OutOfRange => "is outside its admissible range",
                 ParamProblem::BeyondReach => "puts a foot out of reach",
             };
-            format!("{} {what}", option(*param))
+            format!("{} {what}", (naming.param)(*param))
         }
         NackReason::Preflight { leg, fault } => {
             let what = match fault {
@@ -150,8 +180,8 @@ pub fn words(reason: &NackReason) -> String {
         NackReason::MotionRunning => {
             "a motion is running; it keeps running (stop it first)".to_owned()
         }
-        NackReason::NotWalking => "no walk is running (quadctl run trot or walk first)".to_owned(),
-        NackReason::OutputsDisabled => "the outputs are off (quadctl stand first)".to_owned(),
+        NackReason::NotWalking => format!("no walk is running ({} first)", naming.start_walk),
+        NackReason::OutputsDisabled => format!("the outputs are off ({} first)", naming.stand),
         other => other.to_string(),
     }
 }
@@ -239,7 +269,7 @@ impl<L: Link> Session<L> {
             Outcome::Accepted(DeviceToHost::Nack { reason, .. }) => Err(Error::Refused {
                 request: name,
                 reason,
-                shaped_by: reach_options(&request),
+                shaped_by: shaping_params(&request),
             }),
             Outcome::Accepted(other) | Outcome::Rejected(other) => Err(client::Error::Unexpected {
                 request: name,
