@@ -325,10 +325,11 @@ where
             disable = tick.disable_outputs;
         }
         if let Some(held) = &self.held {
-            let mut out = self.out_rad;
-            self.engine.limiter().step(&mut out, &held.angles_rad);
-            if out != self.out_rad {
-                self.out_rad = out;
+            if self
+                .engine
+                .limiter()
+                .step(&mut self.out_rad, &held.angles_rad)
+            {
                 self.write_out();
             }
         }
@@ -435,7 +436,7 @@ where
     pub fn handle(&mut self, msg: HostToDevice) -> DeviceToHost {
         self.last_valid_ms = self.clock.now_ms();
         self.failsafe_armed = true;
-        let answer = self.answer(msg);
+        let answer = self.answer(&msg);
         // Latched until an answer reports it (only the readback carries the flags).
         if answer.readback().is_some() {
             self.failsafe = false;
@@ -444,10 +445,10 @@ where
     }
 
     #[inline(never)]
-    fn answer(&mut self, msg: HostToDevice) -> DeviceToHost {
+    fn answer(&mut self, msg: &HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
         // The host's own check (`Ok` for the requests answered before the handshake).
-        let in_range = check_request(&msg.request, &self.config.robot);
+        let in_range = check_range(&msg.request, &self.config.robot);
         let result = match msg.request {
             Request::Hello { version } => {
                 return if is_compatible(version) {
@@ -577,10 +578,6 @@ where
     /// outputs (zeros while stopped), flags and frame counters.
     #[inline(never)]
     pub fn readback(&self) -> Readback {
-        let (angles_rad, pulses) = match &self.held {
-            Some(h) => (h.angles_rad, h.pulses_half_us),
-            None => ([0.0; 12], [0; 12]),
-        };
         let flags = Flags::EMPTY
             .with(Flags::CLAMPED, self.clamped)
             .with(Flags::LIMITED, self.limited)
@@ -588,17 +585,21 @@ where
             .with(Flags::FAILSAFE_ACTIVE, self.failsafe)
             .with(Flags::CALIBRATION_UNSAVED, self.calibration_unsaved)
             .with(Flags::CALIBRATION_DEFAULT, self.calibration_default);
-        Readback {
-            angles_rad,
-            pulses_half_us: if self.outputs_enabled {
-                pulses
-            } else {
-                [0; 12]
-            },
+        // Built in place: each array is copied once, from the held target when there is one.
+        let mut readback = Readback {
+            angles_rad: [0.0; 12],
+            pulses_half_us: [0; 12],
             flags,
             frames_ok: self.acc.frames_ok(),
             frames_bad: self.acc.frames_bad(),
+        };
+        if let Some(h) = &self.held {
+            readback.angles_rad = h.angles_rad;
+            if self.outputs_enabled {
+                readback.pulses_half_us = h.pulses_half_us;
+            }
         }
+        readback
     }
 
     /// The twelve calibrations in RAM.
@@ -679,12 +680,10 @@ where
         self.apply(angles, clamped, limited)
     }
 
+    /// `SetJoints`, on angles the range check has found finite (`check_request`).
     fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
         for s in ServoId::ALL {
             let a = angles[s.index()];
-            if !a.is_finite() {
-                return Err(NackReason::NonFinite);
-            }
             if !self.config.robot.limits.admits(s.joint, a) {
                 return Err(NackReason::JointLimit {
                     leg: s.leg,
@@ -851,6 +850,13 @@ pub fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<
 #[inline(never)]
 pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
     encode_frame(answer, out).map_or(0, <[u8]>::len)
+}
+
+/// [`check_request`], out of line: inlined into [`Device::answer`], its copies of the request's
+/// values took the dispatcher's stack frame beyond the AVR's 63-byte displacement.
+#[inline(never)]
+fn check_range(request: &Request, robot: &kin_core::Robot) -> Result<(), NackReason> {
+    check_request(request, robot)
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {

@@ -151,13 +151,13 @@ impl Store {
             return None;
         }
         let generation = u32::from_le_bytes([header[3], header[4], header[5], header[6]]);
-        let mut sum = crc_of(crc::INIT, &header[2..]);
+        let mut sum = crc::update_slice(crc::INIT, &header[2..]);
         let mut record = [0u8; RECORD_LEN];
         for i in 0..12u16 {
             let at = addr + HEADER_LEN as u16 + i * RECORD_LEN as u16;
             storage.read(at, &mut record).ok()?;
             decode_record(&record)?;
-            sum = crc_of(sum, &record);
+            sum = crc::update_slice(sum, &record);
         }
         let mut stored = [0u8; 2];
         storage
@@ -215,24 +215,17 @@ impl Store {
         head[0] = LAYOUT_VERSION;
         head[1..].copy_from_slice(&generation.to_le_bytes());
         storage.write(addr + 2, &head)?;
-        let mut sum = crc_of(crc::INIT, &head);
+        let mut sum = crc::update_slice(crc::INIT, &head);
         for (i, c) in table.iter().enumerate() {
             let record = encode_record(c);
             storage.write(addr + (HEADER_LEN + i * RECORD_LEN) as u16, &record)?;
-            sum = crc_of(sum, &record);
+            sum = crc::update_slice(sum, &record);
         }
         storage.write(addr + (BANK_LEN - 2) as u16, &sum.to_be_bytes())?;
         storage.write(addr, &MAGIC)?;
         self.active = Some((bank, generation));
         Ok(())
     }
-}
-
-/// The CRC register `sum` after `bytes`. Out of line: one copy for the four runs of the
-/// loads and saves.
-#[inline(never)]
-fn crc_of(sum: u16, bytes: &[u8]) -> u16 {
-    bytes.iter().fold(sum, |sum, &b| crc::update(sum, b))
 }
 
 #[cfg(test)]

@@ -61,15 +61,21 @@ pub const fn update_bitwise(crc: u16, byte: u8) -> u16 {
     crc
 }
 
-/// CRC of a whole buffer.
-pub const fn checksum(data: &[u8]) -> u16 {
-    let mut crc = INIT;
+/// [`update`] with every byte of `data` in turn. Out of line: one copy of the loop for every
+/// buffer the firmware checks (frames, storage records).
+#[inline(never)]
+pub const fn update_slice(mut crc: u16, data: &[u8]) -> u16 {
     let mut i = 0;
     while i < data.len() {
         crc = update(crc, data[i]);
         i += 1;
     }
-    finish(crc)
+    crc
+}
+
+/// CRC of a whole buffer.
+pub const fn checksum(data: &[u8]) -> u16 {
+    finish(update_slice(INIT, data))
 }
 
 #[cfg(test)]

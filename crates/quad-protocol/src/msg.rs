@@ -29,6 +29,7 @@ use serde::{Deserialize, Serialize};
 pub struct HostToDevice {
     /// Sequence number chosen by the host, echoed by the answer. A retry of the same request
     /// reuses it.
+    #[serde(with = "wire::shared")]
     pub seq: u16,
     /// What the host asks.
     pub request: Request,
@@ -43,7 +44,7 @@ wire_enum! {
         /// layout are frozen across all versions.
         0 => Hello {
             /// The host's protocol version.
-            version: u16,
+            version: u16 as wire::shared,
         },
         /// Report the current state without moving anything. → [`DeviceToHost::Ack`].
         1 => GetState,
@@ -54,13 +55,13 @@ wire_enum! {
         /// → [`DeviceToHost::Ack`] or a nack.
         3 => SetFeet {
             /// The four feet in the body frame, m.
-            feet_in_body_m: [[f32; 3]; 4],
+            feet_in_body_m: [[f32; 3]; 4] as wire::array,
         },
         /// Twelve joint angles, rad, canonical order; bypasses the IK (joint limits and servo
         /// calibration still apply). → [`DeviceToHost::Ack`] or a nack.
         4 => SetJoints {
             /// The twelve joint angles, rad.
-            angles_rad: [f32; 12],
+            angles_rad: [f32; 12] as wire::array,
         },
         /// Switch the servo outputs on or off (off at power-on). → [`DeviceToHost::Ack`].
         5 => SetOutputs {
@@ -182,7 +183,7 @@ wire_enum! {
             cycle_s: f32,
             /// Timeout of the velocity command, ms (> 0): a command not refreshed within it
             /// stops the walk as [`Request::StopMotion`] does.
-            velocity_timeout_ms: u16,
+            velocity_timeout_ms: u16 as wire::shared,
         },
     }
 }
@@ -398,6 +399,7 @@ wire_enum! {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct LinkTimeout {
     /// Time without a valid frame before the failsafe acts, ms; 0 = never.
+    #[serde(with = "wire::shared")]
     pub timeout_ms: u16,
     /// What the failsafe does.
     pub action: LinkLossAction,
@@ -464,12 +466,14 @@ pub struct FirmwareVersion {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DeviceInfo {
     /// The device's [`crate::PROTOCOL_VERSION`].
+    #[serde(with = "wire::shared")]
     pub version: u16,
     /// Firmware release.
     pub firmware: FirmwareVersion,
     /// Robot geometry compiled into the firmware.
     pub robot: RobotPreset,
     /// Largest decoded frame (postcard bytes + CRC) the device accepts, bytes.
+    #[serde(with = "wire::shared")]
     pub max_frame_len: u16,
     /// Current pose interpretation.
     pub pose_config: PoseConfig,
@@ -540,15 +544,19 @@ impl Flags {
 pub struct Readback {
     /// The twelve joint angles the device holds (computed by its IK, or as set), rad;
     /// canonical order. Always finite.
+    #[serde(with = "wire::array")]
     pub angles_rad: [f32; 12],
     /// The twelve pulse widths on the outputs, half-µs (one 0.5 µs timer tick each; 3000 =
     /// 1500 µs); 0 = that output is off. Canonical order.
+    #[serde(with = "wire::array")]
     pub pulses_half_us: [u16; 12],
     /// Status bits.
     pub flags: Flags,
     /// Frames received with a good CRC since power-on (wrapping).
+    #[serde(with = "wire::shared")]
     pub frames_ok: u32,
     /// Frames dropped for a bad CRC, bad encoding or oversize since power-on (wrapping).
+    #[serde(with = "wire::shared")]
     pub frames_bad: u32,
 }
 
@@ -694,7 +702,7 @@ wire_enum! {
         /// The host's major version differs from the device's. Variant index 0 is frozen.
         0 => UnknownVersion {
             /// The device's own [`crate::PROTOCOL_VERSION`].
-            supported: u16,
+            supported: u16 as wire::shared,
         },
         /// A frame arrived whose CRC did not match.
         1 => BadCrc,

@@ -47,9 +47,22 @@ pub fn reach_limit_m(robot: &Robot) -> f32 {
     2.0 * leg_span_m(robot)
 }
 
-/// True when `angle_rad` lies in `[−π, π]`.
-fn angle_in_range(angle_rad: f32) -> bool {
-    (-PI..=PI).contains(&angle_rad)
+/// The first of `values` whose magnitude exceeds its bound (`bounds` repeated: value `i` has
+/// bound `bounds[i % bounds.len()]`), once all are finite. One loop for the pose, the feet and
+/// the joints: on the ATmega2560 each unrolled comparison is a soft-float call with its
+/// register moves.
+///
+/// # Errors
+/// [`NackReason::NonFinite`] when a value is NaN or infinite.
+#[inline(never)]
+fn first_beyond(values: &[f32], bounds: &[f32]) -> Result<Option<usize>, NackReason> {
+    if !values.iter().all(|v| v.is_finite()) {
+        return Err(NackReason::NonFinite);
+    }
+    Ok(values
+        .iter()
+        .zip(bounds.iter().cycle())
+        .position(|(v, &bound)| v.abs() > bound))
 }
 
 /// Checks every field of `request` for `robot` (see the module docs for the ranges).
@@ -96,19 +109,18 @@ pub fn check_pose(pose: &Pose, robot: &Robot) -> Result<(), NackReason> {
         z_m,
     } = *pose;
     let values = [roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m];
-    if !values.iter().all(|v| v.is_finite()) {
-        return Err(NackReason::NonFinite);
-    }
     let span = reach_limit_m(robot);
-    let checks = [
-        (angle_in_range(roll_rad), Field::BodyRoll),
-        (angle_in_range(pitch_rad), Field::BodyPitch),
-        (angle_in_range(yaw_rad), Field::BodyYaw),
-        (x_m.abs() <= span, Field::BodyX),
-        (y_m.abs() <= span, Field::BodyY),
-        (z_m.abs() <= span, Field::BodyZ),
-    ];
-    first_out_of_range(&checks)
+    // An angle in `[−π, π]` is one of magnitude ≤ π.
+    let field = match first_beyond(&values, &[PI, PI, PI, span, span, span])? {
+        None => return Ok(()),
+        Some(0) => Field::BodyRoll,
+        Some(1) => Field::BodyPitch,
+        Some(2) => Field::BodyYaw,
+        Some(3) => Field::BodyX,
+        Some(4) => Field::BodyY,
+        Some(_) => Field::BodyZ,
+    };
+    Err(NackReason::OutOfRange { field })
 }
 
 /// Four feet in the body frame: finite, each within the body's half size plus
@@ -117,23 +129,18 @@ pub fn check_pose(pose: &Pose, robot: &Robot) -> Result<(), NackReason> {
 /// # Errors
 /// As [`check_request`].
 pub fn check_feet(feet_in_body_m: &[[f32; 3]; 4], robot: &Robot) -> Result<(), NackReason> {
-    if !feet_in_body_m.iter().flatten().all(|v| v.is_finite()) {
-        return Err(NackReason::NonFinite);
-    }
     let span = reach_limit_m(robot);
     let bound = [
         0.5 * robot.body_length_m + span,
         0.5 * robot.body_width_m + span,
         span,
     ];
-    for (leg, foot) in LegId::ALL.iter().zip(feet_in_body_m) {
-        if foot.iter().zip(bound).any(|(v, b)| v.abs() > b) {
-            return Err(NackReason::OutOfRange {
-                field: Field::Foot(*leg),
-            });
-        }
+    match first_beyond(feet_in_body_m.as_flattened(), &bound)? {
+        None => Ok(()),
+        Some(i) => Err(NackReason::OutOfRange {
+            field: Field::Foot(LegId::ALL[i / 3]),
+        }),
     }
-    Ok(())
 }
 
 /// Twelve joint angles: finite, within `[−π, π]`.
@@ -141,10 +148,8 @@ pub fn check_feet(feet_in_body_m: &[[f32; 3]; 4], robot: &Robot) -> Result<(), N
 /// # Errors
 /// As [`check_request`].
 pub fn check_joints(angles_rad: &[f32; 12]) -> Result<(), NackReason> {
-    if !angles_rad.iter().all(|a| a.is_finite()) {
-        return Err(NackReason::NonFinite);
-    }
-    match angles_rad.iter().position(|&a| !angle_in_range(a)) {
+    // An angle in `[−π, π]` is one of magnitude ≤ π.
+    match first_beyond(angles_rad, &[PI])? {
         None => Ok(()),
         Some(i) => Err(NackReason::OutOfRange {
             field: Field::JointAngle {
@@ -164,14 +169,12 @@ pub fn check_pose_config(p: &PoseConfig, robot: &Robot) -> Result<(), NackReason
     if !(h.is_finite() && h > 0.0) {
         return Err(NackReason::InvalidArgument);
     }
-    let admissible = (MIN_STANCE_HEIGHT_M..=reach_limit_m(robot)).contains(&h);
-    first_out_of_range(&[(admissible, Field::StanceHeight)])
-}
-
-fn first_out_of_range(checks: &[(bool, Field)]) -> Result<(), NackReason> {
-    match checks.iter().find(|(ok, _)| !ok) {
-        None => Ok(()),
-        Some(&(_, field)) => Err(NackReason::OutOfRange { field }),
+    if (MIN_STANCE_HEIGHT_M..=reach_limit_m(robot)).contains(&h) {
+        Ok(())
+    } else {
+        Err(NackReason::OutOfRange {
+            field: Field::StanceHeight,
+        })
     }
 }
 

@@ -30,6 +30,9 @@ pub const US_PER_RAD_MAX: f32 = 5000.0;
 /// Largest admissible |zero_rad|, rad (one full turn).
 pub const ZERO_RAD_LIMIT: f32 = core::f32::consts::TAU;
 
+/// The sign bit of an `f32`.
+const SIGN_BIT: u32 = 1 << 31;
+
 /// Gain of a standard hobby servo: 1000 µs per 90° (and 2000 µs per 180°), µs per rad.
 pub const STANDARD_US_PER_RAD: f32 = 2000.0 / core::f32::consts::PI;
 
@@ -83,10 +86,13 @@ pub struct Calibration {
     /// Gain, µs of pulse per rad of joint angle (> 0; the direction is `reversed`).
     pub us_per_rad: f32,
     /// Pulse at `zero_rad`, µs.
+    #[serde(with = "crate::wire::shared")]
     pub center_us: u16,
     /// Shortest admissible pulse, µs (mechanical stop or servo limit).
+    #[serde(with = "crate::wire::shared")]
     pub min_us: u16,
     /// Longest admissible pulse, µs.
+    #[serde(with = "crate::wire::shared")]
     pub max_us: u16,
 }
 
@@ -110,11 +116,16 @@ impl Calibration {
 
     /// Checks every field against the admissible ranges (see [`Error`]).
     pub fn validate(&self) -> Result<(), Error> {
-        if !(self.zero_rad.is_finite() && self.zero_rad.abs() <= ZERO_RAD_LIMIT) {
+        // Compared as bit patterns: for non-negative floats their order is that of the values,
+        // and every NaN, infinity and negative value (sign bit set) lies above the finite
+        // positive bounds, so it is refused as the float comparisons refuse it. The device
+        // validates a calibration with every pulse it maps; on the ATmega2560 each float
+        // comparison is a library call.
+        if self.zero_rad.to_bits() & !SIGN_BIT > ZERO_RAD_LIMIT.to_bits() {
             return Err(Error::BadZero);
         }
-        // `!(a && b)` form: NaN fails every comparison and is refused here.
-        if !(self.us_per_rad >= US_PER_RAD_MIN && self.us_per_rad <= US_PER_RAD_MAX) {
+        let gain = self.us_per_rad.to_bits();
+        if !(US_PER_RAD_MIN.to_bits() <= gain && gain <= US_PER_RAD_MAX.to_bits()) {
             return Err(Error::BadGain);
         }
         if !(PULSE_MIN_US <= self.min_us
@@ -228,6 +239,44 @@ pub fn half_us_to_us(pulse_half_us: u16) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn validate_compares_gain_and_zero_as_the_float_comparisons_do() {
+        let edge = [
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -1.0,
+            US_PER_RAD_MIN,
+            US_PER_RAD_MAX,
+            f32::from_bits(US_PER_RAD_MIN.to_bits() - 1),
+            f32::from_bits(US_PER_RAD_MAX.to_bits() + 1),
+            ZERO_RAD_LIMIT,
+            -ZERO_RAD_LIMIT,
+            f32::from_bits(ZERO_RAD_LIMIT.to_bits() + 1),
+            -f32::from_bits(ZERO_RAD_LIMIT.to_bits() + 1),
+            1000.0,
+            -1000.0,
+        ];
+        for v in edge {
+            let gain = Calibration {
+                us_per_rad: v,
+                ..Calibration::STANDARD
+            };
+            let gain_ok = (US_PER_RAD_MIN..=US_PER_RAD_MAX).contains(&v);
+            assert_eq!(gain.validate().is_ok(), gain_ok, "us_per_rad {v:?}");
+            let zero = Calibration {
+                zero_rad: v,
+                ..Calibration::STANDARD
+            };
+            let zero_ok = v.is_finite() && v.abs() <= ZERO_RAD_LIMIT;
+            assert_eq!(zero.validate().is_ok(), zero_ok, "zero_rad {v:?}");
+        }
+    }
 
     #[test]
     fn standard_centre_is_1500_us() {

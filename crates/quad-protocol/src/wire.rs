@@ -11,6 +11,9 @@
 //! - `wire_index!` writes the table of a foreign field-less enum as a module with `index`,
 //!   `from_index` and serde's `with` functions ([`leg_id`], [`joint`], [`rotation_order`],
 //!   [`reach_policy`]); `wire_fields!` fixes the field order of a foreign struct ([`pose`]).
+//! - [`array`](mod@array) and [`shared`] change no byte, only the code that writes and reads
+//!   them: the twelve-value arrays in a loop, the varint integers through one out-of-line call
+//!   (sizes on the ATmega2560 in BENCHMARKS.md).
 //!
 //! Every table is an exhaustive `match`: a variant or field added to kin-core does not compile
 //! until it has its place on the wire. The implementations follow serde's data model as the
@@ -135,7 +138,7 @@ macro_rules! wire_enum {
                 let mut fields = ::serde::Serializer::serialize_struct_variant(
                     $ser, NAME, $idx, stringify!($var), <[&str]>::len(&[$(stringify!($field)),*]))?;
                 $(
-                    ::serde::ser::SerializeStructVariant::serialize_field(
+                    $crate::wire::variant_field(
                         &mut fields,
                         stringify!($field),
                         $crate::wire::wire_ser_field!($field, $fty $(, $($with)::+)?),
@@ -203,12 +206,13 @@ macro_rules! wire_enum {
                         ) -> ::core::fmt::Result {
                             f.write_str(concat!("enum ", stringify!($name)))
                         }
+                        // Out of line: see `variant_index`.
+                        #[inline(never)]
                         fn visit_enum<A: ::serde::de::EnumAccess<'de>>(
                             self,
                             data: A,
                         ) -> Result<$name, A::Error> {
-                            let (index, $var_access) =
-                                ::serde::de::EnumAccess::variant::<u32>(data)?;
+                            let (index, $var_access) = $crate::wire::variant_index(data)?;
                             match index {
                                 $($de_arms)*
                                 other => Err(::serde::de::Error::invalid_value(
@@ -281,7 +285,7 @@ macro_rules! wire_index {
                         self,
                         data: A,
                     ) -> Result<$ty, A::Error> {
-                        let (i, variant) = ::serde::de::EnumAccess::variant::<u32>(data)?;
+                        let (i, variant) = $crate::wire::variant_index(data)?;
                         ::serde::de::VariantAccess::unit_variant(variant)?;
                         from_index(i).ok_or_else(|| {
                             ::serde::de::Error::invalid_value(
@@ -371,6 +375,118 @@ macro_rules! wire_de_newtype {
 }
 
 pub(crate) use {wire_de_newtype, wire_enum, wire_next_field, wire_ser_field};
+
+/// [`serde::de::EnumAccess::variant`] with a `u32` index, out of line: inlined, every enum's
+/// decoder carried its own copy of the format's index code (postcard's varint). With that
+/// code shared, LTO inlines the decoders into one another, and a message's variants, their
+/// fields and the enums within them made one function whose stack frame held all of them,
+/// beyond the AVR's 63-byte displacement; `wire_enum!` keeps each enum's `visit_enum` out of
+/// line for that reason (its variants' fields inlined into it: smaller than each variant out
+/// of line, whose field count the callee no longer knows).
+#[inline(never)]
+pub(crate) fn variant_index<'de, A: serde::de::EnumAccess<'de>>(
+    data: A,
+) -> Result<(u32, A::Variant), A::Error> {
+    data.variant::<u32>()
+}
+
+/// [`serde::ser::SerializeStructVariant::serialize_field`], out of line: one instance per
+/// field type and format serves every variant that has such a field (the sequence number of
+/// every answer, the readback of three of them); inlined, each variant carried its own copy.
+/// (The reading side gains nothing from the same: its fields are read in out-of-line
+/// `visit_seq`s already, and wrapped they grew.)
+#[inline(never)]
+pub(crate) fn variant_field<S: serde::ser::SerializeStructVariant, T: serde::Serialize + ?Sized>(
+    fields: &mut S,
+    key: &'static str,
+    value: &T,
+) -> Result<(), S::Error> {
+    fields.serialize_field(key, value)
+}
+
+/// A field's serde code out of line, for serde's `with` and `wire_enum!`'s `as`: the bytes are
+/// the field type's own. For the varint integers (`u16`): postcard's varint reader inlined
+/// into every struct that has such a field was the larger part of its decoder on the AVR; out
+/// of line one copy per type serves them all.
+pub mod shared {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// `value`'s own serialization, out of line (serde's `with`).
+    ///
+    /// # Errors
+    /// The serializer's.
+    #[inline(never)]
+    pub fn serialize<S: Serializer, T: Serialize>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+        value.serialize(s)
+    }
+
+    /// `T`'s own deserialization, out of line (serde's `with`).
+    ///
+    /// # Errors
+    /// The deserializer's.
+    #[inline(never)]
+    pub fn deserialize<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<T, D::Error> {
+        T::deserialize(d)
+    }
+}
+
+/// Arrays on the wire, for serde's `with` and `wire_enum!`'s `as`: a tuple of `N` elements,
+/// the data model of serde's own `[T; N]` implementations (postcard: the elements one after
+/// the other, no length), so the bytes are the same. serde reads an array with one unrolled
+/// copy of the element code per element; here one loop serves all elements, which on the
+/// ATmega2560 is a fraction of the flash for the twelve-value arrays.
+pub mod array {
+    use core::fmt;
+    use core::marker::PhantomData;
+    use serde::de::{self, Deserializer, SeqAccess, Visitor};
+    use serde::ser::{SerializeTuple, Serializer};
+    use serde::{Deserialize, Serialize};
+
+    /// Serializes `value` as a tuple of its `N` elements (serde's `with`).
+    ///
+    /// # Errors
+    /// The serializer's.
+    pub fn serialize<S: Serializer, T: Serialize, const N: usize>(
+        value: &[T; N],
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        let mut tuple = s.serialize_tuple(N)?;
+        for element in value {
+            tuple.serialize_element(element)?;
+        }
+        tuple.end()
+    }
+
+    /// Deserializes a tuple of `N` elements (serde's `with`).
+    ///
+    /// # Errors
+    /// The deserializer's, or an invalid length when the input ends early.
+    pub fn deserialize<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
+    where
+        D: Deserializer<'de>,
+        T: Deserialize<'de> + Copy + Default,
+    {
+        struct Elements<T, const N: usize>(PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Visitor<'de> for Elements<T, N> {
+            type Value = [T; N];
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                write!(f, "an array of length {N}")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<[T; N], A::Error> {
+                let mut out = [T::default(); N];
+                for (i, slot) in out.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_tuple(N, Elements::<T, N>(PhantomData))
+    }
+}
 
 wire_index! {
     /// [`LegId`] on the wire.

@@ -63,23 +63,25 @@ impl Limiter {
 
     /// One frame: each of `out` moves to its `target` when that is within
     /// [`Limiter::max_step_rad`], else by exactly that much toward it. True when some output
-    /// was held back.
+    /// changed (the caller then writes them), in place: no copy of the twelve outputs to
+    /// compare.
     pub fn step(&self, out: &mut [f32; 12], target: &[f32; 12]) -> bool {
         let b = self.max_step_rad;
-        let mut limited = false;
+        let mut changed = false;
         for (o, &t) in out.iter_mut().zip(target) {
             let d = t - *o;
             if d > b {
                 *o += b;
-                limited = true;
+                changed = true;
             } else if d < -b {
                 *o -= b;
-                limited = true;
-            } else {
+                changed = true;
+            } else if o.to_bits() != t.to_bits() {
                 *o = t;
+                changed = true;
             }
         }
-        limited
+        changed
     }
 }
 

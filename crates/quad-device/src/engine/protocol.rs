@@ -198,24 +198,28 @@ fn reach_fault(u: Unreachable) -> PreflightFault {
 
 impl From<Error> for NackReason {
     fn from(e: Error) -> NackReason {
-        let invalid = |name: motion::Param, problem| NackReason::InvalidParameter {
-            param: motion_param(name),
-            problem,
-        };
         match e {
-            Error::Parameter(p) => match p {
-                motion::Error::NonFinite(n) => invalid(n, ParamProblem::NonFinite),
-                motion::Error::NotPositive(n) => invalid(n, ParamProblem::NotPositive),
-                motion::Error::Negative(n) => invalid(n, ParamProblem::Negative),
-                motion::Error::OutOfRange { parameter, .. } => {
-                    invalid(parameter, ParamProblem::OutOfRange)
+            Error::Parameter(p) => {
+                // One lookup of the parameter's wire name for all the problems (each inlined
+                // lookup was a table of its own, in SRAM as well as flash on the AVR).
+                let (param, problem) = match p {
+                    motion::Error::NonFinite(n) => (n, ParamProblem::NonFinite),
+                    motion::Error::NotPositive(n) => (n, ParamProblem::NotPositive),
+                    motion::Error::Negative(n) => (n, ParamProblem::Negative),
+                    motion::Error::OutOfRange { parameter, .. } => {
+                        (parameter, ParamProblem::OutOfRange)
+                    }
+                    motion::Error::BeyondReach { parameter, .. } => {
+                        (parameter, ParamProblem::BeyondReach)
+                    }
+                    motion::Error::Ik(e) => return e.into(),
+                    _ => return NackReason::InvalidArgument,
+                };
+                NackReason::InvalidParameter {
+                    param: motion_param(param),
+                    problem,
                 }
-                motion::Error::BeyondReach { parameter, .. } => {
-                    invalid(parameter, ParamProblem::BeyondReach)
-                }
-                motion::Error::Ik(e) => e.into(),
-                _ => NackReason::InvalidArgument,
-            },
+            }
             Error::Preflight(f) => NackReason::Preflight {
                 leg: f.leg,
                 fault: match f.kind {
