@@ -823,12 +823,14 @@ pub mod poly {
     /// `(sin x, cos x)` from those of the reduced argument in quadrant `k` (mod 4).
     #[inline(always)]
     fn quadrant(k: u32, sin: f32, cos: f32) -> (f32, f32) {
-        match k & 3 {
-            0 => (sin, cos),
-            1 => (cos, -sin),
-            2 => (-sin, -cos),
-            _ => (-cos, sin),
-        }
+        // (sin, cos), (cos, −sin), (−sin, −cos), (−cos, sin) for k = 0, 1, 2, 3: swapped for
+        // odd k, the first negated for k = 2, 3, the second for k = 1, 2 (sign bits flipped,
+        // exactly the negation).
+        let (a, b) = if k & 1 == 0 { (sin, cos) } else { (cos, sin) };
+        (
+            f32::from_bits(a.to_bits() ^ ((k & 2) << 30)),
+            f32::from_bits(b.to_bits() ^ ((k.wrapping_add(1) & 2) << 30)),
+        )
     }
 }
 
