@@ -1,7 +1,7 @@
 //! Robot description: leg identities, leg geometry, hip mounts, joint limits, knee bend, and the
 //! two presets taken from the papers.
 
-use crate::math::Math;
+use crate::math::{finite_ordered, nonneg_finite, positive_finite, Math};
 use crate::vec::Vec3;
 use core::fmt;
 
@@ -394,32 +394,28 @@ impl Robot {
     /// Checks lengths and limits: femur and tibia > 0, offsets ≥ 0, body sizes ≥ 0, limits
     /// finite with min ≤ max.
     pub fn validate(&self) -> Result<(), RobotError> {
-        let pos = |v: f32, name| {
-            if v.is_finite() && v > 0.0 {
+        // Integer tests of the bit patterns, equal to the float comparisons they replace (a
+        // software-float comparison is a library call on CPUs without floating-point hardware,
+        // and a firmware's engine validates its robot before every motion).
+        let length = |ok: bool, name| {
+            if ok {
                 Ok(())
             } else {
                 Err(RobotError::BadLength(name))
             }
         };
-        let nonneg = |v: f32, name| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(RobotError::BadLength(name))
-            }
-        };
-        pos(self.leg.femur_m, "femur_m")?;
-        pos(self.leg.tibia_m, "tibia_m")?;
-        nonneg(self.leg.d_lat_m, "d_lat_m")?;
-        nonneg(self.leg.d_ax_m, "d_ax_m")?;
-        nonneg(self.body_length_m, "body_length_m")?;
-        nonneg(self.body_width_m, "body_width_m")?;
+        length(positive_finite(self.leg.femur_m), "femur_m")?;
+        length(positive_finite(self.leg.tibia_m), "tibia_m")?;
+        length(nonneg_finite(self.leg.d_lat_m), "d_lat_m")?;
+        length(nonneg_finite(self.leg.d_ax_m), "d_ax_m")?;
+        length(nonneg_finite(self.body_length_m), "body_length_m")?;
+        length(nonneg_finite(self.body_width_m), "body_width_m")?;
         for j in Joint::ALL {
             let (lo, hi) = (
                 self.limits.min_rad[j as usize],
                 self.limits.max_rad[j as usize],
             );
-            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+            if !finite_ordered(lo, hi) {
                 return Err(RobotError::BadLimit(j));
             }
         }
