@@ -134,6 +134,9 @@ impl Eeprom {
 impl quad_device::Storage for Eeprom {
     type Error = Error;
 
+    // Out of line: the calibration store reads at several places (headers, records, CRCs),
+    // each of which would otherwise hold its own copy of the range check and the byte loop.
+    #[inline(never)]
     fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), Error> {
         Self::check_range(addr, buf.len())?;
         for (i, b) in buf.iter_mut().enumerate() {

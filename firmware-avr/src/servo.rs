@@ -252,24 +252,23 @@ fn apply_staged() {
     // bits of the ports are written only here, under `BUSY` (or by the panic handler, which
     // never returns).
     let dp = unsafe { pac::Peripherals::steal() };
-    if after >= before {
-        for (t, &c) in connections.iter().enumerate() {
-            write_timer(&dp, t, &ticks, c);
-        }
-    } else {
+    // No quiet moment: every timer is written at once.
+    let at_once = after >= before;
+    if !at_once {
         let start_before = before.saturating_sub(START_GUARD_TICKS).max(after);
         if !(0..4).all(|t| in_window(tcnt(&dp, t), after, start_before)) {
             return;
         }
-        // One stretch per timer, each with its timer's registers as constants (a timer index
-        // looked up inside the stretch made it longer than a byte time at 1 Mbaud).
-        let written = write_in_window::<0>(&dp, &ticks, connections[0], after, before)
-            && write_in_window::<1>(&dp, &ticks, connections[1], after, before)
-            && write_in_window::<2>(&dp, &ticks, connections[2], after, before)
-            && write_in_window::<3>(&dp, &ticks, connections[3], after, before);
-        if !written {
-            return;
-        }
+    }
+    // One stretch per timer, each with its timer's registers as constants (a timer index
+    // looked up inside the stretch made it longer than a byte time at 1 Mbaud); the same
+    // writes at once, so that the firmware holds one copy of them.
+    let written = write_in_window::<0>(&dp, &ticks, connections[0], after, before, at_once)
+        && write_in_window::<1>(&dp, &ticks, connections[1], after, before, at_once)
+        && write_in_window::<2>(&dp, &ticks, connections[2], after, before, at_once)
+        && write_in_window::<3>(&dp, &ticks, connections[3], after, before, at_once);
+    if !written {
+        return;
     }
     ACTIVE_LONGEST.set(longest_new);
     APPLIED_IN.set(PERIODS.get());
@@ -294,8 +293,11 @@ fn tcnt(dp: &pac::Peripherals, t: usize) -> u16 {
     }
 }
 
-/// Timer `T`'s writes ([`write_timer`]) in one interrupts-off stretch that begins by checking
-/// that its count lies in `(after, before)`; false (nothing written) when it does not.
+/// Timer `T`'s writes — its three compare registers (channels with a non-zero width: fast
+/// PWM keeps the pin high for OCR + 1 ticks, OCR = TOP high throughout) and its connections
+/// `(TCCRnA, port bits to drive low)` — in one interrupts-off stretch that begins by checking
+/// that its count lies in `(after, before)` (or `at_once`, without that check); false (nothing
+/// written) when it does not.
 #[inline(always)]
 fn write_in_window<const T: usize>(
     dp: &pac::Peripherals,
@@ -303,6 +305,7 @@ fn write_in_window<const T: usize>(
     connection: (u8, u8),
     after: u16,
     before: u16,
+    at_once: bool,
 ) -> bool {
     // The compare values before the stretch.
     let ocr: [u16; 3] = core::array::from_fn(|unit| ticks[3 * T + unit].wrapping_sub(1));
@@ -310,33 +313,23 @@ fn write_in_window<const T: usize>(
     // Not `interrupt::free`: its closure may be left out of line, and the call would lengthen
     // the stretch.
     let irq = avr_device::interrupt::disable_save();
-    let inside = in_window(tcnt(dp, T), after, before);
+    let inside = at_once || in_window(tcnt(dp, T), after, before);
     if inside {
-        for unit in 0..3 {
-            if on[unit] {
-                write_ocr(dp, 3 * T + unit, ocr[unit]);
-            }
+        // Unit by unit, not a loop: each write with its register as a constant.
+        if on[0] {
+            write_ocr(dp, 3 * T, ocr[0]);
+        }
+        if on[1] {
+            write_ocr(dp, 3 * T + 1, ocr[1]);
+        }
+        if on[2] {
+            write_ocr(dp, 3 * T + 2, ocr[2]);
         }
         apply_connections(dp, T, connection);
     }
     // SAFETY: restores the interrupt flag saved above, at the end of the stretch it began.
     unsafe { avr_device::interrupt::restore(irq) };
     inside
-}
-
-/// Writes timer `t`'s three compare registers (channels with a non-zero width) and its
-/// connections `(TCCRnA, port bits to drive low)`.
-#[inline(always)]
-fn write_timer(dp: &pac::Peripherals, t: usize, ticks: &[u16; CHANNELS], connection: (u8, u8)) {
-    for unit in 0..3 {
-        let channel = 3 * t + unit;
-        let width = ticks[channel];
-        if width > 0 {
-            // Fast PWM: the pin is high for OCR + 1 ticks; OCR = TOP keeps it high.
-            write_ocr(dp, channel, width - 1);
-        }
-    }
-    apply_connections(dp, t, connection);
 }
 
 #[inline(always)]

@@ -331,8 +331,27 @@ impl<M: Math> Solver<M> {
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
         check_finite(pose, config)?;
-        let local = self.stance_feet_in_hips(pose, config, stance_height_m);
+        let local = if M::STAGE_LEGS {
+            self.stance_feet_in_hips(pose, config, stance_height_m)
+        } else {
+            self.stance_feet_in_hips_apart(pose, config, stance_height_m)
+        };
         self.legs(&local, policy)
+    }
+
+    /// [`Solver::stance_feet_in_hips`] out of line, for the backends that solve the legs one
+    /// after the other ([`Math::STAGE_LEGS`] false: in-order CPUs with software floats): its
+    /// rotation matrix and temporaries in a stack frame of their own, not in the body solve's
+    /// (on the AVR every local beyond the first 63 bytes of a frame costs extra instructions
+    /// at each access; see `BENCHMARKS.md`).
+    #[inline(never)]
+    fn stance_feet_in_hips_apart(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        stance_height_m: f32,
+    ) -> [Vec3; 4] {
+        self.stance_feet_in_hips(pose, config, stance_height_m)
     }
 
     /// The body at the zero pose with its feet at `feet_in_body` (body frame, m): each foot

@@ -41,12 +41,7 @@ impl core::error::Error for Singular {}
 
 /// Analytic leg Jacobian `∂foot_in_hip/∂(abduction, hip, knee)`, m/rad.
 pub fn leg_jacobian(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
-    leg_jacobian_on::<DefaultMath>(g, leg, q)
-}
-
-/// [`leg_jacobian`] on backend `M` (reached through [`crate::leg::Solver::inverse_condition`]).
-#[inline(never)]
-pub(crate) fn leg_jacobian_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Mat3 {
+    type M = DefaultMath;
     let (sa, ca) = M::sin_cos(q.abduction_rad);
     let (sh, ch) = M::sin_cos(q.hip_rad);
     let (shk, chk) = M::sin_cos(q.hip_rad + q.knee_rad);
@@ -70,54 +65,90 @@ pub fn manipulability(j: &Mat3) -> f32 {
 /// Inverse condition number `σ_min / σ_max` of `j` ∈ [0, 1] (1 = isotropic, 0 = singular),
 /// from the closed-form eigenvalues of the symmetric `JᵀJ`, on the [`DefaultMath`] backend.
 pub fn inverse_condition(j: &Mat3) -> f32 {
-    inverse_condition_on::<DefaultMath>(j)
+    let c = |k: usize| j.column(k);
+    let (c0, c1, c2) = (c(0), c(1), c(2));
+    gram_inverse_condition::<DefaultMath>(&Gram {
+        diagonal: [c0.dot(c0), c1.dot(c1), c2.dot(c2)],
+        off: [c0.dot(c1), c0.dot(c2), c1.dot(c2)],
+    })
 }
 
-/// [`inverse_condition`] on backend `M` (reached through
+/// The singularity measure of a leg: [`inverse_condition`] of its [`leg_jacobian`], on the
+/// [`DefaultMath`] backend. The host's preflight and the device's start check
+/// ([`crate::leg::Solver::inverse_condition`]) both use this one computation.
+///
+/// `JᵀJ` does not depend on the abduction (`J = Rx(a)·J₀`, `Rx(a)` orthogonal), so it is
+/// formed from the un-abducted columns `J₀ = [e_x × p, ∂p/∂h, ∂p/∂k]` of the foot
+/// `p = [u, s·d_lat, w]`: `e_x × p = (0, −w, s·d_lat)` and the planar columns
+/// `(h_x, 0, h_z)`, `(k_x, 0, k_z)`, six entries from a few products, no abduction sine.
+pub fn leg_inverse_condition(g: &LegGeometry, leg: LegId, q: JointAngles) -> f32 {
+    leg_inverse_condition_on::<DefaultMath>(g, leg, q)
+}
+
+/// [`leg_inverse_condition`] on backend `M` (reached through
 /// [`crate::leg::Solver::inverse_condition`]).
 #[inline(never)]
-pub(crate) fn inverse_condition_on<M: Math>(j: &Mat3) -> f32 {
-    let jt = j.transpose();
-    let a = jt.mul_mat(j); // symmetric positive semi-definite
-    let e = symmetric_eigenvalues::<M>(&a.rows);
-    let (lo, hi) = (e[0].max(0.0), e[2].max(0.0));
+pub(crate) fn leg_inverse_condition_on<M: Math>(
+    g: &LegGeometry,
+    leg: LegId,
+    q: JointAngles,
+) -> f32 {
+    let (sh, ch) = M::sin_cos(q.hip_rad);
+    let (shk, chk) = M::sin_cos(q.hip_rad + q.knee_rad);
+    let (l1, l2) = (g.femur_m, g.tibia_m);
+    // ∂p/∂k = (k_x, 0, k_z), ∂p/∂h = (h_x, 0, h_z) = ∂p/∂k + L1·(−cos h, 0, sin h).
+    let (kx, kz) = (-l2 * chk, l2 * shk);
+    let (hx, hz) = (kx - l1 * ch, kz + l1 * sh);
+    // The foot's un-abducted depth w = −d_ax − L1·cos h − L2·cos(h+k) = h_x − d_ax.
+    let w = hx - g.d_ax_m;
+    let y0 = leg.side() * g.d_lat_m;
+    gram_inverse_condition::<M>(&Gram {
+        diagonal: [w * w + y0 * y0, hx * hx + hz * hz, kx * kx + kz * kz],
+        off: [y0 * hz, y0 * kz, hx * kx + hz * kz],
+    })
+}
+
+/// A symmetric 3×3 matrix by its distinct entries.
+struct Gram {
+    /// `[a₀₀, a₁₁, a₂₂]`.
+    diagonal: [f32; 3],
+    /// `[a₀₁, a₀₂, a₁₂]`.
+    off: [f32; 3],
+}
+
+/// `√(λ_min / λ_max)` of the symmetric positive semi-definite `a` (0 when `λ_max ≤ 0`): the
+/// inverse condition number of a matrix whose Gram matrix `a` is. Eigenvalues in the
+/// trigonometric closed form: with `q = tr(a)/3`, `p = √(tr((a − qI)²)/6)` and
+/// `r = det(a − qI)/(2p³)`, `φ = acos(r)/3`, the largest is `q + 2p·cos φ` and the smallest
+/// `q + 2p·cos(φ + 2π/3) = q − p·(cos φ + √3·sin φ)` (one sine and cosine); `p = 0` is
+/// `a = q·I`.
+#[inline(never)]
+fn gram_inverse_condition<M: Math>(a: &Gram) -> f32 {
+    let [a00, a11, a22] = a.diagonal;
+    let [a01, a02, a12] = a.off;
+    let p1 = a01 * a01 + a02 * a02 + a12 * a12;
+    let tr = a00 + a11 + a22;
+    let q = tr / 3.0;
+    let (d0, d1, d2) = (a00 - q, a11 - q, a22 - q);
+    let p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * p1;
+    if !M::gt_zero(p2) {
+        // a = q·I: isotropic when q > 0 (else zero, or not finite).
+        return if M::gt_zero(q) { 1.0 } else { 0.0 };
+    }
+    let p = M::sqrt(p2 / 6.0);
+    let det =
+        d0 * (d1 * d2 - a12 * a12) - a01 * (a01 * d2 - a12 * a02) + a02 * (a01 * a12 - d1 * a02);
+    let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
+    // acos r = atan2(√(1 − r²), r) for r in [−1, 1]: the backend's own functions.
+    let phi = M::atan2(M::sqrt((1.0 - r) * (1.0 + r)), r) / 3.0;
+    let (sin, cos) = M::sin_cos(phi);
+    const SQRT_3: f32 = 1.732_050_8;
+    let (lo, hi) = (q - p * (cos + SQRT_3 * sin), q + 2.0 * p * cos);
+    let (lo, hi) = (lo.max(0.0), hi.max(0.0));
     if hi <= 0.0 {
         return 0.0;
     }
     M::sqrt(lo / hi)
-}
-
-/// Eigenvalues of a symmetric 3×3 matrix, ascending (trigonometric closed form).
-#[inline(never)]
-fn symmetric_eigenvalues<M: Math>(a: &[[f32; 3]; 3]) -> [f32; 3] {
-    let p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
-    let tr = a[0][0] + a[1][1] + a[2][2];
-    let q = tr / 3.0;
-    if p1 <= f32::EPSILON * (q * q) {
-        let (x, y, z) = (a[0][0], a[1][1], a[2][2]);
-        let lo = x.min(y).min(z);
-        let hi = x.max(y).max(z);
-        return [lo, x + y + z - lo - hi, hi];
-    }
-    let p2 = (a[0][0] - q) * (a[0][0] - q)
-        + (a[1][1] - q) * (a[1][1] - q)
-        + (a[2][2] - q) * (a[2][2] - q)
-        + 2.0 * p1;
-    let p = M::sqrt(p2 / 6.0);
-    let inv_p = 1.0 / p;
-    let b = [
-        [(a[0][0] - q) * inv_p, a[0][1] * inv_p, a[0][2] * inv_p],
-        [a[1][0] * inv_p, (a[1][1] - q) * inv_p, a[1][2] * inv_p],
-        [a[2][0] * inv_p, a[2][1] * inv_p, (a[2][2] - q) * inv_p],
-    ];
-    let det_b = Mat3 { rows: b }.determinant();
-    let r = (det_b / 2.0).clamp(-1.0, 1.0);
-    // acos r = atan2(√(1 − r²), r) for r in [−1, 1]: the backend's own functions.
-    let phi = M::atan2(M::sqrt((1.0 - r) * (1.0 + r)), r) / 3.0;
-    let e_hi = q + 2.0 * p * M::sin_cos(phi).1;
-    let e_lo = q + 2.0 * p * M::sin_cos(phi + 2.0 * core::f32::consts::PI / 3.0).1;
-    let e_mid = tr - e_hi - e_lo;
-    [e_lo, e_mid, e_hi]
 }
 
 /// Joint rates `q̇ = J⁻¹·v` for a foot velocity `v` in the hip frame (m/s → rad/s).

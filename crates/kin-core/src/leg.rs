@@ -436,12 +436,11 @@ impl<M: Math> Solver<M> {
     }
 
     /// The singularity measure of `leg` at `q`: the inverse condition number of its Jacobian
-    /// ([`crate::jacobian::inverse_condition`] of [`crate::jacobian::leg_jacobian`]) on this
+    /// ([`crate::jacobian::leg_inverse_condition`], the host preflight's measure) on this
     /// solver's backend, in `[0, 1]`; below [`crate::jacobian::SINGULARITY_THRESHOLD`] counts
     /// as near-singular.
     pub fn inverse_condition(&self, leg: LegId, q: JointAngles) -> f32 {
-        let j = crate::jacobian::leg_jacobian_on::<M>(&self.geometry, leg, q);
-        crate::jacobian::inverse_condition_on::<M>(&j)
+        crate::jacobian::leg_inverse_condition_on::<M>(&self.geometry, leg, q)
     }
 
     /// The leg geometry.
@@ -502,7 +501,7 @@ impl<M: Math> Solver<M> {
         let target = match policy {
             ReachPolicy::Clamp => {
                 let m = max_abs(foot_in_hip);
-                if m > FAR_M {
+                if M::lt_nonneg(FAR_M, m) {
                     foot_in_hip * (FAR_M / m)
                 } else {
                     foot_in_hip
@@ -510,31 +509,36 @@ impl<M: Math> Solver<M> {
             }
             ReachPolicy::Reject => foot_in_hip,
         };
-        let (mut angles, reached) = self
+        let (mut angles, projected) = self
             .solve(self.side_d_lat(leg), target, policy)
             .map_err(err)?;
-        if self.limits.admits_all::<M>(angles) {
-            // Within the limits also means finite: a NaN fails every comparison.
-            return Ok(LegSolution {
-                angles,
-                clamped: reached.map(|(kind, p)| Clamp {
-                    kind,
-                    distance_m: distance::<M>(p, foot_in_hip),
-                }),
-            });
-        }
-        // Some joint is outside (any for a NaN angle).
-        let joint = self
-            .limits
-            .first_violation(angles)
-            .unwrap_or(Joint::Abduction);
-        if policy == ReachPolicy::Reject {
-            return Err(err(Unreachable::JointLimit(joint)));
-        }
-        angles = self.limits.clamp(angles);
+        // Within the limits also means finite: a NaN fails every comparison.
+        let within = self.limits.admits_all::<M>(angles);
+        let kind = match (within, projected) {
+            (true, None) => {
+                return Ok(LegSolution {
+                    angles,
+                    clamped: None,
+                })
+            }
+            (true, Some(kind)) => kind,
+            (false, _) => {
+                // Some joint is outside (any for a NaN angle).
+                let joint = self
+                    .limits
+                    .first_violation(angles)
+                    .unwrap_or(Joint::Abduction);
+                if policy == ReachPolicy::Reject {
+                    return Err(err(Unreachable::JointLimit(joint)));
+                }
+                angles = self.limits.clamp(angles);
+                projected.unwrap_or(Unreachable::JointLimit(joint))
+            }
+        };
+        // Under Clamp, moved: the distance of the foot the returned angles reach.
         let foot = forward_on::<M>(&self.geometry, leg, angles);
         let clamped = Some(Clamp {
-            kind: reached.map_or(Unreachable::JointLimit(joint), |(kind, _)| kind),
+            kind,
             distance_m: distance::<M>(foot, foot_in_hip),
         });
         if !angles.is_finite() {
@@ -563,14 +567,14 @@ impl<M: Math> Solver<M> {
 
     /// Solves the abduction and planar problem exactly for a point known to be reachable
     /// (after optional projection), for the leg with `sd = s·d_lat`. Returns the angles and,
-    /// when projecting, the first reason and the foot actually reached.
+    /// when projecting, the first reason.
     #[inline(always)]
     fn solve(
         &self,
         sd: f32,
         target: Vec3,
         policy: ReachPolicy,
-    ) -> Result<(JointAngles, Option<(Unreachable, Vec3)>), Unreachable> {
+    ) -> Result<(JointAngles, Option<Unreachable>), Unreachable> {
         let g = &self.geometry;
         let (mut y, mut z) = (target.y, target.z);
         let mut first: Option<Unreachable> = None;
@@ -632,16 +636,12 @@ impl<M: Math> Solver<M> {
         let (hip_y, hip_x) = hip_yx(u, v, dist2, self.c.diff_sq, knee_y);
         let [abduction, knee, hip] = M::atan2_3([abd_y, knee_y, hip_y], [abd_x, knee_x, hip_x]);
         let angles = JointAngles::new(abduction, hip, knee);
-        let reached = if moved {
-            let (sa, ca) = M::sin_cos(abduction);
-            Some((
-                first.unwrap_or(Unreachable::TooFar),
-                abduct(sa, ca, Vec3::new(u, sd, v - g.d_ax_m)),
-            ))
+        let projected = if moved {
+            Some(first.unwrap_or(Unreachable::TooFar))
         } else {
             None
         };
-        Ok((angles, reached))
+        Ok((angles, projected))
     }
 
     /// The four legs of [`LegId::ALL`] at once under [`ReachPolicy::Reject`], for the
@@ -716,22 +716,28 @@ impl<M: Math> Solver<M> {
 const FAR_M: f32 = 1.0e6;
 
 /// The largest absolute coordinate of `v` (its maximum norm): what decides whether squaring
-/// `v`'s coordinates could overflow.
+/// `v`'s coordinates could overflow. From the bits, which order as the magnitudes do (no
+/// software-float comparison on CPUs without floating-point hardware); a NaN coordinate
+/// (never passed here: the targets are checked finite first) would count as the largest.
 #[inline(always)]
 fn max_abs(v: Vec3) -> f32 {
-    libm::fmaxf(
-        libm::fabsf(v.x),
-        libm::fmaxf(libm::fabsf(v.y), libm::fabsf(v.z)),
-    )
+    const ABS: u32 = 0x7fff_ffff;
+    let (x, y, z) = (
+        v.x.to_bits() & ABS,
+        v.y.to_bits() & ABS,
+        v.z.to_bits() & ABS,
+    );
+    f32::from_bits(x.max(y).max(z))
 }
 
 /// `|a − b|` without overflowing the squares of far targets, with the backend's square root
-/// (a firmware then links one square root, its backend's).
-#[inline]
+/// (a firmware then links one square root, its backend's). Out of line: the solve's common
+/// path keeps a smaller stack frame.
+#[inline(never)]
 fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     let d = a - b;
     let m = max_abs(d);
-    if m > FAR_M {
+    if M::lt_nonneg(FAR_M, m) {
         m * M::sqrt((d * (1.0 / m)).norm_squared())
     } else {
         M::sqrt(d.norm_squared())

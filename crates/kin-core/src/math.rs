@@ -731,7 +731,7 @@ pub mod poly {
     pub fn sin_cos_deg5(x: f32) -> (f32, f32) {
         const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
         let (k, r) = if x.to_bits() & ABS <= FRAC_PI_4_BITS {
-            (0.0, x)
+            (0, x)
         } else {
             reduce(x)
         };
@@ -739,7 +739,7 @@ pub mod poly {
         let (s, c) = (&SIN_DEG5, &COS_DEG6);
         let sin = r * (s[0] + r2 * (s[1] + r2 * s[2]));
         let cos = c[0] + r2 * (c[1] + r2 * (c[2] + r2 * c[3]));
-        if k == 0.0 {
+        if k == 0 {
             (sin, cos)
         } else {
             quadrant(k, sin, cos)
@@ -765,7 +765,7 @@ pub mod poly {
         // range reduction of huge arguments, for which any bounded value will do.
         const CELLS_END_Q24: u32 = (26 << 19) - 1;
         let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
-        let (k, r) = if reduced { reduce(x) } else { (0.0, x) };
+        let (k, r) = if reduced { reduce(x) } else { (0, x) };
         let rb = r.to_bits();
         // |r| = m·2^(e − 150) with the 24-bit mantissa m: R = |r|·2²⁴ = m >> (126 − e),
         // truncated (2⁻²⁴ is far below the cells' error); 0 for |r| < 2⁻²⁴ and subnormals.
@@ -810,28 +810,36 @@ pub mod poly {
         }
     }
 
-    /// Quadrant `k = round(x / (π/2))` and `r = x − k·π/2` in two parts (Cody–Waite).
+    /// Quadrant `k = round(x / (π/2))` modulo 4 and `r = x − k·π/2` in two parts
+    /// (Cody–Waite).
     #[inline(always)]
-    fn reduce(x: f32) -> (f32, f32) {
+    fn reduce(x: f32) -> (u32, f32) {
         const INV_FRAC_PI_2: f32 = core::f32::consts::FRAC_2_PI;
         const PIO2_HI: f32 = 1.570_312_5; // exact in 11 bits
         const PIO2_LO: f32 = 4.838_268e-4;
         // Round to nearest by adding and subtracting 1.5·2²³ (exact for |x·2/π| < 2²²; beyond,
         // any nearby integer does as well as libm::roundf): inline, no call, no branch.
         const ROUND: f32 = 12_582_912.0;
-        let k = (x * INV_FRAC_PI_2 + ROUND) - ROUND;
-        (k, (x - k * PIO2_HI) - k * PIO2_LO)
+        let shifted = x * INV_FRAC_PI_2 + ROUND;
+        let k = shifted - ROUND;
+        // `shifted` = 1.5·2²³ + k has the unit in its last mantissa place, and 1.5·2²³ is a
+        // multiple of 4: its low two bits are k mod 4, with no float-to-integer conversion (a
+        // saturating one is a library call and three comparisons on CPUs without
+        // floating-point hardware).
+        (shifted.to_bits() & 3, (x - k * PIO2_HI) - k * PIO2_LO)
     }
 
-    /// `(sin x, cos x)` from those of the reduced argument in quadrant `k`.
+    /// `(sin x, cos x)` from those of the reduced argument in quadrant `k` (mod 4).
     #[inline(always)]
-    fn quadrant(k: f32, sin: f32, cos: f32) -> (f32, f32) {
-        match (k as i32) & 3 {
-            0 => (sin, cos),
-            1 => (cos, -sin),
-            2 => (-sin, -cos),
-            _ => (-cos, sin),
-        }
+    fn quadrant(k: u32, sin: f32, cos: f32) -> (f32, f32) {
+        // (sin, cos), (cos, −sin), (−sin, −cos), (−cos, sin) for k = 0, 1, 2, 3: swapped for
+        // odd k, the first negated for k = 2, 3, the second for k = 1, 2 (sign bits flipped,
+        // exactly the negation).
+        let (a, b) = if k & 1 == 0 { (sin, cos) } else { (cos, sin) };
+        (
+            f32::from_bits(a.to_bits() ^ ((k & 2) << 30)),
+            f32::from_bits(b.to_bits() ^ ((k.wrapping_add(1) & 2) << 30)),
+        )
     }
 }
 
@@ -840,6 +848,26 @@ pub mod poly {
 #[inline(always)]
 pub(crate) fn finite(x: f32) -> bool {
     x.to_bits() & bits::INF != bits::INF
+}
+
+/// `x.is_finite() && x > 0.0` from the bits: the patterns of the positive subnormals to the
+/// largest finite float.
+#[inline(always)]
+pub(crate) fn positive_finite(x: f32) -> bool {
+    x.to_bits().wrapping_sub(1) < bits::INF - 1
+}
+
+/// `x.is_finite() && x >= 0.0` from the bits: +0 to the largest finite float, or −0.
+#[inline(always)]
+pub(crate) fn nonneg_finite(x: f32) -> bool {
+    let b = x.to_bits();
+    b < bits::INF || b == 0x8000_0000
+}
+
+/// `lo.is_finite() && hi.is_finite() && lo <= hi` from the bits.
+#[inline(always)]
+pub(crate) fn finite_ordered(lo: f32, hi: f32) -> bool {
+    finite(lo) && finite(hi) && bits::key(lo) <= bits::key(hi)
 }
 
 /// Float comparisons as integer comparisons of the bit patterns, with the semantics of the
@@ -866,7 +894,7 @@ mod bits {
     /// A key that orders non-NaN floats as `<` does, with −0 = +0 (sign–magnitude to
     /// two's complement); positive NaNs sort above +∞, negative NaNs below −∞.
     #[inline(always)]
-    fn key(x: f32) -> i32 {
+    pub(super) fn key(x: f32) -> i32 {
         let b = x.to_bits() as i32;
         if b < 0 {
             i32::MIN.wrapping_sub(b)
@@ -1302,8 +1330,23 @@ mod tests {
         for &a in &vals {
             assert_eq!(bits::gt_zero(a), a > 0.0, "{a:e} > 0");
             assert_eq!(finite(a), a.is_finite(), "finite {a:e}");
+            assert_eq!(
+                positive_finite(a),
+                a.is_finite() && a > 0.0,
+                "0 < {a:e} < inf"
+            );
+            assert_eq!(
+                nonneg_finite(a),
+                a.is_finite() && a >= 0.0,
+                "0 <= {a:e} < inf"
+            );
             for &b in &vals {
                 let nonneg = |v: f32| v.is_sign_positive() || v.is_nan();
+                assert_eq!(
+                    finite_ordered(a, b),
+                    a.is_finite() && b.is_finite() && a <= b,
+                    "{a:e} <= {b:e}, finite"
+                );
                 if nonneg(a) && nonneg(b) {
                     assert_eq!(bits::lt_nonneg(a, b), a < b, "{a:e} < {b:e}");
                 }

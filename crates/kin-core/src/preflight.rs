@@ -9,7 +9,7 @@
 //!   [`workspace_margin`]); negative when out of reach;
 //! - **joint-limit margin** (rad): [`JointLimits::margin`](crate::JointLimits::margin) of the
 //!   tightest joint; negative when a limit is exceeded;
-//! - **singularity measure**: [`jacobian::inverse_condition`] of the leg Jacobian (1 =
+//! - **singularity measure**: [`jacobian::leg_inverse_condition`], of the leg Jacobian (1 =
 //!   isotropic, 0 = singular), failing below [`SINGULARITY_THRESHOLD`];
 //! - **joint speed** (rad/s): finite differences between consecutive samples, against a per-joint
 //!   limit.
@@ -488,7 +488,7 @@ impl Checker {
         if tight.0 < 0.0 {
             failure = Some(FailureKind::Unreachable(Unreachable::JointLimit(tight.1)));
         }
-        let ic = jacobian::inverse_condition(&jacobian::leg_jacobian(&self.robot.leg, leg, q));
+        let ic = jacobian::leg_inverse_condition(&self.robot.leg, leg, q);
         let ic = if ic.is_finite() { ic } else { 0.0 };
         update(&mut l.inverse_condition, ic, t_s, true);
         if ic < SINGULARITY_THRESHOLD {

@@ -1,7 +1,7 @@
 //! Robot description: leg identities, leg geometry, hip mounts, joint limits, knee bend, and the
 //! two presets taken from the papers.
 
-use crate::math::Math;
+use crate::math::{finite_ordered, nonneg_finite, positive_finite, Math};
 use crate::vec::Vec3;
 use core::fmt;
 
@@ -394,27 +394,28 @@ impl Robot {
     /// Checks lengths and limits: femur and tibia > 0, offsets ≥ 0, body sizes ≥ 0, limits
     /// finite with min ≤ max.
     pub fn validate(&self) -> Result<(), RobotError> {
-        // One check over a table of the lengths (`true`: zero allowed), not one inlined copy
-        // per length: on a soft-float target each copy is its own library calls.
-        let lengths = [
-            (self.leg.femur_m, "femur_m", false),
-            (self.leg.tibia_m, "tibia_m", false),
-            (self.leg.d_lat_m, "d_lat_m", true),
-            (self.leg.d_ax_m, "d_ax_m", true),
-            (self.body_length_m, "body_length_m", true),
-            (self.body_width_m, "body_width_m", true),
-        ];
-        for (v, name, zero_allowed) in lengths {
-            if !(v.is_finite() && (v > 0.0 || (zero_allowed && v >= 0.0))) {
-                return Err(RobotError::BadLength(name));
+        // Integer tests of the bit patterns, equal to the float comparisons they replace (a
+        // software-float comparison is a library call on CPUs without floating-point hardware,
+        // and a firmware's engine validates its robot before every motion).
+        let length = |ok: bool, name| {
+            if ok {
+                Ok(())
+            } else {
+                Err(RobotError::BadLength(name))
             }
-        }
+        };
+        length(positive_finite(self.leg.femur_m), "femur_m")?;
+        length(positive_finite(self.leg.tibia_m), "tibia_m")?;
+        length(nonneg_finite(self.leg.d_lat_m), "d_lat_m")?;
+        length(nonneg_finite(self.leg.d_ax_m), "d_ax_m")?;
+        length(nonneg_finite(self.body_length_m), "body_length_m")?;
+        length(nonneg_finite(self.body_width_m), "body_width_m")?;
         for j in Joint::ALL {
             let (lo, hi) = (
                 self.limits.min_rad[j as usize],
                 self.limits.max_rad[j as usize],
             );
-            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+            if !finite_ordered(lo, hi) {
                 return Err(RobotError::BadLimit(j));
             }
         }
@@ -433,16 +434,16 @@ impl Robot {
 
     /// Nominal stance for stance height `height_m`: each foot straight below its hip, in the
     /// plane of the zero-abduction leg: `hip_in_body + (0, s·d_lat, −H)` (world = body frame).
-    #[inline]
+    #[inline(never)]
     pub fn stance_feet(&self, height_m: f32) -> [Vec3; 4] {
-        // The front left foot, then the others by their corner's signs: the sums are the same
-        // for every leg up to sign, so one computes them all (fewer float operations, each a
-        // library call on a soft-float target).
-        let fl = self.hip_in_body(LegId::FL) + Vec3::new(0.0, self.leg.d_lat_m, -height_m);
-        let mut feet = [fl; 4];
-        for (foot, leg) in feet.iter_mut().zip(LegId::ALL) {
-            *foot = leg.at_corner(fl);
-        }
-        feet
+        // The front left foot moved to each corner: the same sums as hip plus offset, one set
+        // of float operations instead of one per leg. Out of line: callers on a soft-float
+        // target would each hold a copy of them.
+        let front_left = Vec3::new(
+            0.5 * self.body_length_m,
+            0.5 * self.body_width_m + self.leg.d_lat_m,
+            -height_m,
+        );
+        core::array::from_fn(|i| LegId::ALL[i].at_corner(front_left))
     }
 }

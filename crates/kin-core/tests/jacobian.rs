@@ -156,6 +156,60 @@ fn inverse_condition_matches_svd() {
     );
 }
 
+/// The leg's own measure (`leg_inverse_condition`, from the abduction-free Gram matrix, the
+/// one the host's preflight and the device's start check use) is the measure of the full
+/// Jacobian: against nalgebra's SVD with the tolerances of `inverse_condition_matches_svd`,
+/// the same classification against `SINGULARITY_THRESHOLD` outside its ±10 % band; so is the
+/// device's (`leg::Solver::inverse_condition` on the firmware's `SoftFloat` backend).
+#[test]
+fn leg_inverse_condition_is_the_jacobian_measure() {
+    use kin_core::leg;
+    use kin_core::math::SoftFloat;
+    let mut rng = SplitMix64::new(0x1C0D);
+    let mut compared = 0;
+    for (_, robot) in presets() {
+        let device = leg::Solver::<SoftFloat>::with_math(&robot);
+        for leg in LegId::ALL {
+            for i in 0..SAMPLES * 5 {
+                let mut q = JointAngles::new(
+                    rng.range(-3.0, 3.0) as f32,
+                    rng.range(-3.0, 3.0) as f32,
+                    rng.range(-3.0, 3.0) as f32,
+                );
+                if i % 4 == 0 {
+                    q.knee_rad = rng.range(-0.05, 0.05) as f32;
+                }
+                let host = jacobian::leg_inverse_condition(&robot.leg, leg, q) as f64;
+                let on_device = device.inverse_condition(leg, q) as f64;
+                let j = jacobian::leg_jacobian(&robot.leg, leg, q);
+                let s = to64(&j).svd(false, false).singular_values;
+                let mut sv = [s[0], s[1], s[2]];
+                sv.sort_by(|a, b| a.total_cmp(b));
+                let want = sv[0] / sv[2];
+                let threshold = SINGULARITY_THRESHOLD as f64;
+                for got in [host, on_device] {
+                    assert!((0.0..=1.0).contains(&got), "{got}");
+                    if want >= 1.1 * threshold {
+                        assert!(got >= threshold, "{leg} {q:?}: {got} vs SVD {want}");
+                    }
+                    if want <= 0.9 * threshold {
+                        assert!(got < threshold, "{leg} {q:?}: {got} vs SVD {want}");
+                    }
+                    if sv[1] / sv[2] >= 0.2 {
+                        compared += 1;
+                        let tol = CONDITION_ABS_TOL + CONDITION_REL_TOL * want;
+                        assert!(
+                            (got - want).abs() <= tol,
+                            "{leg} {q:?}: {got} vs SVD {want}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(compared > 10_000, "{compared}");
+}
+
 /// Straight knee (knee = 0) is singular: `joint_rates` refuses with a typed error and the
 /// measure is ~0; so is a foot level with the abduction axis (w = 0).
 #[test]

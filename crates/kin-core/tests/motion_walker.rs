@@ -13,8 +13,12 @@ const DT_S: f32 = 0.02;
 /// integrated in f32 step by step).
 const CLOSED_FORM_TOL_M: f32 = 2e-5;
 
+fn robot() -> Robot {
+    Robot::shahriar2023()
+}
+
 fn params(pattern: Pattern) -> WalkerParams {
-    WalkerParams::new(pattern, Robot::shahriar2023(), 0.40)
+    WalkerParams::new(pattern, 0.40)
 }
 
 fn horizontal(v: Vec3) -> f32 {
@@ -37,9 +41,9 @@ fn a_constant_command_follows_the_closed_form_gait_from_the_second_stride() {
             },
         ] {
             let p = params(pattern);
-            let mut w = Walker::new(p).unwrap();
+            let mut w = Walker::new(&robot(), p).unwrap();
             w.set_velocity::<DefaultMath>(v).unwrap();
-            let gait = Gait::new(p.gait_params(v)).unwrap();
+            let gait = Gait::new(p.gait_params(robot(), v)).unwrap();
             let frames = (3.0 * p.cycle_s / DT_S).round() as u32;
             let mut worst = 0.0f32;
             for k in 1..=frames {
@@ -69,7 +73,7 @@ fn a_constant_command_follows_the_closed_form_gait_from_the_second_stride() {
 #[test]
 fn stance_feet_stay_still_in_the_world_while_the_command_changes() {
     let p = params(Pattern::Trot);
-    let mut w = Walker::new(p).unwrap();
+    let mut w = Walker::new(&robot(), p).unwrap();
     // Body pose in the world, integrated from the commands: (x, y, yaw).
     let (mut bx, mut by, mut byaw) = (0.0f64, 0.0f64, 0.0f64);
     let mut anchored: [Option<(f64, f64)>; 4] = [None; 4];
@@ -118,7 +122,7 @@ fn stance_feet_stay_still_in_the_world_while_the_command_changes() {
 fn stop_finishes_the_strides_and_parks_on_the_neutral_stance() {
     for pattern in [Pattern::Trot, Pattern::Walk] {
         let p = params(pattern);
-        let mut w = Walker::new(p).unwrap();
+        let mut w = Walker::new(&robot(), p).unwrap();
         w.set_velocity::<DefaultMath>(Velocity {
             forward_m_s: 0.1,
             lateral_m_s: 0.0,
@@ -150,7 +154,7 @@ fn stop_finishes_the_strides_and_parks_on_the_neutral_stance() {
 #[test]
 fn a_reversed_command_keeps_the_stance_feet_in_their_discs() {
     let p = params(Pattern::Trot);
-    let mut w = Walker::new(p).unwrap();
+    let mut w = Walker::new(&robot(), p).unwrap();
     let vmax = 0.95 * w.max_forward_m_s();
     let mut saturated = false;
     for k in 0..300u32 {
@@ -189,7 +193,7 @@ fn bad_parameters_and_commands_are_refused_by_name() {
     for (edit, name) in cases {
         let mut p = good;
         edit(&mut p);
-        let e = Walker::new(p).unwrap_err();
+        let e = Walker::new(&robot(), p).unwrap_err();
         let named = match e {
             Error::NonFinite(n) | Error::NotPositive(n) | Error::Negative(n) => n,
             Error::OutOfRange { parameter, .. } | Error::BeyondReach { parameter, .. } => parameter,
@@ -197,7 +201,7 @@ fn bad_parameters_and_commands_are_refused_by_name() {
         };
         assert_eq!(named.name(), name, "{e}");
     }
-    let mut w = Walker::new(good).unwrap();
+    let mut w = Walker::new(&robot(), good).unwrap();
     let vmax = w.max_forward_m_s();
     for (v, name) in [
         (

@@ -7,7 +7,7 @@ use kin_core::body;
 use kin_core::robot::RobotError;
 use kin_core::{BodyConfig, LegId, Math, ReachPolicy, Robot, RotationOrder};
 use quad_protocol::servo::{Calibration, STANDARD_US_PER_RAD};
-use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, RobotPreset, ServoId};
+use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, RobotPreset};
 
 /// Default stance height of [`Robot::fernando2025`]: seed 001's initial pose (eq. 5, α = 60°,
 /// φ = 120°), `H = l0 + (l1 + l2)·sin 60°`, m.
@@ -180,40 +180,38 @@ pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> 
 }
 
 /// [`default_calibration`] written in place (no table-sized temporary on the stack), with the
-/// robot's body solver (the device's own: building a second one repeated its per-leg
-/// constants' code).
+/// body solver of the robot (a device's own, built once).
 #[inline(never)]
 pub(crate) fn write_default_calibration<M: Math>(
     solver: &body::Solver<M>,
     pose_config: &PoseConfig,
     table: &mut Table,
 ) {
-    let stance = stance_angles(solver, pose_config);
-    for ((c, servo), zero_rad) in table.iter_mut().zip(ServoId::ALL).zip(stance) {
-        let right = matches!(servo.leg, LegId::FR | LegId::RR);
-        *c = Calibration {
-            zero_rad,
-            reversed: right && servo.joint != kin_core::Joint::Abduction,
-            us_per_rad: STANDARD_US_PER_RAD,
-            center_us: DEFAULT_CENTER_US,
-            min_us: DEFAULT_CENTER_US - DEFAULT_TRAVEL_US,
-            max_us: DEFAULT_CENTER_US + DEFAULT_TRAVEL_US,
-        };
+    let stance = solver.inverse_at_stance(
+        &body::Pose::default(),
+        &BodyConfig::about_centre(pose_config.order),
+        pose_config.stance_height_m,
+        ReachPolicy::Reject,
+    );
+    // Indexed loops over the legs and joints, read from the solution in place: no copy of
+    // the twelve angles, no table of servo ids.
+    for (leg, calibrations) in table.chunks_exact_mut(3).enumerate() {
+        for (joint, c) in calibrations.iter_mut().enumerate() {
+            let zero_rad = match &stance {
+                Ok(s) => s.legs[leg].angles.to_array()[joint],
+                Err(_) => 0.0,
+            };
+            let right = matches!(LegId::from_index(leg), Some(LegId::FR | LegId::RR));
+            *c = Calibration {
+                zero_rad,
+                reversed: right && joint != kin_core::Joint::Abduction as usize,
+                us_per_rad: STANDARD_US_PER_RAD,
+                center_us: DEFAULT_CENTER_US,
+                min_us: DEFAULT_CENTER_US - DEFAULT_TRAVEL_US,
+                max_us: DEFAULT_CENTER_US + DEFAULT_TRAVEL_US,
+            };
+        }
     }
-}
-
-/// The twelve joint angles of the nominal stance of `pose_config` (zeros when unreachable).
-#[inline(always)]
-fn stance_angles<M: Math>(solver: &body::Solver<M>, pose_config: &PoseConfig) -> [f32; 12] {
-    solver
-        .inverse_at_stance(
-            &body::Pose::default(),
-            &BodyConfig::about_centre(pose_config.order),
-            pose_config.stance_height_m,
-            ReachPolicy::Reject,
-        )
-        .map(|s| s.flat())
-        .unwrap_or([0.0; 12])
 }
 
 #[cfg(test)]

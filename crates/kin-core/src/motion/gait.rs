@@ -114,10 +114,12 @@ impl GaitParams {
     pub const DEFAULT_CYCLE_S: f32 = 1.0;
     /// Default step height as a fraction of the stance height.
     pub const DEFAULT_STEP_HEIGHT_FRACTION: f32 = 0.15;
+    /// Default swing shape: the Bézier swing, which joins a straight stance with C1 continuity.
+    pub const DEFAULT_SWING: PathKind = PathKind::Bezier;
 
     /// `pattern` on `robot` at `stance_height_m`, standing still (zero velocity), with a cycle
     /// of [`Self::DEFAULT_CYCLE_S`], a step height of [`Self::DEFAULT_STEP_HEIGHT_FRACTION`]·H
-    /// and the Bézier swing.
+    /// and the [`Self::DEFAULT_SWING`].
     pub fn new(pattern: Pattern, robot: Robot, stance_height_m: f32) -> GaitParams {
         GaitParams {
             robot,
@@ -127,19 +129,22 @@ impl GaitParams {
             phase_offsets: pattern.phase_offsets(),
             step_height_m: Self::DEFAULT_STEP_HEIGHT_FRACTION * stance_height_m,
             velocity: Velocity::default(),
-            swing: PathKind::Bezier,
+            swing: Self::DEFAULT_SWING,
             order: RotationOrder::default(),
         }
     }
 }
 
-/// `sin(x)/x`, exact at 0.
-#[inline]
-fn sinc<M: Math>(x: f32) -> f32 {
+/// `sin(x)/x` from `sin_x` = `sin(x)`, exact at 0.
+///
+/// Out of line: [`displace`] uses it twice, and on a soft-float target each copy of its
+/// operations is a run of calls.
+#[inline(never)]
+fn sinc(sin_x: f32, x: f32) -> f32 {
     if libm::fabsf(x) < 1e-3 {
         1.0 - x * x / 6.0
     } else {
-        M::sin_cos(x).0 / x
+        sin_x / x
     }
 }
 
@@ -149,10 +154,11 @@ fn sinc<M: Math>(x: f32) -> f32 {
 pub fn displace<M: Math>(velocity: &Velocity, s: f32, n: Vec3) -> Vec3 {
     let v = velocity;
     let x = v.yaw_rad_s * s;
+    // Two sines, each used twice: on a soft-float target each evaluation is costly.
     let (sn, cs) = M::sin_cos(x);
     let (sh, _) = M::sin_cos(0.5 * x);
-    let a = s * sinc::<M>(x); // ∫ cos
-    let b = s * sh * sinc::<M>(0.5 * x); // ∫ sin = (1 − cos x)/ω
+    let a = s * sinc(sn, x); // ∫ cos
+    let b = s * sh * sinc(sh, 0.5 * x); // ∫ sin = (1 − cos x)/ω
     Vec3::new(
         v.forward_m_s * a - v.lateral_m_s * b + cs * n.x - sn * n.y,
         v.forward_m_s * b + v.lateral_m_s * a + sn * n.x + cs * n.y,
@@ -182,6 +188,37 @@ pub fn swing_foot<M: Math>(
     let path = AnyPath::new(swing, Stride::unchecked(length, step_height_m, duty_factor));
     let o = path.offset::<M>(phase);
     Vec3::new(mid.x + ux * o.x, mid.y + uy * o.x, mid.z + o.z)
+}
+
+/// The gait's checks that need no robot: finite values, `H > 0`, `T > 0`, `d ∈ (0, 1)`, the
+/// step height ≥ 0 and below the hips (the [`Gait`]'s and the walker's).
+pub(crate) fn check_timing(
+    stance_height_m: f32,
+    cycle_s: f32,
+    duty_factor: f32,
+    phase_offsets: &[f32; 4],
+    step_height_m: f32,
+) -> Result<(), Error> {
+    positive(stance_height_m, Param::StanceHeightM)?;
+    positive(cycle_s, Param::CycleS)?;
+    let d = finite(duty_factor, Param::DutyFactor)?;
+    if !(d > 0.0 && d < 1.0) {
+        return Err(Error::OutOfRange {
+            parameter: Param::DutyFactor,
+            expected: Expected::OpenUnitInterval,
+        });
+    }
+    for &o in phase_offsets {
+        finite(o, Param::PhaseOffsets)?;
+    }
+    non_negative(step_height_m, Param::StepHeightM)?;
+    if !(step_height_m < stance_height_m) {
+        return Err(Error::OutOfRange {
+            parameter: Param::StepHeightM,
+            expected: Expected::BelowStanceHeight,
+        });
+    }
+    Ok(())
 }
 
 /// A trot or walk: see the module docs.
@@ -215,25 +252,13 @@ impl Gait {
     /// the reach itself through its own IK (a device's start check).
     pub fn without_reach_check(p: GaitParams) -> Result<Gait, Error> {
         p.robot.validate()?;
-        positive(p.stance_height_m, Param::StanceHeightM)?;
-        positive(p.cycle_s, Param::CycleS)?;
-        let d = finite(p.duty_factor, Param::DutyFactor)?;
-        if !(d > 0.0 && d < 1.0) {
-            return Err(Error::OutOfRange {
-                parameter: Param::DutyFactor,
-                expected: Expected::OpenUnitInterval,
-            });
-        }
-        for o in p.phase_offsets {
-            finite(o, Param::PhaseOffsets)?;
-        }
-        non_negative(p.step_height_m, Param::StepHeightM)?;
-        if !(p.step_height_m < p.stance_height_m) {
-            return Err(Error::OutOfRange {
-                parameter: Param::StepHeightM,
-                expected: Expected::BelowStanceHeight,
-            });
-        }
+        check_timing(
+            p.stance_height_m,
+            p.cycle_s,
+            p.duty_factor,
+            &p.phase_offsets,
+            p.step_height_m,
+        )?;
         finite(p.velocity.forward_m_s, Param::ForwardMS)?;
         finite(p.velocity.lateral_m_s, Param::LateralMS)?;
         finite(p.velocity.yaw_rad_s, Param::YawRadS)?;

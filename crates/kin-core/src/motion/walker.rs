@@ -40,7 +40,7 @@
 //! body's displacement of that step is then halved (up to three times, then zero) until every
 //! stance foot stays inside, and [`Walker::saturated`] reports it.
 
-use super::gait::{displace, swing_foot, Gait, GaitParams, Pattern, Velocity};
+use super::gait::{check_timing, displace, swing_foot, Gait, GaitParams, Pattern, Velocity};
 use super::path::PathKind;
 use super::{
     check_reach, finite, fract01, positive, Contact, Error, Expected, Frame, Param, Phase,
@@ -51,11 +51,10 @@ use crate::robot::{LegId, Robot};
 use crate::rotation::RotationOrder;
 use crate::vec::Vec3;
 
-/// Parameters of a [`Walker`].
+/// Parameters of a [`Walker`] (the robot is given apart: the walker keeps its neutral
+/// footholds, not the robot).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WalkerParams {
-    /// The robot.
-    pub robot: Robot,
     /// Stance height `H` (hip plane above the ground), m.
     pub stance_height_m: f32,
     /// Gait cycle `T`, s.
@@ -78,27 +77,48 @@ impl WalkerParams {
     /// Default [`WalkerParams::reach_radius_m`] as a fraction of the stance height.
     pub const DEFAULT_REACH_RADIUS_FRACTION: f32 = 0.2;
 
-    /// `pattern` on `robot` at `stance_height_m` with [`GaitParams::new`]'s cycle, step height
-    /// and swing, and a reach radius of [`Self::DEFAULT_REACH_RADIUS_FRACTION`]·H.
-    pub fn new(pattern: Pattern, robot: Robot, stance_height_m: f32) -> WalkerParams {
-        let g = GaitParams::new(pattern, robot, stance_height_m);
+    /// `pattern` at `stance_height_m` with [`GaitParams::new`]'s cycle, step height, swing and
+    /// rotation order, and a reach radius of [`Self::DEFAULT_REACH_RADIUS_FRACTION`]·H.
+    pub fn new(pattern: Pattern, stance_height_m: f32) -> WalkerParams {
         WalkerParams {
-            robot,
             stance_height_m,
-            cycle_s: g.cycle_s,
-            duty_factor: g.duty_factor,
-            phase_offsets: g.phase_offsets,
-            step_height_m: g.step_height_m,
-            swing: g.swing,
-            order: g.order,
+            cycle_s: GaitParams::DEFAULT_CYCLE_S,
+            duty_factor: pattern.duty_factor(),
+            phase_offsets: pattern.phase_offsets(),
+            step_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * stance_height_m,
+            swing: GaitParams::DEFAULT_SWING,
+            order: RotationOrder::default(),
             reach_radius_m: Self::DEFAULT_REACH_RADIUS_FRACTION * stance_height_m,
         }
     }
 
-    /// The closed-form gait of these parameters at a constant `velocity`.
-    pub fn gait_params(&self, velocity: Velocity) -> GaitParams {
+    /// Checks the parameters: those of [`Gait::new`] that need no robot (finite values,
+    /// `H > 0`, `T > 0`, `d ∈ (0, 1)`, the step height ≥ 0 and below the hips) and `R > 0`.
+    pub fn checked(self) -> Result<CheckedWalkerParams, Error> {
+        check_timing(
+            self.stance_height_m,
+            self.cycle_s,
+            self.duty_factor,
+            &self.phase_offsets,
+            self.step_height_m,
+        )?;
+        positive(self.reach_radius_m, Param::ReachRadiusM)?;
+        Ok(CheckedWalkerParams(self))
+    }
+
+    /// The Bézier swing's overshoot factor `f` (module docs), 1 for the other shapes.
+    fn overshoot_factor(&self) -> f32 {
+        let d = self.duty_factor;
+        match self.swing {
+            PathKind::Bezier => 1.0 + 2.0 * (1.0 - d) / (5.0 * d),
+            _ => 1.0,
+        }
+    }
+
+    /// The closed-form gait of these parameters on `robot` at a constant `velocity`.
+    pub fn gait_params(&self, robot: Robot, velocity: Velocity) -> GaitParams {
         GaitParams {
-            robot: self.robot,
+            robot,
             stance_height_m: self.stance_height_m,
             cycle_s: self.cycle_s,
             duty_factor: self.duty_factor,
@@ -110,6 +130,12 @@ impl WalkerParams {
         }
     }
 }
+
+/// [`WalkerParams`] that passed their checks ([`WalkerParams::checked`]): a walker built from
+/// them ([`Walker::standing`]) needs no fallible step, so a caller can build it where it is
+/// stored instead of moving it out of a `Result`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckedWalkerParams(WalkerParams);
 
 /// One leg's state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -124,33 +150,60 @@ struct Leg {
     parked: bool,
 }
 
+/// One step of [`Walker::step`], as its legs see it.
+struct Span {
+    /// Global phase before the step, cycles.
+    old: f32,
+    /// After the step, cycles.
+    new: f32,
+    /// The step's duration, s.
+    dt_s: f32,
+    /// Fraction of the command by which the body moves over the step.
+    scale: f32,
+    /// `(R/f)²`, m².
+    r_sq: f32,
+}
+
 /// A trot / walk stepper with a changing velocity command: see the module docs.
+///
+/// The fields are laid out in declaration order, those the step reads most first: on the AVR a
+/// field within 63 bytes of the walker's address is one load instruction, one beyond costs a
+/// pointer adjustment at each access.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub struct Walker {
-    p: WalkerParams,
-    neutral: [Vec3; 4],
-    legs: [Leg; 4],
     phase: f32,
     velocity: Velocity,
+    /// `R / f`: the radius within which the planned footholds lie and the stance feet stay
+    /// (module docs), m; computed once, as are the next two.
+    stance_radius_m: f32,
+    /// `1 − d`: the leg phase at which the swing ends, cycles.
+    swing_end: f32,
+    /// `d·T/2`: half a stance, s.
+    half_stance_s: f32,
+    p: WalkerParams,
     stopping: bool,
     saturated: bool,
+    neutral: [Vec3; 4],
+    legs: [Leg; 4],
 }
 
 impl Walker {
     /// Number of envelope points per leg ([`Walker::envelope`]).
     pub const ENVELOPE_SAMPLES: usize = 17;
 
-    /// Validates the parameters (those of [`Gait::new`] at zero velocity, and `R > 0`) and the
-    /// reach of the stride cylinder (module docs; a failure names `reach_radius_m`), and starts
-    /// at phase 0 standing on the neutral footholds with a zero command. The reach checks run
-    /// on the [`DefaultMath`](crate::DefaultMath) backend.
-    pub fn new(p: WalkerParams) -> Result<Walker, Error> {
-        Gait::new(p.gait_params(Velocity::default()))?;
-        let walker = Self::without_reach_check(p)?;
+    /// Validates the parameters (those of [`Gait::new`] on `robot` at zero velocity, and
+    /// `R > 0`) and the reach of the stride cylinder (module docs; a failure names
+    /// `reach_radius_m`), and starts at phase 0 standing on the neutral footholds (`robot`'s
+    /// [`Robot::stance_feet`] at `H`) with a zero command. The reach checks run on the
+    /// [`DefaultMath`](crate::DefaultMath) backend.
+    pub fn new(robot: &Robot, p: WalkerParams) -> Result<Walker, Error> {
+        Gait::new(p.gait_params(*robot, Velocity::default()))?;
+        let walker = Self::on_stance(p, robot.stance_feet(p.stance_height_m))?;
         let cfg = walker.body_config();
         for k in 0..Self::ENVELOPE_SAMPLES {
             check_reach(
-                &p.robot,
+                robot,
                 &Pose::default(),
                 &cfg,
                 &walker.envelope(k),
@@ -160,28 +213,35 @@ impl Walker {
         Ok(walker)
     }
 
-    /// [`Walker::new`]'s parameter checks without its reach checks, for a caller that checks
-    /// the reach itself by running the envelope's points through its own IK (a device's
-    /// start check).
-    pub fn without_reach_check(p: WalkerParams) -> Result<Walker, Error> {
-        let gait = Gait::without_reach_check(p.gait_params(Velocity::default()))?;
-        positive(p.reach_radius_m, Param::ReachRadiusM)?;
-        let neutral = gait.neutral_feet();
+    /// [`Walker::new`]'s parameter checks without the robot's validation and the reach checks,
+    /// standing on `neutral_feet` (the robot's [`Robot::stance_feet`] at `H`): for a caller
+    /// that validated its robot already and checks the reach itself by running the envelope's
+    /// points through its own IK (a device's start check).
+    pub fn on_stance(p: WalkerParams, neutral_feet: [Vec3; 4]) -> Result<Walker, Error> {
+        Ok(Self::standing(p.checked()?, &neutral_feet))
+    }
+
+    /// [`Walker::on_stance`] with parameters checked already: at phase 0 standing on
+    /// `neutral_feet` (the robot's [`Robot::stance_feet`] at `H`) with a zero command.
+    pub fn standing(p: CheckedWalkerParams, neutral_feet: &[Vec3; 4]) -> Walker {
         let leg = |n: Vec3| Leg {
             foot: n,
             lift_off: n,
             touch_down: n,
             parked: false,
         };
-        Ok(Walker {
-            p,
-            neutral,
-            legs: neutral.map(leg),
+        Walker {
+            stance_radius_m: p.0.reach_radius_m / p.0.overshoot_factor(),
+            swing_end: 1.0 - p.0.duty_factor,
+            half_stance_s: 0.5 * p.0.duty_factor * p.0.cycle_s,
+            p: p.0,
+            neutral: *neutral_feet,
+            legs: neutral_feet.map(leg),
             phase: 0.0,
             velocity: Velocity::default(),
             stopping: false,
             saturated: false,
-        })
+        }
     }
 
     /// The parameters.
@@ -212,62 +272,60 @@ impl Walker {
             PathKind::Semicircle => self.p.reach_radius_m,
             _ => self.p.step_height_m,
         };
-        // (cos, sin) of the eight directions k·45°.
-        const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
-        const DIRECTIONS: [(f32, f32); 8] = [
-            (1.0, 0.0),
-            (H, H),
-            (0.0, 1.0),
-            (-H, H),
-            (-1.0, 0.0),
-            (-H, -H),
-            (0.0, -1.0),
-            (H, -H),
-        ];
-        let r = self.p.reach_radius_m / COS_PI_8;
-        let (dx, dy, dz) = match k {
-            0..=15 => {
-                let (c, s) = DIRECTIONS[k % 8];
-                let z = if k < 8 { 0.0 } else { apex };
-                (r * c, r * s, z)
+        let mut d = Vec3::ZERO;
+        if k < 16 {
+            // The vertex in direction k·45°: the one at 0° or 45°, turned by quarter turns
+            // (a swap and a sign change each: exact, and no table, which the AVR would hold in
+            // SRAM).
+            let r = self.p.reach_radius_m / COS_PI_8;
+            let (mut x, mut y) = if k % 2 == 0 {
+                (r, 0.0)
+            } else {
+                let h = r * core::f32::consts::FRAC_1_SQRT_2;
+                (h, h)
+            };
+            for _ in 0..(k / 2) % 4 {
+                (x, y) = (-y, x);
             }
-            16 => (0.0, 0.0, apex),
-            _ => (0.0, 0.0, 0.0),
-        };
-        self.neutral.map(|n| n + Vec3::new(dx, dy, dz))
-    }
-
-    /// The Bézier swing's overshoot factor `f` (module docs), 1 for the other shapes.
-    fn overshoot_factor(&self) -> f32 {
-        let d = self.p.duty_factor;
-        match self.p.swing {
-            PathKind::Bezier => 1.0 + 2.0 * (1.0 - d) / (5.0 * d),
-            _ => 1.0,
+            d = Vec3::new(x, y, if k < 8 { 0.0 } else { apex });
+        } else if k == 16 {
+            d.z = apex;
         }
+        core::array::from_fn(|i| self.neutral[i] + d)
     }
 
-    /// Largest horizontal distance of a planned lift-off or touch-down point from its neutral
-    /// foothold under the constant command `v`, m.
-    fn excursion_m<M: Math>(&self, v: &Velocity) -> f32 {
-        let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
-        let mut e: f32 = 0.0;
-        for n in self.neutral {
+    /// True when every lift-off and touch-down point planned under the constant command `v`
+    /// lies within `sqrt(radius_sq)` of its neutral foothold, horizontally.
+    ///
+    /// Inline in its one caller: out of line, LLVM passes the command through memory and the
+    /// velocity check grows on the AVR.
+    #[inline(always)]
+    fn footholds_within<M: Math>(&self, v: &Velocity, radius_sq: f32) -> bool {
+        let half = self.half_stance_s;
+        for &n in &self.neutral {
             for s in [half, -half] {
-                let q = displace::<M>(v, s, n) - n;
-                e = e.max(M::sqrt(q.x * q.x + q.y * q.y));
+                if !(off_sq(&displace::<M>(v, s, n), &n) <= radius_sq) {
+                    return false;
+                }
             }
         }
-        e
+        true
     }
 
     /// Checks a velocity command: finite components, `|ω|·d·T ≤ π`, and the planned footholds
     /// within the stride disc (module docs). A component that is too large on its own is named
     /// (`forward_m_s`, `lateral_m_s`, `yaw_rad_s`); a combination that is, `velocity`.
     pub fn check_velocity<M: Math>(&self, v: &Velocity) -> Result<(), Error> {
+        // Each component alone, then all three together.
+        const NAMES: [Param; 4] = [
+            Param::ForwardMS,
+            Param::LateralMS,
+            Param::YawRadS,
+            Param::Velocity,
+        ];
         finite(v.forward_m_s, Param::ForwardMS)?;
         finite(v.lateral_m_s, Param::LateralMS)?;
         finite(v.yaw_rad_s, Param::YawRadS)?;
-        const EXPECTED: Expected = Expected::WithinGaitReach;
         let stance_s = self.p.duty_factor * self.p.cycle_s;
         if !(libm::fabsf(v.yaw_rad_s) * stance_s <= core::f32::consts::PI) {
             return Err(Error::OutOfRange {
@@ -275,36 +333,22 @@ impl Walker {
                 expected: Expected::HalfTurnPerStance,
             });
         }
-        let limit = self.p.reach_radius_m / self.overshoot_factor();
-        let zero = Velocity::default();
-        for (single, name) in [
-            (
-                Velocity {
-                    forward_m_s: v.forward_m_s,
-                    ..zero
-                },
-                Param::ForwardMS,
-            ),
-            (
-                Velocity {
-                    lateral_m_s: v.lateral_m_s,
-                    ..zero
-                },
-                Param::LateralMS,
-            ),
-            (
-                Velocity {
-                    yaw_rad_s: v.yaw_rad_s,
-                    ..zero
-                },
-                Param::YawRadS,
-            ),
-            (*v, Param::Velocity),
-        ] {
-            if !(self.excursion_m::<M>(&single) <= limit) {
+        let r = self.stance_radius_m;
+        for (k, &name) in NAMES.iter().enumerate() {
+            let mut single = *v;
+            if k != 0 && k != 3 {
+                single.forward_m_s = 0.0;
+            }
+            if k != 1 && k != 3 {
+                single.lateral_m_s = 0.0;
+            }
+            if k != 2 && k != 3 {
+                single.yaw_rad_s = 0.0;
+            }
+            if !self.footholds_within::<M>(&single, r * r) {
                 return Err(Error::OutOfRange {
                     parameter: name,
-                    expected: EXPECTED,
+                    expected: Expected::WithinGaitReach,
                 });
             }
         }
@@ -314,7 +358,7 @@ impl Walker {
     /// The largest forward speed admitted alone, m/s: `2·R / (f·d·T)`.
     pub fn max_forward_m_s(&self) -> f32 {
         2.0 * self.p.reach_radius_m
-            / (self.overshoot_factor() * self.p.duty_factor * self.p.cycle_s)
+            / (self.p.overshoot_factor() * self.p.duty_factor * self.p.cycle_s)
     }
 
     /// Sets the velocity command after [`Walker::check_velocity`]; it acts on the stance feet
@@ -360,120 +404,123 @@ impl Walker {
         self.phase
     }
 
-    /// Phase of `leg` at global phase `phase`.
-    fn leg_phase(&self, leg: usize, phase: f32) -> f32 {
-        fract01(phase + self.p.phase_offsets[leg])
-    }
-
     /// True when leg phase `q` is in the swing.
     fn in_swing(&self, q: f32) -> bool {
-        q < 1.0 - self.p.duty_factor
+        q < self.swing_end
     }
 
-    /// The touch-down point of `leg` planned now: `X(d·T/2)·n` with the current command.
-    fn plan<M: Math>(&self, leg: usize) -> Vec3 {
-        let n = self.neutral[leg];
-        if self.velocity == Velocity::default() {
-            return n;
+    /// Moves `p` by the body displacement `X(rate·s)` of the current command, when there is a
+    /// command and `s > 0`: a stance foot over `s` seconds of the body moving by `scale` times
+    /// the command is `rate = −scale`, a touch-down point planned `s = d·T/2` ahead `rate = 1`.
+    /// A zero command leaves `p` exactly where it is (a stop parks on the neutral foothold).
+    ///
+    /// Out of line: one copy of the displacement's call for the three uses of a step.
+    #[inline(never)]
+    fn carry<M: Math>(&self, p: &mut Vec3, s: f32, rate: f32) {
+        if self.velocity != Velocity::default() && s > 0.0 {
+            *p = displace::<M>(&self.velocity, rate * s, *p);
         }
-        let half = 0.5 * self.p.duty_factor * self.p.cycle_s;
-        displace::<M>(&self.velocity, half, n)
-    }
-
-    /// Squared horizontal distance of `p` from the neutral foothold of `leg`, m².
-    fn off_neutral_sq(&self, leg: usize, p: Vec3) -> f32 {
-        let q = p - self.neutral[leg];
-        q.x * q.x + q.y * q.y
     }
 
     /// Advances by `dt_s` (> 0, less than the shorter of swing and stance; one servo frame) on
     /// math backend `M`. A non-finite or non-positive `dt_s` is refused and changes nothing.
+    #[inline(never)]
     pub fn step<M: Math>(&mut self, dt_s: f32) -> Result<(), Error> {
         positive(dt_s, Param::DtS)?;
         let old = self.phase;
-        let new = fract01(old + dt_s / self.p.cycle_s);
         // Stance feet within R/f: a swing from there overshoots by at most the factor.
-        let r = self.p.reach_radius_m / self.overshoot_factor();
-        let r_sq = r * r;
+        let r = self.stance_radius_m;
+        let mut span = Span {
+            old,
+            new: fract01(old + dt_s / self.p.cycle_s),
+            dt_s,
+            scale: 1.0,
+            r_sq: r * r,
+        };
         self.saturated = false;
-        let mut scale = 1.0;
         let mut next = self.legs;
         for _ in 0..5 {
             let mut inside = true;
             for (i, leg) in next.iter_mut().enumerate() {
-                *leg = self.advance_leg::<M>(i, old, new, dt_s, scale);
-                let l = &self.legs[i];
-                let stance = !self.in_swing(self.leg_phase(i, new));
-                // A foot already outside (it cannot be, by the checks) may stay.
-                if stance
-                    && !leg.parked
-                    && self.off_neutral_sq(i, leg.foot) > r_sq
-                    && self.off_neutral_sq(i, leg.foot) > self.off_neutral_sq(i, l.foot)
-                {
-                    inside = false;
-                }
+                *leg = self.legs[i];
+                inside &= self.advance_leg::<M>(i, leg, &span);
             }
-            if inside || scale == 0.0 {
+            if inside || span.scale == 0.0 {
                 break;
             }
             self.saturated = true;
-            scale = if scale > 0.2 { 0.5 * scale } else { 0.0 };
+            span.scale = if span.scale > 0.2 {
+                0.5 * span.scale
+            } else {
+                0.0
+            };
         }
         self.legs = next;
-        self.phase = new;
+        self.phase = span.new;
         Ok(())
     }
 
-    /// Leg `i` after a step from global phase `old` to `new` (`dt_s` long), the body moving by
-    /// `scale` times the command.
+    /// Advances leg `i`'s state `l` over `span`. False when the leg ends the step in stance
+    /// with its foot moved farther out, beyond `R/f` (the step must move the body less). A
+    /// foot already outside (it cannot be, by the checks) may stay.
     ///
     /// Out of line: one copy in the step's retry loop, and a small stack frame on targets
     /// where large frames are costly (the ATmega2560).
     #[inline(never)]
-    fn advance_leg<M: Math>(&self, i: usize, old: f32, new: f32, dt_s: f32, scale: f32) -> Leg {
-        let mut l = self.legs[i];
+    fn advance_leg<M: Math>(&self, i: usize, l: &mut Leg, span: &Span) -> bool {
         if l.parked {
-            return l;
+            return true;
         }
+        let n = &self.neutral[i];
+        let before_sq = off_sq(&l.foot, n);
         let t = self.p.cycle_s;
-        let swing_end = 1.0 - self.p.duty_factor;
-        let (q0, q1) = (self.leg_phase(i, old), self.leg_phase(i, new));
-        // The foot fixed in the world for `s` seconds of this step.
-        let stance_for = |p: Vec3, s: f32| {
-            if self.velocity == Velocity::default() || !(s > 0.0) {
-                p
+        let o = self.p.phase_offsets[i];
+        let (q0, q1) = (leg_phase(o, span.old), leg_phase(o, span.new));
+        // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
+        let lift_off = q1 < q0;
+        let stance_only = !lift_off && !self.in_swing(q0);
+        if lift_off || stance_only {
+            // The foot fixed in the world up to the lift-off or the step's end.
+            let s = if lift_off {
+                ((1.0 - q0) * t).min(span.dt_s)
             } else {
-                displace::<M>(&self.velocity, -s * scale, p)
-            }
-        };
-        if q1 < q0 {
-            // Wrapped through 1 → 0: lift-off, after `(1 − q0)·T` of stance.
-            let foot = stance_for(l.foot, ((1.0 - q0) * t).min(dt_s));
-            if self.stopping && foot == self.neutral[i] {
-                l.foot = foot;
+                span.dt_s
+            };
+            self.carry::<M>(&mut l.foot, s, -span.scale);
+        }
+        if lift_off {
+            if self.stopping && l.foot == *n {
                 l.parked = true;
-                return l;
+                return true;
             }
-            l.lift_off = foot;
-            l.touch_down = self.plan::<M>(i);
-        } else if !self.in_swing(q0) {
-            l.foot = stance_for(l.foot, dt_s);
-            return l;
+            l.lift_off = l.foot;
+            // The touch-down point planned now: `X(d·T/2)·n` with the current command.
+            l.touch_down = *n;
+            self.carry::<M>(&mut l.touch_down, self.half_stance_s, 1.0);
         }
-        if self.in_swing(q1) {
-            l.foot = swing_foot::<M>(
-                self.p.swing,
-                self.p.step_height_m,
-                self.p.duty_factor,
-                l.lift_off,
-                l.touch_down,
-                Phase::wrap(q1),
-            );
-        } else {
+        if !stance_only {
+            if self.in_swing(q1) {
+                l.foot = swing_foot::<M>(
+                    self.p.swing,
+                    self.p.step_height_m,
+                    self.p.duty_factor,
+                    l.lift_off,
+                    l.touch_down,
+                    // A leg phase is in [0, 1) already.
+                    Phase(q1),
+                );
+                return true;
+            }
             // Touch-down in this step, `(q1 − (1 − d))·T` ago.
-            l.foot = stance_for(l.touch_down, ((q1 - swing_end) * t).min(dt_s));
+            l.foot = l.touch_down;
+            self.carry::<M>(
+                &mut l.foot,
+                ((q1 - self.swing_end) * t).min(span.dt_s),
+                -span.scale,
+            );
         }
-        l
+        let after_sq = off_sq(&l.foot, n);
+        !(after_sq > span.r_sq && after_sq > before_sq)
     }
 
     /// Feet and contacts now; the body stays at the zero pose, so the world frame is the body
@@ -481,19 +528,44 @@ impl Walker {
     pub fn frame(&self) -> Frame {
         let mut contact = [Contact::Stance; 4];
         for (i, c) in contact.iter_mut().enumerate() {
-            if !self.legs[i].parked && self.in_swing(self.leg_phase(i, self.phase)) {
+            if !self.legs[i].parked && self.in_swing(leg_phase(self.p.phase_offsets[i], self.phase))
+            {
                 *c = Contact::Swing;
             }
         }
         Frame {
             pose: Pose::default(),
-            feet_in_world: self.legs.map(|l| l.foot),
+            feet_in_world: self.feet(),
             contact,
         }
+    }
+
+    /// The four feet now, body frame, m ([`Walker::frame`]'s without the contacts).
+    pub fn feet(&self) -> [Vec3; 4] {
+        // Borrowed, not `map`ped: the legs' whole states would be copied first.
+        core::array::from_fn(|i| self.legs[i].foot)
     }
 
     /// Foot of `leg` now, body frame, m.
     pub fn foot(&self, leg: LegId) -> Vec3 {
         self.legs[leg.index()].foot
     }
+}
+
+/// Squared horizontal distance of `p` from `n`, m².
+///
+/// Out of line and by reference: the step and the velocity check use it at three places, each
+/// then a call with two pointers.
+#[inline(never)]
+fn off_sq(p: &Vec3, n: &Vec3) -> f32 {
+    let q = *p - *n;
+    q.x * q.x + q.y * q.y
+}
+
+/// Phase of a leg with phase offset `offset` at global phase `phase`, cycles in `[0, 1)`.
+///
+/// Out of line: a step wraps two phases per leg, each a few soft-float calls.
+#[inline(never)]
+fn leg_phase(offset: f32, phase: f32) -> f32 {
+    fract01(phase + offset)
 }

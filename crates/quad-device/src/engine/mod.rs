@@ -94,7 +94,7 @@ use kin_core::motion::path::{AnyPath, PathKind, Stride};
 use kin_core::motion::walker::{Walker, WalkerParams};
 use kin_core::motion::{self, AnyMotion, Frame, Motion, Param};
 use kin_core::preflight::{Failure, FailureKind};
-use kin_core::{IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder};
+use kin_core::{IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo;
 use quad_protocol::ServoId;
 
@@ -405,17 +405,22 @@ enum Program {
 }
 
 /// The motion engine (module docs), on kin-core math backend `M`.
+///
+/// The fields are laid out in declaration order, the small ones first: on the AVR a field
+/// within 63 bytes of the engine's address is one load instruction, one beyond costs a pointer
+/// adjustment at each access.
 #[derive(Debug, Clone, Copy)]
+#[repr(C)]
 pub struct Engine<M> {
-    program: Program,
     stage: Stage,
+    /// Frames run since [`Stage::Run`] began.
+    frame: u32,
+    limiter: Limiter,
+    fault: Option<Error>,
+    program: Program,
     ramp: Ramp,
     /// Where the motion ends (stance or rest angles).
     home: [f32; 12],
-    /// Frames run since [`Stage::Run`] began.
-    frame: u32,
-    fault: Option<Error>,
-    limiter: Limiter,
     _math: PhantomData<fn() -> M>,
 }
 
@@ -832,12 +837,15 @@ impl<M: Math> Engine<M> {
         if w.velocity_timeout_ms == 0 {
             return Err(motion::Error::NotPositive(Param::VelocityTimeoutMs).into());
         }
-        let mut p = WalkerParams::new(w.pattern, *s.robot, w.body_height_m);
+        let mut p = WalkerParams::new(w.pattern, w.body_height_m);
         p.step_height_m = w.step_height_m;
         p.cycle_s = w.cycle_s;
         p.order = s.order;
+        let p = p.checked()?;
+        // The device validated its robot at boot.
+        let stance = s.robot.stance_feet(w.body_height_m);
         *program = Program::Walk {
-            walker: Walker::without_reach_check(p)?,
+            walker: Walker::standing(p, &stance),
             timeout_ms: w.velocity_timeout_ms,
             last_command_ms: s.now_ms,
         };
@@ -846,15 +854,11 @@ impl<M: Math> Engine<M> {
 
     #[inline(never)]
     fn check_walk(walker: &Walker, s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
-        let solved = Self::walk_setpoint(walker, s.solver);
+        let order = walker.params().order;
+        let solved = Self::walk_setpoint(s.solver, order, &walker.feet());
         let first = *check_sample::<M>(s, 0, 0.0, &solved, true)?;
         for k in 0..Walker::ENVELOPE_SAMPLES {
-            let frame = Frame {
-                pose: Pose::default(),
-                feet_in_world: walker.envelope(k),
-                contact: [motion::Contact::Stance; 4],
-            };
-            let solved = solve_frame(s.solver, s.order, &frame);
+            let solved = Self::walk_setpoint(s.solver, order, &walker.envelope(k));
             // Sample 0 is the first frame; the envelope's points follow, without the
             // singularity measure (see the module docs).
             check_sample::<M>(s, k as u16 + 1, 0.0, &solved, false)?;
@@ -900,11 +904,20 @@ impl<M: Math> Engine<M> {
         solve_frame(solver, law.motion.body_config().order, &frame)
     }
 
-    /// The walk's joint setpoint at its current frame.
+    /// The walk's joint setpoint with its feet at `feet` (body frame, the body at the zero pose;
+    /// the contacts do not enter the IK), through `solver`.
     #[inline(never)]
-    fn walk_setpoint(walker: &Walker, solver: &body::Solver<M>) -> Result<[f32; 12], IkError> {
-        let p = walker.params();
-        solve_frame(solver, p.order, &walker.frame())
+    fn walk_setpoint(
+        solver: &body::Solver<M>,
+        order: RotationOrder,
+        feet: &[Vec3; 4],
+    ) -> Result<[f32; 12], IkError> {
+        let frame = Frame {
+            pose: Pose::default(),
+            feet_in_world: *feet,
+            contact: [motion::Contact::Stance; 4],
+        };
+        solve_frame(solver, order, &frame)
     }
 
     /// Sets a walk's velocity command at `now_ms`.
@@ -1060,7 +1073,10 @@ impl<M: Math> Engine<M> {
                             let _ = walker.step::<M>(FRAME_S);
                         }
                         self.frame = self.frame.saturating_add(frames);
-                        (Self::walk_setpoint(walker, solver), walker.is_stopped())
+                        (
+                            Self::walk_setpoint(solver, walker.params().order, &walker.feet()),
+                            walker.is_stopped(),
+                        )
                     }
                     _ => {
                         self.cancel();
