@@ -393,7 +393,7 @@ impl<M: Math> Solver<M> {
         };
         for (i, leg) in LegId::ALL.into_iter().enumerate() {
             self.leg
-                .inverse_into(leg, local[i], policy, &mut out.legs[i])?;
+                .inverse_into(leg, &local[i], policy, &mut out.legs[i])?;
         }
         Ok(out)
     }

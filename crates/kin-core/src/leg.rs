@@ -557,11 +557,11 @@ impl<M: Math> Solver<M> {
     pub(crate) fn inverse_into(
         &self,
         leg: LegId,
-        foot_in_hip: Vec3,
+        foot_in_hip: &Vec3,
         policy: ReachPolicy,
         out: &mut LegSolution,
     ) -> Result<(), IkError> {
-        *out = self.inverse_inline(leg, foot_in_hip, policy)?;
+        *out = self.inverse_inline(leg, *foot_in_hip, policy)?;
         Ok(())
     }
 
