@@ -275,13 +275,15 @@ impl<M: Math> Solver<M> {
     ) -> [Vec3; 4] {
         let r: Mat3 =
             rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
-        let [r0, r1, r2] = r.rows.map(Vec3::from_array);
+        // The rows read where they are used: a copy of the matrix (`rows.map`) would take
+        // another 36 bytes of the stack frame.
+        let row = |i: usize| Vec3::from_array(r.rows[i]);
         let c = config.pivot_m;
         let pivot = !is_zero(c);
         let t = pose.translation();
         // K = Rᵀ·(t + c) + H·r₂ − c.
         let k = if !pivot && is_zero(t) {
-            r2 * stance_height_m
+            row(2) * stance_height_m
         } else {
             let g = if pivot { t + c } else { t };
             let k = r.transpose_mul_vec(Vec3::new(g.x, g.y, g.z + stance_height_m));
@@ -292,13 +294,15 @@ impl<M: Math> Solver<M> {
             }
         };
         let hl = self.hip_fl_m.x;
-        let a = r0 * hl;
+        let a = row(0) * hl;
         let a = Vec3::new(a.x - hl, a.y, a.z);
-        let b = r1 * self.stance_lateral_m;
-        let b = Vec3::new(b.x, b.y - self.hip_fl_m.y, b.z);
-        // Front: a − K ± b; rear: −(a + K) ± b (left +, right −).
+        // Front: a − K ± b; rear: −(a + K) ± b (left +, right −). In this order, `a` and `K`
+        // are dead before `b` is computed (fewer values held across the float calls of CPUs
+        // without floating-point hardware).
         let front = a - k;
         let rear = -(a + k);
+        let b = row(1) * self.stance_lateral_m;
+        let b = Vec3::new(b.x, b.y - self.hip_fl_m.y, b.z);
         [front + b, front - b, rear + b, rear - b]
     }
 
