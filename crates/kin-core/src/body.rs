@@ -286,12 +286,9 @@ impl<M: Math> Solver<M> {
             row(2) * stance_height_m
         } else {
             let g = if pivot { t + c } else { t };
-            let k = r.transpose_mul_vec(Vec3::new(g.x, g.y, g.z + stance_height_m));
-            if pivot {
-                k - c
-            } else {
-                k
-            }
+            // `− c` whether or not there is a pivot (`c = ±0` then): a test here made the
+            // compiler copy the product above into both of its arms.
+            r.transpose_mul_vec(Vec3::new(g.x, g.y, g.z + stance_height_m)) - c
         };
         let hl = self.hip_fl_m.x;
         let a = row(0) * hl;
