@@ -2,7 +2,8 @@
 //! answer bytes out.
 
 use crate::config::{
-    validate_pose_config, write_default_calibration, Config, ConfigError, UNBOOTED_CALIBRATION,
+    validate_pose_config, write_default_calibration, Config, ConfigError, ValidConfig,
+    UNBOOTED_CALIBRATION,
 };
 use crate::engine::{self, Engine, Limiter, Setup, FRAME_MS};
 use crate::hal::{Clock, ServoOutputs, Storage};
@@ -145,18 +146,23 @@ where
     ///
     /// # Errors
     /// [`Config::validate`]'s error.
-    pub fn stopped(
-        config: Config,
-        mut outputs: O,
-        clock: C,
-        storage: S,
-    ) -> Result<Self, ConfigError> {
-        config.validate()?;
-        let limiter = Limiter::new(config.joint_speed_limit_rad_s)
-            .map_err(|_| ConfigError::JointSpeedLimit)?;
+    pub fn stopped(config: Config, outputs: O, clock: C, storage: S) -> Result<Self, ConfigError> {
+        Ok(Self::stopped_valid(
+            ValidConfig::new(config)?,
+            outputs,
+            clock,
+            storage,
+        ))
+    }
+
+    /// [`Device::stopped`] on a configuration validated already (infallible): a firmware
+    /// whose configuration is a constant validates it at compile time
+    /// ([`ValidConfig::checked`]) and carries no validation code.
+    pub fn stopped_valid(valid: ValidConfig, mut outputs: O, clock: C, storage: S) -> Self {
+        let config = *valid.config();
         outputs.set_enabled(false);
         let now = clock.now_ms();
-        Ok(Device {
+        Device {
             outputs,
             clock,
             storage,
@@ -176,11 +182,11 @@ where
             calibration_default: true,
             last_valid_ms: now,
             last_framing_nack_ms: None,
-            engine: Engine::new(limiter),
+            engine: Engine::new(*valid.limiter()),
             out_rad: [0.0; 12],
             next_frame: now,
             enabling_frame: false,
-        })
+        }
     }
 
     /// The second half of [`Device::new`], once, on a controller from [`Device::stopped`]:
