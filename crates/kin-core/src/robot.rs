@@ -405,23 +405,25 @@ impl Robot {
         // Integer tests of the bit patterns, equal to the float comparisons they replace (a
         // software-float comparison is a library call on CPUs without floating-point hardware,
         // and a firmware's engine validates its robot before every motion).
-        let lengths = [
-            (positive_finite(self.leg.femur_m), "femur_m"),
-            (positive_finite(self.leg.tibia_m), "tibia_m"),
-            (nonneg_finite(self.leg.d_lat_m), "d_lat_m"),
-            (nonneg_finite(self.leg.d_ax_m), "d_ax_m"),
-            (nonneg_finite(self.body_length_m), "body_length_m"),
-            (nonneg_finite(self.body_width_m), "body_width_m"),
-        ];
-        // Index loops: iterators are not available in a `const fn`.
-        let mut i = 0;
-        while i < lengths.len() {
-            let (ok, name) = lengths[i];
-            if !ok {
-                return Err(RobotError::BadLength(name));
-            }
-            i += 1;
+        let bad_length = if !positive_finite(self.leg.femur_m) {
+            "femur_m"
+        } else if !positive_finite(self.leg.tibia_m) {
+            "tibia_m"
+        } else if !nonneg_finite(self.leg.d_lat_m) {
+            "d_lat_m"
+        } else if !nonneg_finite(self.leg.d_ax_m) {
+            "d_ax_m"
+        } else if !nonneg_finite(self.body_length_m) {
+            "body_length_m"
+        } else if !nonneg_finite(self.body_width_m) {
+            "body_width_m"
+        } else {
+            ""
+        };
+        if !bad_length.is_empty() {
+            return Err(RobotError::BadLength(bad_length));
         }
+        // An index loop: iterators are not available in a `const fn`.
         let mut j = 0;
         while j < Joint::ALL.len() {
             if !finite_ordered(self.limits.min_rad[j], self.limits.max_rad[j]) {
