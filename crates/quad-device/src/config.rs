@@ -8,7 +8,7 @@ use kin_core::body;
 use kin_core::robot::RobotError;
 use kin_core::{BodyConfig, LegId, Math, ReachPolicy, Robot, RotationOrder};
 use quad_protocol::servo::{Calibration, STANDARD_US_PER_RAD};
-use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, RobotPreset};
+use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, Ranges, RobotPreset};
 
 /// Default stance height of [`Robot::fernando2025`]: seed 001's initial pose (eq. 5, α = 60°,
 /// φ = 120°), `H = l0 + (l1 + l2)·sin 60°`, m.
@@ -159,7 +159,8 @@ impl Config {
     }
 }
 
-/// A [`Config`] that passed [`Config::validate`], with the limiter of its joint-speed limit:
+/// A [`Config`] that passed [`Config::validate`], with the limiter of its joint-speed limit
+/// and the request ranges of its robot:
 /// what [`crate::Device::stopped_valid`] builds a controller from without checking again. A
 /// constant one (`const C: ValidConfig = ValidConfig::checked(…)`) is checked at compile
 /// time, so that a firmware carries no validation code for it.
@@ -167,6 +168,7 @@ impl Config {
 pub struct ValidConfig {
     config: Config,
     limiter: Limiter,
+    ranges: Ranges,
 }
 
 impl ValidConfig {
@@ -179,7 +181,11 @@ impl ValidConfig {
             return Err(e);
         }
         match Limiter::new(config.joint_speed_limit_rad_s) {
-            Ok(limiter) => Ok(ValidConfig { config, limiter }),
+            Ok(limiter) => Ok(ValidConfig {
+                config,
+                limiter,
+                ranges: Ranges::of(&config.robot),
+            }),
             Err(_) => Err(ConfigError::JointSpeedLimit),
         }
     }
@@ -204,6 +210,11 @@ impl ValidConfig {
     /// The limiter of [`Config::joint_speed_limit_rad_s`].
     pub const fn limiter(&self) -> &Limiter {
         &self.limiter
+    }
+
+    /// The request ranges of [`Config::robot`].
+    pub const fn ranges(&self) -> &Ranges {
+        &self.ranges
     }
 }
 

@@ -14,9 +14,9 @@ use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{self, Calibration};
 use quad_protocol::{
-    check_request, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags,
-    HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
-    Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    check_request_in, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed,
+    Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges, Readback,
+    Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -88,6 +88,8 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     /// products of the link lengths) would otherwise be computed again for every request.
     solver: body::Solver<M>,
     calibration: Table,
+    /// The request ranges of `config.robot` (the robot never changes).
+    ranges: Ranges,
     store: Store,
     acc: Accumulator<RX_LEN>,
     held: Option<Held>,
@@ -168,6 +170,7 @@ where
             storage,
             calibration: UNBOOTED_CALIBRATION,
             store: Store::new(config.storage_base),
+            ranges: *valid.ranges(),
             solver: body::Solver::<M>::with_math(&config.robot),
             config,
             acc: Accumulator::new(),
@@ -457,7 +460,7 @@ where
     fn answer(&mut self, msg: &HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
         // The host's own check (`Ok` for the requests answered before the handshake).
-        let in_range = check_range(&msg.request, &self.config.robot);
+        let in_range = check_range(&msg.request, &self.ranges);
         let result = match msg.request {
             Request::Hello { version } => {
                 return if is_compatible(version) {
@@ -872,11 +875,11 @@ pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
     encode_frame(answer, out).map_or(0, <[u8]>::len)
 }
 
-/// [`check_request`], out of line: inlined into [`Device::answer`], its copies of the request's
+/// [`check_request_in`], out of line: inlined into [`Device::answer`], its copies of the request's
 /// values took the dispatcher's stack frame beyond the AVR's 63-byte displacement.
 #[inline(never)]
-fn check_range(request: &Request, robot: &kin_core::Robot) -> Result<(), NackReason> {
-    check_request(request, robot)
+fn check_range(request: &Request, ranges: &Ranges) -> Result<(), NackReason> {
+    check_request_in(request, ranges)
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {
