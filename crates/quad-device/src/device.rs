@@ -198,12 +198,15 @@ where
     /// the nominal stance (zero body pose) when it maps within that calibration.
     #[inline(never)]
     pub fn boot(&mut self) {
-        write_default_calibration(
-            &self.solver,
-            &self.config.pose_config,
-            &mut self.calibration,
-        );
         self.calibration_default = !self.load_calibration();
+        if self.calibration_default {
+            // Also over a table that a failing load left half-read.
+            write_default_calibration(
+                &self.solver,
+                &self.config.pose_config,
+                &mut self.calibration,
+            );
+        }
         // The stance may not map within a stored calibration: then nothing is held.
         let _ = self.set_body_pose(&Pose::default());
     }
