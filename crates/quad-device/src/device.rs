@@ -12,7 +12,7 @@ use kin_core::body::{self, BodySolution, Pose};
 use kin_core::motion::gait::Velocity;
 use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
-use quad_protocol::servo::{self, Calibration};
+use quad_protocol::servo::Calibration;
 use quad_protocol::{
     check_request_in, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed,
     Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges, Readback,
@@ -355,12 +355,11 @@ where
     /// Makes a motion setpoint the held target, after mapping it through the calibration.
     fn hold_motion_target(&mut self, angles_rad: [f32; 12]) -> Result<(), engine::Error> {
         let mut pulses_half_us = [0u16; 12];
-        map_pulses(&self.calibration, &angles_rad, &mut pulses_half_us, false).map_err(
-            |(servo, fault)| engine::Error::ServoRange {
-                servo,
-                fault: fault.unwrap_or(servo::Error::NonFiniteAngle),
-            },
-        )?;
+        for s in ServoId::ALL {
+            pulses_half_us[s.index()] = self.calibration[s.index()]
+                .pulse_half_us(angles_rad[s.index()])
+                .map_err(|fault| engine::Error::ServoRange { servo: s, fault })?;
+        }
         self.held = Some(Held {
             angles_rad,
             pulses_half_us,
@@ -718,16 +717,20 @@ where
         limited: bool,
     ) -> Result<(), NackReason> {
         let mut pulses_half_us = [0u16; 12];
-        map_pulses(&self.calibration, &angles_rad, &mut pulses_half_us, true).map_err(
-            |(s, fault)| match fault {
-                Some(fault) => NackReason::ServoRange {
-                    leg: s.leg,
-                    joint: s.joint,
-                    fault,
-                },
-                None => NackReason::NonFinite,
-            },
-        )?;
+        for s in ServoId::ALL {
+            let a = angles_rad[s.index()];
+            if !a.is_finite() {
+                return Err(NackReason::NonFinite);
+            }
+            pulses_half_us[s.index()] =
+                self.calibration[s.index()]
+                    .pulse_half_us(a)
+                    .map_err(|fault| NackReason::ServoRange {
+                        leg: s.leg,
+                        joint: s.joint,
+                        fault,
+                    })?;
+        }
         self.held = Some(Held {
             angles_rad,
             pulses_half_us,
@@ -748,9 +751,17 @@ where
     /// targets).
     fn write_out(&mut self) -> bool {
         let mut pulses = [0u16; 12];
-        if map_pulses(&self.calibration, &self.out_rad, &mut pulses, false).is_err() {
-            self.stop_outputs();
-            return false;
+        for (p, (c, &a)) in pulses
+            .iter_mut()
+            .zip(self.calibration.iter().zip(&self.out_rad))
+        {
+            match c.pulse_half_us(a) {
+                Ok(v) => *p = v,
+                Err(_) => {
+                    self.stop_outputs();
+                    return false;
+                }
+            }
         }
         self.outputs.set_pulses(&pulses);
         true
@@ -838,29 +849,6 @@ where
         self.config.pose_config = p;
         Ok(())
     }
-}
-
-/// Maps twelve angles through their servos' calibrations into `pulses_half_us`, in
-/// [`ServoId::ALL`] order, up to the first that does not map: that servo and why (`None`: a
-/// non-finite angle, tested before the mapping when `finite_first`). The one mapping loop of
-/// the requests, the motion targets and the outputs.
-#[inline(never)]
-fn map_pulses(
-    calibration: &Table,
-    angles_rad: &[f32; 12],
-    pulses_half_us: &mut [u16; 12],
-    finite_first: bool,
-) -> Result<(), (ServoId, Option<servo::Error>)> {
-    for s in ServoId::ALL {
-        let a = angles_rad[s.index()];
-        if finite_first && !a.is_finite() {
-            return Err((s, None));
-        }
-        pulses_half_us[s.index()] = calibration[s.index()]
-            .pulse_half_us(a)
-            .map_err(|fault| (s, Some(fault)))?;
-    }
-    Ok(())
 }
 
 /// The device's receive path: the protocol's frame decoder (postcard) on the accumulator.
