@@ -36,15 +36,13 @@ fn the_firmwares_pulses_equal_the_device_controllers() {
         let Some(expected) = previous.replace(a.pulses_half_us) else {
             continue;
         };
-        for i in 0..12 {
-            let d = expected[i].abs_diff(b.pulses_half_us[i]);
+        for (i, (&want, &got)) in expected.iter().zip(&b.pulses_half_us).enumerate() {
+            let d = want.abs_diff(got);
             worst = worst.max(d);
             assert!(
                 d <= PULSE_TOLERANCE_HALF_US,
-                "frame {k} servo {i}: device (frame {}) {} firmware {} half-µs",
+                "frame {k} servo {i}: device (frame {}) {want} firmware {got} half-µs",
                 k - 1,
-                expected[i],
-                b.pulses_half_us[i]
             );
         }
     }
