@@ -405,8 +405,16 @@ impl<M: Math> Solver<M> {
 #[inline(always)]
 fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = config.pivot_m;
-    let ok =
-        pose.to_array().iter().all(|&v| finite(v)) && finite(p.x) && finite(p.y) && finite(p.z);
+    // Field by field, without copying the pose into an array first.
+    let ok = finite(pose.roll_rad)
+        && finite(pose.pitch_rad)
+        && finite(pose.yaw_rad)
+        && finite(pose.x_m)
+        && finite(pose.y_m)
+        && finite(pose.z_m)
+        && finite(p.x)
+        && finite(p.y)
+        && finite(p.z);
     if ok {
         Ok(())
     } else {
