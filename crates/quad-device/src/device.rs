@@ -805,16 +805,17 @@ where
     fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), NackReason> {
         c.validate().map_err(NackReason::BadCalibration)?;
         let i = servo.index();
-        if let Some(held) = &mut self.held {
-            let pulse =
-                c.pulse_half_us(held.angles_rad[i])
-                    .map_err(|fault| NackReason::ServoRange {
-                        leg: servo.leg,
-                        joint: servo.joint,
-                        fault,
-                    })?;
-            held.pulses_half_us[i] = pulse;
-        }
+        // Both checks before anything changes: a refusal leaves the held pulses as they were.
+        let held_pulse = match &self.held {
+            Some(held) => Some(c.pulse_half_us(held.angles_rad[i]).map_err(|fault| {
+                NackReason::ServoRange {
+                    leg: servo.leg,
+                    joint: servo.joint,
+                    fault,
+                }
+            })?),
+            None => None,
+        };
         if self.outputs_enabled {
             // The outputs may still be on their way to the held angle.
             c.pulse_half_us(self.out_rad[i])
@@ -823,6 +824,9 @@ where
                     joint: servo.joint,
                     fault,
                 })?;
+        }
+        if let (Some(held), Some(pulse)) = (&mut self.held, held_pulse) {
+            held.pulses_half_us[i] = pulse;
         }
         if self.calibration[i] != c {
             self.calibration[i] = c;
