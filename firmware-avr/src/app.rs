@@ -33,10 +33,11 @@ use crate::servo::Servos;
 use crate::usart::{Baud, Usart0};
 use crate::watchdog::{self, Timeout, Watchdog};
 use avr_libc_math::AvrFast;
-use quad_device::{Config, Device};
+use quad_device::{Config, Device, ValidConfig};
 
-/// What the device runs: seed 000's robot with the controller's defaults.
-pub const DEVICE_CONFIG: Config = Config::shahriar2023();
+/// What the device runs: seed 000's robot with the controller's defaults, validated when the
+/// firmware is built (an invalid one fails the build; no validation code on the device).
+pub const DEVICE_CONFIG: ValidConfig = ValidConfig::checked(Config::shahriar2023());
 
 /// Watchdog timeout: far above the longest main-loop iteration (one body-pose solve plus, when
 /// the transmit ring is full, waiting for room in it: a few ms each at 115,200 baud; see
@@ -90,14 +91,11 @@ pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
 /// boots it where it lies, so that no second copy of it is ever on the stack. Out of line so
 /// that the temporaries of its construction do not stay in [`run`]'s stack frame for good.
 ///
-/// The configuration is a validated constant (quad-device's tests): construction cannot fail;
-/// if it did, the panic handler keeps the outputs low.
+/// The configuration was validated at compile time ([`DEVICE_CONFIG`]): construction cannot
+/// fail.
 #[inline(never)]
 fn new_device(servos: Servos, clock: Clock, eeprom: Eeprom) -> BoardDevice {
-    match BoardDevice::stopped(DEVICE_CONFIG, servos, clock, eeprom) {
-        Ok(device) => device,
-        Err(_) => panic!(),
-    }
+    BoardDevice::stopped_valid(DEVICE_CONFIG, servos, clock, eeprom)
 }
 
 /// One pass of the main loop: received bytes to the controller, answers out, failsafe check.

@@ -275,30 +275,31 @@ impl<M: Math> Solver<M> {
     ) -> [Vec3; 4] {
         let r: Mat3 =
             rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
-        let [r0, r1, r2] = r.rows.map(Vec3::from_array);
+        // The rows read where they are used: a copy of the matrix (`rows.map`) would take
+        // another 36 bytes of the stack frame.
+        let row = |i: usize| Vec3::from_array(r.rows[i]);
         let c = config.pivot_m;
         let pivot = !is_zero(c);
         let t = pose.translation();
         // K = Rᵀ·(t + c) + H·r₂ − c.
         let k = if !pivot && is_zero(t) {
-            r2 * stance_height_m
+            row(2) * stance_height_m
         } else {
             let g = if pivot { t + c } else { t };
-            let k = r.transpose_mul_vec(Vec3::new(g.x, g.y, g.z + stance_height_m));
-            if pivot {
-                k - c
-            } else {
-                k
-            }
+            // `− c` whether or not there is a pivot (`c = ±0` then): a test here made the
+            // compiler copy the product above into both of its arms.
+            r.transpose_mul_vec(Vec3::new(g.x, g.y, g.z + stance_height_m)) - c
         };
         let hl = self.hip_fl_m.x;
-        let a = r0 * hl;
+        let a = row(0) * hl;
         let a = Vec3::new(a.x - hl, a.y, a.z);
-        let b = r1 * self.stance_lateral_m;
-        let b = Vec3::new(b.x, b.y - self.hip_fl_m.y, b.z);
-        // Front: a − K ± b; rear: −(a + K) ± b (left +, right −).
+        // Front: a − K ± b; rear: −(a + K) ± b (left +, right −). In this order, `a` and `K`
+        // are dead before `b` is computed (fewer values held across the float calls of CPUs
+        // without floating-point hardware).
         let front = a - k;
         let rear = -(a + k);
+        let b = row(1) * self.stance_lateral_m;
+        let b = Vec3::new(b.x, b.y - self.hip_fl_m.y, b.z);
         [front + b, front - b, rear + b, rear - b]
     }
 
@@ -393,7 +394,7 @@ impl<M: Math> Solver<M> {
         };
         for (i, leg) in LegId::ALL.into_iter().enumerate() {
             self.leg
-                .inverse_into(leg, local[i], policy, &mut out.legs[i])?;
+                .inverse_into(leg, &local[i], policy, &mut out.legs[i])?;
         }
         Ok(out)
     }
@@ -404,8 +405,16 @@ impl<M: Math> Solver<M> {
 #[inline(always)]
 fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = config.pivot_m;
-    let ok =
-        pose.to_array().iter().all(|&v| finite(v)) && finite(p.x) && finite(p.y) && finite(p.z);
+    // Field by field, without copying the pose into an array first.
+    let ok = finite(pose.roll_rad)
+        && finite(pose.pitch_rad)
+        && finite(pose.yaw_rad)
+        && finite(pose.x_m)
+        && finite(pose.y_m)
+        && finite(pose.z_m)
+        && finite(p.x)
+        && finite(p.y)
+        && finite(p.z);
     if ok {
         Ok(())
     } else {

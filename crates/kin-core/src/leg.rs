@@ -389,8 +389,14 @@ impl Consts {
         let mut c = dist2 - self.sum_sq;
         // Only rounding can push a projected point past ±2·L1·L2 here.
         if moved {
+            // `c.clamp(−2·L1·L2, 2·L1·L2)` by the magnitude's comparison of the backend and
+            // the sign bit (a NaN stays NaN): no float comparison calls on CPUs without
+            // floating-point hardware.
             let two_l1l2 = 2.0 * g.femur_m * g.tibia_m;
-            c = c.clamp(-two_l1l2, two_l1l2);
+            const SIGN: u32 = 0x8000_0000;
+            if M::lt_nonneg(two_l1l2, f32::from_bits(c.to_bits() & !SIGN)) {
+                c = f32::from_bits(two_l1l2.to_bits() | (c.to_bits() & SIGN));
+            }
         }
         let s_sq = (dist2 - self.near_sq) * (self.far_sq - dist2);
         let s_abs = M::sqrt(if M::gt_zero(s_sq) { s_sq } else { 0.0 });
@@ -557,11 +563,11 @@ impl<M: Math> Solver<M> {
     pub(crate) fn inverse_into(
         &self,
         leg: LegId,
-        foot_in_hip: Vec3,
+        foot_in_hip: &Vec3,
         policy: ReachPolicy,
         out: &mut LegSolution,
     ) -> Result<(), IkError> {
-        *out = self.inverse_inline(leg, foot_in_hip, policy)?;
+        *out = self.inverse_inline(leg, *foot_in_hip, policy)?;
         Ok(())
     }
 

@@ -846,27 +846,27 @@ pub mod poly {
 /// `x.is_finite()` from the exponent bits, on every target (core's `is_finite` is a float
 /// comparison, a library call on CPUs without floating-point hardware).
 #[inline(always)]
-pub(crate) fn finite(x: f32) -> bool {
+pub(crate) const fn finite(x: f32) -> bool {
     x.to_bits() & bits::INF != bits::INF
 }
 
 /// `x.is_finite() && x > 0.0` from the bits: the patterns of the positive subnormals to the
 /// largest finite float.
 #[inline(always)]
-pub(crate) fn positive_finite(x: f32) -> bool {
+pub(crate) const fn positive_finite(x: f32) -> bool {
     x.to_bits().wrapping_sub(1) < bits::INF - 1
 }
 
 /// `x.is_finite() && x >= 0.0` from the bits: +0 to the largest finite float, or −0.
 #[inline(always)]
-pub(crate) fn nonneg_finite(x: f32) -> bool {
+pub(crate) const fn nonneg_finite(x: f32) -> bool {
     let b = x.to_bits();
     b < bits::INF || b == 0x8000_0000
 }
 
 /// `lo.is_finite() && hi.is_finite() && lo <= hi` from the bits.
 #[inline(always)]
-pub(crate) fn finite_ordered(lo: f32, hi: f32) -> bool {
+pub(crate) const fn finite_ordered(lo: f32, hi: f32) -> bool {
     finite(lo) && finite(hi) && bits::key(lo) <= bits::key(hi)
 }
 
@@ -894,7 +894,7 @@ mod bits {
     /// A key that orders non-NaN floats as `<` does, with −0 = +0 (sign–magnitude to
     /// two's complement); positive NaNs sort above +∞, negative NaNs below −∞.
     #[inline(always)]
-    pub(super) fn key(x: f32) -> i32 {
+    pub(super) const fn key(x: f32) -> i32 {
         let b = x.to_bits() as i32;
         if b < 0 {
             i32::MIN.wrapping_sub(b)

@@ -280,8 +280,9 @@ impl JointLimits {
     }
 }
 
-/// Everything the kinematics needs to know about a robot.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Everything the kinematics needs to know about a robot. Equal ([`PartialEq`]) when every
+/// field is: [`Robot::equals`].
+#[derive(Debug, Clone, Copy)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Robot {
     /// Leg link lengths (identical for all legs).
@@ -294,6 +295,12 @@ pub struct Robot {
     pub limits: JointLimits,
     /// Which planar IK solution the knee takes.
     pub knee_bend: KneeBend,
+}
+
+impl PartialEq for Robot {
+    fn eq(&self, other: &Robot) -> bool {
+        self.equals(other)
+    }
 }
 
 /// Why a robot description was refused.
@@ -392,34 +399,62 @@ impl Robot {
     }
 
     /// Checks lengths and limits: femur and tibia > 0, offsets ≥ 0, body sizes ≥ 0, limits
-    /// finite with min ≤ max.
-    pub fn validate(&self) -> Result<(), RobotError> {
+    /// finite with min ≤ max. A `const fn`: a firmware whose robot is a constant checks it
+    /// at compile time.
+    pub const fn validate(&self) -> Result<(), RobotError> {
         // Integer tests of the bit patterns, equal to the float comparisons they replace (a
         // software-float comparison is a library call on CPUs without floating-point hardware,
         // and a firmware's engine validates its robot before every motion).
-        let length = |ok: bool, name| {
-            if ok {
-                Ok(())
-            } else {
-                Err(RobotError::BadLength(name))
-            }
+        let bad_length = if !positive_finite(self.leg.femur_m) {
+            "femur_m"
+        } else if !positive_finite(self.leg.tibia_m) {
+            "tibia_m"
+        } else if !nonneg_finite(self.leg.d_lat_m) {
+            "d_lat_m"
+        } else if !nonneg_finite(self.leg.d_ax_m) {
+            "d_ax_m"
+        } else if !nonneg_finite(self.body_length_m) {
+            "body_length_m"
+        } else if !nonneg_finite(self.body_width_m) {
+            "body_width_m"
+        } else {
+            ""
         };
-        length(positive_finite(self.leg.femur_m), "femur_m")?;
-        length(positive_finite(self.leg.tibia_m), "tibia_m")?;
-        length(nonneg_finite(self.leg.d_lat_m), "d_lat_m")?;
-        length(nonneg_finite(self.leg.d_ax_m), "d_ax_m")?;
-        length(nonneg_finite(self.body_length_m), "body_length_m")?;
-        length(nonneg_finite(self.body_width_m), "body_width_m")?;
-        for j in Joint::ALL {
-            let (lo, hi) = (
-                self.limits.min_rad[j as usize],
-                self.limits.max_rad[j as usize],
-            );
-            if !finite_ordered(lo, hi) {
-                return Err(RobotError::BadLimit(j));
+        if !bad_length.is_empty() {
+            return Err(RobotError::BadLength(bad_length));
+        }
+        // An index loop: iterators are not available in a `const fn`.
+        let mut j = 0;
+        while j < Joint::ALL.len() {
+            if !finite_ordered(self.limits.min_rad[j], self.limits.max_rad[j]) {
+                return Err(RobotError::BadLimit(Joint::ALL[j]));
             }
+            j += 1;
         }
         Ok(())
+    }
+
+    /// `self == other` (field by field, float `==`), usable in a `const fn`: a
+    /// configuration that names a preset is checked against the preset's robot at compile
+    /// time. The one definition of [`Robot`]'s equality.
+    pub const fn equals(&self, other: &Robot) -> bool {
+        let (a, b) = (self, other);
+        let mut j = 0;
+        while j < 3 {
+            if a.limits.min_rad[j] != b.limits.min_rad[j]
+                || a.limits.max_rad[j] != b.limits.max_rad[j]
+            {
+                return false;
+            }
+            j += 1;
+        }
+        a.leg.d_lat_m == b.leg.d_lat_m
+            && a.leg.d_ax_m == b.leg.d_ax_m
+            && a.leg.femur_m == b.leg.femur_m
+            && a.leg.tibia_m == b.leg.tibia_m
+            && a.body_length_m == b.body_length_m
+            && a.body_width_m == b.body_width_m
+            && a.knee_bend as u8 == b.knee_bend as u8
     }
 
     /// Hip (abduction-axis) mount of `leg` in the body frame: `(±length/2, ±width/2, 0)`.

@@ -46,3 +46,26 @@ fn round_trip_grid_both_presets() {
         }
     }
 }
+
+#[test]
+fn robot_equality_is_field_by_field_float_equality() {
+    let r = Robot::shahriar2023();
+    assert_eq!(r, r);
+    assert!(r.equals(&r));
+    assert_ne!(r, Robot::fernando2025());
+    assert_ne!(r, r.with_knee_bend(KneeBend::Forward));
+    let (mut z, mut p) = (r, r);
+    z.leg.d_ax_m = -0.0;
+    p.leg.d_ax_m = 0.0;
+    assert_eq!(z, p, "-0 == +0, as the float operator has it");
+    let mut l = r;
+    l.limits.max_rad[2] += 0.1;
+    assert_ne!(r, l);
+    let mut n = r;
+    n.body_width_m = f32::NAN;
+    assert_ne!(n, n, "a NaN field is unequal to itself");
+}
+
+/// Both presets pass the check at compile time (`validate` is a `const fn`).
+const _: () = assert!(Robot::shahriar2023().validate().is_ok());
+const _: () = assert!(Robot::fernando2025().validate().is_ok());

@@ -1,13 +1,14 @@
 //! What the device is built for: the robot, how body poses are read, the link-loss failsafe,
 //! where the calibration is stored, and the default servo calibration.
 
+use crate::engine::Limiter;
 use crate::store::Table;
 use core::fmt;
 use kin_core::body;
 use kin_core::robot::RobotError;
 use kin_core::{BodyConfig, LegId, Math, ReachPolicy, Robot, RotationOrder};
 use quad_protocol::servo::{Calibration, STANDARD_US_PER_RAD};
-use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, RobotPreset};
+use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, Ranges, RobotPreset};
 
 /// Default stance height of [`Robot::fernando2025`]: seed 001's initial pose (eq. 5, α = 60°,
 /// φ = 120°), `H = l0 + (l1 + l2)·sin 60°`, m.
@@ -77,7 +78,7 @@ impl fmt::Display for ConfigError {
 impl core::error::Error for ConfigError {}
 
 /// Checks a pose configuration: the stance height must be finite and > 0.
-pub fn validate_pose_config(p: &PoseConfig) -> Result<(), ConfigError> {
+pub const fn validate_pose_config(p: &PoseConfig) -> Result<(), ConfigError> {
     if p.stance_height_m.is_finite() && p.stance_height_m > 0.0 {
         Ok(())
     } else {
@@ -134,22 +135,86 @@ impl Config {
     }
 
     /// Checks the robot, the pose configuration, that a named preset matches the robot, and
-    /// that the storage fits.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        self.robot.validate().map_err(ConfigError::Robot)?;
-        validate_pose_config(&self.pose_config)?;
+    /// that the storage fits. A `const fn`: a firmware's constant configuration is checked at
+    /// compile time ([`ValidConfig::checked`]).
+    pub const fn validate(&self) -> Result<(), ConfigError> {
+        if let Err(e) = self.robot.validate() {
+            return Err(ConfigError::Robot(e));
+        }
+        if let Err(e) = validate_pose_config(&self.pose_config) {
+            return Err(e);
+        }
         if let Some(r) = self.preset.robot() {
-            if r != self.robot {
+            if !r.equals(&self.robot) {
                 return Err(ConfigError::PresetMismatch);
             }
         }
-        if u32::from(self.storage_base) + u32::from(crate::store::STORAGE_LEN) > 0x1_0000 {
+        if self.storage_base as u32 + crate::store::STORAGE_LEN as u32 > 0x1_0000 {
             return Err(ConfigError::StorageBase);
         }
         if crate::engine::Limiter::new(self.joint_speed_limit_rad_s).is_err() {
             return Err(ConfigError::JointSpeedLimit);
         }
         Ok(())
+    }
+}
+
+/// A [`Config`] that passed [`Config::validate`], with the limiter of its joint-speed limit
+/// and the request ranges of its robot:
+/// what [`crate::Device::stopped_valid`] builds a controller from without checking again. A
+/// constant one (`const C: ValidConfig = ValidConfig::checked(…)`) is checked at compile
+/// time, so that a firmware carries no validation code for it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ValidConfig {
+    config: Config,
+    limiter: Limiter,
+    ranges: Ranges,
+}
+
+impl ValidConfig {
+    /// `config` once [`Config::validate`] accepts it.
+    ///
+    /// # Errors
+    /// [`Config::validate`]'s error.
+    pub const fn new(config: Config) -> Result<ValidConfig, ConfigError> {
+        if let Err(e) = config.validate() {
+            return Err(e);
+        }
+        match Limiter::new(config.joint_speed_limit_rad_s) {
+            Ok(limiter) => Ok(ValidConfig {
+                config,
+                limiter,
+                ranges: Ranges::of(&config.robot),
+            }),
+            Err(_) => Err(ConfigError::JointSpeedLimit),
+        }
+    }
+
+    /// [`ValidConfig::new`] for a constant: in a `const` item, an invalid `config` fails the
+    /// build.
+    ///
+    /// # Panics
+    /// When `config` is invalid (at compile time in a `const` item).
+    pub const fn checked(config: Config) -> ValidConfig {
+        match ValidConfig::new(config) {
+            Ok(c) => c,
+            Err(_) => panic!("invalid device configuration"),
+        }
+    }
+
+    /// The configuration.
+    pub const fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The limiter of [`Config::joint_speed_limit_rad_s`].
+    pub const fn limiter(&self) -> &Limiter {
+        &self.limiter
+    }
+
+    /// The request ranges of [`Config::robot`].
+    pub const fn ranges(&self) -> &Ranges {
+        &self.ranges
     }
 }
 
@@ -233,6 +298,32 @@ mod tests {
         c = Config::fernando2025();
         c.pose_config.stance_height_m = f32::NAN;
         assert_eq!(c.validate(), Err(ConfigError::StanceHeight));
+    }
+
+    /// Both presets pass the check at compile time (a failing one would fail the build).
+    const CHECKED: [ValidConfig; 2] = [
+        ValidConfig::checked(Config::fernando2025()),
+        ValidConfig::checked(Config::shahriar2023()),
+    ];
+
+    #[test]
+    fn valid_config_is_the_validated_config_with_its_limiter() {
+        for (v, c) in CHECKED
+            .iter()
+            .zip([Config::fernando2025(), Config::shahriar2023()])
+        {
+            assert_eq!(*v.config(), c);
+            assert_eq!(
+                *v.limiter(),
+                Limiter::new(c.joint_speed_limit_rad_s).unwrap()
+            );
+        }
+        let mut c = Config::fernando2025();
+        c.robot = Robot::shahriar2023();
+        assert_eq!(ValidConfig::new(c), Err(ConfigError::PresetMismatch));
+        c = Config::fernando2025();
+        c.joint_speed_limit_rad_s = 0.0;
+        assert_eq!(ValidConfig::new(c), Err(ConfigError::JointSpeedLimit));
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //! answer bytes out.
 
 use crate::config::{
-    validate_pose_config, write_default_calibration, Config, ConfigError, UNBOOTED_CALIBRATION,
+    validate_pose_config, write_default_calibration, Config, ConfigError, ValidConfig,
+    UNBOOTED_CALIBRATION,
 };
 use crate::engine::{self, Engine, Limiter, Setup, FRAME_MS};
 use crate::hal::{Clock, ServoOutputs, Storage};
@@ -13,9 +14,9 @@ use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    check_request, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed, Flags,
-    HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Readback, Request, ServoId,
-    Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    check_request_in, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed,
+    Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges, Readback,
+    Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -87,6 +88,8 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     /// products of the link lengths) would otherwise be computed again for every request.
     solver: body::Solver<M>,
     calibration: Table,
+    /// The request ranges of `config.robot` (the robot never changes).
+    ranges: Ranges,
     store: Store,
     acc: Accumulator<RX_LEN>,
     held: Option<Held>,
@@ -145,23 +148,29 @@ where
     ///
     /// # Errors
     /// [`Config::validate`]'s error.
-    pub fn stopped(
-        config: Config,
-        mut outputs: O,
-        clock: C,
-        storage: S,
-    ) -> Result<Self, ConfigError> {
-        config.validate()?;
-        let limiter = Limiter::new(config.joint_speed_limit_rad_s)
-            .map_err(|_| ConfigError::JointSpeedLimit)?;
+    pub fn stopped(config: Config, outputs: O, clock: C, storage: S) -> Result<Self, ConfigError> {
+        Ok(Self::stopped_valid(
+            ValidConfig::new(config)?,
+            outputs,
+            clock,
+            storage,
+        ))
+    }
+
+    /// [`Device::stopped`] on a configuration validated already (infallible): a firmware
+    /// whose configuration is a constant validates it at compile time
+    /// ([`ValidConfig::checked`]) and carries no validation code.
+    pub fn stopped_valid(valid: ValidConfig, mut outputs: O, clock: C, storage: S) -> Self {
+        let config = *valid.config();
         outputs.set_enabled(false);
         let now = clock.now_ms();
-        Ok(Device {
+        Device {
             outputs,
             clock,
             storage,
             calibration: UNBOOTED_CALIBRATION,
             store: Store::new(config.storage_base),
+            ranges: *valid.ranges(),
             solver: body::Solver::<M>::with_math(&config.robot),
             config,
             acc: Accumulator::new(),
@@ -176,11 +185,11 @@ where
             calibration_default: true,
             last_valid_ms: now,
             last_framing_nack_ms: None,
-            engine: Engine::new(limiter),
+            engine: Engine::new(*valid.limiter()),
             out_rad: [0.0; 12],
             next_frame: now,
             enabling_frame: false,
-        })
+        }
     }
 
     /// The second half of [`Device::new`], once, on a controller from [`Device::stopped`]:
@@ -189,12 +198,15 @@ where
     /// the nominal stance (zero body pose) when it maps within that calibration.
     #[inline(never)]
     pub fn boot(&mut self) {
-        write_default_calibration(
-            &self.solver,
-            &self.config.pose_config,
-            &mut self.calibration,
-        );
         self.calibration_default = !self.load_calibration();
+        if self.calibration_default {
+            // Also over a table that a failing load left half-read.
+            write_default_calibration(
+                &self.solver,
+                &self.config.pose_config,
+                &mut self.calibration,
+            );
+        }
         // The stance may not map within a stored calibration: then nothing is held.
         let _ = self.set_body_pose(&Pose::default());
     }
@@ -449,7 +461,7 @@ where
     fn answer(&mut self, msg: &HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
         // The host's own check (`Ok` for the requests answered before the handshake).
-        let in_range = check_range(&msg.request, &self.config.robot);
+        let in_range = check_range(&msg.request, &self.ranges);
         let result = match msg.request {
             Request::Hello { version } => {
                 return if is_compatible(version) {
@@ -792,16 +804,17 @@ where
     fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), NackReason> {
         c.validate().map_err(NackReason::BadCalibration)?;
         let i = servo.index();
-        if let Some(held) = &mut self.held {
-            let pulse =
-                c.pulse_half_us(held.angles_rad[i])
-                    .map_err(|fault| NackReason::ServoRange {
-                        leg: servo.leg,
-                        joint: servo.joint,
-                        fault,
-                    })?;
-            held.pulses_half_us[i] = pulse;
-        }
+        // Both checks before anything changes: a refusal leaves the held pulses as they were.
+        let held_pulse = match &self.held {
+            Some(held) => Some(c.pulse_half_us(held.angles_rad[i]).map_err(|fault| {
+                NackReason::ServoRange {
+                    leg: servo.leg,
+                    joint: servo.joint,
+                    fault,
+                }
+            })?),
+            None => None,
+        };
         if self.outputs_enabled {
             // The outputs may still be on their way to the held angle.
             c.pulse_half_us(self.out_rad[i])
@@ -810,6 +823,9 @@ where
                     joint: servo.joint,
                     fault,
                 })?;
+        }
+        if let (Some(held), Some(pulse)) = (&mut self.held, held_pulse) {
+            held.pulses_half_us[i] = pulse;
         }
         if self.calibration[i] != c {
             self.calibration[i] = c;
@@ -853,11 +869,11 @@ pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
     encode_frame(answer, out).map_or(0, <[u8]>::len)
 }
 
-/// [`check_request`], out of line: inlined into [`Device::answer`], its copies of the request's
+/// [`check_request_in`], out of line: inlined into [`Device::answer`], its copies of the request's
 /// values took the dispatcher's stack frame beyond the AVR's 63-byte displacement.
 #[inline(never)]
-fn check_range(request: &Request, robot: &kin_core::Robot) -> Result<(), NackReason> {
-    check_request(request, robot)
+fn check_range(request: &Request, ranges: &Ranges) -> Result<(), NackReason> {
+    check_request_in(request, ranges)
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {

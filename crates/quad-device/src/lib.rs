@@ -58,6 +58,6 @@ pub mod engine;
 pub mod hal;
 pub mod store;
 
-pub use config::{default_calibration, Config, ConfigError};
+pub use config::{default_calibration, Config, ConfigError, ValidConfig};
 pub use device::Device;
 pub use hal::{Clock, ServoOutputs, Storage};

@@ -142,8 +142,14 @@ impl Store {
         }
     }
 
-    /// The generation of `bank` when it holds a valid table.
-    fn verify<S: Storage>(&self, storage: &mut S, bank: Bank) -> Option<u32> {
+    /// The generation of `bank` when it holds a valid table; each record read is also decoded
+    /// into `out` when given (whatever the verdict: the records before a bad one stay there).
+    fn verify<S: Storage>(
+        &self,
+        storage: &mut S,
+        bank: Bank,
+        mut out: Option<&mut Table>,
+    ) -> Option<u32> {
         let addr = self.bank_addr(bank);
         let mut header = [0u8; HEADER_LEN];
         storage.read(addr, &mut header).ok()?;
@@ -156,7 +162,10 @@ impl Store {
         for i in 0..12u16 {
             let at = addr + HEADER_LEN as u16 + i * RECORD_LEN as u16;
             storage.read(at, &mut record).ok()?;
-            decode_record(&record)?;
+            let c = decode_record(&record)?;
+            if let Some(table) = out.as_deref_mut() {
+                table[usize::from(i)] = c;
+            }
             sum = crc::update_slice(sum, &record);
         }
         let mut stored = [0u8; 2];
@@ -167,36 +176,26 @@ impl Store {
     }
 
     /// Reads the newest valid table into `table` and makes its bank the active one. Returns
-    /// `false`, leaving `table` as it was, when neither bank holds a valid table.
+    /// `false` when neither bank holds a valid table (`table` is then as it was) or when the
+    /// chosen bank does not read back the same on the second pass that loads it (unreliable
+    /// storage: `table` may then be partly overwritten, and the caller fills it otherwise).
+    /// The second pass verifies again while it loads: one reading loop for both.
     pub fn load<S: Storage>(&mut self, storage: &mut S, table: &mut Table) -> bool {
-        let a = self.verify(storage, Bank::A);
-        let b = self.verify(storage, Bank::B);
-        let best = match (a, b) {
-            (Some(ga), Some(gb)) if newer(gb, ga) => Some((Bank::B, gb)),
-            (Some(ga), _) => Some((Bank::A, ga)),
-            (None, Some(gb)) => Some((Bank::B, gb)),
-            (None, None) => None,
+        let a = self.verify(storage, Bank::A, None);
+        let b = self.verify(storage, Bank::B, None);
+        let bank = match (a, b) {
+            (Some(ga), Some(gb)) if newer(gb, ga) => Bank::B,
+            (Some(_), _) => Bank::A,
+            (None, Some(_)) => Bank::B,
+            (None, None) => return false,
         };
-        let Some((bank, generation)) = best else {
-            return false;
-        };
-        let addr = self.bank_addr(bank);
-        let mut loaded = *table;
-        let mut record = [0u8; RECORD_LEN];
-        for (i, slot) in loaded.iter_mut().enumerate() {
-            let at = addr + (HEADER_LEN + i * RECORD_LEN) as u16;
-            // Verified just before; a failing second read means the storage is unreliable.
-            if storage.read(at, &mut record).is_err() {
-                return false;
+        match self.verify(storage, bank, Some(table)) {
+            Some(generation) => {
+                self.active = Some((bank, generation));
+                true
             }
-            match decode_record(&record) {
-                Some(c) => *slot = c,
-                None => return false,
-            }
+            None => false,
         }
-        *table = loaded;
-        self.active = Some((bank, generation));
-        true
     }
 
     /// Saves `table` to the inactive bank (see the module docs for the order of the writes) and
@@ -286,6 +285,44 @@ mod tests {
             assert_eq!(back, table);
             assert_eq!(fresh.active(), Some((expected, n)));
         }
+    }
+
+    /// Storage whose reads fail once `reads_left` is used up.
+    struct Flaky {
+        mem: Mem,
+        reads_left: usize,
+    }
+
+    impl Storage for Flaky {
+        type Error = ();
+        fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), ()> {
+            self.reads_left = self.reads_left.checked_sub(1).ok_or(())?;
+            self.mem.read(addr, buf)
+        }
+        fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), ()> {
+            self.mem.write(addr, data)
+        }
+    }
+
+    #[test]
+    fn a_bank_that_fails_on_the_loading_pass_is_not_loaded() {
+        let mut mem = Mem([0xFF; STORAGE_LEN as usize]);
+        let mut table = [Calibration::STANDARD; 12];
+        table[0].center_us = 1400;
+        Store::new(0).save(&mut mem, &table).unwrap();
+        // A pass over a valid bank reads the header, twelve records and the CRC; over the
+        // erased bank B only the header. Then the loading pass fails after three records.
+        let mut flaky = Flaky {
+            mem,
+            reads_left: 14 + 1 + 4,
+        };
+        let mut store = Store::new(0);
+        let mut back = [Calibration::STANDARD; 12];
+        assert!(!store.load(&mut flaky, &mut back));
+        assert_eq!(store.active(), None);
+        flaky.reads_left = usize::MAX;
+        assert!(store.load(&mut flaky, &mut back));
+        assert_eq!(back, table);
     }
 
     #[test]

@@ -554,6 +554,58 @@ fn calibration_changes_are_checked_against_the_held_angle() {
 }
 
 #[test]
+fn a_refused_calibration_leaves_the_held_pulses_as_they_were() {
+    // The outputs on their way to a new knee target: a travel that admits the target but not
+    // where the output is now is refused, and the readback's pulses stay the old mapping's.
+    let clock = TestClock::default();
+    let mut dev = Device::new(
+        Config::fernando2025(),
+        Outputs::default(),
+        clock.clone(),
+        Mem::erased(),
+    )
+    .unwrap();
+    hello(&mut dev);
+    ack(ask(&mut dev, 1, Request::SetOutputs { enabled: true }));
+    clock.set(25); // Past the enabling frame: new targets go through the limiter.
+    dev.poll();
+    let s = ServoId {
+        leg: LegId::RR,
+        joint: Joint::Knee,
+    };
+    let i = s.index();
+    let mut angles_rad = ack(ask(&mut dev, 2, Request::GetState)).angles_rad;
+    let now_rad = angles_rad[i];
+    angles_rad[i] = now_rad - 0.5;
+    let before = ack(ask(&mut dev, 3, Request::SetJoints { angles_rad }));
+    assert_eq!(dev.output_angles().unwrap()[i], now_rad, "not there yet");
+    let old = dev.calibration()[i];
+    // Zero at the target: the target maps to the centre, the output's angle 0.5 rad away.
+    let narrow = Calibration {
+        zero_rad: angles_rad[i],
+        min_us: old.center_us - 100,
+        max_us: old.center_us + 100,
+        ..old
+    };
+    assert!(narrow.pulse_half_us(angles_rad[i]).is_ok());
+    assert!(narrow.pulse_half_us(now_rad).is_err());
+    assert!(matches!(
+        nack_reason(ask(
+            &mut dev,
+            4,
+            Request::SetCalibration {
+                servo: s,
+                calibration: narrow
+            }
+        )),
+        NackReason::ServoRange { .. }
+    ));
+    let after = ack(ask(&mut dev, 5, Request::GetState));
+    assert_eq!(after.pulses_half_us, before.pulses_half_us);
+    assert_eq!(dev.calibration()[i], old);
+}
+
+#[test]
 fn saved_calibration_survives_a_power_cycle() {
     let mut dev = device(Config::fernando2025());
     hello(&mut dev);

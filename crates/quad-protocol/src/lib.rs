@@ -45,7 +45,7 @@ pub use msg::{
     ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset, ServoId,
     Setting,
 };
-pub use range::check_request;
+pub use range::{check_request, check_request_in, Ranges};
 
 /// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions).
 pub const PROTOCOL_VERSION: u16 = 0x0201;

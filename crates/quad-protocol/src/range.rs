@@ -37,14 +37,42 @@ pub const MIN_STANCE_HEIGHT_M: f32 = 0.01;
 
 /// The farthest a foot can be from its hip, m: `d_lat + d_ax + femur + tibia` (the leg
 /// stretched, its offsets in line — more than any real pose reaches).
-pub fn leg_span_m(robot: &Robot) -> f32 {
+pub const fn leg_span_m(robot: &Robot) -> f32 {
     let l = &robot.leg;
     l.d_lat_m + l.d_ax_m + l.femur_m + l.tibia_m
 }
 
 /// The bound of every length in a request, m: twice [`leg_span_m`] (see the module docs).
-pub fn reach_limit_m(robot: &Robot) -> f32 {
+pub const fn reach_limit_m(robot: &Robot) -> f32 {
     2.0 * leg_span_m(robot)
+}
+
+/// The bounds a robot's requests are checked against (see the module docs), computed once:
+/// by a `const fn`, so that a device whose robot is a constant computes them at compile time
+/// and [`check_request_in`] does no arithmetic on the robot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ranges {
+    /// `|x|`, `|y|`, `|z|` bounds of a foot in the body frame, m; `[2]` is [`reach_limit_m`].
+    feet_m: [f32; 3],
+}
+
+impl Ranges {
+    /// The bounds for `robot`.
+    pub const fn of(robot: &Robot) -> Ranges {
+        let span = reach_limit_m(robot);
+        Ranges {
+            feet_m: [
+                0.5 * robot.body_length_m + span,
+                0.5 * robot.body_width_m + span,
+                span,
+            ],
+        }
+    }
+
+    /// [`reach_limit_m`] of the robot.
+    pub const fn reach_limit_m(&self) -> f32 {
+        self.feet_m[2]
+    }
 }
 
 /// The first of `values` whose magnitude exceeds its bound (`bounds` repeated: value `i` has
@@ -72,11 +100,19 @@ fn first_beyond(values: &[f32], bounds: &[f32]) -> Result<Option<usize>, NackRea
 /// (in declaration order), or [`NackReason::InvalidArgument`] for a stance height that is not
 /// positive.
 pub fn check_request(request: &Request, robot: &Robot) -> Result<(), NackReason> {
+    check_request_in(request, &Ranges::of(robot))
+}
+
+/// [`check_request`] with the robot's bounds computed already ([`Ranges::of`]).
+///
+/// # Errors
+/// As [`check_request`].
+pub fn check_request_in(request: &Request, ranges: &Ranges) -> Result<(), NackReason> {
     match request {
-        Request::SetBodyPose(pose) => check_pose(pose, robot),
-        Request::SetFeet { feet_in_body_m } => check_feet(feet_in_body_m, robot),
+        Request::SetBodyPose(pose) => pose_in(pose, ranges),
+        Request::SetFeet { feet_in_body_m } => feet_in(feet_in_body_m, ranges),
         Request::SetJoints { angles_rad } => check_joints(angles_rad),
-        Request::SetPoseConfig(p) => check_pose_config(p, robot),
+        Request::SetPoseConfig(p) => pose_config_in(p, ranges),
         Request::Hello { .. }
         | Request::GetState
         | Request::SetOutputs { .. }
@@ -100,6 +136,10 @@ pub fn check_request(request: &Request, robot: &Robot) -> Result<(), NackReason>
 /// # Errors
 /// As [`check_request`].
 pub fn check_pose(pose: &Pose, robot: &Robot) -> Result<(), NackReason> {
+    pose_in(pose, &Ranges::of(robot))
+}
+
+fn pose_in(pose: &Pose, ranges: &Ranges) -> Result<(), NackReason> {
     let Pose {
         roll_rad,
         pitch_rad,
@@ -109,7 +149,7 @@ pub fn check_pose(pose: &Pose, robot: &Robot) -> Result<(), NackReason> {
         z_m,
     } = *pose;
     let values = [roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m];
-    let span = reach_limit_m(robot);
+    let span = ranges.reach_limit_m();
     // An angle in `[−π, π]` is one of magnitude ≤ π.
     let field = match first_beyond(&values, &[PI, PI, PI, span, span, span])? {
         None => return Ok(()),
@@ -129,13 +169,11 @@ pub fn check_pose(pose: &Pose, robot: &Robot) -> Result<(), NackReason> {
 /// # Errors
 /// As [`check_request`].
 pub fn check_feet(feet_in_body_m: &[[f32; 3]; 4], robot: &Robot) -> Result<(), NackReason> {
-    let span = reach_limit_m(robot);
-    let bound = [
-        0.5 * robot.body_length_m + span,
-        0.5 * robot.body_width_m + span,
-        span,
-    ];
-    match first_beyond(feet_in_body_m.as_flattened(), &bound)? {
+    feet_in(feet_in_body_m, &Ranges::of(robot))
+}
+
+fn feet_in(feet_in_body_m: &[[f32; 3]; 4], ranges: &Ranges) -> Result<(), NackReason> {
+    match first_beyond(feet_in_body_m.as_flattened(), &ranges.feet_m)? {
         None => Ok(()),
         Some(i) => Err(NackReason::OutOfRange {
             field: Field::Foot(LegId::ALL[i / 3]),
@@ -165,11 +203,15 @@ pub fn check_joints(angles_rad: &[f32; 12]) -> Result<(), NackReason> {
 /// # Errors
 /// As [`check_request`].
 pub fn check_pose_config(p: &PoseConfig, robot: &Robot) -> Result<(), NackReason> {
+    pose_config_in(p, &Ranges::of(robot))
+}
+
+fn pose_config_in(p: &PoseConfig, ranges: &Ranges) -> Result<(), NackReason> {
     let h = p.stance_height_m;
     if !(h.is_finite() && h > 0.0) {
         return Err(NackReason::InvalidArgument);
     }
-    if (MIN_STANCE_HEIGHT_M..=reach_limit_m(robot)).contains(&h) {
+    if (MIN_STANCE_HEIGHT_M..=ranges.reach_limit_m()).contains(&h) {
         Ok(())
     } else {
         Err(NackReason::OutOfRange {
@@ -183,6 +225,20 @@ mod tests {
     use super::*;
 
     const ROBOT: Robot = Robot::shahriar2023();
+
+    /// Computed at compile time, as a device with a constant robot does.
+    const RANGES: Ranges = Ranges::of(&ROBOT);
+
+    #[test]
+    fn ranges_computed_once_check_as_the_robot_does() {
+        assert_eq!(RANGES.reach_limit_m(), reach_limit_m(&ROBOT));
+        let feet = [[0.0, 0.0, -RANGES.reach_limit_m() - 1e-3]; 4];
+        let r = Request::SetFeet {
+            feet_in_body_m: feet,
+        };
+        assert_eq!(check_request_in(&r, &RANGES), check_request(&r, &ROBOT));
+        assert_eq!(check_request_in(&r, &RANGES), out(Field::Foot(LegId::FL)));
+    }
 
     fn out(field: Field) -> Result<(), NackReason> {
         Err(NackReason::OutOfRange { field })

@@ -34,7 +34,7 @@ impl Limiter {
     ///
     /// # Errors
     /// [`Error::Parameter`] naming `joint_speed_limit_rad_s`.
-    pub fn new(speed_rad_s: f32) -> Result<Limiter, Error> {
+    pub const fn new(speed_rad_s: f32) -> Result<Limiter, Error> {
         if !speed_rad_s.is_finite() {
             return Err(Error::Parameter(motion::Error::NonFinite(
                 motion::Param::JointSpeedLimitRadS,
