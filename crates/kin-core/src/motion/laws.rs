@@ -141,6 +141,7 @@ impl Sway {
     /// both extremes `angle0 ± A` (a quick check; [`crate::preflight`] sweeps the whole motion).
     /// The reach checks run on the [`DefaultMath`] backend.
     pub fn new(p: SwayParams) -> Result<Sway, Error> {
+        p.robot.validate()?;
         let s = Self::without_reach_check(p)?;
         let cfg = s.body_config();
         check_reach(
@@ -162,9 +163,10 @@ impl Sway {
         Ok(s)
     }
 
-    /// [`Sway::new`]'s parameter checks without its reach checks, for a caller that checks
-    /// the reach itself by running the motion's frames through its own IK (a device's start
-    /// check).
+    /// [`Sway::new`]'s parameter checks without its reach checks and without validating
+    /// `p.robot`, for a caller that validated its robot already and checks the reach itself by
+    /// running the motion's frames through its own IK (a device's start check, on the robot it
+    /// validated at boot).
     pub fn without_reach_check(p: SwayParams) -> Result<Sway, Error> {
         Self::check(&p)?;
         Ok(Sway { p })
@@ -175,7 +177,6 @@ impl Sway {
     /// one pointer (on the AVR, within its 63-byte displacement) wherever they are built.
     #[inline(never)]
     fn check(p: &SwayParams) -> Result<(), Error> {
-        p.robot.validate()?;
         finite(p.amplitude_rad, Param::AmplitudeRad)?;
         positive(p.period_s, Param::PeriodS)?;
         finite(p.roll0_rad, Param::Roll0Rad)?;
@@ -317,6 +318,7 @@ impl YawTurn {
     /// [`crate::preflight`] sweeps the whole motion). The checks run on the [`DefaultMath`]
     /// backend.
     pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
+        p.robot.validate()?;
         let turn = Self::without_reach_check::<DefaultMath>(p)?;
         let cfg = turn.body_config();
         let t1 = p.step_period_s;
@@ -333,9 +335,10 @@ impl YawTurn {
         Ok(turn)
     }
 
-    /// [`YawTurn::new`]'s parameter checks without its reach checks, with the foot radii and
-    /// angles on math backend `M`, for a caller that checks the reach itself by running the
-    /// motion's frames through its own IK (a device's start check).
+    /// [`YawTurn::new`]'s parameter checks without its reach checks and without validating
+    /// `p.robot`, with the foot radii and angles on math backend `M`, for a caller that
+    /// validated its robot already and checks the reach itself by running the motion's frames
+    /// through its own IK (a device's start check, on the robot it validated at boot).
     pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
         Self::check(&p)?;
         Ok(YawTurn {
@@ -349,7 +352,6 @@ impl YawTurn {
     /// as [`Sway`]'s.
     #[inline(never)]
     fn check(p: &YawTurnParams) -> Result<(), Error> {
-        p.robot.validate()?;
         finite(p.yaw_rate_rad_s, Param::YawRateRadS)?;
         positive(p.step_period_s, Param::StepPeriodS)?;
         non_negative(p.lift_height_m, Param::LiftHeightM)?;
@@ -526,6 +528,7 @@ impl LegPaths {
     /// leg at 64 evenly spaced phases (a quick check; [`crate::preflight`] is exhaustive), on
     /// the [`DefaultMath`] backend.
     pub fn new(p: LegPathsParams) -> Result<LegPaths, Error> {
+        p.robot.validate()?;
         let lp = Self::without_reach_check(p)?;
         let cfg = lp.body_config();
         for i in 0..Self::REACH_SAMPLES {
@@ -537,9 +540,10 @@ impl LegPaths {
         Ok(lp)
     }
 
-    /// [`LegPaths::new`]'s parameter checks without its reach checks, for a caller that checks
-    /// the reach itself by running the motion's frames through its own IK (a device's start
-    /// check).
+    /// [`LegPaths::new`]'s parameter checks without its reach checks and without validating
+    /// `p.robot`, for a caller that validated its robot already and checks the reach itself by
+    /// running the motion's frames through its own IK (a device's start check, on the robot it
+    /// validated at boot).
     pub fn without_reach_check(p: LegPathsParams) -> Result<LegPaths, Error> {
         Self::check(&p)?;
         Ok(LegPaths { p })
@@ -549,7 +553,6 @@ impl LegPaths {
     /// as [`Sway`]'s.
     #[inline(never)]
     fn check(p: &LegPathsParams) -> Result<(), Error> {
-        p.robot.validate()?;
         positive(p.cycle_s, Param::CycleS)?;
         for o in &p.phase_offsets {
             finite(*o, Param::PhaseOffsets)?;
