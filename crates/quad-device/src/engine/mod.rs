@@ -567,24 +567,44 @@ fn check_sample<'r, M: Math>(
 /// The kin-core motion of a law request (its parameters checked, not its reach: the start
 /// check does that).
 ///
-/// One builder per law, each out of line: a law's parameters are a hundred bytes and more,
-/// and the three sets in one stack frame would put most of its accesses beyond the AVR's
-/// 63-byte displacement.
+/// The laws carry no robot (the device's solver holds it): one builder for the three, their
+/// stance feet computed once.
 #[inline(never)]
 fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<LawMotion, Error> {
-    match *request {
+    let stance = s.robot.stance_feet(s.stance_height_m);
+    let motion = match *request {
         Request::Sway {
             axis,
             amplitude_rad,
             period_s,
             ..
-        } => sway_motion(axis, amplitude_rad, period_s, s),
+        } => LawMotion::Sway(laws::SwayLaw {
+            axis,
+            amplitude_rad,
+            period_s,
+            roll0_rad: 0.0,
+            pitch0_rad: 0.0,
+            yaw0_rad: 0.0,
+            order: s.order,
+            feet_in_world: stance,
+        }),
         Request::YawTurn {
             yaw_rate_rad_s,
             step_period_s,
             lift_height_m,
             ..
-        } => yaw_turn_motion(yaw_rate_rad_s, step_period_s, lift_height_m, s),
+        } => LawMotion::YawTurn(laws::YawTurnLaw::without_reach_check::<M>(
+            laws::YawTurnLawParams {
+                yaw_rate_rad_s,
+                step_period_s,
+                lift_height_m,
+                yaw0_rad: 0.0,
+                roll0_rad: 0.0,
+                pitch0_rad: 0.0,
+                order: s.order,
+                stance_feet: stance,
+            },
+        )?),
         Request::FootPath {
             path,
             stride_m,
@@ -592,70 +612,20 @@ fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<LawMotion,
             duty_factor,
             cycle_s,
             ..
-        } => {
-            let stride = Stride::new(stride_m, step_height_m, duty_factor)?;
-            leg_paths_motion(AnyPath::new(path, stride), cycle_s, s)
-        }
-        _ => Err(Error::Busy),
+        } => LawMotion::LegPaths(laws::LegPathsLaw {
+            path: AnyPath::new(path, Stride::new(stride_m, step_height_m, duty_factor)?),
+            cycle_s,
+            phase_offsets: [0.0; 4],
+            stance_feet: stance,
+        }),
+        _ => return Err(Error::Busy),
+    };
+    match &motion {
+        LawMotion::Sway(m) => m.check()?,
+        LawMotion::LegPaths(m) => m.check()?,
+        LawMotion::YawTurn(_) => {}
     }
-}
-
-#[inline(never)]
-fn sway_motion<M: Math>(
-    axis: Axis,
-    amplitude_rad: f32,
-    period_s: f32,
-    s: &Setup<'_, M>,
-) -> Result<LawMotion, Error> {
-    let law = laws::SwayLaw {
-        axis,
-        amplitude_rad,
-        period_s,
-        roll0_rad: 0.0,
-        pitch0_rad: 0.0,
-        yaw0_rad: 0.0,
-        order: s.order,
-        feet_in_world: s.robot.stance_feet(s.stance_height_m),
-    };
-    law.check()?;
-    Ok(LawMotion::Sway(law))
-}
-
-#[inline(never)]
-fn yaw_turn_motion<M: Math>(
-    yaw_rate_rad_s: f32,
-    step_period_s: f32,
-    lift_height_m: f32,
-    s: &Setup<'_, M>,
-) -> Result<LawMotion, Error> {
-    Ok(LawMotion::YawTurn(laws::YawTurnLaw::without_reach_check::<
-        M,
-    >(laws::YawTurnLawParams {
-        yaw_rate_rad_s,
-        step_period_s,
-        lift_height_m,
-        yaw0_rad: 0.0,
-        roll0_rad: 0.0,
-        pitch0_rad: 0.0,
-        order: s.order,
-        stance_feet: s.robot.stance_feet(s.stance_height_m),
-    })?))
-}
-
-#[inline(never)]
-fn leg_paths_motion<M: Math>(
-    path: AnyPath,
-    cycle_s: f32,
-    s: &Setup<'_, M>,
-) -> Result<LawMotion, Error> {
-    let law = laws::LegPathsLaw {
-        path,
-        cycle_s,
-        phase_offsets: [0.0; 4],
-        stance_feet: s.robot.stance_feet(s.stance_height_m),
-    };
-    law.check()?;
-    Ok(LawMotion::LegPaths(law))
+    Ok(motion)
 }
 
 /// Whole frames from 0 to the first period boundary at or after `t_s`.
