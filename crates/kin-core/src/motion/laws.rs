@@ -12,8 +12,8 @@
 
 use super::path::{AnyPath, FootPath};
 use super::{
-    check_reach, finite, finite_feet, finite_vec, fract01, non_negative, positive, Contact, Error,
-    Frame, Motion, Phase,
+    check_reach, finite, finite_feet, fract01, non_negative, positive, Contact, Error, Frame,
+    Motion, Phase,
 };
 use super::{Expected, Param};
 use crate::body::{BodyConfig, Pose};
@@ -442,8 +442,8 @@ impl YawTurnLaw {
         finite(p.yaw0_rad, Param::Yaw0Rad)?;
         finite(p.roll0_rad, Param::Roll0Rad)?;
         finite(p.pitch0_rad, Param::Pitch0Rad)?;
+        finite_feet(&p.stance_feet, Param::StanceFeet)?;
         for f in &p.stance_feet {
-            finite_vec(*f, Param::StanceFeet)?;
             if !(f.z + p.lift_height_m < 0.0) {
                 return Err(Error::OutOfRange {
                     parameter: Param::LiftHeightM,
