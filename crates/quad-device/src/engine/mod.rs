@@ -564,47 +564,59 @@ fn check_sample<'r, M: Math>(
     Ok(q)
 }
 
-/// The kin-core motion of a law request (its parameters checked, not its reach: the start
-/// check does that).
+/// The kin-core motion of a law request, written into `motion` (its parameters checked, not
+/// its reach: the start check does that).
 ///
-/// The laws carry no robot (the device's solver holds it): one builder for the three, their
-/// stance feet computed once.
+/// The laws carry no robot (the device's solver holds it): one builder for the three, each
+/// law's variant set first and its stance feet then written where they stay.
 #[inline(never)]
-fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<LawMotion, Error> {
-    let stance = s.robot.stance_feet(s.stance_height_m);
-    let motion = match *request {
+fn law_motion<M: Math>(
+    request: &Request,
+    s: &Setup<'_, M>,
+    motion: &mut LawMotion,
+) -> Result<(), Error> {
+    let h = s.stance_height_m;
+    match *request {
         Request::Sway {
             axis,
             amplitude_rad,
             period_s,
             ..
-        } => LawMotion::Sway(laws::SwayLaw {
-            axis,
-            amplitude_rad,
-            period_s,
-            roll0_rad: 0.0,
-            pitch0_rad: 0.0,
-            yaw0_rad: 0.0,
-            order: s.order,
-            feet_in_world: stance,
-        }),
+        } => {
+            *motion = LawMotion::Sway(laws::SwayLaw {
+                axis,
+                amplitude_rad,
+                period_s,
+                roll0_rad: 0.0,
+                pitch0_rad: 0.0,
+                yaw0_rad: 0.0,
+                order: s.order,
+                feet_in_world: [Vec3::ZERO; 4],
+            });
+            if let LawMotion::Sway(m) = motion {
+                m.feet_in_world = s.robot.stance_feet(h);
+                m.check()?;
+            }
+        }
         Request::YawTurn {
             yaw_rate_rad_s,
             step_period_s,
             lift_height_m,
             ..
-        } => LawMotion::YawTurn(laws::YawTurnLaw::without_reach_check::<M>(
-            laws::YawTurnLawParams {
-                yaw_rate_rad_s,
-                step_period_s,
-                lift_height_m,
-                yaw0_rad: 0.0,
-                roll0_rad: 0.0,
-                pitch0_rad: 0.0,
-                order: s.order,
-                stance_feet: stance,
-            },
-        )?),
+        } => {
+            *motion = LawMotion::YawTurn(laws::YawTurnLaw::without_reach_check::<M>(
+                laws::YawTurnLawParams {
+                    yaw_rate_rad_s,
+                    step_period_s,
+                    lift_height_m,
+                    yaw0_rad: 0.0,
+                    roll0_rad: 0.0,
+                    pitch0_rad: 0.0,
+                    order: s.order,
+                    stance_feet: s.robot.stance_feet(h),
+                },
+            )?);
+        }
         Request::FootPath {
             path,
             stride_m,
@@ -612,20 +624,22 @@ fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<LawMotion,
             duty_factor,
             cycle_s,
             ..
-        } => LawMotion::LegPaths(laws::LegPathsLaw {
-            path: AnyPath::new(path, Stride::new(stride_m, step_height_m, duty_factor)?),
-            cycle_s,
-            phase_offsets: [0.0; 4],
-            stance_feet: stance,
-        }),
+        } => {
+            let stride = Stride::new(stride_m, step_height_m, duty_factor)?;
+            *motion = LawMotion::LegPaths(laws::LegPathsLaw {
+                path: AnyPath::new(path, stride),
+                cycle_s,
+                phase_offsets: [0.0; 4],
+                stance_feet: [Vec3::ZERO; 4],
+            });
+            if let LawMotion::LegPaths(m) = motion {
+                m.stance_feet = s.robot.stance_feet(h);
+                m.check()?;
+            }
+        }
         _ => return Err(Error::Busy),
-    };
-    match &motion {
-        LawMotion::Sway(m) => m.check()?,
-        LawMotion::LegPaths(m) => m.check()?,
-        LawMotion::YawTurn(_) => {}
     }
-    Ok(motion)
+    Ok(())
 }
 
 /// Whole frames from 0 to the first period boundary at or after `t_s`.
@@ -747,10 +761,12 @@ impl<M: Math> Engine<M> {
     /// the motion's parameters.
     #[inline(never)]
     fn law(request: &Request, s: &Setup<'_, M>, program: &mut Program) -> Result<[f32; 12], Error> {
-        Self::build_law(request, s, program)?;
-        let checked = match program {
-            Program::Law(law) => Self::check_law(law, s),
-            _ => Err(Error::Busy),
+        let checked = match Self::build_law(request, s, program) {
+            Ok(()) => match program {
+                Program::Law(law) => Self::check_law(law, s),
+                _ => Err(Error::Busy),
+            },
+            Err(e) => Err(e),
         };
         if checked.is_err() {
             *program = Program::Idle;
@@ -776,14 +792,25 @@ impl<M: Math> Engine<M> {
             _ => return Err(Error::Busy),
         };
         let d = duration(d)?;
-        // The motion written where it stays, then the fields that follow from it.
+        // The law written where it stays (its motion a placeholder until built there), then
+        // the fields that follow from its motion.
         *program = Program::Law(Law {
-            motion: law_motion::<M>(request, s)?,
+            motion: LawMotion::Sway(laws::SwayLaw {
+                axis: Axis::Roll,
+                amplitude_rad: 0.0,
+                period_s: 1.0,
+                roll0_rad: 0.0,
+                pitch0_rad: 0.0,
+                yaw0_rad: 0.0,
+                order: s.order,
+                feet_in_world: [Vec3::ZERO; 4],
+            }),
             legs,
             period_s: 1.0,
             end_frame: None,
         });
         if let Program::Law(law) = program {
+            law_motion::<M>(request, s, &mut law.motion)?;
             let period_s = law.motion.period_s();
             law.period_s = period_s;
             law.end_frame = d.map(|d| frames_to_boundary(d, period_s).max(1));
