@@ -1,9 +1,10 @@
 //! The motion engine: the papers' motions, stand-up and sit, run on the device one servo frame
 //! at a time, every setpoint through one joint-speed limiter.
 //!
-//! The engine calls kin-core's motion code — [`laws::Sway`], [`laws::YawTurn`],
-//! [`laws::LegPaths`] over the [`PathKind`] paths, and the [`Walker`] stepper — and kin-core's
-//! body IK; it holds no law of its own. It is `no_std`, allocation-free and generic over the
+//! The engine calls kin-core's motion code — the robot-free laws [`laws::SwayLaw`],
+//! [`laws::YawTurnLaw`], [`laws::LegPathsLaw`] over the [`PathKind`] paths (the robot is the
+//! device's, in its body solver), and the [`Walker`] stepper — and kin-core's body IK; it holds
+//! no law of its own. It is `no_std`, allocation-free and generic over the
 //! kin-core [`Math`] backend, so the firmware and the host's simulated link run the same code.
 //!
 //! ## Frames
