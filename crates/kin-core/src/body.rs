@@ -362,6 +362,24 @@ impl<M: Math> Solver<M> {
         feet_in_world: &[Vec3; 4],
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
+        if M::SHARE_FLOAT_CODE {
+            return self.inverse_shared(pose, config, feet_in_world, policy);
+        }
+        check_finite(pose, config)?;
+        let local = self.feet_in_hips(pose, config, feet_in_world);
+        self.legs(&local, policy)
+    }
+
+    /// [`Solver::inverse`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]), which the
+    /// stance solve shares.
+    #[inline(never)]
+    fn inverse_shared(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        feet_in_world: &[Vec3; 4],
+        policy: ReachPolicy,
+    ) -> Result<BodySolution, IkError> {
         check_finite(pose, config)?;
         let local = self.feet_in_hips(pose, config, feet_in_world);
         self.legs(&local, policy)
@@ -379,20 +397,19 @@ impl<M: Math> Solver<M> {
         stance_height_m: f32,
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
-        check_finite(pose, config)?;
-        let local = if M::SHARE_FLOAT_CODE {
-            // One copy of the body transform in the program: the stance feet through the
-            // general transform (the closed form saves a tenth of a body solve's float
-            // operations but is a second copy of them; BENCHMARKS.md has both figures).
+        if M::SHARE_FLOAT_CODE {
+            // One copy of the body solve in the program: the stance feet through the general
+            // solve (the closed form saves a tenth of a body solve's float operations but is
+            // a second copy of them; BENCHMARKS.md has both figures).
             let front_left = Vec3::new(self.hip_fl_m.x, self.stance_lateral_m, -stance_height_m);
             let mut feet = [Vec3::ZERO; 4];
             for (f, leg) in feet.iter_mut().zip(LegId::ALL) {
                 *f = leg.at_corner(front_left);
             }
-            self.feet_in_hips(pose, config, &feet)
-        } else {
-            self.stance_feet_in_hips(pose, config, stance_height_m)
-        };
+            return self.inverse_shared(pose, config, &feet, policy);
+        }
+        check_finite(pose, config)?;
+        let local = self.stance_feet_in_hips(pose, config, stance_height_m);
         self.legs(&local, policy)
     }
 
