@@ -12,8 +12,8 @@
 
 use super::path::{AnyPath, FootPath};
 use super::{
-    check_reach, finite, finite_feet, finite_vec, fract01, non_negative, positive, Contact, Error,
-    Frame, Motion, Phase,
+    check_reach, finite, finite_feet, fract01, non_negative, positive, Contact, Error, Frame,
+    Motion, Phase,
 };
 use super::{Expected, Param};
 use crate::body::{BodyConfig, Pose};
@@ -130,10 +130,92 @@ impl SwayParams {
     }
 }
 
+impl SwayParams {
+    /// The robot-free law of these parameters (all but the robot).
+    pub const fn law(&self) -> SwayLaw {
+        SwayLaw {
+            axis: self.axis,
+            amplitude_rad: self.amplitude_rad,
+            period_s: self.period_s,
+            roll0_rad: self.roll0_rad,
+            pitch0_rad: self.pitch0_rad,
+            yaw0_rad: self.yaw0_rad,
+            order: self.order,
+            feet_in_world: self.feet_in_world,
+        }
+    }
+}
+
+/// A sway's law without its robot: [`SwayParams`] but the robot, the frames' whole input. The
+/// robot enters only the reach checks of [`Sway::new`] and the caller's IK; a device builds
+/// this where it keeps it and checks it there ([`SwayLaw::check`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SwayLaw {
+    /// The axis that oscillates.
+    pub axis: Axis,
+    /// Amplitude `A`, rad.
+    pub amplitude_rad: f32,
+    /// Period `T`, s.
+    pub period_s: f32,
+    /// Constant roll θ0, rad.
+    pub roll0_rad: f32,
+    /// Constant pitch γ0, rad.
+    pub pitch0_rad: f32,
+    /// Constant yaw ψ0, rad.
+    pub yaw0_rad: f32,
+    /// Rotation order of the pose.
+    pub order: RotationOrder,
+    /// The feet on the ground, world frame, m.
+    pub feet_in_world: [Vec3; 4],
+}
+
+impl SwayLaw {
+    /// The parameter checks of [`Sway::new`] without its reach checks: finite values, `T > 0`.
+    /// Out of line, on a reference: the law's reads then stay close to one pointer (on the
+    /// AVR, within its 63-byte displacement) wherever it is kept.
+    #[inline(never)]
+    pub fn check(&self) -> Result<(), Error> {
+        finite(self.amplitude_rad, Param::AmplitudeRad)?;
+        positive(self.period_s, Param::PeriodS)?;
+        finite(self.roll0_rad, Param::Roll0Rad)?;
+        finite(self.pitch0_rad, Param::Pitch0Rad)?;
+        finite(self.yaw0_rad, Param::Yaw0Rad)?;
+        finite_feet(&self.feet_in_world, Param::FeetInWorld)?;
+        Ok(())
+    }
+
+    /// The oscillating angle's offset from its constant, `A·sin(2πt/T)`, rad.
+    pub fn offset_rad<M: Math>(&self, t_s: f32) -> f32 {
+        let phase = fract01(t_s / self.period_s);
+        self.amplitude_rad * M::sin_cos(2.0 * PI * phase).0
+    }
+
+    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite): no frame
+    /// passed by value, for a caller that keeps one.
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        finite(t_s, Param::TS)?;
+        frame.pose = self.pose_at(self.offset_rad::<M>(t_s));
+        frame.feet_in_world = self.feet_in_world;
+        frame.contact = [Contact::Stance; 4];
+        Ok(())
+    }
+
+    fn pose_at(&self, offset_rad: f32) -> Pose {
+        let (mut r, mut p, mut y) = (self.roll0_rad, self.pitch0_rad, self.yaw0_rad);
+        match self.axis {
+            Axis::Roll => r += offset_rad,
+            Axis::Pitch => p += offset_rad,
+            Axis::Yaw => y += offset_rad,
+        }
+        Pose::rotation(r, p, y)
+    }
+}
+
 /// Seed 001's sway laws (eq. 6–8): one body angle oscillates, feet fixed, centre fixed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sway {
-    p: SwayParams,
+    robot: Robot,
+    law: SwayLaw,
 }
 
 impl Sway {
@@ -146,7 +228,7 @@ impl Sway {
         let cfg = s.body_config();
         check_reach(
             &p.robot,
-            &s.pose_at(0.0),
+            &s.law.pose_at(0.0),
             &cfg,
             &p.feet_in_world,
             Param::FeetInWorld,
@@ -154,7 +236,7 @@ impl Sway {
         for sign in [1.0, -1.0] {
             check_reach(
                 &p.robot,
-                &s.pose_at(sign * p.amplitude_rad),
+                &s.law.pose_at(sign * p.amplitude_rad),
                 &cfg,
                 &p.feet_in_world,
                 Param::AmplitudeRad,
@@ -164,67 +246,55 @@ impl Sway {
     }
 
     /// [`Sway::new`]'s parameter checks without its reach checks and without validating
-    /// `p.robot`, for a caller that validated its robot already and checks the reach itself by
-    /// running the motion's frames through its own IK (a device's start check, on the robot it
-    /// validated at boot).
+    /// `p.robot`, for a caller that validated its robot already and checks the reach itself.
     pub fn without_reach_check(p: SwayParams) -> Result<Sway, Error> {
-        Self::check(&p)?;
-        Ok(Sway { p })
-    }
-
-    /// The parameter checks of [`Sway::without_reach_check`]. Out of line, on a reference:
-    /// the parameters are a hundred bytes and more, and the checks' reads then stay close to
-    /// one pointer (on the AVR, within its 63-byte displacement) wherever they are built.
-    #[inline(never)]
-    fn check(p: &SwayParams) -> Result<(), Error> {
-        finite(p.amplitude_rad, Param::AmplitudeRad)?;
-        positive(p.period_s, Param::PeriodS)?;
-        finite(p.roll0_rad, Param::Roll0Rad)?;
-        finite(p.pitch0_rad, Param::Pitch0Rad)?;
-        finite(p.yaw0_rad, Param::Yaw0Rad)?;
-        finite_feet(&p.feet_in_world, Param::FeetInWorld)?;
-        Ok(())
+        let law = p.law();
+        law.check()?;
+        Ok(Sway {
+            robot: p.robot,
+            law,
+        })
     }
 
     /// The parameters.
-    pub const fn params(&self) -> &SwayParams {
-        &self.p
+    pub const fn params(&self) -> SwayParams {
+        let l = &self.law;
+        SwayParams {
+            robot: self.robot,
+            axis: l.axis,
+            amplitude_rad: l.amplitude_rad,
+            period_s: l.period_s,
+            roll0_rad: l.roll0_rad,
+            pitch0_rad: l.pitch0_rad,
+            yaw0_rad: l.yaw0_rad,
+            order: l.order,
+            feet_in_world: l.feet_in_world,
+        }
+    }
+
+    /// The robot-free law.
+    pub const fn law(&self) -> &SwayLaw {
+        &self.law
     }
 
     /// The oscillating angle's offset from its constant, `A·sin(2πt/T)`, rad.
     pub fn offset_rad<M: Math>(&self, t_s: f32) -> f32 {
-        let phase = fract01(t_s / self.p.period_s);
-        self.p.amplitude_rad * M::sin_cos(2.0 * PI * phase).0
+        self.law.offset_rad::<M>(t_s)
     }
 
-    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite): no frame
-    /// passed by value, for a caller that keeps one.
+    /// [`Motion::frame`] written into `frame` ([`SwayLaw::frame_into`]).
     pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
-        finite(t_s, Param::TS)?;
-        frame.pose = self.pose_at(self.offset_rad::<M>(t_s));
-        frame.feet_in_world = self.p.feet_in_world;
-        frame.contact = [Contact::Stance; 4];
-        Ok(())
-    }
-
-    fn pose_at(&self, offset_rad: f32) -> Pose {
-        let (mut r, mut p, mut y) = (self.p.roll0_rad, self.p.pitch0_rad, self.p.yaw0_rad);
-        match self.p.axis {
-            Axis::Roll => r += offset_rad,
-            Axis::Pitch => p += offset_rad,
-            Axis::Yaw => y += offset_rad,
-        }
-        Pose::rotation(r, p, y)
+        self.law.frame_into::<M>(t_s, frame)
     }
 }
 
 impl Motion for Sway {
     fn robot(&self) -> &Robot {
-        &self.p.robot
+        &self.robot
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig::about_centre(self.p.order)
+        BodyConfig::about_centre(self.law.order)
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
@@ -234,7 +304,7 @@ impl Motion for Sway {
     }
 
     fn period_s(&self) -> Option<f32> {
-        Some(self.p.period_s)
+        Some(self.law.period_s)
     }
 }
 
@@ -293,7 +363,44 @@ pub const fn in_pair_13(leg: LegId) -> bool {
     matches!(leg, LegId::FL | LegId::RR)
 }
 
-/// Seed 001's yaw turn, eq. 9–11 as corrected in `docs/papers.md` ("Seed 001 eq. 10–11").
+impl YawTurnParams {
+    /// These parameters but the robot.
+    pub const fn law_params(&self) -> YawTurnLawParams {
+        YawTurnLawParams {
+            yaw_rate_rad_s: self.yaw_rate_rad_s,
+            step_period_s: self.step_period_s,
+            lift_height_m: self.lift_height_m,
+            yaw0_rad: self.yaw0_rad,
+            roll0_rad: self.roll0_rad,
+            pitch0_rad: self.pitch0_rad,
+            order: self.order,
+            stance_feet: self.stance_feet,
+        }
+    }
+}
+
+/// [`YawTurnParams`] but the robot: a [`YawTurnLaw`]'s input.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct YawTurnLawParams {
+    /// Yaw rate `r = −ω_z`, rad/s; positive turns counter-clockwise seen from above.
+    pub yaw_rate_rad_s: f32,
+    /// Step period `T1` (one full cycle of both pairs), s.
+    pub step_period_s: f32,
+    /// Lift height `h_K` of the half-wave sine, m.
+    pub lift_height_m: f32,
+    /// Initial yaw ψ0, rad.
+    pub yaw0_rad: f32,
+    /// Constant roll θ0, rad.
+    pub roll0_rad: f32,
+    /// Constant pitch γ0, rad.
+    pub pitch0_rad: f32,
+    /// Rotation order of the pose.
+    pub order: RotationOrder,
+    /// The feet at `t = 0` relative to the body, m.
+    pub stance_feet: [Vec3; 4],
+}
+
+/// Seed 001's yaw turn without its robot ([`YawTurn`]'s law), eq. 9–11 as corrected in `docs/papers.md` ("Seed 001 eq. 10–11").
 ///
 /// With `τ = t mod T1` and `k = ⌊t/T1⌋`:
 /// - `Δ13 = k·T1 + (2τ if τ < T1/2 else T1)`, `Δ24 = k·T1 + (0 if τ < T1/2 else 2(τ − T1/2))`
@@ -306,60 +413,37 @@ pub const fn in_pair_13(leg: LegId) -> bool {
 /// A stance foot stays fixed while the body turns by `r·T1/2`; a swing foot moves by
 /// `r·T1` along its circle in `T1/2`. The joint angles repeat with period `T1`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct YawTurn {
-    p: YawTurnParams,
+pub struct YawTurnLaw {
+    p: YawTurnLawParams,
     rho_m: [f32; 4],
     alpha_rad: [f32; 4],
 }
 
-impl YawTurn {
-    /// Validates the parameters: finite values, `T1 > 0`, `h_K ≥ 0` and below the hips, and
-    /// the feet reachable at `t = 0`, at both apexes and at the end of each swing (a quick check;
-    /// [`crate::preflight`] sweeps the whole motion). The checks run on the [`DefaultMath`]
-    /// backend.
-    pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
-        p.robot.validate()?;
-        let turn = Self::without_reach_check::<DefaultMath>(p)?;
-        let cfg = turn.body_config();
-        let t1 = p.step_period_s;
-        for (t, name) in [
-            (0.0, Param::StanceFeet),
-            (0.25 * t1, Param::LiftHeightM),
-            (0.75 * t1, Param::LiftHeightM),
-            (0.499 * t1, Param::YawRateRadS),
-            (0.999 * t1, Param::YawRateRadS),
-        ] {
-            let f = turn.frame::<DefaultMath>(t)?;
-            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
-        }
-        Ok(turn)
-    }
-
-    /// [`YawTurn::new`]'s parameter checks without its reach checks and without validating
-    /// `p.robot`, with the foot radii and angles on math backend `M`, for a caller that
-    /// validated its robot already and checks the reach itself by running the motion's frames
-    /// through its own IK (a device's start check, on the robot it validated at boot).
-    pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
+impl YawTurnLaw {
+    /// [`YawTurn::new`]'s parameter checks without its reach checks, with the foot radii and
+    /// angles on math backend `M`, for a caller that checks the reach itself by running the
+    /// law's frames through its own IK (a device's start check).
+    pub fn without_reach_check<M: Math>(p: YawTurnLawParams) -> Result<YawTurnLaw, Error> {
         Self::check(&p)?;
-        Ok(YawTurn {
+        Ok(YawTurnLaw {
             p,
             rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
             alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
         })
     }
 
-    /// The parameter checks of [`YawTurn::without_reach_check`], out of line on a reference
-    /// as [`Sway`]'s.
+    /// The parameter checks of [`YawTurnLaw::without_reach_check`], out of line on a reference
+    /// as [`SwayLaw::check`].
     #[inline(never)]
-    fn check(p: &YawTurnParams) -> Result<(), Error> {
+    fn check(p: &YawTurnLawParams) -> Result<(), Error> {
         finite(p.yaw_rate_rad_s, Param::YawRateRadS)?;
         positive(p.step_period_s, Param::StepPeriodS)?;
         non_negative(p.lift_height_m, Param::LiftHeightM)?;
         finite(p.yaw0_rad, Param::Yaw0Rad)?;
         finite(p.roll0_rad, Param::Roll0Rad)?;
         finite(p.pitch0_rad, Param::Pitch0Rad)?;
+        finite_feet(&p.stance_feet, Param::StanceFeet)?;
         for f in &p.stance_feet {
-            finite_vec(*f, Param::StanceFeet)?;
             if !(f.z + p.lift_height_m < 0.0) {
                 return Err(Error::OutOfRange {
                     parameter: Param::LiftHeightM,
@@ -371,10 +455,9 @@ impl YawTurn {
     }
 
     /// The parameters.
-    pub const fn params(&self) -> &YawTurnParams {
+    pub const fn params(&self) -> &YawTurnLawParams {
         &self.p
     }
-
     /// Radius `ρ_i` of each foot's circle, m (order FL, FR, RL, RR).
     pub const fn rho_m(&self) -> [f32; 4] {
         self.rho_m
@@ -463,13 +546,94 @@ impl YawTurn {
     }
 }
 
+/// Seed 001's yaw turn ([`YawTurnLaw`] on a robot).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct YawTurn {
+    robot: Robot,
+    law: YawTurnLaw,
+}
+
+impl YawTurn {
+    /// Validates the parameters: finite values, `T1 > 0`, `h_K ≥ 0` and below the hips, and
+    /// the feet reachable at `t = 0`, at both apexes and at the end of each swing (a quick check;
+    /// [`crate::preflight`] sweeps the whole motion). The checks run on the [`DefaultMath`]
+    /// backend.
+    pub fn new(p: YawTurnParams) -> Result<YawTurn, Error> {
+        p.robot.validate()?;
+        let turn = Self::without_reach_check::<DefaultMath>(p)?;
+        let cfg = turn.body_config();
+        let t1 = p.step_period_s;
+        for (t, name) in [
+            (0.0, Param::StanceFeet),
+            (0.25 * t1, Param::LiftHeightM),
+            (0.75 * t1, Param::LiftHeightM),
+            (0.499 * t1, Param::YawRateRadS),
+            (0.999 * t1, Param::YawRateRadS),
+        ] {
+            let f = turn.frame::<DefaultMath>(t)?;
+            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
+        }
+        Ok(turn)
+    }
+
+    /// [`YawTurn::new`]'s parameter checks without its reach checks and without validating
+    /// `p.robot` ([`YawTurnLaw::without_reach_check`]).
+    pub fn without_reach_check<M: Math>(p: YawTurnParams) -> Result<YawTurn, Error> {
+        Ok(YawTurn {
+            robot: p.robot,
+            law: YawTurnLaw::without_reach_check::<M>(p.law_params())?,
+        })
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> YawTurnParams {
+        let l = &self.law.p;
+        YawTurnParams {
+            robot: self.robot,
+            yaw_rate_rad_s: l.yaw_rate_rad_s,
+            step_period_s: l.step_period_s,
+            lift_height_m: l.lift_height_m,
+            yaw0_rad: l.yaw0_rad,
+            roll0_rad: l.roll0_rad,
+            pitch0_rad: l.pitch0_rad,
+            order: l.order,
+            stance_feet: l.stance_feet,
+        }
+    }
+
+    /// The robot-free law.
+    pub const fn law(&self) -> &YawTurnLaw {
+        &self.law
+    }
+
+    /// Radius `ρ_i` of each foot's circle, m (order FL, FR, RL, RR).
+    pub const fn rho_m(&self) -> [f32; 4] {
+        self.law.rho_m
+    }
+
+    /// Angle `α_i = atan2(y_i, x_i)` of each foot at `t = 0` relative to the body, rad.
+    pub const fn alpha_rad(&self) -> [f32; 4] {
+        self.law.alpha_rad
+    }
+
+    /// Eq. 11's `Δ13` and `Δ24` within the current step period (`Δ − k·T1`), s.
+    pub fn deltas_in_period_s(&self, t_s: f32) -> (f32, f32) {
+        self.law.deltas_in_period_s(t_s)
+    }
+
+    /// [`Motion::frame`] written into `frame` ([`YawTurnLaw::frame_into`]).
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        self.law.frame_into::<M>(t_s, frame)
+    }
+}
+
 impl Motion for YawTurn {
     fn robot(&self) -> &Robot {
-        &self.p.robot
+        &self.robot
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig::about_centre(self.p.order)
+        BodyConfig::about_centre(self.law.p.order)
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
@@ -479,7 +643,7 @@ impl Motion for YawTurn {
     }
 
     fn period_s(&self) -> Option<f32> {
-        Some(self.p.step_period_s)
+        Some(self.law.p.step_period_s)
     }
 }
 
@@ -514,10 +678,66 @@ impl LegPathsParams {
     }
 }
 
+impl LegPathsParams {
+    /// The robot-free law of these parameters (all but the robot).
+    pub const fn law(&self) -> LegPathsLaw {
+        LegPathsLaw {
+            path: self.path,
+            cycle_s: self.cycle_s,
+            phase_offsets: self.phase_offsets,
+            stance_feet: self.stance_feet,
+        }
+    }
+}
+
+/// Feet following a path under a held body, without the robot: [`LegPathsParams`] but the
+/// robot (as [`SwayLaw`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegPathsLaw {
+    /// The path each foot follows (x along the body's x axis).
+    pub path: AnyPath,
+    /// Duration of one loop of the path, s.
+    pub cycle_s: f32,
+    /// Phase offset of each leg (order FL, FR, RL, RR), cycles.
+    pub phase_offsets: [f32; 4],
+    /// The stance point of each foot (path offset zero), world frame, m.
+    pub stance_feet: [Vec3; 4],
+}
+
+impl LegPathsLaw {
+    /// The parameter checks of [`LegPaths::new`] without its reach checks: finite values,
+    /// `cycle_s > 0`; out of line on a reference as [`SwayLaw::check`].
+    #[inline(never)]
+    pub fn check(&self) -> Result<(), Error> {
+        positive(self.cycle_s, Param::CycleS)?;
+        for o in &self.phase_offsets {
+            finite(*o, Param::PhaseOffsets)?;
+        }
+        finite_feet(&self.stance_feet, Param::StanceFeet)?;
+        Ok(())
+    }
+
+    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite): no frame
+    /// passed by value, for a caller that keeps one.
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        finite(t_s, Param::TS)?;
+        let base = fract01(t_s / self.cycle_s);
+        frame.pose = Pose::default();
+        for leg in LegId::ALL {
+            let i = leg.index();
+            let phase = Phase::wrap(base + self.phase_offsets[i]);
+            frame.feet_in_world[i] = self.stance_feet[i] + self.path.offset::<M>(phase);
+            frame.contact[i] = self.path.contact(phase);
+        }
+        Ok(())
+    }
+}
+
 /// Feet following a path under a held body (the body does not move; stance feet slide).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LegPaths {
-    p: LegPathsParams,
+    robot: Robot,
+    law: LegPathsLaw,
 }
 
 impl LegPaths {
@@ -541,50 +761,42 @@ impl LegPaths {
     }
 
     /// [`LegPaths::new`]'s parameter checks without its reach checks and without validating
-    /// `p.robot`, for a caller that validated its robot already and checks the reach itself by
-    /// running the motion's frames through its own IK (a device's start check, on the robot it
-    /// validated at boot).
+    /// `p.robot`, for a caller that validated its robot already and checks the reach itself.
     pub fn without_reach_check(p: LegPathsParams) -> Result<LegPaths, Error> {
-        Self::check(&p)?;
-        Ok(LegPaths { p })
-    }
-
-    /// The parameter checks of [`LegPaths::without_reach_check`], out of line on a reference
-    /// as [`Sway`]'s.
-    #[inline(never)]
-    fn check(p: &LegPathsParams) -> Result<(), Error> {
-        positive(p.cycle_s, Param::CycleS)?;
-        for o in &p.phase_offsets {
-            finite(*o, Param::PhaseOffsets)?;
-        }
-        finite_feet(&p.stance_feet, Param::StanceFeet)?;
-        Ok(())
+        let law = p.law();
+        law.check()?;
+        Ok(LegPaths {
+            robot: p.robot,
+            law,
+        })
     }
 
     /// The parameters.
-    pub const fn params(&self) -> &LegPathsParams {
-        &self.p
+    pub const fn params(&self) -> LegPathsParams {
+        let l = &self.law;
+        LegPathsParams {
+            robot: self.robot,
+            path: l.path,
+            cycle_s: l.cycle_s,
+            phase_offsets: l.phase_offsets,
+            stance_feet: l.stance_feet,
+        }
     }
 
-    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite): no frame
-    /// passed by value, for a caller that keeps one.
+    /// The robot-free law.
+    pub const fn law(&self) -> &LegPathsLaw {
+        &self.law
+    }
+
+    /// [`Motion::frame`] written into `frame` ([`LegPathsLaw::frame_into`]).
     pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
-        finite(t_s, Param::TS)?;
-        let base = fract01(t_s / self.p.cycle_s);
-        frame.pose = Pose::default();
-        for leg in LegId::ALL {
-            let i = leg.index();
-            let phase = Phase::wrap(base + self.p.phase_offsets[i]);
-            frame.feet_in_world[i] = self.p.stance_feet[i] + self.p.path.offset::<M>(phase);
-            frame.contact[i] = self.p.path.contact(phase);
-        }
-        Ok(())
+        self.law.frame_into::<M>(t_s, frame)
     }
 }
 
 impl Motion for LegPaths {
     fn robot(&self) -> &Robot {
-        &self.p.robot
+        &self.robot
     }
 
     fn body_config(&self) -> BodyConfig {
@@ -598,6 +810,6 @@ impl Motion for LegPaths {
     }
 
     fn period_s(&self) -> Option<f32> {
-        Some(self.p.cycle_s)
+        Some(self.law.cycle_s)
     }
 }

@@ -92,7 +92,7 @@ use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
 use kin_core::motion::path::{AnyPath, PathKind, Stride};
 use kin_core::motion::walker::{Walker, WalkerParams};
-use kin_core::motion::{self, AnyMotion, Frame, Motion, Param};
+use kin_core::motion::{self, Frame, Param};
 use kin_core::preflight::{Failure, FailureKind};
 use kin_core::{IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::servo;
@@ -378,10 +378,38 @@ pub struct Tick {
     pub disable_outputs: bool,
 }
 
+/// A law's kin-core motion, without the robot (the device's solver holds it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum LawMotion {
+    Sway(laws::SwayLaw),
+    YawTurn(laws::YawTurnLaw),
+    LegPaths(laws::LegPathsLaw),
+}
+
+impl LawMotion {
+    /// The rotation order of the law's poses.
+    fn order(&self) -> RotationOrder {
+        match self {
+            LawMotion::Sway(m) => m.order,
+            LawMotion::YawTurn(m) => m.params().order,
+            LawMotion::LegPaths(_) => BodyConfig::default().order,
+        }
+    }
+
+    /// One period (one loop of the foot paths), s.
+    fn period_s(&self) -> f32 {
+        match self {
+            LawMotion::Sway(m) => m.period_s,
+            LawMotion::YawTurn(m) => m.params().step_period_s,
+            LawMotion::LegPaths(m) => m.cycle_s,
+        }
+    }
+}
+
 /// A law motion: the kin-core motion, the legs it moves, when it ends.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Law {
-    motion: AnyMotion,
+    motion: LawMotion,
     /// Legs that follow the motion; the others stay at their stance point (the foot paths'
     /// only: the other laws move every leg).
     legs: [bool; 4],
@@ -536,27 +564,59 @@ fn check_sample<'r, M: Math>(
     Ok(q)
 }
 
-/// The kin-core motion of a law request (its parameters checked, not its reach: the start
-/// check does that).
+/// The kin-core motion of a law request, written into `motion` (its parameters checked, not
+/// its reach: the start check does that).
 ///
-/// One builder per law, each out of line: a law's parameters are a hundred bytes and more,
-/// and the three sets in one stack frame would put most of its accesses beyond the AVR's
-/// 63-byte displacement.
+/// The laws carry no robot (the device's solver holds it): one builder for the three, each
+/// law's variant set first and its stance feet then written where they stay.
 #[inline(never)]
-fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<AnyMotion, Error> {
+fn law_motion<M: Math>(
+    request: &Request,
+    s: &Setup<'_, M>,
+    motion: &mut LawMotion,
+) -> Result<(), Error> {
+    let h = s.stance_height_m;
     match *request {
         Request::Sway {
             axis,
             amplitude_rad,
             period_s,
             ..
-        } => sway_motion(axis, amplitude_rad, period_s, s),
+        } => {
+            *motion = LawMotion::Sway(laws::SwayLaw {
+                axis,
+                amplitude_rad,
+                period_s,
+                roll0_rad: 0.0,
+                pitch0_rad: 0.0,
+                yaw0_rad: 0.0,
+                order: s.order,
+                feet_in_world: [Vec3::ZERO; 4],
+            });
+            if let LawMotion::Sway(m) = motion {
+                m.feet_in_world = s.robot.stance_feet(h);
+                m.check()?;
+            }
+        }
         Request::YawTurn {
             yaw_rate_rad_s,
             step_period_s,
             lift_height_m,
             ..
-        } => yaw_turn_motion(yaw_rate_rad_s, step_period_s, lift_height_m, s),
+        } => {
+            *motion = LawMotion::YawTurn(laws::YawTurnLaw::without_reach_check::<M>(
+                laws::YawTurnLawParams {
+                    yaw_rate_rad_s,
+                    step_period_s,
+                    lift_height_m,
+                    yaw0_rad: 0.0,
+                    roll0_rad: 0.0,
+                    pitch0_rad: 0.0,
+                    order: s.order,
+                    stance_feet: s.robot.stance_feet(h),
+                },
+            )?);
+        }
         Request::FootPath {
             path,
             stride_m,
@@ -566,71 +626,20 @@ fn law_motion<M: Math>(request: &Request, s: &Setup<'_, M>) -> Result<AnyMotion,
             ..
         } => {
             let stride = Stride::new(stride_m, step_height_m, duty_factor)?;
-            leg_paths_motion(AnyPath::new(path, stride), cycle_s, s)
+            *motion = LawMotion::LegPaths(laws::LegPathsLaw {
+                path: AnyPath::new(path, stride),
+                cycle_s,
+                phase_offsets: [0.0; 4],
+                stance_feet: [Vec3::ZERO; 4],
+            });
+            if let LawMotion::LegPaths(m) = motion {
+                m.stance_feet = s.robot.stance_feet(h);
+                m.check()?;
+            }
         }
-        _ => Err(Error::Busy),
+        _ => return Err(Error::Busy),
     }
-}
-
-#[inline(never)]
-fn sway_motion<M: Math>(
-    axis: Axis,
-    amplitude_rad: f32,
-    period_s: f32,
-    s: &Setup<'_, M>,
-) -> Result<AnyMotion, Error> {
-    Ok(AnyMotion::Sway(laws::Sway::without_reach_check(
-        laws::SwayParams {
-            robot: *s.robot,
-            axis,
-            amplitude_rad,
-            period_s,
-            roll0_rad: 0.0,
-            pitch0_rad: 0.0,
-            yaw0_rad: 0.0,
-            order: s.order,
-            feet_in_world: s.robot.stance_feet(s.stance_height_m),
-        },
-    )?))
-}
-
-#[inline(never)]
-fn yaw_turn_motion<M: Math>(
-    yaw_rate_rad_s: f32,
-    step_period_s: f32,
-    lift_height_m: f32,
-    s: &Setup<'_, M>,
-) -> Result<AnyMotion, Error> {
-    Ok(AnyMotion::YawTurn(laws::YawTurn::without_reach_check::<M>(
-        laws::YawTurnParams {
-            robot: *s.robot,
-            yaw_rate_rad_s,
-            step_period_s,
-            lift_height_m,
-            yaw0_rad: 0.0,
-            roll0_rad: 0.0,
-            pitch0_rad: 0.0,
-            order: s.order,
-            stance_feet: s.robot.stance_feet(s.stance_height_m),
-        },
-    )?))
-}
-
-#[inline(never)]
-fn leg_paths_motion<M: Math>(
-    path: AnyPath,
-    cycle_s: f32,
-    s: &Setup<'_, M>,
-) -> Result<AnyMotion, Error> {
-    Ok(AnyMotion::LegPaths(laws::LegPaths::without_reach_check(
-        laws::LegPathsParams {
-            robot: *s.robot,
-            path,
-            cycle_s,
-            phase_offsets: [0.0; 4],
-            stance_feet: s.robot.stance_feet(s.stance_height_m),
-        },
-    )?))
+    Ok(())
 }
 
 /// Whole frames from 0 to the first period boundary at or after `t_s`.
@@ -752,10 +761,12 @@ impl<M: Math> Engine<M> {
     /// the motion's parameters.
     #[inline(never)]
     fn law(request: &Request, s: &Setup<'_, M>, program: &mut Program) -> Result<[f32; 12], Error> {
-        Self::build_law(request, s, program)?;
-        let checked = match program {
-            Program::Law(law) => Self::check_law(law, s),
-            _ => Err(Error::Busy),
+        let checked = match Self::build_law(request, s, program) {
+            Ok(()) => match program {
+                Program::Law(law) => Self::check_law(law, s),
+                _ => Err(Error::Busy),
+            },
+            Err(e) => Err(e),
         };
         if checked.is_err() {
             *program = Program::Idle;
@@ -781,21 +792,26 @@ impl<M: Math> Engine<M> {
             _ => return Err(Error::Busy),
         };
         let d = duration(d)?;
-        // The motion written where it stays, then the fields that follow from it.
+        // The law written where it stays (its motion a placeholder until built there), then
+        // the fields that follow from its motion.
         *program = Program::Law(Law {
-            motion: law_motion::<M>(request, s)?,
+            motion: LawMotion::Sway(laws::SwayLaw {
+                axis: Axis::Roll,
+                amplitude_rad: 0.0,
+                period_s: 1.0,
+                roll0_rad: 0.0,
+                pitch0_rad: 0.0,
+                yaw0_rad: 0.0,
+                order: s.order,
+                feet_in_world: [Vec3::ZERO; 4],
+            }),
             legs,
             period_s: 1.0,
             end_frame: None,
         });
         if let Program::Law(law) = program {
-            let period_s = match &law.motion {
-                AnyMotion::Sway(m) => m.period_s(),
-                AnyMotion::YawTurn(m) => m.period_s(),
-                AnyMotion::LegPaths(m) => m.period_s(),
-                _ => None,
-            }
-            .unwrap_or(1.0);
+            law_motion::<M>(request, s, &mut law.motion)?;
+            let period_s = law.motion.period_s();
             law.period_s = period_s;
             law.end_frame = d.map(|d| frames_to_boundary(d, period_s).max(1));
         }
@@ -873,14 +889,12 @@ impl<M: Math> Engine<M> {
     /// through a pointer, not through a stack frame beyond the AVR's 63-byte displacement.
     #[inline(never)]
     fn law_frame(law: &Law, t_s: f32, frame: &mut Frame) -> Result<(), motion::Error> {
-        // The engine's law motions only: matching them keeps the gait's frame code out of the
-        // firmware.
         match &law.motion {
-            AnyMotion::Sway(m) => m.frame_into::<M>(t_s, frame),
-            AnyMotion::YawTurn(m) => m.frame_into::<M>(t_s, frame),
-            AnyMotion::LegPaths(m) => {
+            LawMotion::Sway(m) => m.frame_into::<M>(t_s, frame),
+            LawMotion::YawTurn(m) => m.frame_into::<M>(t_s, frame),
+            LawMotion::LegPaths(m) => {
                 m.frame_into::<M>(t_s, frame)?;
-                let stance = &m.params().stance_feet;
+                let stance = &m.stance_feet;
                 for (i, moves) in law.legs.iter().enumerate() {
                     if !moves {
                         frame.feet_in_world[i] = stance[i];
@@ -889,7 +903,6 @@ impl<M: Math> Engine<M> {
                 }
                 Ok(())
             }
-            _ => Err(motion::Error::NonFinite(Param::TS)),
         }
     }
 
@@ -901,7 +914,7 @@ impl<M: Math> Engine<M> {
             leg: LegId::FL,
             kind: kin_core::Unreachable::NonFinite,
         })?;
-        solve_frame(solver, law.motion.body_config().order, &frame)
+        solve_frame(solver, law.motion.order(), &frame)
     }
 
     /// The walk's joint setpoint with its feet at `feet` (body frame, the body at the zero pose;
@@ -1107,9 +1120,9 @@ impl<M: Math> Engine<M> {
 impl Law {
     fn motion_kind(&self) -> Kind {
         match self.motion {
-            AnyMotion::Sway(_) => Kind::Sway,
-            AnyMotion::YawTurn(_) => Kind::YawTurn,
-            _ => Kind::FootPath,
+            LawMotion::Sway(_) => Kind::Sway,
+            LawMotion::YawTurn(_) => Kind::YawTurn,
+            LawMotion::LegPaths(_) => Kind::FootPath,
         }
     }
 }
