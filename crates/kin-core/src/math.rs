@@ -956,7 +956,9 @@ pub fn ceil(x: f32) -> f32 {
 #[inline(never)]
 pub fn wrap_pi(angle_rad: f32) -> f32 {
     let two_pi = 2.0 * PI;
-    let mut a = angle_rad - two_pi * libm::roundf(angle_rad / two_pi);
+    // The nearest whole turn by `floor` (libm's `roundf` is a second copy of its bit
+    // manipulation on a soft-float target); a half turn either way is put right below.
+    let mut a = angle_rad - two_pi * floor(angle_rad / two_pi + 0.5);
     if a <= -PI {
         a += two_pi;
     }
@@ -983,6 +985,19 @@ pub fn wrap_two_pi(angle_rad: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wrap_pi_lands_in_the_half_open_turn_on_the_same_angle() {
+        let mut rng = SplitMix64::new(0x0077_a9);
+        let halves = [PI, -PI, 3.0 * PI, -3.0 * PI, 0.5 * PI, 0.0, -0.0];
+        let random = (0..100_000).map(|_| (rng.next_u64() % 2_000_001) as f32 * 1e-4 - 100.0);
+        for a in halves.into_iter().chain(random) {
+            let w = wrap_pi(a);
+            assert!(w > -PI && w <= PI, "{a}: {w}");
+            let turns = (f64::from(a) - f64::from(w)) / (2.0 * core::f64::consts::PI);
+            assert!((turns - turns.round()).abs() < 1e-5, "{a}: {w}");
+        }
+    }
 
     #[test]
     fn floor_and_ceil_equal_libm_on_special_and_random_inputs() {
