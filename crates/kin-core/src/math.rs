@@ -988,7 +988,7 @@ mod tests {
 
     #[test]
     fn wrap_pi_lands_in_the_half_open_turn_on_the_same_angle() {
-        let mut rng = SplitMix64::new(0x0077_a9);
+        let mut rng = SplitMix64::new(0x77a9);
         let halves = [PI, -PI, 3.0 * PI, -3.0 * PI, 0.5 * PI, 0.0, -0.0];
         let random = (0..100_000).map(|_| (rng.next_u64() % 2_000_001) as f32 * 1e-4 - 100.0);
         for a in halves.into_iter().chain(random) {
