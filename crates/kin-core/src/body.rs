@@ -148,6 +148,14 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
     core::array::from_fn(|i| JointAngles::new(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]))
 }
 
+/// One foot in its hip frame: `Rᵀ·v + c − hip` (`v` the foot less the translation and the
+/// pivot). Out of line: one copy of its float operations for the four feet.
+#[inline(never)]
+fn foot_in_hip(r: &Mat3, v: Vec3, c: Vec3, hip: Vec3) -> Vec3 {
+    let p = r.transpose_mul_vec(v);
+    Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z)
+}
+
 /// Full-body IK on math backend `M` with the robot's constants prepared once (the leg IK's
 /// [`leg::Solver`], the hip mounts). A caller that solves many poses of one robot keeps one:
 ///
@@ -237,6 +245,46 @@ impl<M: Math> Solver<M> {
         config: &BodyConfig,
         feet_in_world: &[Vec3; 4],
     ) -> [Vec3; 4] {
+        if M::SHARE_FLOAT_CODE {
+            self.feet_in_hips_shared(pose, config, feet_in_world)
+        } else {
+            self.feet_in_hips_inline(pose, config, feet_in_world)
+        }
+    }
+
+    /// [`Solver::feet_in_hips`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]): the
+    /// general solve and the stance solve ([`Solver::inverse_at_stance`]) share it, and its
+    /// feet go one at a time through one copy of the per-foot transform.
+    #[inline(never)]
+    fn feet_in_hips_shared(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        feet_in_world: &[Vec3; 4],
+    ) -> [Vec3; 4] {
+        let r: Mat3 =
+            rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+        let c = config.pivot_m;
+        let offset = pose.translation() + c;
+        let mut out = [Vec3::ZERO; 4];
+        for (i, leg) in LegId::ALL.into_iter().enumerate() {
+            out[i] = foot_in_hip(
+                &r,
+                feet_in_world[i] - offset,
+                c,
+                leg.at_corner(self.hip_fl_m),
+            );
+        }
+        out
+    }
+
+    #[inline(always)]
+    fn feet_in_hips_inline(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        feet_in_world: &[Vec3; 4],
+    ) -> [Vec3; 4] {
         let r: Mat3 =
             rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
         let c = config.pivot_m;
@@ -314,6 +362,24 @@ impl<M: Math> Solver<M> {
         feet_in_world: &[Vec3; 4],
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
+        if M::SHARE_FLOAT_CODE {
+            return self.inverse_shared(pose, config, feet_in_world, policy);
+        }
+        check_finite(pose, config)?;
+        let local = self.feet_in_hips(pose, config, feet_in_world);
+        self.legs(&local, policy)
+    }
+
+    /// [`Solver::inverse`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]), which the
+    /// stance solve shares.
+    #[inline(never)]
+    fn inverse_shared(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        feet_in_world: &[Vec3; 4],
+        policy: ReachPolicy,
+    ) -> Result<BodySolution, IkError> {
         check_finite(pose, config)?;
         let local = self.feet_in_hips(pose, config, feet_in_world);
         self.legs(&local, policy)
@@ -331,28 +397,20 @@ impl<M: Math> Solver<M> {
         stance_height_m: f32,
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
+        if M::SHARE_FLOAT_CODE {
+            // One copy of the body solve in the program: the stance feet through the general
+            // solve (the closed form saves a tenth of a body solve's float operations but is
+            // a second copy of them; BENCHMARKS.md has both figures).
+            let front_left = Vec3::new(self.hip_fl_m.x, self.stance_lateral_m, -stance_height_m);
+            let mut feet = [Vec3::ZERO; 4];
+            for (f, leg) in feet.iter_mut().zip(LegId::ALL) {
+                *f = leg.at_corner(front_left);
+            }
+            return self.inverse_shared(pose, config, &feet, policy);
+        }
         check_finite(pose, config)?;
-        let local = if M::STAGE_LEGS {
-            self.stance_feet_in_hips(pose, config, stance_height_m)
-        } else {
-            self.stance_feet_in_hips_apart(pose, config, stance_height_m)
-        };
+        let local = self.stance_feet_in_hips(pose, config, stance_height_m);
         self.legs(&local, policy)
-    }
-
-    /// [`Solver::stance_feet_in_hips`] out of line, for the backends that solve the legs one
-    /// after the other ([`Math::STAGE_LEGS`] false: in-order CPUs with software floats): its
-    /// rotation matrix and temporaries in a stack frame of their own, not in the body solve's
-    /// (on the AVR every local beyond the first 63 bytes of a frame costs extra instructions
-    /// at each access; see `BENCHMARKS.md`).
-    #[inline(never)]
-    fn stance_feet_in_hips_apart(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        stance_height_m: f32,
-    ) -> [Vec3; 4] {
-        self.stance_feet_in_hips(pose, config, stance_height_m)
     }
 
     /// The body at the zero pose with its feet at `feet_in_body` (body frame, m): each foot

@@ -923,6 +923,32 @@ mod bits {
     }
 }
 
+/// `⌊x⌋`: equal to `libm::floorf` on every input (tested against it), written with one
+/// float-to-integer conversion and back rather than libm's bit manipulation of the pattern,
+/// whose 32-bit shifts and masks are a few hundred bytes of code on an 8-bit CPU (the
+/// firmware's flash; the conversions are linked there anyway). Out of line: one copy.
+#[inline(never)]
+pub fn floor(x: f32) -> f32 {
+    // From 2^23 on (and ±∞, NaN) every f32 is whole already.
+    if !(x.abs() < 8_388_608.0) {
+        return x;
+    }
+    let t = x as i32 as f32;
+    if t == x {
+        x // Whole (keeps the sign of −0).
+    } else if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
+/// `⌈x⌉`: equal to `libm::ceilf` on every input, as `−⌊−x⌋` ([`floor`]).
+#[inline]
+pub fn ceil(x: f32) -> f32 {
+    -floor(-x)
+}
+
 /// Wraps an angle into `(-π, π]`.
 ///
 /// Out of line: its callers wrap once or twice per frame, and on a soft-float target each
@@ -930,7 +956,9 @@ mod bits {
 #[inline(never)]
 pub fn wrap_pi(angle_rad: f32) -> f32 {
     let two_pi = 2.0 * PI;
-    let mut a = angle_rad - two_pi * libm::roundf(angle_rad / two_pi);
+    // The nearest whole turn by `floor` (libm's `roundf` is a second copy of its bit
+    // manipulation on a soft-float target); a half turn either way is put right below.
+    let mut a = angle_rad - two_pi * floor(angle_rad / two_pi + 0.5);
     if a <= -PI {
         a += two_pi;
     }
@@ -944,7 +972,7 @@ pub fn wrap_pi(angle_rad: f32) -> f32 {
 #[inline]
 pub fn wrap_two_pi(angle_rad: f32) -> f32 {
     let two_pi = 2.0 * PI;
-    let mut a = angle_rad - two_pi * libm::floorf(angle_rad / two_pi);
+    let mut a = angle_rad - two_pi * floor(angle_rad / two_pi);
     if a >= two_pi {
         a -= two_pi;
     }
@@ -957,6 +985,60 @@ pub fn wrap_two_pi(angle_rad: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wrap_pi_lands_in_the_half_open_turn_on_the_same_angle() {
+        let mut rng = SplitMix64::new(0x77a9);
+        let halves = [PI, -PI, 3.0 * PI, -3.0 * PI, 0.5 * PI, 0.0, -0.0];
+        let random = (0..100_000).map(|_| (rng.next_u64() % 2_000_001) as f32 * 1e-4 - 100.0);
+        for a in halves.into_iter().chain(random) {
+            let w = wrap_pi(a);
+            assert!(w > -PI && w <= PI, "{a}: {w}");
+            let turns = (f64::from(a) - f64::from(w)) / (2.0 * core::f64::consts::PI);
+            assert!((turns - turns.round()).abs() < 1e-5, "{a}: {w}");
+        }
+    }
+
+    #[test]
+    fn floor_and_ceil_equal_libm_on_special_and_random_inputs() {
+        let special = [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.5,
+            -1.5,
+            0.999_999_94,
+            -0.999_999_94,
+            8_388_607.5,
+            -8_388_607.5,
+            8_388_608.0,
+            -8_388_608.0,
+            16_777_217.0,
+            1e-45,
+            -1e-45,
+            2.147_483_6e9,
+            -2.147_483_6e9,
+            3.4e38,
+            -3.4e38,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+        ];
+        let mut rng = SplitMix64::new(0xf100_c0de);
+        let random = (0..100_000).map(|_| f32::from_bits(rng.next_u64() as u32));
+        for x in special.into_iter().chain(random) {
+            for (got, want) in [(floor(x), libm::floorf(x)), (ceil(x), libm::ceilf(x))] {
+                assert!(
+                    got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+                    "{x:e}: {got:e} vs {want:e}"
+                );
+            }
+        }
+    }
     use seeded_rng::SplitMix64;
     extern crate std;
     use std::vec;

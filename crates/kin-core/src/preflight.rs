@@ -53,7 +53,7 @@ impl Sweep {
         }
         positive(rate_hz, Param::RateHz)?;
         // The small allowance absorbs rounding of products such as 0.3 s × 10 Hz.
-        let n = libm::floorf(duration_s * rate_hz + 1e-3) + 1.0;
+        let n = crate::math::floor(duration_s * rate_hz + 1e-3) + 1.0;
         if !(n <= MAX_SWEEP_SAMPLES as f32) {
             return Err(Error::OutOfRange {
                 parameter: Param::DurationS,

@@ -471,7 +471,7 @@ impl YawTurnLaw {
     /// `(k, τ)` with `t = k·T1 + τ`, `τ ∈ [0, T1)`.
     fn split(&self, t_s: f32) -> (f32, f32) {
         let t1 = self.p.step_period_s;
-        let mut k = libm::floorf(t_s / t1);
+        let mut k = crate::math::floor(t_s / t1);
         let mut tau = t_s - k * t1;
         if tau < 0.0 {
             k -= 1.0;

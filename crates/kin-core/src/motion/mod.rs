@@ -297,7 +297,7 @@ pub(crate) fn finite_feet(feet: &[Vec3; 4], name: Param) -> Result<(), Error> {
 /// `x − floor(x)` in `[0, 1)` for finite `x` (guards the rounding of tiny negative values to 1).
 #[inline]
 pub(crate) fn fract01(x: f32) -> f32 {
-    let r = x - libm::floorf(x);
+    let r = x - crate::math::floor(x);
     if !(0.0..1.0).contains(&r) {
         0.0
     } else {

@@ -115,7 +115,7 @@ impl Ramp {
             widest = widest.max(libm::fabsf(b - a));
         }
         // Non-finite input cannot occur (the ends are validated angles); 0 frames if it did.
-        let frames = libm::ceilf(widest / limiter.max_step_rad());
+        let frames = kin_core::math::ceil(widest / limiter.max_step_rad());
         let frames = if frames.is_finite() && frames > 0.0 {
             frames as u32
         } else {

@@ -645,8 +645,8 @@ fn law_motion<M: Math>(
 
 /// Whole frames from 0 to the first period boundary at or after `t_s`.
 fn frames_to_boundary(t_s: f32, period_s: f32) -> u32 {
-    let periods = libm::ceilf(t_s / period_s - 1e-4);
-    let frames = libm::ceilf(periods * period_s / FRAME_S - 1e-3);
+    let periods = kin_core::math::ceil(t_s / period_s - 1e-4);
+    let frames = kin_core::math::ceil(periods * period_s / FRAME_S - 1e-3);
     if frames.is_finite() && frames >= 0.0 {
         frames as u32
     } else {
@@ -1131,7 +1131,7 @@ impl Law {
 /// `t/T` wrapped into `[0, 1)`.
 fn motion_phase(t_s: f32, period_s: f32) -> f32 {
     let x = t_s / period_s;
-    let r = x - libm::floorf(x);
+    let r = x - kin_core::math::floor(x);
     if (0.0..1.0).contains(&r) {
         r
     } else {
