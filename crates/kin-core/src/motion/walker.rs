@@ -482,7 +482,7 @@ impl Walker {
         if lift_off || stance_only {
             // The foot fixed in the world up to the lift-off or the step's end.
             let s = if lift_off {
-                ((1.0 - q0) * t).min(span.dt_s)
+                shorter((1.0 - q0) * t, span.dt_s)
             } else {
                 span.dt_s
             };
@@ -515,7 +515,7 @@ impl Walker {
             l.foot = l.touch_down;
             self.carry::<M>(
                 &mut l.foot,
-                ((q1 - self.swing_end) * t).min(span.dt_s),
+                shorter((q1 - self.swing_end) * t, span.dt_s),
                 -span.scale,
             );
         }
@@ -566,6 +566,31 @@ fn off_sq(p: &Vec3, n: &Vec3) -> f32 {
 ///
 /// Out of line: a step wraps two phases per leg, each a few soft-float calls.
 #[inline(never)]
+/// The smaller of a span `a_s` and the step `dt_s` (finite, > 0): `f32::min` for a `dt_s` that
+/// is never NaN, as one comparison, where `min` links a libm routine on the AVR.
+fn shorter(a_s: f32, dt_s: f32) -> f32 {
+    if a_s < dt_s {
+        a_s
+    } else {
+        dt_s
+    }
+}
+
 fn leg_phase(offset: f32, phase: f32) -> f32 {
     fract01(phase + offset)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shorter;
+
+    #[test]
+    fn shorter_is_min_for_every_span_and_a_positive_step() {
+        let spans = [0.0, -0.0, 0.01, 0.02, 0.03, 1.0, f32::INFINITY, f32::NAN];
+        for &a in &spans {
+            for dt in [0.001, 0.02, 0.5] {
+                assert_eq!(shorter(a, dt).to_bits(), a.min(dt).to_bits(), "{a} {dt}");
+            }
+        }
+    }
 }
