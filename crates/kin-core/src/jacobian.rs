@@ -144,7 +144,10 @@ fn gram_inverse_condition<M: Math>(a: &Gram) -> f32 {
     let (sin, cos) = M::sin_cos(phi);
     const SQRT_3: f32 = 1.732_050_8;
     let (lo, hi) = (q - p * (cos + SQRT_3 * sin), q + 2.0 * p * cos);
-    let (lo, hi) = (lo.max(0.0), hi.max(0.0));
+    // `max(0.0)` by comparison (NaN and −0 give +0 as with `f32::max`): `max` links a libm
+    // routine on the AVR.
+    let non_negative = |x: f32| if x > 0.0 { x } else { 0.0 };
+    let (lo, hi) = (non_negative(lo), non_negative(hi));
     if hi <= 0.0 {
         return 0.0;
     }

@@ -110,9 +110,14 @@ impl Ramp {
 
     /// A ramp at `limiter`'s speed.
     pub fn new(from: [f32; 12], to: [f32; 12], limiter: &Limiter) -> Ramp {
+        // `f32::max` by comparison, NaN skipped as `max` does: `max` links a libm routine on
+        // the AVR.
         let mut widest = 0.0f32;
         for (a, b) in from.iter().zip(&to) {
-            widest = widest.max(libm::fabsf(b - a));
+            let d = libm::fabsf(b - a);
+            if d > widest {
+                widest = d;
+            }
         }
         // Non-finite input cannot occur (the ends are validated angles); 0 frames if it did.
         let frames = kin_core::math::ceil(widest / limiter.max_step_rad());
