@@ -110,10 +110,18 @@ impl Ramp {
 
     /// A ramp at `limiter`'s speed.
     pub fn new(from: [f32; 12], to: [f32; 12], limiter: &Limiter) -> Ramp {
+        let mut ramp = Ramp::idle();
+        ramp.restart(&from, &to, limiter);
+        ramp
+    }
+
+    /// Makes this the ramp [`Ramp::new`] builds, in place: a ramp returned by value is a
+    /// 104-byte copy on the way, beyond the AVR's 63-byte stack displacement.
+    pub fn restart(&mut self, from: &[f32; 12], to: &[f32; 12], limiter: &Limiter) {
         // `f32::max` by comparison, NaN skipped as `max` does: `max` links a libm routine on
         // the AVR.
         let mut widest = 0.0f32;
-        for (a, b) in from.iter().zip(&to) {
+        for (a, b) in from.iter().zip(to) {
             let d = libm::fabsf(b - a);
             if d > widest {
                 widest = d;
@@ -126,12 +134,10 @@ impl Ramp {
         } else {
             0
         };
-        Ramp {
-            from,
-            to,
-            frames,
-            done: 0,
-        }
+        self.from = *from;
+        self.to = *to;
+        self.frames = frames;
+        self.done = 0;
     }
 
     /// Advances one frame and returns the new point (`to` exactly at the end).

@@ -747,7 +747,7 @@ impl<M: Math> Engine<M> {
             }
         };
         self.stage = Stage::Approach;
-        self.ramp = Ramp::new(start, first, &self.limiter);
+        self.ramp.restart(&start, &first, &self.limiter);
         self.home = home;
         self.frame = 0;
         self.fault = None;
@@ -990,7 +990,7 @@ impl<M: Math> Engine<M> {
 
     fn leave(&mut self, from: [f32; 12]) {
         self.stage = Stage::Leave;
-        self.ramp = Ramp::new(from, self.home, &self.limiter);
+        self.ramp.restart(&from, &self.home, &self.limiter);
     }
 
     /// The status.
