@@ -963,22 +963,16 @@ impl<M: Math> Engine<M> {
                 let t = self.frame as f32 * FRAME_S;
                 let end = frames_to_boundary(t, law.period_s);
                 law.end_frame = Some(law.end_frame.map_or(end, |e| e.min(end)));
-                if self.stage == Stage::Approach {
-                    // Not started: ramp back from where the ramp is.
-                    self.leave(self.ramp.point());
-                } else {
-                    self.stage = Stage::Stopping;
-                }
             }
-            Program::Walk { walker, .. } => {
-                walker.stop();
-                if self.stage == Stage::Approach {
-                    self.leave(self.ramp.point());
-                } else if self.stage == Stage::Run {
-                    self.stage = Stage::Stopping;
-                }
-            }
-            _ => {}
+            Program::Walk { walker, .. } => walker.stop(),
+            _ => return,
+        }
+        // One tail for both programs: one ramp call site, not two.
+        if self.stage == Stage::Approach {
+            // Not started: ramp back from where the ramp is.
+            self.leave(self.ramp.point());
+        } else if self.stage == Stage::Run {
+            self.stage = Stage::Stopping;
         }
     }
 
