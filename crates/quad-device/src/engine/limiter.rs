@@ -150,13 +150,13 @@ impl Ramp {
 
     /// The current point.
     pub fn point(&self) -> [f32; 12] {
-        if self.done >= self.frames {
-            return self.to;
-        }
-        let s = self.done as f32 / self.frames as f32;
-        let mut p = self.from;
-        for (p, &b) in p.iter_mut().zip(&self.to) {
-            *p += (b - *p) * s;
+        // One copy, of `to`, for both branches: each array copy is a call on the AVR.
+        let mut p = self.to;
+        if self.done < self.frames {
+            let s = self.done as f32 / self.frames as f32;
+            for (p, &a) in p.iter_mut().zip(&self.from) {
+                *p = a + (*p - a) * s;
+            }
         }
         p
     }
