@@ -331,7 +331,7 @@ where
             let tick = self.engine.tick(frames, now, &self.out_rad, &self.solver);
             if let Some(q) = tick.target {
                 if let Err(e) = self.hold_motion_target(q) {
-                    self.engine.fail(e, self.out_rad);
+                    self.engine.fail(e, &self.out_rad);
                 }
             }
             disable = tick.disable_outputs;

@@ -970,7 +970,8 @@ impl<M: Math> Engine<M> {
         // One tail for both programs: one ramp call site, not two.
         if self.stage == Stage::Approach {
             // Not started: ramp back from where the ramp is.
-            self.leave(self.ramp.point());
+            let from = self.ramp.point();
+            self.leave(&from);
         } else if self.stage == Stage::Run {
             self.stage = Stage::Stopping;
         }
@@ -982,9 +983,9 @@ impl<M: Math> Engine<M> {
         self.stage = Stage::Run;
     }
 
-    fn leave(&mut self, from: [f32; 12]) {
+    fn leave(&mut self, from: &[f32; 12]) {
         self.stage = Stage::Leave;
-        self.ramp.restart(&from, &self.home, &self.limiter);
+        self.ramp.restart(from, &self.home, &self.limiter);
     }
 
     /// The status.
@@ -1092,11 +1093,11 @@ impl<M: Math> Engine<M> {
                     }
                 };
                 if let (true, Ok(q)) = (ended, result) {
-                    self.leave(q);
+                    self.leave(&q);
                 }
                 match result {
                     Ok(q) => tick.target = Some(q),
-                    Err(e) => self.fail(Error::Ik(e), *out),
+                    Err(e) => self.fail(Error::Ik(e), out),
                 }
                 tick
             }
@@ -1104,7 +1105,7 @@ impl<M: Math> Engine<M> {
     }
 
     /// Stops the motion after a run-time failure: a ramp from `from` to the stance.
-    pub fn fail(&mut self, e: Error, from: [f32; 12]) {
+    pub fn fail(&mut self, e: Error, from: &[f32; 12]) {
         self.fault = Some(e);
         if self.is_active() {
             self.leave(from);
