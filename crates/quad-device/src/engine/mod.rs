@@ -647,7 +647,8 @@ fn law_motion<M: Math>(
 fn frames_to_boundary(t_s: f32, period_s: f32) -> u32 {
     let periods = kin_core::math::ceil(t_s / period_s - 1e-4);
     let frames = kin_core::math::ceil(periods * period_s / FRAME_S - 1e-3);
-    if frames.is_finite() && frames >= 0.0 {
+    // NaN and every negative fail the comparison; `+∞` saturates in the cast.
+    if frames >= 0.0 {
         frames as u32
     } else {
         u32::MAX
