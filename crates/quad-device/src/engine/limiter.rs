@@ -129,7 +129,8 @@ impl Ramp {
         }
         // Non-finite input cannot occur (the ends are validated angles); 0 frames if it did.
         let frames = kin_core::math::ceil(widest / limiter.max_step_rad());
-        let frames = if frames.is_finite() && frames > 0.0 {
+        // NaN fails the comparison, and the cast takes every negative to 0.
+        let frames = if frames < f32::INFINITY {
             frames as u32
         } else {
             0
