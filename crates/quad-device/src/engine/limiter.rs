@@ -128,13 +128,7 @@ impl Ramp {
             }
         }
         // Non-finite input cannot occur (the ends are validated angles); 0 frames if it did.
-        let frames = kin_core::math::ceil(widest / limiter.max_step_rad());
-        // NaN fails the comparison, and the cast takes every negative to 0.
-        let frames = if frames < f32::INFINITY {
-            frames as u32
-        } else {
-            0
-        };
+        let frames = frame_count(kin_core::math::ceil(widest / limiter.max_step_rad()));
         self.from = *from;
         self.to = *to;
         self.frames = frames;
@@ -170,5 +164,66 @@ impl Ramp {
     /// The end point.
     pub const fn to(&self) -> &[f32; 12] {
         &self.to
+    }
+}
+
+/// A ramp's frame count from its whole number of frames: 0 unless finite and positive.
+fn frame_count(frames: f32) -> u32 {
+    // NaN fails the comparison, and the cast takes every negative to 0.
+    if frames < f32::INFINITY {
+        frames as u32
+    } else {
+        0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{frame_count, Limiter, Ramp};
+
+    #[test]
+    fn a_nan_joint_does_not_set_the_ramp_length() {
+        let limiter = Limiter::new(3.0).unwrap();
+        let mut to = [0.0; 12];
+        to[0] = 0.3;
+        to[1] = f32::NAN;
+        to[2] = -0.2;
+        let frames = |to: [f32; 12]| {
+            let mut ramp = Ramp::new([0.0; 12], to, &limiter);
+            let mut frames = 0;
+            while !ramp.finished() {
+                ramp.advance();
+                frames += 1;
+            }
+            frames
+        };
+        let mut finite = to;
+        finite[1] = 0.0;
+        // As `f32::max` would: the NaN skipped, the widest finite change sets the length.
+        assert!(frames(finite) > 1);
+        assert_eq!(frames(to), frames(finite));
+    }
+
+    #[test]
+    fn frame_count_is_zero_unless_finite_and_positive() {
+        for x in [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            1.0,
+            3.0,
+            1e9,
+            1e12,
+        ] {
+            let reference = if x.is_finite() && x > 0.0 {
+                x as u32
+            } else {
+                0
+            };
+            assert_eq!(frame_count(x), reference, "{x}");
+        }
     }
 }

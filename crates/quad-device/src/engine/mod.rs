@@ -1134,3 +1134,38 @@ fn motion_phase(t_s: f32, period_s: f32) -> f32 {
         0.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{frames_to_boundary, FRAME_S};
+
+    #[test]
+    fn frames_to_boundary_is_max_unless_finite_and_non_negative() {
+        let reference = |t_s: f32, period_s: f32| {
+            let periods = kin_core::math::ceil(t_s / period_s - 1e-4);
+            let frames = kin_core::math::ceil(periods * period_s / FRAME_S - 1e-3);
+            if frames.is_finite() && frames >= 0.0 {
+                frames as u32
+            } else {
+                u32::MAX
+            }
+        };
+        let values = [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            0.013,
+            0.5,
+            2.0,
+            1e30,
+        ];
+        for t in values {
+            for p in values {
+                assert_eq!(frames_to_boundary(t, p), reference(t, p), "{t} {p}");
+            }
+        }
+    }
+}
