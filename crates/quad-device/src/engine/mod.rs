@@ -518,9 +518,11 @@ fn stance_angles<M: Math>(s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
         feet_in_world: s.robot.stance_feet(s.stance_height_m),
         contact: [motion::Contact::Stance; 4],
     };
-    let q = solve_frame(s.solver, s.order, &frame).map_err(Error::Ik)?;
-    check_travel(s.calibration, &q)?;
-    Ok(q)
+    // Matched in place, not `map_err(…)?`: one copy of the angles fewer on the way.
+    match solve_frame(s.solver, s.order, &frame) {
+        Ok(q) => check_travel(s.calibration, &q).map(|()| q),
+        Err(e) => Err(Error::Ik(e)),
+    }
 }
 
 /// One sample of a start check (module docs): `solved` is what the per-frame path (the
