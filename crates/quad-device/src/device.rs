@@ -353,9 +353,10 @@ where
     /// Makes a motion setpoint the held target, after mapping it through the calibration.
     fn hold_motion_target(&mut self, angles_rad: [f32; 12]) -> Result<(), engine::Error> {
         let mut pulses_half_us = [0u16; 12];
-        for s in ServoId::ALL {
-            pulses_half_us[s.index()] = self.calibration[s.index()]
-                .pulse_half_us(angles_rad[s.index()])
+        // `ServoId::ALL` is in index order: the position is the index, no bounds checks.
+        for (i, s) in ServoId::ALL.into_iter().enumerate() {
+            pulses_half_us[i] = self.calibration[i]
+                .pulse_half_us(angles_rad[i])
                 .map_err(|fault| engine::Error::ServoRange { servo: s, fault })?;
         }
         self.held = Some(Held {
@@ -716,13 +717,13 @@ where
         limited: bool,
     ) -> Result<(), NackReason> {
         let mut pulses_half_us = [0u16; 12];
-        for s in ServoId::ALL {
-            let a = angles_rad[s.index()];
+        for (i, s) in ServoId::ALL.into_iter().enumerate() {
+            let a = angles_rad[i];
             if !a.is_finite() {
                 return Err(NackReason::NonFinite);
             }
-            pulses_half_us[s.index()] =
-                self.calibration[s.index()]
+            pulses_half_us[i] =
+                self.calibration[i]
                     .pulse_half_us(a)
                     .map_err(|fault| NackReason::ServoRange {
                         leg: s.leg,
