@@ -686,8 +686,7 @@ where
         // A clamp to the joint limits puts the angle exactly on a bound.
         let limits = &self.config.robot.limits;
         let limited = clamped
-            && ServoId::ALL.iter().any(|s| {
-                let a = angles[s.index()];
+            && ServoId::ALL.iter().zip(&angles).any(|(s, &a)| {
                 let j = s.joint as usize;
                 a == limits.min_rad[j] || a == limits.max_rad[j]
             });
@@ -696,8 +695,7 @@ where
 
     /// `SetJoints`, on angles the range check has found finite (`check_request`).
     fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
-        for s in ServoId::ALL {
-            let a = angles[s.index()];
+        for (s, &a) in ServoId::ALL.iter().zip(angles) {
             if !self.config.robot.limits.admits(s.joint, a) {
                 return Err(NackReason::JointLimit {
                     leg: s.leg,
