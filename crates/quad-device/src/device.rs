@@ -765,6 +765,7 @@ where
         true
     }
 
+    #[inline(never)]
     fn stop_outputs(&mut self) {
         self.outputs.set_enabled(false);
         self.outputs_enabled = false;
