@@ -663,7 +663,7 @@ where
             c.stance_height_m,
             c.policy,
         );
-        self.apply_solution(solution)
+        self.apply_solution(&solution)
     }
 
     /// `SetFeet`: the feet in the body frame at the zero pose.
@@ -673,14 +673,15 @@ where
         let solution = self
             .solver
             .inverse_feet_in_body(&feet, self.config.pose_config.policy);
-        self.apply_solution(solution)
+        self.apply_solution(&solution)
     }
 
     fn apply_solution(
         &mut self,
-        solution: Result<BodySolution, IkError>,
+        solution: &Result<BodySolution, IkError>,
     ) -> Result<(), NackReason> {
-        let solution = solution.map_err(NackReason::from)?;
+        // Borrowed: the solution is read where the solve left it, not copied into this frame.
+        let solution = solution.as_ref().map_err(|&e| NackReason::from(e))?;
         let angles = solution.flat();
         let clamped = solution.any_clamped();
         // A clamp to the joint limits puts the angle exactly on a bound.
