@@ -353,9 +353,10 @@ where
     /// Makes a motion setpoint the held target, after mapping it through the calibration.
     fn hold_motion_target(&mut self, angles_rad: [f32; 12]) -> Result<(), engine::Error> {
         let mut pulses_half_us = [0u16; 12];
-        for s in ServoId::ALL {
-            pulses_half_us[s.index()] = self.calibration[s.index()]
-                .pulse_half_us(angles_rad[s.index()])
+        // `ServoId::ALL` is in index order: the position is the index, no bounds checks.
+        for (i, s) in ServoId::ALL.into_iter().enumerate() {
+            pulses_half_us[i] = self.calibration[i]
+                .pulse_half_us(angles_rad[i])
                 .map_err(|fault| engine::Error::ServoRange { servo: s, fault })?;
         }
         self.held = Some(Held {
@@ -662,7 +663,7 @@ where
             c.stance_height_m,
             c.policy,
         );
-        self.apply_solution(solution)
+        self.apply_solution(&solution)
     }
 
     /// `SetFeet`: the feet in the body frame at the zero pose.
@@ -672,21 +673,21 @@ where
         let solution = self
             .solver
             .inverse_feet_in_body(&feet, self.config.pose_config.policy);
-        self.apply_solution(solution)
+        self.apply_solution(&solution)
     }
 
     fn apply_solution(
         &mut self,
-        solution: Result<BodySolution, IkError>,
+        solution: &Result<BodySolution, IkError>,
     ) -> Result<(), NackReason> {
-        let solution = solution.map_err(NackReason::from)?;
+        // Borrowed: the solution is read where the solve left it, not copied into this frame.
+        let solution = solution.as_ref().map_err(|&e| NackReason::from(e))?;
         let angles = solution.flat();
         let clamped = solution.any_clamped();
         // A clamp to the joint limits puts the angle exactly on a bound.
         let limits = &self.config.robot.limits;
         let limited = clamped
-            && ServoId::ALL.iter().any(|s| {
-                let a = angles[s.index()];
+            && ServoId::ALL.iter().zip(&angles).any(|(s, &a)| {
                 let j = s.joint as usize;
                 a == limits.min_rad[j] || a == limits.max_rad[j]
             });
@@ -695,8 +696,7 @@ where
 
     /// `SetJoints`, on angles the range check has found finite (`check_request`).
     fn set_joints(&mut self, angles: &[f32; 12]) -> Result<(), NackReason> {
-        for s in ServoId::ALL {
-            let a = angles[s.index()];
+        for (s, &a) in ServoId::ALL.iter().zip(angles) {
             if !self.config.robot.limits.admits(s.joint, a) {
                 return Err(NackReason::JointLimit {
                     leg: s.leg,
@@ -716,13 +716,13 @@ where
         limited: bool,
     ) -> Result<(), NackReason> {
         let mut pulses_half_us = [0u16; 12];
-        for s in ServoId::ALL {
-            let a = angles_rad[s.index()];
+        for (i, s) in ServoId::ALL.into_iter().enumerate() {
+            let a = angles_rad[i];
             if !a.is_finite() {
                 return Err(NackReason::NonFinite);
             }
-            pulses_half_us[s.index()] =
-                self.calibration[s.index()]
+            pulses_half_us[i] =
+                self.calibration[i]
                     .pulse_half_us(a)
                     .map_err(|fault| NackReason::ServoRange {
                         leg: s.leg,
@@ -766,6 +766,7 @@ where
         true
     }
 
+    #[inline(never)]
     fn stop_outputs(&mut self) {
         self.outputs.set_enabled(false);
         self.outputs_enabled = false;
