@@ -97,8 +97,7 @@ macro_rules! wire_enum {
     ) => {
         $crate::wire::wire_enum!(@munch $head [$ser $var_access]
             [$($decl)* $(#[$vattr])* $var,]
-            [$($ser_arms)* Self::$var => ::serde::Serializer::serialize_unit_variant(
-                $ser, NAME, $idx, stringify!($var)),]
+            [$($ser_arms)* Self::$var => ($idx, stringify!($var)),]
             [$($de_arms)* $idx => {
                 ::serde::de::VariantAccess::unit_variant($var_access)?;
                 Ok(Target::$var)
@@ -115,7 +114,7 @@ macro_rules! wire_enum {
     ) => {
         $crate::wire::wire_enum!(@munch $head [$ser $var_access]
             [$($decl)* $(#[$vattr])* $var($ty),]
-            [$($ser_arms)* Self::$var(value) => ::serde::Serializer::serialize_newtype_variant(
+            [$($ser_arms)* Self::$var(value) => return ::serde::Serializer::serialize_newtype_variant(
                 $ser, NAME, $idx, stringify!($var),
                 $crate::wire::wire_ser_field!(value, $ty $(, $($with)::+)?)),]
             [$($de_arms)* $idx => $crate::wire::wire_de_newtype!(
@@ -144,7 +143,7 @@ macro_rules! wire_enum {
                         $crate::wire::wire_ser_field!($field, $fty $(, $($with)::+)?),
                     )?;
                 )*
-                ::serde::ser::SerializeStructVariant::end(fields)
+                return ::serde::ser::SerializeStructVariant::end(fields);
             }]
             [$($de_arms)* $idx => {
                 struct Fields;
@@ -188,10 +187,15 @@ macro_rules! wire_enum {
             type Target = $name;
 
             impl ::serde::Serialize for $name {
+                // The unit variants share one call, their index looked up first: one such call
+                // per enum instead of one per variant (an enum without unit variants never
+                // gets there).
+                #[allow(unreachable_code)]
                 fn serialize<S: ::serde::Serializer>(&self, $ser: S) -> Result<S::Ok, S::Error> {
-                    match self {
+                    let (index, variant): (u32, &'static str) = match self {
                         $($ser_arms)*
-                    }
+                    };
+                    ::serde::Serializer::serialize_unit_variant($ser, NAME, index, variant)
                 }
             }
 

@@ -993,17 +993,12 @@ impl<M: Math> Engine<M> {
 
     /// The status.
     pub fn status(&self) -> Status {
-        let kind = match &self.program {
-            Program::Idle => None,
-            Program::Pose { kind } => Some(*kind),
-            Program::Law(law) => Some(law.motion_kind()),
-            Program::Walk { .. } => Some(Kind::Walk),
-        };
         let t_s = self.frame as f32 * FRAME_S;
-        let phase = match &self.program {
-            Program::Law(law) => motion_phase(t_s, law.period_s),
-            Program::Walk { walker, .. } => walker.phase(),
-            _ => 0.0,
+        let (kind, phase) = match &self.program {
+            Program::Idle => (None, 0.0),
+            Program::Pose { kind } => (Some(*kind), 0.0),
+            Program::Law(law) => (Some(law.motion_kind()), motion_phase(t_s, law.period_s)),
+            Program::Walk { walker, .. } => (Some(Kind::Walk), walker.phase()),
         };
         Status {
             kind,

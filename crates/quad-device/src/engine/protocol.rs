@@ -10,6 +10,8 @@ use quad_protocol::{
 };
 
 impl From<MotionCommand> for Request {
+    // Inlined into its one caller, the device's request handler, whose frame the copy shares.
+    #[inline(always)]
     fn from(m: MotionCommand) -> Request {
         match m {
             MotionCommand::StandUp => Request::StandUp,
