@@ -434,6 +434,21 @@ impl<M: Math> Solver<M> {
     /// after the other through one out-of-line leg solve; the same results either way.
     #[inline(always)]
     fn legs(&self, local: &[Vec3; 4], policy: ReachPolicy) -> Result<BodySolution, IkError> {
+        if M::SHARE_FLOAT_CODE {
+            return self.legs_shared(local, policy);
+        }
+        self.legs_inline(local, policy)
+    }
+
+    /// [`Solver::legs`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]): the general, the
+    /// stance and the feet-in-body solves share it.
+    #[inline(never)]
+    fn legs_shared(&self, local: &[Vec3; 4], policy: ReachPolicy) -> Result<BodySolution, IkError> {
+        self.legs_inline(local, policy)
+    }
+
+    #[inline(always)]
+    fn legs_inline(&self, local: &[Vec3; 4], policy: ReachPolicy) -> Result<BodySolution, IkError> {
         if M::STAGE_LEGS && policy == ReachPolicy::Reject {
             if let Some(angles) = self.leg.inverse_all_reject(local) {
                 return Ok(BodySolution {
