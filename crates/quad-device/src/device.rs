@@ -670,9 +670,15 @@ where
     #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
-        let solution = self
-            .solver
-            .inverse_feet_in_body(&feet, self.config.pose_config.policy);
+        // Through the general solve at the zero pose (the body frame is the world frame):
+        // its one out-of-line copy, not a second for the feet in the body frame.
+        let pc = &self.config.pose_config;
+        let solution = self.solver.inverse(
+            &Pose::default(),
+            &BodyConfig::about_centre(pc.order),
+            &feet,
+            pc.policy,
+        );
         self.apply_solution(&solution)
     }
 
