@@ -68,24 +68,14 @@ impl FrameSource for HostDriven {
     }
 
     fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
-        let t_s = k as f32 * FRAME_S;
-        let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
-        let device_error = |error: DeviceError| crate::Error::Device { frame: k, error };
-        self.device
-            .request(Request::SetFeet {
-                feet_in_body_m: target.feet_in_body_m,
-            })
-            .map_err(device_error)?;
-        self.device.tick(FRAME_MS);
-        let outputs = self.device.outputs();
-        Ok(DeviceFrame {
-            t_s,
-            enabled: outputs.enabled,
-            pulses_half_us: outputs.pulses_half_us,
-            angles_rad: self.device.output_angles_rad().map_err(device_error)?,
-            commanded_pose: target.pose,
-            stance: target.stance,
-        })
+        let target = self
+            .plan
+            .target(k as f32 * FRAME_S)
+            .map_err(crate::Error::Motion)?;
+        let request = Request::SetFeet {
+            feet_in_body_m: target.feet_in_body_m,
+        };
+        step(&mut self.device, k, Some(request), &target)
     }
 }
 
@@ -144,21 +134,35 @@ impl FrameSource for Onboard {
     }
 
     fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
-        let t_s = k as f32 * FRAME_S;
-        let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
-        let device_error = |error: DeviceError| crate::Error::Device { frame: k, error };
-        if let Some(request) = onboard_request(k, self.command, self.velocity) {
-            self.device.request(request).map_err(device_error)?;
-        }
-        self.device.tick(FRAME_MS);
-        let outputs = self.device.outputs();
-        Ok(DeviceFrame {
-            t_s,
-            enabled: outputs.enabled,
-            pulses_half_us: outputs.pulses_half_us,
-            angles_rad: self.device.output_angles_rad().map_err(device_error)?,
-            commanded_pose: target.pose,
-            stance: target.stance,
-        })
+        let target = self
+            .plan
+            .target(k as f32 * FRAME_S)
+            .map_err(crate::Error::Motion)?;
+        let request = onboard_request(k, self.command, self.velocity);
+        step(&mut self.device, k, request, &target)
     }
+}
+
+/// Frame `k` of an in-process run: `request` (if any) sent, one frame of the device's clock,
+/// its outputs read; the commanded pose and the feet on the ground are `target`'s.
+fn step(
+    device: &mut SimDevice,
+    k: u32,
+    request: Option<Request>,
+    target: &crate::motions::Target,
+) -> Result<DeviceFrame, crate::Error> {
+    let device_error = |error: DeviceError| crate::Error::Device { frame: k, error };
+    if let Some(request) = request {
+        device.request(request).map_err(device_error)?;
+    }
+    device.tick(FRAME_MS);
+    let outputs = device.outputs();
+    Ok(DeviceFrame {
+        t_s: k as f32 * FRAME_S,
+        enabled: outputs.enabled,
+        pulses_half_us: outputs.pulses_half_us,
+        angles_rad: device.output_angles_rad().map_err(device_error)?,
+        commanded_pose: target.pose,
+        stance: target.stance,
+    })
 }
