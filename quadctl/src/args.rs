@@ -42,6 +42,16 @@ pub fn fail(prefix: &str, e: &dyn std::error::Error) -> ExitCode {
     ExitCode::from(EXIT_FATAL)
 }
 
+/// Writes `summary` to stdout as one JSON line (a command's last line); `Err` carries the
+/// [`fail`] status when it cannot be encoded or written.
+pub fn print_json_line<T: serde::Serialize>(summary: &T) -> Result<(), ExitCode> {
+    let json = serde_json::to_string(summary).map_err(|e| fail("quadctl", &e))?;
+    let mut out = io::stdout().lock();
+    writeln!(out, "{json}")
+        .and_then(|()| out.flush())
+        .map_err(|e| fail("quadctl", &e))
+}
+
 /// [`EXIT_OK`], or [`fail`] with `quadctl`.
 pub fn exit_status<E: std::error::Error>(result: Result<(), E>) -> ExitCode {
     match result {

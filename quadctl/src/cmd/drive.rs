@@ -229,13 +229,8 @@ pub fn main(args: &Args) -> ExitCode {
         Ok(s) => s,
         Err(e) => return args::fail("quadctl", &e),
     };
-    let json = match serde_json::to_string(&summary) {
-        Ok(j) => j,
-        Err(e) => return args::fail("quadctl", &e),
-    };
-    let mut out = io::stdout().lock();
-    match writeln!(out, "{json}").and_then(|()| out.flush()) {
+    match args::print_json_line(&summary) {
         Ok(()) => ExitCode::from(EXIT_OK),
-        Err(e) => args::fail("quadctl", &e),
+        Err(status) => status,
     }
 }

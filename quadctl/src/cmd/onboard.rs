@@ -9,7 +9,6 @@ use kin_core::motion::path::PathKind;
 use kin_core::LegId;
 use quad_device::engine::{self, WalkRequest};
 use quad_host::ops::onboard::{self, Session, VelocityStep};
-use std::io::{self, Write};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -331,14 +330,9 @@ fn finish<L: quad_host::link::Link>(
         Ok(s) => s,
         Err(e) => return args::fail("quadctl", &e),
     };
-    let json = match serde_json::to_string(&summary) {
-        Ok(j) => j,
-        Err(e) => return args::fail("quadctl", &e),
-    };
-    let mut out = io::stdout().lock();
-    match writeln!(out, "{json}").and_then(|()| out.flush()) {
+    match args::print_json_line(&summary) {
         Ok(()) => ExitCode::from(EXIT_OK),
-        Err(e) => args::fail("quadctl", &e),
+        Err(status) => status,
     }
 }
 

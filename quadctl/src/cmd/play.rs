@@ -5,7 +5,7 @@
 use crate::args::{self, SessionArgs, EXIT_CHECK_FAILED, EXIT_OK};
 use quad_host::csv::play::ColumnKind;
 use quad_host::ops::play::{self, Request};
-use std::io::{self, Write};
+use std::io;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -82,13 +82,8 @@ pub fn main(args: &Args) -> ExitCode {
         Ok(s) => s,
         Err(e) => return args::fail("quadctl", &e),
     };
-    let json = match serde_json::to_string(&summary) {
-        Ok(j) => j,
-        Err(e) => return args::fail("quadctl", &e),
-    };
-    let mut out = io::stdout().lock();
-    if let Err(e) = writeln!(out, "{json}").and_then(|()| out.flush()) {
-        return args::fail("quadctl", &e);
+    if let Err(status) = args::print_json_line(&summary) {
+        return status;
     }
     ExitCode::from(if summary.check_failed() {
         EXIT_CHECK_FAILED

@@ -4,7 +4,7 @@
 
 use crate::args::{self, InputArgs, SessionArgs, EXIT_CHECK_FAILED, EXIT_MALFORMED, EXIT_OK};
 use quad_host::ops::stream::{self, Request};
-use std::io::{self, Write};
+use std::io;
 use std::process::ExitCode;
 
 const LONG_ABOUT: &str = "\
@@ -76,13 +76,8 @@ pub fn main(args: &Args) -> ExitCode {
         Ok(o) => o,
         Err(e) => return args::fail("quadctl", &e),
     };
-    let json = match serde_json::to_string(&outcome.summary) {
-        Ok(j) => j,
-        Err(e) => return args::fail("quadctl", &e),
-    };
-    let mut out = io::stdout().lock();
-    if let Err(e) = writeln!(out, "{json}").and_then(|()| out.flush()) {
-        return args::fail("quadctl", &e);
+    if let Err(status) = args::print_json_line(&outcome.summary) {
+        return status;
     }
     ExitCode::from(if outcome.summary.check_failed() {
         EXIT_CHECK_FAILED
