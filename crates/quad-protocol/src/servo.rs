@@ -33,6 +33,31 @@ pub const ZERO_RAD_LIMIT: f32 = core::f32::consts::TAU;
 /// The sign bit of an `f32`.
 const SIGN_BIT: u32 = 1 << 31;
 
+/// The bits of +∞; above them (sign cleared), NaN.
+const INF_BITS: u32 = 0x7f80_0000;
+
+/// The bits of 65536.0, the first pulse beyond a `u16` of half-µs.
+const HALF_US_END_BITS: u32 = 0x4780_0000;
+
+/// `⌊x⌋` of a finite `x` in `[0, 2³²)`, from the bits: `x as u32` without the saturating
+/// conversion's float comparisons (library calls on the ATmega2560).
+#[inline(always)]
+fn floor_nonneg(x: f32) -> u32 {
+    let bits = x.to_bits();
+    let e = (bits >> 23) as i32; // the sign bit is clear
+    if e < 127 {
+        0
+    } else {
+        let m = (bits & 0x007f_ffff) | 0x0080_0000;
+        // x = m·2^(e − 150)
+        if e >= 150 {
+            m << (e - 150)
+        } else {
+            m >> (150 - e)
+        }
+    }
+}
+
 /// Gain of a standard hobby servo: 1000 µs per 90° (and 2000 µs per 180°), µs per rad.
 pub const STANDARD_US_PER_RAD: f32 = 2000.0 / core::f32::consts::PI;
 
@@ -172,26 +197,31 @@ impl Calibration {
     /// [`Error::BelowMin`] / [`Error::AboveMax`] when the rounded pulse leaves the travel.
     pub fn pulse_half_us(&self, angle_rad: f32) -> Result<u16, Error> {
         self.validate()?;
-        if !angle_rad.is_finite() {
+        // The comparisons on the bit patterns, equal to the float comparisons they stand for
+        // (each float comparison is a library call on the ATmega2560, which maps twelve pulses
+        // per command and per servo frame; the tests hold them to the float forms).
+        if angle_rad.to_bits() & !SIGN_BIT >= INF_BITS {
             return Err(Error::NonFiniteAngle);
         }
         // Finite inputs: the only non-finite outcome is ±inf from the product, never NaN.
         let offset_us = self.us_per_rad * (angle_rad - self.zero_rad);
         let signed_us = if self.reversed { -offset_us } else { offset_us };
         let half = 2.0 * (f32::from(self.center_us) + signed_us);
-        if half.is_nan() {
-            // Unreachable for a validated calibration and a finite angle; kept so that no
+        let bits = half.to_bits();
+        if bits & !SIGN_BIT > INF_BITS {
+            // NaN: unreachable for a validated calibration and a finite angle; kept so that no
             // NaN can ever turn into a pulse.
             return Err(Error::NonFiniteAngle);
         }
-        if half < 0.0 {
+        // `half < 0.0`: the sign bit of anything but −0.
+        if bits > SIGN_BIT {
             return Err(Error::BelowMin);
         }
-        if half >= 65_536.0 {
+        // `half >= 65536.0` for a non-negative `half` (+∞ included).
+        if bits & !SIGN_BIT >= HALF_US_END_BITS {
             return Err(Error::AboveMax);
         }
-        // half ∈ [0, 65536): truncation of a positive value is floor.
-        let ticks = (half + 0.5) as u32;
+        let ticks = floor_nonneg(half + 0.5);
         if ticks < u32::from(self.min_half_us()) {
             Err(Error::BelowMin)
         } else if ticks > u32::from(self.max_half_us()) {
@@ -239,6 +269,83 @@ pub fn half_us_to_us(pulse_half_us: u16) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// [`Calibration::pulse_half_us`] with the float comparisons and conversion written out:
+    /// the form the bit-pattern comparisons stand for.
+    fn pulse_half_us_float_form(c: &Calibration, angle_rad: f32) -> Result<u16, Error> {
+        c.validate()?;
+        if !angle_rad.is_finite() {
+            return Err(Error::NonFiniteAngle);
+        }
+        let offset_us = c.us_per_rad * (angle_rad - c.zero_rad);
+        let signed_us = if c.reversed { -offset_us } else { offset_us };
+        let half = 2.0 * (f32::from(c.center_us) + signed_us);
+        if half.is_nan() {
+            return Err(Error::NonFiniteAngle);
+        }
+        if half < 0.0 {
+            return Err(Error::BelowMin);
+        }
+        if half >= 65_536.0 {
+            return Err(Error::AboveMax);
+        }
+        let ticks = (half + 0.5) as u32;
+        if ticks < u32::from(c.min_half_us()) {
+            Err(Error::BelowMin)
+        } else if ticks > u32::from(c.max_half_us()) {
+            Err(Error::AboveMax)
+        } else {
+            Ok(ticks as u16)
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(20_000))]
+        /// The bit-pattern comparisons give the float form's result on every input: any angle
+        /// bits (NaN, infinities, huge values included) and calibrations near and beyond the
+        /// limits.
+        #[test]
+        fn pulse_half_us_equals_the_float_form(
+            angle_bits in any::<u32>(),
+            angle in -10.0f32..10.0,
+            use_bits in any::<bool>(),
+            zero_rad in -7.0f32..7.0,
+            reversed in any::<bool>(),
+            us_per_rad in 40.0f32..6000.0,
+            center_us in 0u16..3000,
+            min_us in 0u16..3000,
+            max_us in 0u16..3000,
+        ) {
+            let c = Calibration { zero_rad, reversed, us_per_rad, center_us, min_us, max_us };
+            let a = if use_bits { f32::from_bits(angle_bits) } else { angle };
+            prop_assert_eq!(c.pulse_half_us(a), pulse_half_us_float_form(&c, a));
+        }
+    }
+
+    #[test]
+    fn floor_of_the_bits_is_the_truncating_conversion() {
+        for x in [
+            0.0f32,
+            0.25,
+            0.5,
+            0.999_999_94,
+            1.0,
+            1.5,
+            2.0,
+            1000.5,
+            65_535.5,
+            65_536.49,
+            1e9,
+        ] {
+            assert_eq!(floor_nonneg(x), x as u32, "{x}");
+        }
+        let mut x = 0.5f32;
+        while x < 70_000.0 {
+            assert_eq!(floor_nonneg(x), x as u32, "{x}");
+            x = f32::from_bits(x.to_bits() + 997);
+        }
+    }
 
     #[test]
     fn validate_compares_gain_and_zero_as_the_float_comparisons_do() {

@@ -40,7 +40,7 @@ static BACKENDS: [Backend; 4] = [
 ];
 
 /// Primitives: 0 add, 1 mul, 2 div, 3 sqrt, 4 atan2, 5 sin, 6 cos, 7 less-than,
-/// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrLibm`:
+/// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrFast`:
 /// 10 the rotation matrix (roll = yaw = a, pitch = b), 11 the four feet in their hip frames
 /// (including the matrix); kin-core's kernels for `AvrFast`: 12 `poly::atan2_fixed`,
 /// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5`, 15 `poly::sin_cos_fixed` (sums of both).
@@ -59,12 +59,12 @@ static PRIMS: [bench::PrimFn; 16] = [
         s + c
     },
     |a, b| {
-        let m = kin_core::rotation::matrix::<AvrLibm>(RotationOrder::Zyx, a, b, a);
+        let m = kin_core::rotation::matrix::<AvrFast>(RotationOrder::Zyx, a, b, a);
         core::hint::black_box(m).rows[0][0]
     },
     |a, b| {
         let robot = core::hint::black_box(bench::ROBOT);
-        let feet = kin_core::body::Solver::<AvrLibm>::with_math(&robot).feet_in_hips(
+        let feet = kin_core::body::Solver::<AvrFast>::with_math(&robot).feet_in_hips(
             &Pose::rotation(a, b, a),
             &BodyConfig::default(),
             &robot.stance_feet(bench::STANCE_HEIGHT_M),

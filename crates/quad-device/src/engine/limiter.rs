@@ -66,14 +66,21 @@ impl Limiter {
     /// changed (the caller then writes them), in place: no copy of the twelve outputs to
     /// compare.
     pub fn step(&self, out: &mut [f32; 12], target: &[f32; 12]) -> bool {
+        const ABS: u32 = 0x7fff_ffff;
+        const INF_BITS: u32 = 0x7f80_0000;
         let b = self.max_step_rad;
         let mut changed = false;
         for (o, &t) in out.iter_mut().zip(target) {
             let d = t - *o;
-            if d > b {
+            // `d > b` and `d < −b` for the bound `b > 0` by the magnitude's bits and the sign
+            // (a NaN `d` fails both, as the float comparisons it stands for): no software-float
+            // comparison calls on CPUs without floating-point hardware, twelve per servo frame.
+            let m = d.to_bits() & ABS;
+            let beyond = m > b.to_bits() && m <= INF_BITS;
+            if beyond && d.to_bits() == m {
                 *o += b;
                 changed = true;
-            } else if d < -b {
+            } else if beyond {
                 *o -= b;
                 changed = true;
             } else if o.to_bits() != t.to_bits() {
@@ -179,6 +186,70 @@ fn frame_count(frames: f32) -> u32 {
 
 #[cfg(test)]
 mod tests {
+
+    /// [`Limiter::step`] with the float comparisons it stands for.
+    fn step_float_form(b: f32, out: &mut [f32; 12], target: &[f32; 12]) -> bool {
+        let mut changed = false;
+        for (o, &t) in out.iter_mut().zip(target) {
+            let d = t - *o;
+            if d > b {
+                *o += b;
+                changed = true;
+            } else if d < -b {
+                *o -= b;
+                changed = true;
+            } else if o.to_bits() != t.to_bits() {
+                *o = t;
+                changed = true;
+            }
+        }
+        changed
+    }
+
+    /// The bit-pattern comparisons move every output as the float comparisons do, bit for
+    /// bit: random and edge outputs and targets (zeros of both signs, steps of exactly the
+    /// bound, infinities, NaN).
+    #[test]
+    fn step_equals_the_float_form() {
+        let mut rng = seeded_rng::SplitMix64::new(5);
+        let edge = [
+            0.0,
+            -0.0,
+            0.06,
+            -0.06,
+            0.06 + 1e-7,
+            1.0,
+            -3.0,
+            f32::INFINITY,
+            f32::NAN,
+        ];
+        for case in 0..20_000 {
+            let limiter = Limiter::new(rng.range(0.1, 20.0) as f32).unwrap();
+            let b = limiter.max_step_rad();
+            let pick = |rng: &mut seeded_rng::SplitMix64| {
+                if case % 3 == 0 {
+                    edge[(rng.next_u64() % edge.len() as u64) as usize]
+                } else {
+                    rng.range(-0.5, 0.5) as f32
+                }
+            };
+            let out: [f32; 12] = core::array::from_fn(|_| pick(&mut rng));
+            let mut target: [f32; 12] = core::array::from_fn(|_| pick(&mut rng));
+            // Steps of exactly ±b.
+            target[0] = out[0] + b;
+            target[1] = out[1] - b;
+            let (mut a, mut f) = (out, out);
+            let changed = limiter.step(&mut a, &target);
+            let changed_float = step_float_form(b, &mut f, &target);
+            assert_eq!(changed, changed_float, "{out:?} → {target:?}");
+            assert_eq!(
+                a.map(f32::to_bits),
+                f.map(f32::to_bits),
+                "{out:?} → {target:?}"
+            );
+        }
+    }
+
     use super::{frame_count, Limiter, Ramp};
 
     #[test]

@@ -1,0 +1,209 @@
+//! Where the firmware's cycles go while it serves one kind of request: runs the release
+//! firmware in simavr, sends the request `N` times (one at a time, after `Hello`), and charges
+//! every instruction's cycles from the request's last byte (handed to the emulated UART) to
+//! the answer's first byte to the function that holds its program counter (the ELF's symbols, by `avr-nm`). Prints the
+//! functions by cycles per request.
+//!
+//! ```text
+//! cargo run -p integration-tests --example avr_profile -- [set-body-pose|set-feet|get-state] [N]
+//! ```
+//!
+//! Interrupt handlers are charged as functions of their own; idle polling in the main loop
+//! while bytes are still on the line is charged to the loop's functions.
+
+use kin_core::body::Pose;
+use quad_host::emu::{build, Mega2560};
+use quad_protocol::{encode_frame, HostToDevice, Request, MAX_FRAME_LEN, PROTOCOL_VERSION};
+use std::collections::HashMap;
+use std::path::Path;
+use std::process::Command;
+
+/// The ELF's function symbols: (start byte address, size, demangled name), sorted.
+fn symbols(elf: &Path) -> Vec<(u32, u32, String)> {
+    let out = Command::new("avr-nm")
+        .args(["-n", "-S", "-C", "--defined-only"])
+        .arg(elf)
+        .output()
+        .expect("avr-nm runs (Debian binutils-avr)");
+    let mut syms = Vec::new();
+    for line in String::from_utf8_lossy(&out.stdout).lines() {
+        let mut parts = line.splitn(4, ' ');
+        let (Some(addr), Some(size), Some(kind), Some(name)) =
+            (parts.next(), parts.next(), parts.next(), parts.next())
+        else {
+            continue;
+        };
+        if !matches!(kind, "t" | "T" | "W" | "w") {
+            continue;
+        }
+        let (Ok(addr), Ok(size)) = (u32::from_str_radix(addr, 16), u32::from_str_radix(size, 16))
+        else {
+            continue;
+        };
+        syms.push((addr, size, name.to_owned()));
+    }
+    syms.sort();
+    syms
+}
+
+fn name_at(syms: &[(u32, u32, String)], pc: u32) -> &str {
+    let i = syms.partition_point(|s| s.0 <= pc);
+    match i.checked_sub(1).map(|i| &syms[i]) {
+        Some((a, s, n)) if pc < a + s.max(&2) => n,
+        _ => "?",
+    }
+}
+
+fn frame(seq: u16, request: Request) -> Vec<u8> {
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    encode_frame(&HostToDevice { seq, request }, &mut buf)
+        .expect("encodes")
+        .to_vec()
+}
+
+/// The name of the function at `pc`; inside avr-libc's `memcpy`/`memset` (leaf routines that
+/// push nothing: the return address, a word address high byte first, is at SP + 1), with
+/// their caller's.
+fn charged_name(mcu: &Mega2560, syms: &[(u32, u32, String)], pc: u32) -> String {
+    let name = name_at(syms, pc);
+    if matches!(name, "memcpy" | "memset") {
+        let sp = mcu.sp();
+        let ret = (u32::from(mcu.data(sp + 1)) << 16
+            | u32::from(mcu.data(sp + 2)) << 8
+            | u32::from(mcu.data(sp + 3)))
+            * 2;
+        format!("{name} from {}", name_at(syms, ret))
+    } else {
+        name.to_owned()
+    }
+}
+
+fn print_rows(title: &str, by_fn: HashMap<String, u64>, total: u64, per: u64) {
+    let mut rows: Vec<_> = by_fn.into_iter().collect();
+    rows.sort_by(|a, b| b.1.cmp(&a.1));
+    println!("{title}: {} cycles, by function:", total / per);
+    for (name, cycles) in rows.iter().take(40) {
+        let short: String = name.chars().take(160).collect();
+        println!(
+            "{:>8}  {:>5.1}%  {short}",
+            cycles / per,
+            100.0 * *cycles as f64 / total as f64
+        );
+    }
+}
+
+/// The worst frame of an onboard motion in the benchmark firmware (`bench.elf`, motion ids of
+/// `firmware_avr::bench`), charged by function while its marker pin is high.
+fn profile_motion(motion: u8, frames: u32) {
+    let elf = build::firmware_elf(build::BENCH).unwrap_or_else(|e| panic!("{e}"));
+    let syms = symbols(&elf);
+    let mut mcu = Mega2560::new(&elf).unwrap_or_else(|e| panic!("{e}"));
+    mcu.read_exact(1, 16_000_000).expect("boots");
+    mcu.uart_write(&[b'M', motion]);
+    let started = mcu.read_exact(2, 16_000_000 * 20).expect("starts");
+    assert_eq!(started, b"m\0", "motion {motion} refused");
+    let (port, bit) = quad_host::emu::MARKER_PIN;
+    let mut worst: (u64, HashMap<String, u64>) = (0, HashMap::new());
+    for _ in 0..frames {
+        mcu.uart_write(b"N");
+        let mut frame: HashMap<String, u64> = HashMap::new();
+        let mut total = 0;
+        let mut got = 0;
+        while got < 3 {
+            let pc = mcu.pc();
+            let high = mcu.pin(port, bit);
+            let cycles = mcu.step().expect("runs");
+            if high {
+                *frame.entry(charged_name(&mcu, &syms, pc)).or_default() += cycles;
+                total += cycles;
+            }
+            got += mcu.uart_take().len();
+        }
+        if total > worst.0 {
+            worst = (total, frame);
+        }
+    }
+    print_rows(
+        &format!("motion {motion}, worst of {frames} frames"),
+        worst.1,
+        worst.0,
+        1,
+    );
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let kind = args.next().unwrap_or_else(|| "set-body-pose".to_owned());
+    if let Some(motion) = kind.strip_prefix("motion-") {
+        let frames = args
+            .next()
+            .map_or(150, |s| s.parse().expect("a frame count"));
+        profile_motion(motion.parse().expect("a motion id"), frames);
+        return;
+    }
+    let n: u32 = args.next().map_or(5, |s| s.parse().expect("N is a count"));
+    let request = match kind.as_str() {
+        "set-body-pose" => Request::SetBodyPose(Pose::rotation(0.1, -0.05, 0.08)),
+        "set-feet" => Request::SetFeet {
+            feet_in_body_m: [
+                [0.3, 0.184, -0.27],
+                [0.3, -0.184, -0.27],
+                [-0.3, 0.184, -0.27],
+                [-0.3, -0.184, -0.27],
+            ],
+        },
+        "get-state" => Request::GetState,
+        other => panic!("unknown request kind {other}"),
+    };
+    let elf = build::firmware_elf(build::FIRMWARE).unwrap_or_else(|e| panic!("{e}"));
+    let syms = symbols(&elf);
+    let mut mcu = Mega2560::new(&elf).unwrap_or_else(|e| panic!("{e}"));
+    while mcu.uart_baud().is_none() {
+        mcu.step().expect("boots");
+    }
+    mcu.run_cycles(16_000 * 30).expect("runs");
+    let mut by_fn: HashMap<String, u64> = HashMap::new();
+    let mut total = 0u64;
+    for seq in 0..=n {
+        let request = if seq == 0 {
+            Request::Hello {
+                version: PROTOCOL_VERSION,
+            }
+        } else {
+            request
+        };
+        mcu.run_cycles(16_000 * 5).expect("runs");
+        let _ = mcu.uart_take();
+        mcu.uart_write(&frame(seq as u16, request));
+        let start = mcu.cycle();
+        let mut answered = false;
+        let before = total;
+        // From the request's last byte on the line until the answer's first byte.
+        while !answered && mcu.cycle() < start + 16_000_000 {
+            let pc = mcu.pc();
+            let counting = mcu.uart_input_pending() == 0;
+            let cycles = mcu.step().expect("runs");
+            if seq > 0 && counting {
+                *by_fn.entry(charged_name(&mcu, &syms, pc)).or_default() += cycles;
+                total += cycles;
+            }
+            // The first byte after the leading delimiter (which may go out early).
+            answered = mcu.uart_take().iter().any(|(_, b)| *b != 0);
+        }
+        mcu.run_cycles(16_000 * 5).expect("runs");
+        let rest: Vec<u8> = mcu.uart_take().iter().map(|(_, b)| *b).collect();
+        eprintln!(
+            "request {seq}: {} cycles, answer tail {:?}",
+            total - before,
+            &rest[..rest.len().min(12)]
+        );
+    }
+    print_rows(
+        &format!(
+            "{kind}, per request from its last byte handed to the UART to the answer's first byte"
+        ),
+        by_fn,
+        total,
+        u64::from(n),
+    );
+}
