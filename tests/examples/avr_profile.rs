@@ -80,7 +80,7 @@ fn charged_name(mcu: &Mega2560, syms: &[(u32, u32, String)], pc: u32) -> String 
 
 fn print_rows(title: &str, by_fn: HashMap<String, u64>, total: u64, per: u64) {
     let mut rows: Vec<_> = by_fn.into_iter().collect();
-    rows.sort_by(|a, b| b.1.cmp(&a.1));
+    rows.sort_by_key(|r| std::cmp::Reverse(r.1));
     println!("{title}: {} cycles, by function:", total / per);
     for (name, cycles) in rows.iter().take(40) {
         let short: String = name.chars().take(160).collect();
