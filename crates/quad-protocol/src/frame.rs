@@ -1,7 +1,7 @@
 //! Framing: `0x00 ‖ COBS(postcard(message) ‖ CRC-16 big-endian) ‖ 0x00`.
 //!
-//! - [`encode_frame`] serializes a message straight into COBS-encoded bytes (no intermediate
-//!   buffer), appending the CRC ([`crate::crc`]), between two `0x00` delimiters.
+//! - [`encode_frame`] serializes a message into the output buffer, appends the CRC
+//!   ([`crate::crc`]) and COBS-encodes the bytes in place, between two `0x00` delimiters.
 //! - [`Accumulator`] takes received bytes in any chunking, decodes COBS on the fly into a
 //!   bounded buffer of `N` bytes, checks the CRC and deserializes at each delimiter. The caller
 //!   loops on [`Feed::remaining`] until [`Feed::NeedMore`] so that back-to-back frames in one
@@ -109,102 +109,81 @@ impl From<postcard::Error> for Error {
     }
 }
 
-/// A postcard flavor that updates the CRC and COBS-encodes each byte straight into a slice.
-struct CobsCrcSlice<'b> {
+/// A postcard flavor that writes the message's bytes into a slice; [`encode_frame`] then adds
+/// the CRC and the COBS encoding in two passes over them.
+struct PlainSlice<'b> {
     out: &'b mut [u8],
     /// Next free position.
     pos: usize,
-    /// Position of the current block's code byte.
-    code_idx: usize,
-    /// Current block's code: 1 + number of data bytes in the block.
-    code: u8,
-    crc: u16,
 }
 
-impl<'b> CobsCrcSlice<'b> {
-    fn new(out: &'b mut [u8]) -> Result<Self, postcard::Error> {
-        if out.len() < 2 {
-            return Err(postcard::Error::SerializeBufferFull);
-        }
-        out[0] = DELIMITER;
-        Ok(CobsCrcSlice {
-            out,
-            pos: 2,
-            code_idx: 1,
-            code: 1,
-            crc: crc::INIT,
-        })
-    }
-
-    fn write(&mut self, at: usize, byte: u8) -> Result<(), postcard::Error> {
-        *self
-            .out
-            .get_mut(at)
-            .ok_or(postcard::Error::SerializeBufferFull)? = byte;
-        Ok(())
-    }
-
-    /// Closes the current block and reserves the code byte of the next one.
-    fn close_block(&mut self) -> Result<(), postcard::Error> {
-        self.write(self.code_idx, self.code)?;
-        self.code_idx = self.pos;
-        self.write(self.pos, 0)?;
-        self.pos += 1;
-        self.code = 1;
-        Ok(())
-    }
-
-    /// COBS-encodes one byte.
-    fn put(&mut self, byte: u8) -> Result<(), postcard::Error> {
-        if byte == 0 {
-            return self.close_block();
-        }
-        self.write(self.pos, byte)?;
-        self.pos += 1;
-        self.code += 1;
-        if self.code == 0xFF {
-            self.close_block()?;
-        }
-        Ok(())
-    }
-}
-
-impl<'b> Flavor for CobsCrcSlice<'b> {
-    type Output = &'b [u8];
+impl Flavor for PlainSlice<'_> {
+    type Output = usize;
 
     // Out of line: serde writes a message field by field, and each field's bytes come here; one
-    // copy of the CRC and COBS step serves them all instead of one inlined per field (on the
-    // AVR the inlined copies were most of the answer encoder's code).
+    // copy of the store serves them all instead of one inlined per field (on the AVR the
+    // inlined copies were most of the answer encoder's code).
     #[inline(never)]
     fn try_push(&mut self, data: u8) -> postcard::Result<()> {
-        self.crc = crc::update(self.crc, data);
-        self.put(data)
+        *self
+            .out
+            .get_mut(self.pos)
+            .ok_or(postcard::Error::SerializeBufferFull)? = data;
+        self.pos += 1;
+        Ok(())
     }
 
-    fn finalize(mut self) -> postcard::Result<&'b [u8]> {
-        let [hi, lo] = crc::finish(self.crc).to_be_bytes();
-        self.put(hi)?;
-        self.put(lo)?;
-        self.write(self.code_idx, self.code)?;
-        self.write(self.pos, DELIMITER)?;
-        let len = self.pos + 1;
-        let out: &'b [u8] = self.out;
-        Ok(&out[..len])
+    fn finalize(self) -> postcard::Result<usize> {
+        Ok(self.pos)
     }
 }
+
+/// The longest COBS block: a frame of fewer decoded bytes needs no code byte but the first.
+const COBS_BLOCK: usize = 254;
 
 /// Serializes `msg`, appends its CRC, COBS-encodes everything and puts it between two `0x00`
 /// delimiters, in `out`. Returns the frame (a prefix of `out`).
 ///
+/// The message's bytes go into `out` as they are; then one pass computes the CRC and one pass
+/// from the end replaces each `0x00` with the distance to the next (COBS for a frame of fewer
+/// than 254 decoded bytes, which every frame of this protocol is: [`MAX_DECODED_LEN`]). Two
+/// tight loops over the bytes instead of the CRC and COBS steps per serialized byte: fewer
+/// cycles per answer on the ATmega2560.
+///
 /// # Errors
 /// [`Error::BufferFull`] when `out` is too small ([`MAX_FRAME_LEN`] is always enough for this
-/// crate's messages).
+/// crate's messages); [`Error::Oversize`] when the decoded frame would exceed
+/// [`MAX_DECODED_LEN`] (no receiver of this protocol takes it).
 pub fn encode_frame<'b, T: Serialize + ?Sized>(
     msg: &T,
     out: &'b mut [u8],
 ) -> Result<&'b [u8], Error> {
-    let flavor = CobsCrcSlice::new(out)?;
-    Ok(postcard::serialize_with_flavor(msg, flavor)?)
+    const { assert!(MAX_DECODED_LEN < COBS_BLOCK) };
+    // 0x00, the first code byte, the message, the CRC, 0x00.
+    let body = out.get_mut(2..).ok_or(Error::BufferFull)?;
+    let n = postcard::serialize_with_flavor(msg, PlainSlice { out: body, pos: 0 })?;
+    let end = 2 + n + CRC_LEN;
+    if n + CRC_LEN > MAX_DECODED_LEN {
+        return Err(Error::Oversize);
+    }
+    if end >= out.len() {
+        return Err(Error::BufferFull);
+    }
+    let [hi, lo] = crc::checksum(&out[2..2 + n]).to_be_bytes();
+    out[2 + n] = hi;
+    out[3 + n] = lo;
+    // COBS from the end: each zero becomes the distance to the next zero (or the delimiter).
+    let mut next = end;
+    for i in (2..end).rev() {
+        if out[i] == 0 {
+            out[i] = (next - i) as u8;
+            next = i;
+        }
+    }
+    out[0] = DELIMITER;
+    out[1] = (next - 1) as u8;
+    out[end] = DELIMITER;
+    Ok(&out[..=end])
 }
 
 /// Checks the CRC of a decoded frame (postcard bytes ‖ CRC) and deserializes its message.

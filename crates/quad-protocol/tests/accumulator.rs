@@ -374,6 +374,51 @@ fn encode_into_too_small_buffer_is_an_error_at_every_size() {
     }
 }
 
+/// The frame of any payload up to the largest decoded length is the reference COBS encoding
+/// of its bytes and CRC between two delimiters (zero-dense payloads, zero-free ones, zeros at
+/// both ends); one byte more is refused as oversize, since no receiver takes it.
+#[test]
+fn encoded_frames_are_the_reference_cobs_of_payload_and_crc() {
+    let mut rng = seeded_rng::SplitMix64::new(3);
+    let largest = MAX_DECODED_LEN - 2;
+    for case in 0..3000 {
+        // A byte slice serializes as its varint length and its bytes.
+        let len = (rng.next_u64() % (largest as u64 - 1)) as usize;
+        let zero_share = [0, 1, 2, 8][case % 4];
+        let bytes: Vec<u8> = (0..len)
+            .map(|_| {
+                let b = rng.next_u64() as u8;
+                if zero_share > 0 && b % zero_share == 0 {
+                    0
+                } else {
+                    b
+                }
+            })
+            .collect();
+        let msg: &[u8] = &bytes;
+        let mut tmp = [0u8; 2 * MAX_FRAME_LEN];
+        let payload = postcard::to_slice(&msg, &mut tmp).unwrap().to_vec();
+        if payload.len() + 2 > MAX_DECODED_LEN {
+            continue;
+        }
+        let mut decoded = payload.clone();
+        decoded.extend_from_slice(&ref_crc(&payload).to_be_bytes());
+        let mut want = vec![0u8];
+        want.extend(ref_cobs_encode(&decoded));
+        want.push(0);
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        assert_eq!(
+            encode_frame(&msg, &mut buf).unwrap(),
+            &want[..],
+            "{bytes:?}"
+        );
+    }
+    // A payload of MAX_DECODED_LEN − 1 bytes: with its CRC one byte beyond the bound.
+    let too_long = vec![7u8; MAX_DECODED_LEN - 2];
+    let mut buf = [0u8; 2 * MAX_FRAME_LEN];
+    assert_eq!(encode_frame(&too_long[..], &mut buf), Err(Error::Oversize));
+}
+
 #[test]
 fn largest_messages_fit_the_declared_bounds() {
     // Worst-case varints everywhere.
