@@ -414,7 +414,7 @@ fn encoded_frames_are_the_reference_cobs_of_payload_and_crc() {
         );
     }
     // A payload of MAX_DECODED_LEN − 1 bytes: with its CRC one byte beyond the bound.
-    let too_long = vec![7u8; MAX_DECODED_LEN - 2];
+    let too_long = [7u8; MAX_DECODED_LEN - 2];
     let mut buf = [0u8; 2 * MAX_FRAME_LEN];
     assert_eq!(encode_frame(&too_long[..], &mut buf), Err(Error::Oversize));
 }
