@@ -53,7 +53,16 @@ fn floor_nonneg(x: f32) -> u32 {
         if e >= 150 {
             m << (e - 150)
         } else {
-            m >> (150 - e)
+            // Whole bytes first: a variable shift is a loop of single-bit steps on 8-bit CPUs.
+            let s = (150 - e) as u32;
+            let (m, s) = if s >= 16 {
+                (m >> 16, s - 16)
+            } else if s >= 8 {
+                (m >> 8, s - 8)
+            } else {
+                (m, s)
+            };
+            m >> s
         }
     }
 }
