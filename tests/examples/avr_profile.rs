@@ -40,10 +40,26 @@ fn symbols(elf: &Path) -> Vec<(u32, u32, String)> {
         else {
             continue;
         };
-        syms.push((addr, size, name.to_owned()));
+        syms.push((
+            addr,
+            size,
+            short_name(&format!("{:#}", rustc_demangle::demangle(name))),
+        ));
     }
     syms.sort();
     syms
+}
+
+/// `<a::B<generic args>>::method` as `a::B::method` (the firmware's types carry long generic
+/// arguments); other names as they are.
+fn short_name(name: &str) -> String {
+    match name.rsplit_once(">::") {
+        Some((head, method)) if head.starts_with('<') => {
+            let base = head[1..].split(['<', ' ']).next().unwrap_or(head);
+            format!("{base}::{method}")
+        }
+        _ => name.to_owned(),
+    }
 }
 
 fn name_at(syms: &[(u32, u32, String)], pc: u32) -> &str {
@@ -83,7 +99,7 @@ fn print_rows(title: &str, by_fn: HashMap<String, u64>, total: u64, per: u64) {
     rows.sort_by_key(|r| std::cmp::Reverse(r.1));
     println!("{title}: {} cycles, by function:", total / per);
     for (name, cycles) in rows.iter().take(40) {
-        let short: String = name.chars().take(160).collect();
+        let short: String = name.chars().take(120).collect();
         println!(
             "{:>8}  {:>5.1}%  {short}",
             cycles / per,
@@ -177,7 +193,6 @@ fn main() {
         mcu.uart_write(&frame(seq as u16, request));
         let start = mcu.cycle();
         let mut answered = false;
-        let before = total;
         // From the request's last byte on the line until the answer's first byte.
         while !answered && mcu.cycle() < start + 16_000_000 {
             let pc = mcu.pc();
@@ -190,13 +205,9 @@ fn main() {
             // The first byte after the leading delimiter (which may go out early).
             answered = mcu.uart_take().iter().any(|(_, b)| *b != 0);
         }
+        // The rest of the answer drains before the next request.
         mcu.run_cycles(16_000 * 5).expect("runs");
-        let rest: Vec<u8> = mcu.uart_take().iter().map(|(_, b)| *b).collect();
-        eprintln!(
-            "request {seq}: {} cycles, answer tail {:?}",
-            total - before,
-            &rest[..rest.len().min(12)]
-        );
+        let _ = mcu.uart_take();
     }
     print_rows(
         &format!(
