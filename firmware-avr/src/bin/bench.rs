@@ -43,8 +43,9 @@ static BACKENDS: [Backend; 4] = [
 /// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrFast`:
 /// 10 the rotation matrix (roll = yaw = a, pitch = b), 11 the four feet in their hip frames
 /// (including the matrix); kin-core's kernels for `AvrFast`: 12 `poly::atan2_fixed`,
-/// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5`, 15 `poly::sin_cos_fixed` (sums of both).
-static PRIMS: [bench::PrimFn; 16] = [
+/// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5`, 15 `poly::sin_cos_fixed` (sums of both);
+/// 16 `AvrLibm::atan2_fixed` (the firmware's form of kernel 12, the same bits).
+static PRIMS: [bench::PrimFn; 17] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -81,6 +82,7 @@ static PRIMS: [bench::PrimFn; 16] = [
         let (s, c) = poly::sin_cos_fixed::<AvrFast>(a);
         s + c
     },
+    |a, b| AvrLibm::atan2_fixed(a, b),
 ];
 
 #[avr_device::entry]
