@@ -677,19 +677,19 @@ pub mod poly {
     /// hosts do not use this kernel in their backends, so the call costs them nothing.
     #[inline(never)]
     pub fn atan2_fixed<M: Math + ?Sized>(y: f32, x: f32) -> f32 {
-        atan2_fixed_with::<M>(y, x, atan_ratio_q21)
+        atan2_fixed_with::<M>(y, x, atan_q29::<M>)
     }
 
-    /// [`atan2_fixed`] with the quotient `T = ⌊t·2²¹⌋` computed by `ratio` (called as
-    /// `ratio(num, den)` with the magnitudes' bits, `num ≤ den`, `den ≠ 0`), which must return
-    /// what [`atan_ratio_q21`] returns for every such pair: the part of the kernel a backend
-    /// may write for its target (on the AVR, the division in assembly), the rest of the kernel
+    /// [`atan2_fixed`] with `p = atan(t)` in Q29 computed by `atan_q29` (called as
+    /// `atan_q29(num, den)` with the magnitudes' bits, `num ≤ den`, `den ≠ 0`), which must
+    /// return what [`atan_q29`] returns for every such pair: the part of the kernel a backend
+    /// may write for its target (on the AVR, in assembly), the octants and the conversion
     /// shared. Never inlined, for [`atan2_fixed`]'s reason.
     #[inline(never)]
     pub fn atan2_fixed_with<M: Math + ?Sized>(
         y: f32,
         x: f32,
-        ratio: impl FnOnce(u32, u32) -> u32,
+        atan_q29: impl FnOnce(u32, u32) -> u32,
     ) -> f32 {
         const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
         const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
@@ -701,20 +701,7 @@ pub mod poly {
         // division: fewer registers to save.
         let octant = swap as u8 | ((xb >> 30) as u8 & 2) | ((yb >> 29) as u8 & 4);
         // p = atan(t) in Q29, t ∈ [0, 1].
-        let p: u32 = if den == 0 {
-            0
-        } else {
-            let big_t = ratio(num, den);
-            // Cell k = ⌊32·t⌋ (t = 1: cell 32) and the offset d = t − k/32 in Q21 (16 bits).
-            let k = (big_t >> 16) as usize;
-            let d = big_t as u16;
-            // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
-            let [a_lo, a_hi, b, c] = M::read_table_cell(ATAN_CELLS.entry(k));
-            let lin = (mul_16x16(d, b) + (1 << 6)) >> 7;
-            let d_sq = (mul_16x16(d, d) >> 16) as u16;
-            let quad = (mul_16x16(d_sq, c) + (1 << 12)) >> 13;
-            join(a_lo, a_hi) + lin - quad
-        };
+        let p: u32 = if den == 0 { 0 } else { atan_q29(num, den) };
         let r = match octant & 3 {
             0 => p,
             2 => PI_Q29 - p,
@@ -728,6 +715,30 @@ pub mod poly {
             (r as f32).to_bits() - (29 << 23)
         };
         f32::from_bits(r | ((octant as u32 & 4) << 29))
+    }
+
+    /// [`atan2_fixed`]'s `p = atan(num / den)` in Q29 from the magnitudes' bits `num ≤ den`,
+    /// `den ≠ 0`: the quotient `T` ([`atan_ratio_q21`]), then its cell of the table
+    /// ([`atan_cells`], read by `M`) in 16-bit fixed point.
+    #[inline(always)]
+    pub fn atan_q29<M: Math + ?Sized>(num: u32, den: u32) -> u32 {
+        let big_t = atan_ratio_q21(num, den);
+        // Cell k = ⌊32·t⌋ (t = 1: cell 32) and the offset d = t − k/32 in Q21 (16 bits).
+        let k = (big_t >> 16) as usize;
+        let d = big_t as u16;
+        // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
+        let [a_lo, a_hi, b, c] = M::read_table_cell(ATAN_CELLS.entry(k));
+        let lin = (mul_16x16(d, b) + (1 << 6)) >> 7;
+        let d_sq = (mul_16x16(d, d) >> 16) as u16;
+        let quad = (mul_16x16(d_sq, c) + (1 << 12)) >> 13;
+        join(a_lo, a_hi) + lin - quad
+    }
+
+    /// The first of [`atan_q29`]'s 33 cells `[a_lo, a_hi, b, c]` (cell `k` is `k` rows
+    /// further, contiguous), for a backend's own form of it ([`atan2_fixed_with`]); read like
+    /// any cell ([`Math::read_table_cell`]: in program memory on the AVR).
+    pub fn atan_cells() -> super::TableEntry<[u16; 4]> {
+        ATAN_CELLS.entry(0)
     }
 
     /// [`atan2_fixed`]'s quotient `T = ⌊t·2²¹⌋` of `t = num / den`, exact, from the bits

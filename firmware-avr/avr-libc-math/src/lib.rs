@@ -21,7 +21,7 @@
 
 #![no_std]
 #![cfg(target_arch = "avr")]
-// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent's division).
+// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent's `atan_q29`).
 #![feature(asm_experimental_arch)]
 
 use core::arch::asm;
@@ -82,11 +82,11 @@ impl Math for AvrLibm {
     // `poly::atan2_fixed`), where a cell is a run of `lpm Rd, Z+` straight into the registers
     // the kernel computes with; and it has had no release for the toolchains since 2023.
 
-    /// [`poly::atan2_fixed`] with its quotient divided in assembly ([`ratio_q21`]): the same
-    /// bits, in fewer cycles (see `BENCHMARKS.md`).
+    /// [`poly::atan2_fixed`] with its `atan(t)` in assembly ([`atan_q29`]): the same bits,
+    /// in fewer cycles (see `BENCHMARKS.md`).
     #[inline]
     fn atan2_fixed(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed_with::<Self>(y, x, ratio_q21)
+        poly::atan2_fixed_with::<Self>(y, x, atan_q29)
     }
 
     #[inline(always)]
@@ -105,65 +105,77 @@ impl Math for AvrLibm {
     }
 }
 
-/// [`poly::atan_ratio_q21`] in AVR assembly, bit for bit (the emulator test `avr_atan2` checks
-/// [`AvrLibm::atan2_fixed`] against the portable kernel): `T = ⌊t·2²¹⌋` of the magnitudes'
-/// bits `num ≤ den`, `den ≠ 0`. A restoring division of the 24-bit mantissas that stops after
-/// the `22 − (e_d − eₙ)` quotient bits `T` keeps (the shift of the quotient comes free), one
-/// compare-and-subtract per bit in three-byte registers. Hand-written because LLVM's AVR
-/// backend has no such division: `u64` or `u32` division is a library call for a 64- or
-/// 32-bit quotient with no early stop, and the float division it replaced rounds.
+/// [`poly::atan_q29`] in AVR assembly, bit for bit (the emulator test `avr_atan2` checks
+/// [`AvrLibm::atan2_fixed`] against the portable kernel): `p = atan(num / den)` in Q29 from
+/// the magnitudes' bits `num ≤ den`, `den ≠ 0`.
+///
+/// The quotient `T = ⌊t·2²¹⌋` ([`poly::atan_ratio_q21`]) by a restoring division of the 24-bit
+/// mantissas that stops after the `22 − (e_d − eₙ)` quotient bits `T` keeps (the shift of the
+/// quotient comes free), one compare-and-subtract per bit in three-byte registers; then the
+/// cell `k = T >> 16` read with `lpm` ([`poly::atan_cells`]) and its three 16 × 16-bit
+/// products with `mul`, each rounded as the portable kernel rounds it. Hand-written because
+/// LLVM's AVR backend has no such division (`u64` or `u32` division is a library call for a
+/// wide quotient with no early stop; the float division the kernel had rounds) and spends
+/// twice the instructions on the products' byte moves.
 #[inline(always)]
-fn ratio_q21(num: u32, den: u32) -> u32 {
-    let [mut n0, mut n1, mut n2, mut n3] = num.to_le_bytes();
-    let [d0, d1, mut d2, mut d3] = den.to_le_bytes();
-    let (q0, q1, q2): (u8, u8, u8);
-    // SAFETY: register arithmetic only (r1 is read as the zero register, never written).
+fn atan_q29(num: u32, den: u32) -> u32 {
+    let [n0, n1, n2, n3] = num.to_le_bytes();
+    let [e0, e1, e2, e3] = den.to_le_bytes();
+    let (p0, p1, p2, p3): (u8, u8, u8, u8);
+    // SAFETY: register arithmetic, and `lpm` reads of the cell `k ≤ 32` of kin-core's table in
+    // `.progmem.data` (below 64 KB, `lpm`'s reach, as for `lpm_word`). r1, the zero register,
+    // is read as zero before the first `mul` and cleared after the last.
     unsafe {
         asm!(
-            // Exponents to n3, d3 (the sign bits are clear), mantissas with their implicit
-            // one (none for a subnormal, exponent 0) to n2:n1:n0, d2:d1:d0.
-            "lsl {d2}",
-            "rol {d3}",
-            "cp r1, {d3}",
-            "ror {d2}",
+            // Exponents to n3, e3 (the sign bits are clear), mantissas with their implicit
+            // one (none for a subnormal, exponent 0) to n2:n1:n0, e2:e1:e0.
+            "lsl {e2}",
+            "rol {e3}",
+            "cp r1, {e3}",
+            "ror {e2}",
             "lsl {n2}",
             "rol {n3}",
             "cp r1, {n3}",
             "ror {n2}",
-            "cpi {d3}, 255",
+            "clr {q0}",
+            "clr {q1}",
+            "clr {q2}",
+            "cpi {e3}, 255",
             "breq 7f",
-            // Subnormals at exponent 1; s = ed − en, T = 0 when s ≥ 22.
-            "cpi {d3}, 1",
-            "adc {d3}, r1",
+            // Subnormals at exponent 1; s = ed − en, T = 0 (so p = 0) when s ≥ 22.
+            "cpi {e3}, 1",
+            "adc {e3}, r1",
             "cpi {n3}, 1",
             "adc {n3}, r1",
-            "sub {d3}, {n3}",
-            "cpi {d3}, 22",
-            "brsh 8f",
+            "sub {e3}, {n3}",
+            "cpi {e3}, 22",
+            "brlo 5f",
+            "rjmp 8f",
+            "5:",
             "ldi {cnt}, 22",
-            "sub {cnt}, {d3}",
+            "sub {cnt}, {e3}",
             // The quotient's bits go in inverted (the carry of a compare that fails is 1), into
             // ones that end as the leading zeros.
-            "ldi {q2}, 0xff",
-            "mov {q0}, {q2}",
-            "mov {q1}, {q2}",
+            "com {q0}",
+            "com {q1}",
+            "com {q2}",
             // The first bit: mn ≥ md (mn < 2·md), no shift.
             "rjmp 2f",
             "1:",
             "lsl {n0}",
             "rol {n1}",
             "rol {n2}",
-            // Remainder ≥ 2²⁴ > md: subtract (the borrow of the low 24 bits is then set).
+            // Remainder ≥ 2²⁴ > md: subtract (the low 24 bits' borrow is then set).
             "brcs 3f",
             "2:",
-            "cp {n0}, {d0}",
-            "cpc {n1}, {d1}",
-            "cpc {n2}, {d2}",
+            "cp {n0}, {e0}",
+            "cpc {n1}, {e1}",
+            "cpc {n2}, {e2}",
             "brcs 4f",
             "3:",
-            "sub {n0}, {d0}",
-            "sbc {n1}, {d1}",
-            "sbc {n2}, {d2}",
+            "sub {n0}, {e0}",
+            "sbc {n1}, {e1}",
+            "sbc {n2}, {e2}",
             "clc",
             "4:",
             "rol {q0}",
@@ -174,38 +186,138 @@ fn ratio_q21(num: u32, den: u32) -> u32 {
             "com {q0}",
             "com {q1}",
             "com {q2}",
-            "rjmp 9f",
+            "rjmp 6f",
             // den infinite (or NaN): T = 2²¹ when num is too, else 0.
             "7:",
-            "clr {q0}",
-            "clr {q1}",
-            "ldi {q2}, 0",
             "cpi {n3}, 255",
-            "brne 9f",
+            "brne 6f",
             "ldi {q2}, 0x20",
-            "rjmp 9f",
-            "8:",
-            "clr {q0}",
-            "clr {q1}",
+            // The cell k = q2 ≤ 32: Z += 8·k (9 bits), a to p3:p2:p1:p0, b to e1:e0, c to
+            // e3:e2; d = q1:q0.
+            "6:",
+            "lsl {q2}",
+            "lsl {q2}",
+            "lsl {q2}",
+            "adc r31, r1",
+            "add r30, {q2}",
+            "adc r31, r1",
+            "lpm {p0}, Z+",
+            "lpm {p1}, Z+",
+            "lpm {p2}, Z+",
+            "lpm {p3}, Z+",
+            "lpm {e0}, Z+",
+            "lpm {e1}, Z+",
+            "lpm {e2}, Z+",
+            "lpm {e3}, Z+",
+            "clr {cnt}",
+            // d·b to n3:n2:n1:n0; p += (d·b + 2⁶) >> 7 (d·b < 2³¹).
+            "mul {q0}, {e0}",
+            "mov {n0}, r0",
+            "mov {n1}, r1",
+            "mul {q1}, {e1}",
+            "mov {n2}, r0",
+            "mov {n3}, r1",
+            "mul {q0}, {e1}",
+            "add {n1}, r0",
+            "adc {n2}, r1",
+            "adc {n3}, {cnt}",
+            "mul {q1}, {e0}",
+            "add {n1}, r0",
+            "adc {n2}, r1",
+            "adc {n3}, {cnt}",
+            "ldi {q2}, 0x40",
+            "add {n0}, {q2}",
+            "adc {n1}, {cnt}",
+            "adc {n2}, {cnt}",
+            "adc {n3}, {cnt}",
+            "lsl {n0}",
+            "rol {n1}",
+            "rol {n2}",
+            "rol {n3}",
+            "add {p0}, {n1}",
+            "adc {p1}, {n2}",
+            "adc {p2}, {n3}",
+            "adc {p3}, {cnt}",
+            // d² >> 16 to n3:n2.
+            "mul {q0}, {q0}",
+            "mov {n1}, r1",
+            "mul {q1}, {q1}",
+            "mov {n2}, r0",
+            "mov {n3}, r1",
+            "mul {q0}, {q1}",
+            "add {n1}, r0",
+            "adc {n2}, r1",
+            "adc {n3}, {cnt}",
+            "add {n1}, r0",
+            "adc {n2}, r1",
+            "adc {n3}, {cnt}",
+            // d²·c to e1:e0:q1:q0; p −= (d²·c + 2¹²) >> 13, from q2:e1:e0 after three
+            // left shifts of q2:e1:e0:q1 (d²·c < 2³¹).
+            "mul {n2}, {e2}",
+            "mov {q0}, r0",
+            "mov {q1}, r1",
+            "mul {n3}, {e3}",
+            "mov {e0}, r0",
+            "mov {e1}, r1",
+            "mul {n2}, {e3}",
+            "add {q1}, r0",
+            "adc {e0}, r1",
+            "adc {e1}, {cnt}",
+            "mul {n3}, {e2}",
+            "add {q1}, r0",
+            "adc {e0}, r1",
+            "adc {e1}, {cnt}",
+            "clr r1",
+            "ldi {q2}, 0x10",
+            "add {q1}, {q2}",
+            "adc {e0}, r1",
+            "adc {e1}, r1",
             "clr {q2}",
+            "lsl {q1}",
+            "rol {e0}",
+            "rol {e1}",
+            "rol {q2}",
+            "lsl {q1}",
+            "rol {e0}",
+            "rol {e1}",
+            "rol {q2}",
+            "lsl {q1}",
+            "rol {e0}",
+            "rol {e1}",
+            "rol {q2}",
+            "sub {p0}, {e0}",
+            "sbc {p1}, {e1}",
+            "sbc {p2}, {q2}",
+            "sbc {p3}, r1",
+            "rjmp 9f",
+            // T = 0: p = 0 (cell 0's a and the rounded products of d = 0 are 0).
+            "8:",
+            "clr {p0}",
+            "clr {p1}",
+            "clr {p2}",
+            "clr {p3}",
             "9:",
-            n0 = inout(reg) n0,
-            n1 = inout(reg) n1,
-            n2 = inout(reg) n2,
-            n3 = inout(reg_upper) n3,
-            d0 = in(reg) d0,
-            d1 = in(reg) d1,
-            d2 = inout(reg) d2,
-            d3 = inout(reg_upper) d3,
-            q0 = out(reg) q0,
-            q1 = out(reg) q1,
-            q2 = out(reg_upper) q2,
+            n0 = inout(reg) n0 => _,
+            n1 = inout(reg) n1 => _,
+            n2 = inout(reg) n2 => _,
+            n3 = inout(reg_upper) n3 => _,
+            e0 = inout(reg) e0 => _,
+            e1 = inout(reg) e1 => _,
+            e2 = inout(reg) e2 => _,
+            e3 = inout(reg_upper) e3 => _,
+            q0 = out(reg) _,
+            q1 = out(reg) _,
+            q2 = out(reg_upper) _,
             cnt = out(reg_upper) _,
-            options(pure, nomem, nostack),
+            p0 = out(reg) p0,
+            p1 = out(reg) p1,
+            p2 = out(reg) p2,
+            p3 = out(reg) p3,
+            inout("Z") poly::atan_cells().addr() => _,
+            options(pure, readonly, nostack),
         );
     }
-    let _ = (n0, n1, n2, n3, d2, d3);
-    u32::from_le_bytes([q0, q1, q2, 0])
+    u32::from_le_bytes([p0, p1, p2, p3])
 }
 
 /// Repeats `$body` with `$i` bound to each listed index in turn.
