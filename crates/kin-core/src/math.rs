@@ -677,44 +677,53 @@ pub mod poly {
     /// hosts do not use this kernel in their backends, so the call costs them nothing.
     #[inline(never)]
     pub fn atan2_fixed<M: Math + ?Sized>(y: f32, x: f32) -> f32 {
-        atan2_fixed_with::<M>(y, x, atan_q29::<M>)
+        atan2_fixed_with::<M>(y, x, atan2_fixed_magnitude::<M>)
     }
 
-    /// [`atan2_fixed`] with `p = atan(t)` in Q29 computed by `atan_q29` (called as
-    /// `atan_q29(num, den)` with the magnitudes' bits, `num ≤ den`, `den ≠ 0`), which must
-    /// return what [`atan_q29`] returns for every such pair: the part of the kernel a backend
-    /// may write for its target (on the AVR, in assembly), the octants and the conversion
-    /// shared. Never inlined, for [`atan2_fixed`]'s reason.
+    /// [`atan2_fixed`] with its magnitude `|atan2(y, x)|` (the float's bits) computed by
+    /// `magnitude` (called as `magnitude(num, den, octant)`, see [`atan2_fixed_magnitude`]),
+    /// which must return what [`atan2_fixed_magnitude`] returns for every argument: the part
+    /// of the kernel a backend may write for its target (on the AVR, in assembly), the
+    /// octant's choice and the sign shared. Never inlined, for [`atan2_fixed`]'s reason.
     #[inline(never)]
     pub fn atan2_fixed_with<M: Math + ?Sized>(
         y: f32,
         x: f32,
-        atan_q29: impl FnOnce(u32, u32) -> u32,
+        magnitude: impl FnOnce(u32, u32, u8) -> u32,
     ) -> f32 {
-        const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
-        const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
         let (yb, xb) = (y.to_bits(), x.to_bits());
         let (ay, ax) = (yb & ABS, xb & ABS);
         let swap = ay > ax;
         let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
-        // The octant in one byte (swap, x < 0, y < 0), the only state kept across the
-        // division: fewer registers to save.
+        // The octant in one byte (swap, x < 0, y < 0): fewer registers to keep.
         let octant = swap as u8 | ((xb >> 30) as u8 & 2) | ((yb >> 29) as u8 & 4);
-        // p = atan(t) in Q29, t ∈ [0, 1].
-        let p: u32 = if den == 0 { 0 } else { atan_q29(num, den) };
+        // ≥ 0 in every octant: the sign of y goes on by its bit.
+        f32::from_bits(magnitude(num, den, octant) | ((octant as u32 & 4) << 29))
+    }
+
+    /// The bits of [`atan2_fixed`]'s `|atan2(y, x)|` from the magnitudes' bits `num ≤ den`
+    /// (`den = 0`: both zero) and the octant (bit 0: `|y| > |x|`, swapped; bit 1: `x < 0`;
+    /// bit 2, the sign of `y`, ignored): `p = atan(num / den)` in Q29 ([`atan_q29`]), the
+    /// octant's angle `r` from it in Q29 (π/2 ± p, π − p or p, never negative), and
+    /// `r·2⁻²⁹` as a float, rounded to nearest even.
+    #[inline(always)]
+    pub fn atan2_fixed_magnitude<M: Math + ?Sized>(num: u32, den: u32, octant: u8) -> u32 {
+        const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
+        const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
+                                           // p = atan(t) in Q29, t ∈ [0, 1].
+        let p: u32 = if den == 0 { 0 } else { atan_q29::<M>(num, den) };
         let r = match octant & 3 {
             0 => p,
             2 => PI_Q29 - p,
             1 => FRAC_PI_2_Q29 - p,
             _ => FRAC_PI_2_Q29 + p,
         };
-        // r ≥ 0; r·2⁻²⁹ by the exponent (r = 0 stays 0), then the sign of y.
-        let r = if r == 0 {
+        // r ≥ 0; r·2⁻²⁹ by the exponent (r = 0 stays 0).
+        if r == 0 {
             0
         } else {
             (r as f32).to_bits() - (29 << 23)
-        };
-        f32::from_bits(r | ((octant as u32 & 4) << 29))
+        }
     }
 
     /// [`atan2_fixed`]'s `p = atan(num / den)` in Q29 from the magnitudes' bits `num ≤ den`,

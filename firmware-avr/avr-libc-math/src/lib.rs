@@ -21,7 +21,7 @@
 
 #![no_std]
 #![cfg(target_arch = "avr")]
-// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent's `atan_q29`).
+// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent's `atan2_magnitude`).
 #![feature(asm_experimental_arch)]
 
 use core::arch::asm;
@@ -82,11 +82,11 @@ impl Math for AvrLibm {
     // `poly::atan2_fixed`), where a cell is a run of `lpm Rd, Z+` straight into the registers
     // the kernel computes with; and it has had no release for the toolchains since 2023.
 
-    /// [`poly::atan2_fixed`] with its `atan(t)` in assembly ([`atan_q29`]): the same bits,
-    /// in fewer cycles (see `BENCHMARKS.md`).
+    /// [`poly::atan2_fixed`] with its magnitude in assembly ([`atan2_magnitude`]): the same
+    /// bits, in fewer cycles (see `BENCHMARKS.md`).
     #[inline]
     fn atan2_fixed(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed_with::<Self>(y, x, atan_q29)
+        poly::atan2_fixed_with::<Self>(y, x, atan2_magnitude)
     }
 
     #[inline(always)]
@@ -105,20 +105,23 @@ impl Math for AvrLibm {
     }
 }
 
-/// [`poly::atan_q29`] in AVR assembly, bit for bit (the emulator test `avr_atan2` checks
-/// [`AvrLibm::atan2_fixed`] against the portable kernel): `p = atan(num / den)` in Q29 from
-/// the magnitudes' bits `num ≤ den`, `den ≠ 0`.
+/// [`poly::atan2_fixed_magnitude`] in AVR assembly, bit for bit (the emulator test
+/// `avr_atan2` checks [`AvrLibm::atan2_fixed`] against the portable kernel): the bits of
+/// `|atan2|` from the magnitudes' bits `num ≤ den` and the octant.
 ///
 /// The quotient `T = ⌊t·2²¹⌋` ([`poly::atan_ratio_q21`]) by a restoring division of the 24-bit
 /// mantissas that stops after the `22 − (e_d − eₙ)` quotient bits `T` keeps (the shift of the
 /// quotient comes free), one compare-and-subtract per bit in three-byte registers; then the
 /// cell `k = T >> 16` read with `lpm` ([`poly::atan_cells`]) and its three 16 × 16-bit
-/// products with `mul`, each rounded as the portable kernel rounds it. Hand-written because
+/// products with `mul`, each rounded as the portable kernel rounds it; the octant's angle, and
+/// its conversion to a float (normalised bytewise then bitwise, rounded to nearest even).
+/// Hand-written because
 /// LLVM's AVR backend has no such division (`u64` or `u32` division is a library call for a
 /// wide quotient with no early stop; the float division the kernel had rounds) and spends
-/// twice the instructions on the products' byte moves.
+/// twice the instructions on the products' byte moves (and calls a library routine for the
+/// conversion).
 #[inline(always)]
-fn atan_q29(num: u32, den: u32) -> u32 {
+fn atan2_magnitude(num: u32, den: u32, octant: u8) -> u32 {
     let [n0, n1, n2, n3] = num.to_le_bytes();
     let [e0, e1, e2, e3] = den.to_le_bytes();
     let (p0, p1, p2, p3): (u8, u8, u8, u8);
@@ -127,6 +130,14 @@ fn atan_q29(num: u32, den: u32) -> u32 {
     // is read as zero before the first `mul` and cleared after the last.
     unsafe {
         asm!(
+            // den = 0 (num = 0 too): p = 0.
+            "cp {e0}, r1",
+            "cpc {e1}, r1",
+            "cpc {e2}, r1",
+            "cpc {e3}, r1",
+            "brne 5f",
+            "rjmp 8f",
+            "5:",
             // Exponents to n3, e3 (the sign bits are clear), mantissas with their implicit
             // one (none for a subnormal, exponent 0) to n2:n1:n0, e2:e1:e0.
             "lsl {e2}",
@@ -289,13 +300,101 @@ fn atan_q29(num: u32, den: u32) -> u32 {
             "sbc {p1}, {e1}",
             "sbc {p2}, {q2}",
             "sbc {p3}, r1",
-            "rjmp 9f",
-            // T = 0: p = 0 (cell 0's a and the rounded products of d = 0 are 0).
+            "rjmp 20f",
+            // T = 0 or den = 0: p = 0 (cell 0's a and the rounded products of d = 0 are 0).
             "8:",
             "clr {p0}",
             "clr {p1}",
             "clr {p2}",
             "clr {p3}",
+            // The octant's angle r to p3:p2:p1:p0: p (octant 0), π − p (2), π/2 − p (1),
+            // π/2 + p (3), the constants in Q29 (round(π·2²⁹) = 0x6487ed51).
+            "20:",
+            "sbrc {o}, 0",
+            "rjmp 22f",
+            "sbrs {o}, 1",
+            "rjmp 24f",
+            "ldi {n3}, 0x51",
+            "ldi {e3}, 0xed",
+            "ldi {q2}, 0x87",
+            "ldi {cnt}, 0x64",
+            "rjmp 23f",
+            "22:",
+            "ldi {n3}, 0xa9",
+            "ldi {e3}, 0xf6",
+            "ldi {q2}, 0x43",
+            "ldi {cnt}, 0x32",
+            "sbrs {o}, 1",
+            "rjmp 23f",
+            "add {p0}, {n3}",
+            "adc {p1}, {e3}",
+            "adc {p2}, {q2}",
+            "adc {p3}, {cnt}",
+            "rjmp 30f",
+            "23:",
+            "sub {n3}, {p0}",
+            "sbc {e3}, {p1}",
+            "sbc {q2}, {p2}",
+            "sbc {cnt}, {p3}",
+            "mov {p0}, {n3}",
+            "mov {p1}, {e3}",
+            "mov {p2}, {q2}",
+            "mov {p3}, {cnt}",
+            "rjmp 30f",
+            // Octant 0: r = p, 0 when p is (the float +0).
+            "24:",
+            "mov {n0}, {p0}",
+            "or {n0}, {p1}",
+            "or {n0}, {p2}",
+            "or {n0}, {p3}",
+            "breq 9f",
+            // r > 0 (r < 2³¹) as a float times 2⁻²⁹: the biased exponent 129 less the shifts
+            // that bring r's leading one to bit 31, in q2.
+            "30:",
+            "ldi {q2}, 129",
+            "31:",
+            "tst {p3}",
+            "brne 32f",
+            "mov {p3}, {p2}",
+            "mov {p2}, {p1}",
+            "mov {p1}, {p0}",
+            "clr {p0}",
+            "subi {q2}, 8",
+            "rjmp 31b",
+            "32:",
+            "sbrc {p3}, 7",
+            "rjmp 33f",
+            "lsl {p0}",
+            "rol {p1}",
+            "rol {p2}",
+            "rol {p3}",
+            "dec {q2}",
+            "rjmp 32b",
+            // The mantissa p3:p2:p1, rounded by p0 to nearest even; a carry out of it makes
+            // the mantissa 2²³ of the next exponent.
+            "33:",
+            "lsl {p0}",
+            "brcc 34f",
+            "brne 35f",
+            "sbrs {p1}, 0",
+            "rjmp 34f",
+            "35:",
+            "sec",
+            "adc {p1}, r1",
+            "adc {p2}, r1",
+            "adc {p3}, r1",
+            "brcc 34f",
+            "ror {p3}",
+            "inc {q2}",
+            // Pack: exponent q2 over the mantissa without its leading one.
+            "34:",
+            "lsl {p3}",
+            "lsr {q2}",
+            "ror {p3}",
+            "mov {p0}, {p1}",
+            "mov {p1}, {p2}",
+            "mov {p2}, {p3}",
+            "mov {p3}, {q2}",
             "9:",
             n0 = inout(reg) n0 => _,
             n1 = inout(reg) n1 => _,
@@ -313,6 +412,7 @@ fn atan_q29(num: u32, den: u32) -> u32 {
             p1 = out(reg) p1,
             p2 = out(reg) p2,
             p3 = out(reg) p3,
+            o = in(reg) octant,
             inout("Z") poly::atan_cells().addr() => _,
             options(pure, readonly, nostack),
         );
