@@ -93,8 +93,8 @@ pub trait Math {
     }
     /// The fixed-point arctangent [`poly::atan2_fixed`] with this backend's table reads: the
     /// arctangent of [`SoftFloat`] over this backend. A backend overrides it only with a
-    /// faster form of the same kernel for its target (the AVR's division in assembly,
-    /// through [`poly::atan2_fixed_with`]): an override must return the same bits as
+    /// faster form of the same kernel for its target (the AVR's, in assembly, from the
+    /// table [`poly::atan_cells`]): an override must return the same bits as
     /// `poly::atan2_fixed::<Self>` for every input (NaN arguments: a bounded value), which
     /// its target's tests check.
     #[inline]
@@ -677,75 +677,47 @@ pub mod poly {
     /// hosts do not use this kernel in their backends, so the call costs them nothing.
     #[inline(never)]
     pub fn atan2_fixed<M: Math + ?Sized>(y: f32, x: f32) -> f32 {
-        atan2_fixed_with::<M>(y, x, atan2_fixed_magnitude::<M>)
-    }
-
-    /// [`atan2_fixed`] with its magnitude `|atan2(y, x)|` (the float's bits) computed by
-    /// `magnitude` (called as `magnitude(num, den, octant)`, see [`atan2_fixed_magnitude`]),
-    /// which must return what [`atan2_fixed_magnitude`] returns for every argument: the part
-    /// of the kernel a backend may write for its target (on the AVR, in assembly), the
-    /// octant's choice and the sign shared. Never inlined, for [`atan2_fixed`]'s reason.
-    #[inline(never)]
-    pub fn atan2_fixed_with<M: Math + ?Sized>(
-        y: f32,
-        x: f32,
-        magnitude: impl FnOnce(u32, u32, u8) -> u32,
-    ) -> f32 {
+        const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
+        const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
         let (yb, xb) = (y.to_bits(), x.to_bits());
         let (ay, ax) = (yb & ABS, xb & ABS);
         let swap = ay > ax;
         let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
         // The octant in one byte (swap, x < 0, y < 0): fewer registers to keep.
         let octant = swap as u8 | ((xb >> 30) as u8 & 2) | ((yb >> 29) as u8 & 4);
-        // ≥ 0 in every octant: the sign of y goes on by its bit.
-        f32::from_bits(magnitude(num, den, octant) | ((octant as u32 & 4) << 29))
-    }
-
-    /// The bits of [`atan2_fixed`]'s `|atan2(y, x)|` from the magnitudes' bits `num ≤ den`
-    /// (`den = 0`: both zero) and the octant (bit 0: `|y| > |x|`, swapped; bit 1: `x < 0`;
-    /// bit 2, the sign of `y`, ignored): `p = atan(num / den)` in Q29 ([`atan_q29`]), the
-    /// octant's angle `r` from it in Q29 (π/2 ± p, π − p or p, never negative), and
-    /// `r·2⁻²⁹` as a float, rounded to nearest even.
-    #[inline(always)]
-    pub fn atan2_fixed_magnitude<M: Math + ?Sized>(num: u32, den: u32, octant: u8) -> u32 {
-        const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
-        const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
-                                           // p = atan(t) in Q29, t ∈ [0, 1].
-        let p: u32 = if den == 0 { 0 } else { atan_q29::<M>(num, den) };
+        // p = atan(t) in Q29, t ∈ [0, 1].
+        let p: u32 = if den == 0 {
+            0
+        } else {
+            let big_t = atan_ratio_q21(num, den);
+            // Cell k = ⌊32·t⌋ (t = 1: cell 32) and the offset d = t − k/32 in Q21 (16 bits).
+            let k = (big_t >> 16) as usize;
+            let d = big_t as u16;
+            // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
+            let [a_lo, a_hi, b, c] = M::read_table_cell(ATAN_CELLS.entry(k));
+            let lin = (mul_16x16(d, b) + (1 << 6)) >> 7;
+            let d_sq = (mul_16x16(d, d) >> 16) as u16;
+            let quad = (mul_16x16(d_sq, c) + (1 << 12)) >> 13;
+            join(a_lo, a_hi) + lin - quad
+        };
         let r = match octant & 3 {
             0 => p,
             2 => PI_Q29 - p,
             1 => FRAC_PI_2_Q29 - p,
             _ => FRAC_PI_2_Q29 + p,
         };
-        // r ≥ 0; r·2⁻²⁹ by the exponent (r = 0 stays 0).
-        if r == 0 {
+        // r ≥ 0; r·2⁻²⁹ by the exponent (r = 0 stays 0), then the sign of y.
+        let r = if r == 0 {
             0
         } else {
             (r as f32).to_bits() - (29 << 23)
-        }
+        };
+        f32::from_bits(r | ((octant as u32 & 4) << 29))
     }
 
-    /// [`atan2_fixed`]'s `p = atan(num / den)` in Q29 from the magnitudes' bits `num ≤ den`,
-    /// `den ≠ 0`: the quotient `T` ([`atan_ratio_q21`]), then its cell of the table
-    /// ([`atan_cells`], read by `M`) in 16-bit fixed point.
-    #[inline(always)]
-    pub fn atan_q29<M: Math + ?Sized>(num: u32, den: u32) -> u32 {
-        let big_t = atan_ratio_q21(num, den);
-        // Cell k = ⌊32·t⌋ (t = 1: cell 32) and the offset d = t − k/32 in Q21 (16 bits).
-        let k = (big_t >> 16) as usize;
-        let d = big_t as u16;
-        // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
-        let [a_lo, a_hi, b, c] = M::read_table_cell(ATAN_CELLS.entry(k));
-        let lin = (mul_16x16(d, b) + (1 << 6)) >> 7;
-        let d_sq = (mul_16x16(d, d) >> 16) as u16;
-        let quad = (mul_16x16(d_sq, c) + (1 << 12)) >> 13;
-        join(a_lo, a_hi) + lin - quad
-    }
-
-    /// The first of [`atan_q29`]'s 33 cells `[a_lo, a_hi, b, c]` (cell `k` is `k` rows
-    /// further, contiguous), for a backend's own form of it ([`atan2_fixed_with`]); read like
-    /// any cell ([`Math::read_table_cell`]: in program memory on the AVR).
+    /// The first of [`atan2_fixed`]'s 33 cells `[a_lo, a_hi, b, c]` (cell `k` is `k` rows
+    /// further, contiguous), for a backend's own form of the kernel ([`Math::atan2_fixed`]);
+    /// read like any cell ([`Math::read_table_cell`]: in program memory on the AVR).
     pub fn atan_cells() -> super::TableEntry<[u16; 4]> {
         ATAN_CELLS.entry(0)
     }
@@ -755,8 +727,8 @@ pub mod poly {
     /// (subnormals without the implicit one, at exponent 1) divided,
     /// `T = ⌊mₙ·2²¹ / m_d⌋ >> (e_d − eₙ)`. `den` infinite: `T = 2²¹` (t = 1) when `num` is
     /// infinite too, else 0; a NaN gives some `T ≤ 2²¹`. Integer arithmetic only, so that a
-    /// backend's division ([`atan2_fixed_with`]) can equal it bit for bit, which a float
-    /// division's rounding would make harder.
+    /// backend's own form of the kernel ([`Math::atan2_fixed`]) can equal it bit for bit,
+    /// which a float division's rounding would make harder.
     pub fn atan_ratio_q21(num: u32, den: u32) -> u32 {
         const INF: u32 = 0x7f80_0000;
         if den >= INF {

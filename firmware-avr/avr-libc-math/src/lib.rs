@@ -21,7 +21,7 @@
 
 #![no_std]
 #![cfg(target_arch = "avr")]
-// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent's `atan2_magnitude`).
+// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent `atan2_fixed`).
 #![feature(asm_experimental_arch)]
 
 use core::arch::asm;
@@ -82,11 +82,11 @@ impl Math for AvrLibm {
     // `poly::atan2_fixed`), where a cell is a run of `lpm Rd, Z+` straight into the registers
     // the kernel computes with; and it has had no release for the toolchains since 2023.
 
-    /// [`poly::atan2_fixed`] with its magnitude in assembly ([`atan2_magnitude`]): the same
-    /// bits, in fewer cycles (see `BENCHMARKS.md`).
+    /// [`poly::atan2_fixed`] in assembly (the crate's `atan2_fixed`): the same bits, in fewer
+    /// cycles (see `BENCHMARKS.md`).
     #[inline]
     fn atan2_fixed(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed_with::<Self>(y, x, atan2_magnitude)
+        atan2_fixed(y, x)
     }
 
     #[inline(always)]
@@ -105,31 +105,65 @@ impl Math for AvrLibm {
     }
 }
 
-/// [`poly::atan2_fixed_magnitude`] in AVR assembly, bit for bit (the emulator test
-/// `avr_atan2` checks [`AvrLibm::atan2_fixed`] against the portable kernel): the bits of
-/// `|atan2|` from the magnitudes' bits `num ≤ den` and the octant.
+/// [`poly::atan2_fixed`] in AVR assembly, bit for bit (the emulator test `avr_atan2` checks
+/// [`AvrLibm::atan2_fixed`] against the portable kernel on the AVR):
 ///
-/// The quotient `T = ⌊t·2²¹⌋` ([`poly::atan_ratio_q21`]) by a restoring division of the 24-bit
-/// mantissas that stops after the `22 − (e_d − eₙ)` quotient bits `T` keeps (the shift of the
-/// quotient comes free), one compare-and-subtract per bit in three-byte registers; then the
-/// cell `k = T >> 16` read with `lpm` ([`poly::atan_cells`]) and its three 16 × 16-bit
-/// products with `mul`, each rounded as the portable kernel rounds it; the octant's angle, and
-/// its conversion to a float (normalised bytewise then bitwise, rounded to nearest even).
-/// Hand-written because
-/// LLVM's AVR backend has no such division (`u64` or `u32` division is a library call for a
-/// wide quotient with no early stop; the float division the kernel had rounds) and spends
-/// twice the instructions on the products' byte moves (and calls a library routine for the
-/// conversion).
-#[inline(always)]
-fn atan2_magnitude(num: u32, den: u32, octant: u8) -> u32 {
-    let [n0, n1, n2, n3] = num.to_le_bytes();
-    let [e0, e1, e2, e3] = den.to_le_bytes();
+/// - the octant and the magnitudes `num ≤ den` from the bits;
+/// - the quotient `T = ⌊t·2²¹⌋` ([`poly::atan_ratio_q21`]) by a restoring division of the
+///   24-bit mantissas that stops after the `22 − (e_d − eₙ)` quotient bits `T` keeps (the
+///   shift of the quotient comes free), one compare-and-subtract per bit in three-byte
+///   registers;
+/// - the cell `k = T >> 16` read with `lpm` ([`poly::atan_cells`]) and its three
+///   16 × 16-bit products with `mul`, each rounded as the portable kernel rounds it;
+/// - the octant's angle in Q29, its conversion to a float (normalised bytewise then bitwise,
+///   rounded to nearest even) and the sign of `y`.
+///
+/// Hand-written because LLVM's AVR backend has no such division (`u64` or `u32` division is
+/// a library call for a wide quotient with no early stop; the float division the kernel had
+/// rounds, which an integer form could not match cheaply), spends twice the instructions on
+/// the products' byte moves, and calls a library routine for the conversion.
+///
+/// Never inlined: one copy in flash for all callers.
+#[inline(never)]
+fn atan2_fixed(y: f32, x: f32) -> f32 {
+    let [n0, n1, n2, n3] = y.to_bits().to_le_bytes();
+    let [e0, e1, e2, e3] = x.to_bits().to_le_bytes();
     let (p0, p1, p2, p3): (u8, u8, u8, u8);
     // SAFETY: register arithmetic, and `lpm` reads of the cell `k ≤ 32` of kin-core's table in
     // `.progmem.data` (below 64 KB, `lpm`'s reach, as for `lpm_word`). r1, the zero register,
     // is read as zero before the first `mul` and cleared after the last.
     unsafe {
         asm!(
+            // The octant in o: bit 2 the sign of y, bit 1 the sign of x, bit 0 |y| > |x|
+            // (swapped); n3:n2:n1:n0 = num = min(|y|, |x|), e3:e2:e1:e0 = den = the other.
+            "clr {o}",
+            "bst {n3}, 7",
+            "bld {o}, 2",
+            "bst {e3}, 7",
+            "bld {o}, 1",
+            "lsl {n3}",
+            "lsr {n3}",
+            "lsl {e3}",
+            "lsr {e3}",
+            "cp {e0}, {n0}",
+            "cpc {e1}, {n1}",
+            "cpc {e2}, {n2}",
+            "cpc {e3}, {n3}",
+            "brsh 5f",
+            "inc {o}",
+            "eor {n0}, {e0}",
+            "eor {e0}, {n0}",
+            "eor {n0}, {e0}",
+            "eor {n1}, {e1}",
+            "eor {e1}, {n1}",
+            "eor {n1}, {e1}",
+            "eor {n2}, {e2}",
+            "eor {e2}, {n2}",
+            "eor {n2}, {e2}",
+            "eor {n3}, {e3}",
+            "eor {e3}, {n3}",
+            "eor {n3}, {e3}",
+            "5:",
             // den = 0 (num = 0 too): p = 0.
             "cp {e0}, r1",
             "cpc {e1}, r1",
@@ -395,7 +429,10 @@ fn atan2_magnitude(num: u32, den: u32, octant: u8) -> u32 {
             "mov {p1}, {p2}",
             "mov {p2}, {p3}",
             "mov {p3}, {q2}",
+            // The sign of y.
             "9:",
+            "bst {o}, 2",
+            "bld {p3}, 7",
             n0 = inout(reg) n0 => _,
             n1 = inout(reg) n1 => _,
             n2 = inout(reg) n2 => _,
@@ -412,12 +449,12 @@ fn atan2_magnitude(num: u32, den: u32, octant: u8) -> u32 {
             p1 = out(reg) p1,
             p2 = out(reg) p2,
             p3 = out(reg) p3,
-            o = in(reg) octant,
+            o = out(reg) _,
             inout("Z") poly::atan_cells().addr() => _,
             options(pure, readonly, nostack),
         );
     }
-    u32::from_le_bytes([p0, p1, p2, p3])
+    f32::from_bits(u32::from_le_bytes([p0, p1, p2, p3]))
 }
 
 /// Repeats `$body` with `$i` bound to each listed index in turn.
