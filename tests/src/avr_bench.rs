@@ -60,7 +60,7 @@ pub enum Backend {
     /// kin-core's `Libm` backend (Rust libm); soft-float primitives from whichever ELF.
     Libm = 2,
     /// The firmware's backend (`avr_libc_math::AvrFast`): avr-libc's `sqrt`, kin-core's
-    /// `poly::atan2_fixed` and `poly::sin_cos_fixed`.
+    /// `poly::atan2_fixed` (in `AvrLibm`'s assembly form) and `poly::sin_cos_fixed`.
     AvrFast = 3,
 }
 

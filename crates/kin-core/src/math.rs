@@ -17,8 +17,10 @@
 //!   [`poly::atan2_fixed`] and [`poly::sin_cos_fixed`] (tables of quadratic cells in fixed
 //!   point), which cost far fewer software-float operations, comparisons of the bit patterns instead of software-float comparisons, and
 //!   the four legs of a body solved one after the other. The kernels' tables are the one thing
-//!   a backend reads per target ([`Math::read_table_cell`]): on the AVR they stay in flash, out
-//!   of the scarce SRAM, and the backend reads them with `lpm`.
+//!   a backend must read per target ([`Math::read_table_cell`]): on the AVR they stay in flash,
+//!   out of the scarce SRAM, and the backend reads them with `lpm`. A backend may also supply
+//!   the arctangent kernel in its own form for its target, bit for bit the same
+//!   ([`Math::atan2_fixed`]; the AVR's is in assembly).
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
 //! minimax fit), and so do the fixed-point kernels' cell tables (quadratics through Chebyshev
