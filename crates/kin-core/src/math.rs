@@ -1244,11 +1244,9 @@ mod tests {
             let m = (b & 0x7f_ffff) | if e == 0 { 0 } else { 1 << 23 };
             (m as u128, e.max(1) as i32)
         };
-        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = SplitMix64::new(0x0a7a_2f1d);
         for _ in 0..200_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
+            let state = rng.next_u64();
             let (a, b) = (
                 state as u32 & 0x7fff_ffff,
                 (state >> 32) as u32 & 0x7fff_ffff,
