@@ -17,8 +17,10 @@
 //!   [`poly::atan2_fixed`] and [`poly::sin_cos_fixed`] (tables of quadratic cells in fixed
 //!   point), which cost far fewer software-float operations, comparisons of the bit patterns instead of software-float comparisons, and
 //!   the four legs of a body solved one after the other. The kernels' tables are the one thing
-//!   a backend reads per target ([`Math::read_table_cell`]): on the AVR they stay in flash, out
-//!   of the scarce SRAM, and the backend reads them with `lpm`.
+//!   a backend must read per target ([`Math::read_table_cell`]): on the AVR they stay in flash,
+//!   out of the scarce SRAM, and the backend reads them with `lpm`. A backend may also supply
+//!   the arctangent kernel in its own form for its target, bit for bit the same
+//!   ([`Math::atan2_fixed`]; the AVR's is in assembly).
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
 //! minimax fit), and so do the fixed-point kernels' cell tables (quadratics through Chebyshev
@@ -90,6 +92,16 @@ pub trait Math {
     #[inline(always)]
     fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
         entry.read_data_memory::<Self>()
+    }
+    /// The fixed-point arctangent [`poly::atan2_fixed`] with this backend's table reads: the
+    /// arctangent of [`SoftFloat`] over this backend. A backend overrides it only with a
+    /// faster form of the same kernel for its target (the AVR's, in assembly, from the
+    /// table [`poly::atan_cells`]): an override must return the same bits as
+    /// `poly::atan2_fixed::<Self>` for every input (NaN arguments: a bounded value), which
+    /// its target's tests check.
+    #[inline]
+    fn atan2_fixed(y: f32, x: f32) -> f32 {
+        poly::atan2_fixed::<Self>(y, x)
     }
 }
 
@@ -233,8 +245,10 @@ impl Math for Fast {
 /// (the ATmega2560 firmware: `SoftFloat<AvrLibm>`, avr-libc's hand-written `sqrt`; the host
 /// tests: `SoftFloat<Libm>`, the default, which rounds the same):
 ///
-/// - [`poly::atan2_fixed`]: one float division, then in 16-bit fixed point on the
-///   integer multiplier, atan from a table of quadratic cells (error ≤ 2e-6 rad);
+/// - [`poly::atan2_fixed`] (through `S`'s [`Math::atan2_fixed`], which a backend may
+///   implement for its target, bit for bit the same): an exact integer quotient of the
+///   mantissas, then in 16-bit fixed point on the integer multiplier, atan from a table of
+///   quadratic cells (error ≤ 2e-6 rad);
 /// - [`poly::sin_cos_fixed`]: no range reduction within ±π/4, then a table of quadratic cells
 ///   in 16-bit fixed point (error ≤ 1e-6);
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
@@ -261,7 +275,7 @@ impl<S: Math> Math for SoftFloat<S> {
 
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
-        poly::atan2_fixed::<S>(y, x)
+        S::atan2_fixed(y, x)
     }
 
     #[inline]
@@ -288,6 +302,11 @@ impl<S: Math> Math for SoftFloat<S> {
     fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
         S::read_table_cell(entry)
     }
+
+    #[inline]
+    fn atan2_fixed(y: f32, x: f32) -> f32 {
+        S::atan2_fixed(y, x)
+    }
 }
 
 const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
@@ -300,7 +319,7 @@ const PI: f32 = core::f32::consts::PI;
 /// |---|---|---|
 /// | [`atan2_deg15`](poly::atan2_deg15) | 3e-7 rad | hosts: branch-free, Estrin |
 /// | [`atan2_deg9`](poly::atan2_deg9) | 1.2e-5 rad (0.0007°) | in-order CPUs with software floats: 6 multiplications, 4 additions, 1 division, no float comparison |
-/// | [`atan2_fixed`](poly::atan2_fixed) | 2e-6 rad (0.0001°) | CPUs with software floats and an integer multiplier (the ATmega2560): 1 float division, a table of 32 quadratic cells in 16-bit fixed point |
+/// | [`atan2_fixed`](poly::atan2_fixed) | 2e-6 rad (0.0001°) | CPUs with software floats and an integer multiplier (the ATmega2560): an integer division of the mantissas, a table of 32 quadratic cells in 16-bit fixed point |
 /// | [`sin_cos_deg9`](poly::sin_cos_deg9) | 2e-7 | hosts: branch-free |
 /// | [`sin_cos_deg5`](poly::sin_cos_deg5) | 7e-7 | software floats: 7 multiplications, 5 additions, no range reduction for \|x\| ≤ π/4 |
 /// | [`sin_cos_fixed`](poly::sin_cos_fixed) | 1e-6 | CPUs with software floats and an integer multiplier (the ATmega2560): no range reduction for \|x\| ≤ π/4, a table of 26 quadratic cells in 16-bit fixed point, two integer-to-float conversions |
@@ -639,55 +658,43 @@ pub mod poly {
         (a0 * b0) as u32 + (mid << 8) + (((a1 * b1) as u32) << 16)
     }
 
-    /// Four-quadrant arctangent for CPUs without hardware floating point: one float division
-    /// `t = min(|x|,|y|) / max(|x|,|y|)`, then atan(t) from a table of 32 quadratic cells
+    /// Four-quadrant arctangent for CPUs without hardware floating point: the exact integer
+    /// quotient `t = min(|x|,|y|) / max(|x|,|y|)` of the two floats' mantissas
+    /// ([`atan_ratio_q21`]), then atan(t) from a table of 32 quadratic cells
     /// (`ATAN_CELL_A_Q29`) in 16-bit fixed point (three 16 × 16-bit products), the octant
     /// added in fixed point, and one integer-to-float conversion: on the ATmega2560 far fewer
     /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
-    /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the rounding of `t` and of the result).
-    /// `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes. The backend `M` reads the
-    /// tables ([`Math::read_table_cell`]: in flash on the AVR), the
+    /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the truncation of `t` to 2⁻²¹ and the
+    /// rounding of the result). `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes. The
+    /// backend `M` reads the tables ([`Math::read_table_cell`]: in flash on the AVR), the
     /// kernel's only per-target part; [`SoftFloat`](super::SoftFloat) passes its own.
     ///
-    /// Formats: `t` in Q24 (`T`, from the float's mantissa, truncated), the cell offset `d` in Q21, the
-    /// result in Q29 (π < 2²).
+    /// Formats: `t` in Q21 (`T = ⌊t·2²¹⌋`, exact: no float rounding, so that a backend's own
+    /// implementation ([`Math::atan2_fixed`]) can match it bit for bit), the cell offset `d`
+    /// in Q21, the result in Q29 (π < 2²).
     ///
     /// Never inlined: on the AVR its `mul` instructions stay in this function's own small stack
     /// frame, clear of an LLVM AVR miscompilation in frames beyond 63 bytes (see the
     /// firmware's emulator test `no_mul_result_is_clobbered_by_a_frame_pointer_adjustment`);
     /// hosts do not use this kernel in their backends, so the call costs them nothing.
     #[inline(never)]
-    pub fn atan2_fixed<M: Math>(y: f32, x: f32) -> f32 {
+    pub fn atan2_fixed<M: Math + ?Sized>(y: f32, x: f32) -> f32 {
         const FRAC_PI_2_Q29: u32 = 843_314_857; // round(π/2 · 2²⁹)
         const PI_Q29: u32 = 1_686_629_713; // round(π · 2²⁹)
         let (yb, xb) = (y.to_bits(), x.to_bits());
         let (ay, ax) = (yb & ABS, xb & ABS);
         let swap = ay > ax;
         let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
-        // The octant in one byte (swap, x < 0, y < 0), the only state kept across the
-        // division's call: fewer registers to save.
+        // The octant in one byte (swap, x < 0, y < 0): fewer registers to keep.
         let octant = swap as u8 | ((xb >> 30) as u8 & 2) | ((yb >> 29) as u8 & 4);
         // p = atan(t) in Q29, t ∈ [0, 1].
         let p: u32 = if den == 0 {
             0
         } else {
-            let t = (f32::from_bits(num) / f32::from_bits(den)).to_bits();
-            // t = m·2^(e − 23) with the 24-bit mantissa m, so T = t·2²⁴ = m >> (−e − 1),
-            // truncated (2⁻²⁴ is far below the cells' error); 0 for t < 2⁻²⁴ (t = 0 and
-            // subnormals included). t ≥ 1 is t = 1 (or a NaN argument, for which any bounded
-            // value will do).
-            let m = (t & 0x007f_ffff) | 0x0080_0000;
-            let shift = 126i32 - (t >> 23) as i32; // −e − 1
-            let big_t: u32 = if t >= 0x3f80_0000 {
-                1 << 24
-            } else if shift < 25 {
-                m >> shift
-            } else {
-                0
-            };
+            let big_t = atan_ratio_q21(num, den);
             // Cell k = ⌊32·t⌋ (t = 1: cell 32) and the offset d = t − k/32 in Q21 (16 bits).
-            let k = (big_t >> 19) as usize;
-            let d = ((big_t & 0x7_ffff) >> 3) as u16;
+            let k = (big_t >> 16) as usize;
+            let d = big_t as u16;
             // b·d: Q36 → Q29; d² in Q26; c·d²: Q42 → Q29 (below b·d for d < 1/32).
             let [a_lo, a_hi, b, c] = M::read_table_cell(ATAN_CELLS.entry(k));
             let lin = (mul_16x16(d, b) + (1 << 6)) >> 7;
@@ -708,6 +715,40 @@ pub mod poly {
             (r as f32).to_bits() - (29 << 23)
         };
         f32::from_bits(r | ((octant as u32 & 4) << 29))
+    }
+
+    /// The first of [`atan2_fixed`]'s 33 cells `[a_lo, a_hi, b, c]` (cell `k` is `k` rows
+    /// further, contiguous), for a backend's own form of the kernel ([`Math::atan2_fixed`]);
+    /// read like any cell ([`Math::read_table_cell`]: in program memory on the AVR).
+    pub fn atan_cells() -> super::TableEntry<[u16; 4]> {
+        ATAN_CELLS.entry(0)
+    }
+
+    /// [`atan2_fixed`]'s quotient `T = ⌊t·2²¹⌋` of `t = num / den`, exact, from the bits
+    /// `num ≤ den` of two non-negative floats, `den ≠ 0` (so `T ≤ 2²¹`): the 24-bit mantissas
+    /// (subnormals without the implicit one, at exponent 1) divided,
+    /// `T = ⌊mₙ·2²¹ / m_d⌋ >> (e_d − eₙ)`. `den` infinite: `T = 2²¹` (t = 1) when `num` is
+    /// infinite too, else 0; a NaN gives some `T ≤ 2²¹`. Integer arithmetic only, so that a
+    /// backend's own form of the kernel ([`Math::atan2_fixed`]) can equal it bit for bit,
+    /// which a float division's rounding would make harder.
+    pub fn atan_ratio_q21(num: u32, den: u32) -> u32 {
+        const INF: u32 = 0x7f80_0000;
+        if den >= INF {
+            return if num >= INF { 1 << 21 } else { 0 };
+        }
+        let (en, ed) = (num >> 23, den >> 23);
+        let implicit = |e: u32| if e == 0 { 0 } else { 1 << 23 };
+        let mn = (num & 0x7f_ffff) | implicit(en);
+        let md = (den & 0x7f_ffff) | implicit(ed);
+        // mn < 2·md (md ≥ 2²³ or, den subnormal, mn ≤ md): q < 2²², so a shift of 22 or
+        // more leaves 0.
+        let q = ((mn as u64) << 21) / md as u64;
+        let shift = ed.max(1) - en.max(1);
+        if shift >= 22 {
+            0
+        } else {
+            (q >> shift) as u32
+        }
     }
 
     /// `(sin x, cos x)` with degree-9/8 polynomials after a Cody–Waite reduction to
@@ -1177,6 +1218,53 @@ mod tests {
                     "atan2_fixed({y:e}, {x:e}) = {r}"
                 );
             }
+        }
+    }
+
+    /// [`poly::atan_ratio_q21`]: exact at its edges (infinities, subnormals, equal
+    /// magnitudes, the smallest ratios) and against the exact rational quotient elsewhere.
+    #[test]
+    fn atan_ratio_q21_is_the_exact_floor() {
+        use poly::atan_ratio_q21 as ratio;
+        let inf = f32::INFINITY.to_bits();
+        assert_eq!(ratio(inf, inf), 1 << 21);
+        assert_eq!(ratio(f32::MAX.to_bits(), inf), 0);
+        assert_eq!(ratio(0, inf), 0);
+        assert_eq!(ratio(1, 1), 1 << 21);
+        assert_eq!(ratio(1, 2), 1 << 20);
+        assert_eq!(ratio(12, 0x0080_0000), 3);
+        assert_eq!(ratio(0x0040_0000, 0x0080_0000), 1 << 20);
+        assert_eq!(ratio(1.0f32.to_bits(), 2.0f32.to_bits()), 1 << 20);
+        assert_eq!(ratio(1.0f32.to_bits(), 2.0f32.powi(21).to_bits()), 1);
+        assert_eq!(ratio(0.99f32.to_bits(), 2.0f32.powi(21).to_bits()), 0);
+        assert_eq!(ratio(0, 1.0f32.to_bits()), 0);
+        // The value of a finite float's bits as mantissa · 2^(exponent − 150).
+        let parts = |b: u32| {
+            let e = b >> 23;
+            let m = (b & 0x7f_ffff) | if e == 0 { 0 } else { 1 << 23 };
+            (m as u128, e.max(1) as i32)
+        };
+        let mut rng = SplitMix64::new(0x0a7a_2f1d);
+        for _ in 0..200_000 {
+            let state = rng.next_u64();
+            let (a, b) = (
+                state as u32 & 0x7fff_ffff,
+                (state >> 32) as u32 & 0x7fff_ffff,
+            );
+            let b = b >> (state as u32 >> 27); // wide exponent differences
+            let (num, den) = (a.min(b), a.max(b));
+            if den == 0 || den >= inf {
+                continue;
+            }
+            let ((mn, en), (md, ed)) = (parts(num), parts(den));
+            let s = (ed - en) as u32;
+            // ⌊mn·2²¹ / (md·2^s)⌋ in 128-bit integers (s < 106 here, else 0).
+            let want = if s > 100 {
+                0
+            } else {
+                ((mn << 21) / (md << s)) as u32
+            };
+            assert_eq!(ratio(num, den), want, "{num:#x} / {den:#x}");
         }
     }
 

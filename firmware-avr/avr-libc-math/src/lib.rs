@@ -21,11 +21,11 @@
 
 #![no_std]
 #![cfg(target_arch = "avr")]
-// `asm!` on the AVR (the `lpm` of `read_table_cell`).
+// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent `atan2_fixed`).
 #![feature(asm_experimental_arch)]
 
 use core::arch::asm;
-use kin_core::math::{SoftFloat, TableEntry};
+use kin_core::math::{poly, SoftFloat, TableEntry};
 use kin_core::Math;
 
 /// Links avr-libc's `libm.a` (and `libc.a`, for its `memcpy`/`memset`) ahead of
@@ -82,6 +82,13 @@ impl Math for AvrLibm {
     // `poly::atan2_fixed`), where a cell is a run of `lpm Rd, Z+` straight into the registers
     // the kernel computes with; and it has had no release for the toolchains since 2023.
 
+    /// [`poly::atan2_fixed`] in assembly (the crate's `atan2_fixed`): the same bits, in fewer
+    /// cycles (see `BENCHMARKS.md`).
+    #[inline]
+    fn atan2_fixed(y: f32, x: f32) -> f32 {
+        atan2_fixed(y, x)
+    }
+
     #[inline(always)]
     fn read_table_cell<const N: usize>(entry: TableEntry<[u16; N]>) -> [u16; N] {
         const { assert!(N <= 8, "kin-core's cells are at most 8 words") };
@@ -96,6 +103,381 @@ impl Math for AvrLibm {
         });
         cell
     }
+}
+
+/// [`poly::atan2_fixed`] in AVR assembly, bit for bit (the emulator test `avr_atan2` checks
+/// [`AvrLibm::atan2_fixed`] against the portable kernel on the AVR):
+///
+/// - the octant and the magnitudes `num ≤ den` from the bits;
+/// - the quotient `T = ⌊t·2²¹⌋` ([`poly::atan_ratio_q21`]) by a restoring division of the
+///   24-bit mantissas that stops after the `22 − (e_d − eₙ)` quotient bits `T` keeps (the
+///   shift of the quotient comes free), one compare-and-subtract per bit in three-byte
+///   registers;
+/// - the cell `k = T >> 16` read with `lpm` ([`poly::atan_cells`]) and its three
+///   16 × 16-bit products with `mul`, each rounded as the portable kernel rounds it;
+/// - the octant's angle in Q29, its conversion to a float (normalised bytewise then bitwise,
+///   rounded to nearest even) and the sign of `y`.
+///
+/// Hand-written because LLVM's AVR backend has no such division (`u64` or `u32` division is
+/// a library call for a wide quotient with no early stop; the float division the kernel had
+/// rounds, which an integer form could not match cheaply), spends twice the instructions on
+/// the products' byte moves, and calls a library routine for the conversion.
+///
+/// Never inlined: one copy in flash for all callers.
+#[inline(never)]
+fn atan2_fixed(y: f32, x: f32) -> f32 {
+    let (yb, xb) = (y.to_bits(), x.to_bits());
+    // In 16-bit pairs: byte operands' results cost LLVM a dozen moves to join.
+    let (mut lo, mut hi) = (yb as u16, (yb >> 16) as u16);
+    // SAFETY: register arithmetic, and `lpm` reads of the cell `k ≤ 32` of kin-core's table in
+    // `.progmem.data` (below 64 KB, `lpm`'s reach, as for `lpm_word`). r1, the zero register,
+    // is read as zero before the first `mul` and cleared after the last.
+    unsafe {
+        asm!(
+            // The octant in o: bit 2 the sign of y, bit 1 the sign of x, bit 0 |y| > |x|
+            // (swapped); n3:n2:n1:n0 = num = min(|y|, |x|), e3:e2:e1:e0 = den = the other.
+            "clr {o}",
+            "bst r25, 7",
+            "bld {o}, 2",
+            "bst r21, 7",
+            "bld {o}, 1",
+            "lsl r25",
+            "lsr r25",
+            "lsl r21",
+            "lsr r21",
+            "cp r18, r22",
+            "cpc r19, r23",
+            "cpc r20, r24",
+            "cpc r21, r25",
+            "brsh 5f",
+            "inc {o}",
+            "eor r22, r18",
+            "eor r18, r22",
+            "eor r22, r18",
+            "eor r23, r19",
+            "eor r19, r23",
+            "eor r23, r19",
+            "eor r24, r20",
+            "eor r20, r24",
+            "eor r24, r20",
+            "eor r25, r21",
+            "eor r21, r25",
+            "eor r25, r21",
+            "5:",
+            // den = 0 (num = 0 too): p = 0.
+            "cp r18, r1",
+            "cpc r19, r1",
+            "cpc r20, r1",
+            "cpc r21, r1",
+            "brne 5f",
+            "rjmp 8f",
+            "5:",
+            // Exponents to n3, e3 (the sign bits are clear), mantissas with their implicit
+            // one (none for a subnormal, exponent 0) to n2:n1:n0, e2:e1:e0.
+            "lsl r20",
+            "rol r21",
+            "cp r1, r21",
+            "ror r20",
+            "lsl r24",
+            "rol r25",
+            "cp r1, r25",
+            "ror r24",
+            "clr {q0}",
+            "clr {q1}",
+            "clr {q2}",
+            "cpi r21, 255",
+            "breq 7f",
+            // Subnormals at exponent 1; s = ed − en, T = 0 (so p = 0) when s ≥ 22.
+            "cpi r21, 1",
+            "adc r21, r1",
+            "cpi r25, 1",
+            "adc r25, r1",
+            "sub r21, r25",
+            "cpi r21, 22",
+            "brlo 5f",
+            "rjmp 8f",
+            "5:",
+            "ldi {cnt}, 22",
+            "sub {cnt}, r21",
+            // The quotient's bits go in inverted (the carry of a compare that fails is 1), into
+            // ones that end as the leading zeros.
+            "com {q0}",
+            "com {q1}",
+            "com {q2}",
+            // Two bits a pass (⌈N/2⌉ passes for N bits), the first bit (mn ≥ md, mn < 2·md,
+            // no shift) at the compare of the pass's first half (N even) or second (N odd).
+            // Each bit: a remainder ≥ 2²⁴ > md after the shift is subtracted at once (the
+            // low 24 bits' borrow is then set, hence the `clc`).
+            "lsr {cnt}",
+            "brcc 2f",
+            "inc {cnt}",
+            "rjmp 12f",
+            "1:",
+            "lsl r22",
+            "rol r23",
+            "rol r24",
+            "brcs 3f",
+            "2:",
+            "cp r22, r18",
+            "cpc r23, r19",
+            "cpc r24, r20",
+            "brcs 4f",
+            "3:",
+            "sub r22, r18",
+            "sbc r23, r19",
+            "sbc r24, r20",
+            "clc",
+            "4:",
+            "rol {q0}",
+            "rol {q1}",
+            "rol {q2}",
+            "lsl r22",
+            "rol r23",
+            "rol r24",
+            "brcs 13f",
+            "12:",
+            "cp r22, r18",
+            "cpc r23, r19",
+            "cpc r24, r20",
+            "brcs 14f",
+            "13:",
+            "sub r22, r18",
+            "sbc r23, r19",
+            "sbc r24, r20",
+            "clc",
+            "14:",
+            "rol {q0}",
+            "rol {q1}",
+            "rol {q2}",
+            "dec {cnt}",
+            "brne 1b",
+            "com {q0}",
+            "com {q1}",
+            "com {q2}",
+            "rjmp 6f",
+            // den infinite (or NaN): T = 2²¹ when num is too, else 0.
+            "7:",
+            "cpi r25, 255",
+            "brne 6f",
+            "ldi {q2}, 0x20",
+            // The cell k = q2 ≤ 32: Z += 8·k (9 bits), a to p3:p2:p1:p0, b to e1:e0, c to
+            // e3:e2; d = q1:q0.
+            "6:",
+            "lsl {q2}",
+            "lsl {q2}",
+            "lsl {q2}",
+            "adc r31, r1",
+            "add r30, {q2}",
+            "adc r31, r1",
+            "lpm {p0}, Z+",
+            "lpm {p1}, Z+",
+            "lpm {p2}, Z+",
+            "lpm {p3}, Z+",
+            "lpm r18, Z+",
+            "lpm r19, Z+",
+            "lpm r20, Z+",
+            "lpm r21, Z+",
+            "clr {cnt}",
+            // d·b to n3:n2:n1:n0; p += (d·b + 2⁶) >> 7 (d·b < 2³¹).
+            "mul {q0}, r18",
+            "mov r22, r0",
+            "mov r23, r1",
+            "mul {q1}, r19",
+            "mov r24, r0",
+            "mov r25, r1",
+            "mul {q0}, r19",
+            "add r23, r0",
+            "adc r24, r1",
+            "adc r25, {cnt}",
+            "mul {q1}, r18",
+            "add r23, r0",
+            "adc r24, r1",
+            "adc r25, {cnt}",
+            "ldi {q2}, 0x40",
+            "add r22, {q2}",
+            "adc r23, {cnt}",
+            "adc r24, {cnt}",
+            "adc r25, {cnt}",
+            "lsl r22",
+            "rol r23",
+            "rol r24",
+            "rol r25",
+            "add {p0}, r23",
+            "adc {p1}, r24",
+            "adc {p2}, r25",
+            "adc {p3}, {cnt}",
+            // d² >> 16 to n3:n2.
+            "mul {q0}, {q0}",
+            "mov r23, r1",
+            "mul {q1}, {q1}",
+            "mov r24, r0",
+            "mov r25, r1",
+            "mul {q0}, {q1}",
+            "add r23, r0",
+            "adc r24, r1",
+            "adc r25, {cnt}",
+            "add r23, r0",
+            "adc r24, r1",
+            "adc r25, {cnt}",
+            // d²·c to e1:e0:q1:q0; p −= (d²·c + 2¹²) >> 13, from q2:e1:e0 after three
+            // left shifts of q2:e1:e0:q1 (d²·c < 2³¹).
+            "mul r24, r20",
+            "mov {q0}, r0",
+            "mov {q1}, r1",
+            "mul r25, r21",
+            "mov r18, r0",
+            "mov r19, r1",
+            "mul r24, r21",
+            "add {q1}, r0",
+            "adc r18, r1",
+            "adc r19, {cnt}",
+            "mul r25, r20",
+            "add {q1}, r0",
+            "adc r18, r1",
+            "adc r19, {cnt}",
+            "clr r1",
+            "ldi {q2}, 0x10",
+            "add {q1}, {q2}",
+            "adc r18, r1",
+            "adc r19, r1",
+            "clr {q2}",
+            "lsl {q1}",
+            "rol r18",
+            "rol r19",
+            "rol {q2}",
+            "lsl {q1}",
+            "rol r18",
+            "rol r19",
+            "rol {q2}",
+            "lsl {q1}",
+            "rol r18",
+            "rol r19",
+            "rol {q2}",
+            "sub {p0}, r18",
+            "sbc {p1}, r19",
+            "sbc {p2}, {q2}",
+            "sbc {p3}, r1",
+            "rjmp 20f",
+            // T = 0 or den = 0: p = 0 (cell 0's a and the rounded products of d = 0 are 0).
+            "8:",
+            "clr {p0}",
+            "clr {p1}",
+            "clr {p2}",
+            "clr {p3}",
+            // The octant's angle r to p3:p2:p1:p0: p (octant 0), π − p (2), π/2 − p (1),
+            // π/2 + p (3), the constants in Q29 (round(π·2²⁹) = 0x6487ed51).
+            "20:",
+            "sbrc {o}, 0",
+            "rjmp 22f",
+            "sbrs {o}, 1",
+            "rjmp 24f",
+            "ldi r25, 0x51",
+            "ldi r21, 0xed",
+            "ldi {q2}, 0x87",
+            "ldi {cnt}, 0x64",
+            "rjmp 23f",
+            "22:",
+            "ldi r25, 0xa9",
+            "ldi r21, 0xf6",
+            "ldi {q2}, 0x43",
+            "ldi {cnt}, 0x32",
+            "sbrs {o}, 1",
+            "rjmp 23f",
+            "add {p0}, r25",
+            "adc {p1}, r21",
+            "adc {p2}, {q2}",
+            "adc {p3}, {cnt}",
+            "rjmp 30f",
+            "23:",
+            "sub r25, {p0}",
+            "sbc r21, {p1}",
+            "sbc {q2}, {p2}",
+            "sbc {cnt}, {p3}",
+            "mov {p0}, r25",
+            "mov {p1}, r21",
+            "mov {p2}, {q2}",
+            "mov {p3}, {cnt}",
+            "rjmp 30f",
+            // Octant 0: r = p, 0 when p is (the float +0).
+            "24:",
+            "mov r22, {p0}",
+            "or r22, {p1}",
+            "or r22, {p2}",
+            "or r22, {p3}",
+            "brne 30f",
+            "clr {q2}",
+            "rjmp 9f",
+            // r > 0 (r < 2³¹) as a float times 2⁻²⁹: the biased exponent 129 less the shifts
+            // that bring r's leading one to bit 31, in q2.
+            "30:",
+            "ldi {q2}, 129",
+            "31:",
+            "tst {p3}",
+            "brne 32f",
+            "mov {p3}, {p2}",
+            "mov {p2}, {p1}",
+            "mov {p1}, {p0}",
+            "clr {p0}",
+            "subi {q2}, 8",
+            "rjmp 31b",
+            "32:",
+            "sbrc {p3}, 7",
+            "rjmp 33f",
+            "lsl {p0}",
+            "rol {p1}",
+            "rol {p2}",
+            "rol {p3}",
+            "dec {q2}",
+            "rjmp 32b",
+            // The mantissa p3:p2:p1, rounded by p0 to nearest even; a carry out of it makes
+            // the mantissa 2²³ of the next exponent.
+            "33:",
+            "lsl {p0}",
+            "brcc 34f",
+            "brne 35f",
+            "sbrs {p1}, 0",
+            "rjmp 34f",
+            "35:",
+            "sec",
+            "adc {p1}, r1",
+            "adc {p2}, r1",
+            "adc {p3}, r1",
+            "brcc 34f",
+            "ror {p3}",
+            "inc {q2}",
+            // Pack: exponent q2 over the mantissa without its leading one.
+            "34:",
+            "lsl {p3}",
+            "lsr {q2}",
+            "ror {p3}",
+            // The result to r25:r22 (where the calling convention returns it), with the
+            // sign of y.
+            "9:",
+            "mov r22, {p1}",
+            "mov r23, {p2}",
+            "mov r24, {p3}",
+            "mov r25, {q2}",
+            "bst {o}, 2",
+            "bld r25, 7",
+            // The arguments and the result where the calling convention has them.
+            inout("r23r22") lo,
+            inout("r25r24") hi,
+            inout("r19r18") xb as u16 => _,
+            inout("r21r20") (xb >> 16) as u16 => _,
+            q0 = out(reg) _,
+            q1 = out(reg) _,
+            q2 = out(reg_upper) _,
+            cnt = out(reg_upper) _,
+            p0 = out(reg) _,
+            p1 = out(reg) _,
+            p2 = out(reg) _,
+            p3 = out(reg) _,
+            o = out(reg) _,
+            inout("Z") poly::atan_cells().addr() => _,
+            options(pure, readonly, nostack),
+        );
+    }
+    f32::from_bits((hi as u32) << 16 | lo as u32)
 }
 
 /// Repeats `$body` with `$i` bound to each listed index in turn.

@@ -1,8 +1,9 @@
 //! Cycle benchmark on avr-libc's float routines (see `firmware_avr::bench`).
 //!
 //! Backends: 0 = `AvrLibm` (avr-libc math), 1 = kin-core `Fast` (polynomials), 2 = kin-core
-//! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`, kin-core `poly::atan2_fixed` and
-//! `poly::sin_cos_fixed`), all on avr-libc's float primitives (`__mulsf3`, …).
+//! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`, kin-core's `poly::atan2_fixed` in
+//! `AvrLibm`'s assembly form and `poly::sin_cos_fixed`), all on avr-libc's float primitives
+//! (`__mulsf3`, …).
 
 #![no_std]
 #![no_main]
@@ -42,9 +43,11 @@ static BACKENDS: [Backend; 4] = [
 /// Primitives: 0 add, 1 mul, 2 div, 3 sqrt, 4 atan2, 5 sin, 6 cos, 7 less-than,
 /// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrFast`:
 /// 10 the rotation matrix (roll = yaw = a, pitch = b), 11 the four feet in their hip frames
-/// (including the matrix); kin-core's kernels for `AvrFast`: 12 `poly::atan2_fixed`,
-/// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5`, 15 `poly::sin_cos_fixed` (sums of both).
-static PRIMS: [bench::PrimFn; 16] = [
+/// (including the matrix); kin-core's kernels for `AvrFast`: 12 `poly::atan2_fixed` (the
+/// portable form, which the firmware does not use),
+/// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5`, 15 `poly::sin_cos_fixed` (sums of both);
+/// 16 `AvrLibm::atan2_fixed` (the firmware's form of kernel 12, the same bits).
+static PRIMS: [bench::PrimFn; 17] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -81,6 +84,7 @@ static PRIMS: [bench::PrimFn; 16] = [
         let (s, c) = poly::sin_cos_fixed::<AvrFast>(a);
         s + c
     },
+    |a, b| AvrLibm::atan2_fixed(a, b),
 ];
 
 #[avr_device::entry]

@@ -1,0 +1,160 @@
+//! The firmware's arctangent kernel `AvrLibm::atan2_fixed` (its division in assembly) against
+//! the portable `poly::atan2_fixed` compiled for the AVR, bit for bit, in simavr: both are
+//! primitives of the benchmark firmware (`bench.elf`), run on the same seeded random pairs (all
+//! quadrants, wide exponent ranges, tiny and huge ratios, equal magnitudes, signed zeros,
+//! subnormals, infinities, NaNs). The portable kernel's bits are also those of the host's
+//! (`SoftFloat`): integer arithmetic and one correctly rounded conversion on both.
+//!
+//! The firmware is built once per test process (`quad_host::emu::build`); the test fails —
+//! never skips — when it cannot be built.
+
+use integration_tests::avr_bench::{BenchFirmware, PRIMITIVES};
+use kin_core::math::{poly, SoftFloat};
+use quad_host::emu::build;
+use seeded_rng::SplitMix64 as Rng;
+
+/// Random pairs compared.
+const PAIRS: usize = 20_000;
+
+/// The op id of a primitive of `bench.elf`, by name.
+fn op(name: &str) -> u8 {
+    PRIMITIVES
+        .iter()
+        .position(|&n| n == name)
+        .unwrap_or_else(|| panic!("bench.elf lacks {name}")) as u8
+}
+
+/// A float of the given biased exponent (0: zero or subnormal, 255: infinity or NaN), random
+/// mantissa (none at all one time in eight) and sign.
+fn float(rng: &mut Rng, exponent: u32) -> f32 {
+    let bits = rng.next_u64();
+    let mantissa = if bits & 7 == 0 {
+        0
+    } else {
+        (bits >> 8) as u32 & 0x7f_ffff
+    };
+    f32::from_bits(((bits >> 40) as u32 & 1) << 31 | exponent << 23 | mantissa)
+}
+
+/// One argument pair of a kind chosen at random.
+fn pair(rng: &mut Rng) -> (f32, f32) {
+    let pick = rng.next_u64();
+    let exp = |rng: &mut Rng, lo: u32, hi: u32| lo + (rng.next_u64() % (hi - lo + 1) as u64) as u32;
+    let near = |rng: &mut Rng, e: u32, spread: u32| {
+        let d = exp(rng, 0, 2 * spread) as i64 - spread as i64;
+        (e as i64 + d).clamp(0, 255) as u32
+    };
+    match pick % 8 {
+        // Any exponents, infinities and NaNs included.
+        0 => {
+            let (ea, eb) = (exp(rng, 0, 255), exp(rng, 0, 255));
+            (float(rng, ea), float(rng, eb))
+        }
+        // The kinematics' range: ratios near one.
+        1 | 2 => {
+            let e = exp(rng, 100, 140);
+            let eb = near(rng, e, 3);
+            (float(rng, e), float(rng, eb))
+        }
+        // Tiny ratios around the quotient's last bits (exponent differences 18 to 26).
+        3 => {
+            let e = exp(rng, 30, 220);
+            let d = exp(rng, 18, 26);
+            let (a, b) = (float(rng, e), float(rng, e - d));
+            if pick & 8 == 0 {
+                (a, b)
+            } else {
+                (b, a)
+            }
+        }
+        // Equal magnitudes, and one ulp apart.
+        4 => {
+            let e = exp(rng, 0, 254);
+            let a = float(rng, e);
+            let b = f32::from_bits(a.to_bits() ^ ((pick >> 8) as u32 & 0x8000_0001));
+            (a, b)
+        }
+        // Subnormals and the smallest normals.
+        5 => {
+            let (ea, eb) = (exp(rng, 0, 2), exp(rng, 0, 24));
+            (float(rng, ea), float(rng, eb))
+        }
+        // Signed zeros and infinities against anything.
+        6 => {
+            let special =
+                [0.0f32, -0.0, f32::INFINITY, f32::NEG_INFINITY][(pick >> 8) as usize % 4];
+            let e = exp(rng, 0, 255);
+            let other = float(rng, e);
+            if pick & 1 << 12 == 0 {
+                (special, other)
+            } else {
+                (other, special)
+            }
+        }
+        // Huge ratios near the top of the range.
+        _ => {
+            let (ea, eb) = (exp(rng, 200, 254), exp(rng, 0, 254));
+            (float(rng, ea), float(rng, eb))
+        }
+    }
+}
+
+#[test]
+fn asm_atan2_fixed_is_the_portable_kernel_bit_for_bit() {
+    let elf = build::firmware_elf(build::BENCH).unwrap_or_else(|e| panic!("{e}"));
+    let mut fw = BenchFirmware::boot(&elf);
+    let (portable, asm) = (op("poly::atan2_fixed"), op("AvrLibm::atan2_fixed"));
+    let mut rng = Rng::new(0x00a7_a2f1);
+    let mut fixed_cases = vec![
+        (0.0f32, 0.0f32),
+        (-0.0, 0.0),
+        (0.0, -0.0),
+        (-0.0, -0.0),
+        (1.0, 1.0),
+        (-1.0, 1.0),
+        (f32::INFINITY, f32::INFINITY),
+        (f32::NEG_INFINITY, f32::INFINITY),
+        (f32::MAX, f32::INFINITY),
+        (f32::INFINITY, -f32::MAX),
+        (f32::NAN, 1.0),
+        (1.0, f32::NAN),
+        (f32::from_bits(1), f32::from_bits(1)),
+        (f32::from_bits(1), f32::from_bits(2)),
+        (f32::from_bits(1), f32::MAX),
+        (f32::MIN_POSITIVE, f32::from_bits(0x007f_ffff)),
+        (0.3, 0.2),
+        (0.4, -0.2),
+    ];
+    fixed_cases.extend((0..PAIRS).map(|_| pair(&mut rng)));
+    let (mut cycles_portable, mut cycles_asm) = (0u64, 0u64);
+    for &(y, x) in &fixed_cases {
+        let (cp, rp) = fw.primitive(portable, y, x);
+        let (ca, ra) = fw.primitive(asm, y, x);
+        cycles_portable += cp;
+        cycles_asm += ca;
+        assert_eq!(
+            ra.to_bits(),
+            rp.to_bits(),
+            "atan2_fixed({y:e} [{:#010x}], {x:e} [{:#010x}]): asm {ra:e}, portable {rp:e}",
+            y.to_bits(),
+            x.to_bits()
+        );
+        let host = poly::atan2_fixed::<SoftFloat>(y, x);
+        assert_eq!(
+            rp.to_bits(),
+            host.to_bits(),
+            "atan2_fixed({y:e}, {x:e}): AVR {rp:e}, host {host:e}"
+        );
+        assert!(
+            rp.abs() <= core::f32::consts::PI,
+            "atan2_fixed({y:e}, {x:e}) = {rp:e}"
+        );
+    }
+    let n = fixed_cases.len() as f64;
+    eprintln!(
+        "atan2_fixed on the AVR, {} pairs: portable {:.0} cycles, asm {:.0} cycles (mean)",
+        fixed_cases.len(),
+        cycles_portable as f64 / n,
+        cycles_asm as f64 / n
+    );
+}
