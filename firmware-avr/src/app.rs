@@ -19,9 +19,10 @@
 //! - Robot and defaults: [`DEVICE_CONFIG`], [`quad_device::Config::shahriar2023`] (seed 000's
 //!   robot, the one with the Arduino Mega): body poses in rotation order zyx at its default
 //!   stance height, unreachable targets rejected, no link-loss timeout until the host sets one.
-//! - Math: [`avr_libc_math::AvrFast`] (avr-libc's `sqrt`, kin-core's fixed-point arctangent
-//!   `poly::atan2_fixed` and sine/cosine `poly::sin_cos_fixed`, their tables read from flash), the fastest backend measured (`cargo xtask
-//!   avr-bench`).
+//! - Math: [`avr_libc_math::AvrFast`] (avr-libc's `sqrt`; kin-core's fixed-point arctangent
+//!   `poly::atan2_fixed` in the assembly form of `AvrLibm::atan2_fixed`, bit for bit the same;
+//!   kin-core's sine/cosine `poly::sin_cos_fixed`; the tables read from flash), the fastest
+//!   backend measured (`cargo xtask avr-bench`).
 //! - Outputs stay low until the host sends `SetOutputs { enabled: true }`.
 //! - Watchdog: [`WATCHDOG_TIMEOUT`], fed by the main loop and during EEPROM writes. A hung main
 //!   loop resets the MCU; the reset leaves every pin an input (no pulses) and the device comes
