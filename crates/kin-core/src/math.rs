@@ -19,8 +19,9 @@
 //!   the four legs of a body solved one after the other. The kernels' tables are the one thing
 //!   a backend must read per target ([`Math::read_table_cell`]): on the AVR they stay in flash,
 //!   out of the scarce SRAM, and the backend reads them with `lpm`. A backend may also supply
-//!   the arctangent kernel in its own form for its target, bit for bit the same
-//!   ([`Math::atan2_fixed`]; the AVR's is in assembly).
+//!   the arctangent kernel and the sine/cosine kernel's fixed-point core in its own form for
+//!   its target, bit for bit the same ([`Math::atan2_fixed`], [`Math::sin_cos_fixed`]; the
+//!   AVR's are in assembly).
 //!
 //! The polynomial coefficients come from `scripts/fit_polynomials.py` (a weighted least-squares
 //! minimax fit), and so do the fixed-point kernels' cell tables (quadratics through Chebyshev
@@ -102,6 +103,17 @@ pub trait Math {
     #[inline]
     fn atan2_fixed(y: f32, x: f32) -> f32 {
         poly::atan2_fixed::<Self>(y, x)
+    }
+    /// The fixed-point sine and cosine [`poly::sin_cos_fixed`] with this backend's table
+    /// reads: the `sin_cos` of [`SoftFloat`] over this backend. A backend overrides it only
+    /// with a faster form of the same kernel for its target (the AVR's: the range reduction
+    /// and quadrant of [`poly::sin_cos_fixed_with`] around an assembly form of
+    /// [`poly::sin_cos_fixed_core`]): an override must return the same bits as
+    /// `poly::sin_cos_fixed::<Self>` for every input (NaN and infinite arguments: bounded
+    /// values), which its target's tests check.
+    #[inline]
+    fn sin_cos_fixed(x: f32) -> (f32, f32) {
+        poly::sin_cos_fixed::<Self>(x)
     }
 }
 
@@ -249,8 +261,9 @@ impl Math for Fast {
 ///   implement for its target, bit for bit the same): an exact integer quotient of the
 ///   mantissas, then in 16-bit fixed point on the integer multiplier, atan from a table of
 ///   quadratic cells (error ≤ 2e-6 rad);
-/// - [`poly::sin_cos_fixed`]: no range reduction within ±π/4, then a table of quadratic cells
-///   in 16-bit fixed point (error ≤ 1e-6);
+/// - [`poly::sin_cos_fixed`] (through `S`'s [`Math::sin_cos_fixed`], likewise): no range
+///   reduction within ±π/4, then a table of quadratic cells in 16-bit fixed point
+///   (error ≤ 1e-6);
 /// - comparisons of the bit patterns (a software-float comparison is a library call, these
 ///   are a few integer instructions), equal to the float operators on every input;
 /// - the four legs of a body solved one after the other ([`Math::STAGE_LEGS`] false);
@@ -280,7 +293,7 @@ impl<S: Math> Math for SoftFloat<S> {
 
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
-        poly::sin_cos_fixed::<S>(x)
+        S::sin_cos_fixed(x)
     }
 
     #[inline(always)]
@@ -306,6 +319,11 @@ impl<S: Math> Math for SoftFloat<S> {
     #[inline]
     fn atan2_fixed(y: f32, x: f32) -> f32 {
         S::atan2_fixed(y, x)
+    }
+
+    #[inline]
+    fn sin_cos_fixed(x: f32) -> (f32, f32) {
+        S::sin_cos_fixed(x)
     }
 }
 
@@ -649,7 +667,7 @@ pub mod poly {
 
     /// `a·b` of two 16-bit numbers from its four 8 × 8-bit partial products: on the
     /// ATmega2560 four hardware multiplications inline, where `a as u32 * b as u32` would call
-    /// a 32 × 32-bit routine. Only [`atan2_fixed`] uses it, the kernel of CPUs without
+    /// a 32 × 32-bit routine. Only the fixed-point kernels use it, those of CPUs without
     /// floating-point hardware, so every target compiles this one form.
     #[inline(always)]
     pub(super) fn mul_16x16(a: u16, b: u16) -> u32 {
@@ -798,16 +816,43 @@ pub mod poly {
     /// the tables, as for [`atan2_fixed`].
     ///
     /// Never inlined, for [`atan2_fixed`]'s reason (its `mul` instructions in a small frame).
+    /// In two parts, so that a backend can supply the fixed-point part in its own form
+    /// ([`Math::sin_cos_fixed`]): the range reduction and quadrant ([`sin_cos_fixed_with`])
+    /// around the cells ([`sin_cos_fixed_core`]).
     #[inline(never)]
-    pub fn sin_cos_fixed<M: Math>(x: f32) -> (f32, f32) {
-        const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
+    pub fn sin_cos_fixed<M: Math + ?Sized>(x: f32) -> (f32, f32) {
+        sin_cos_fixed_with(x, sin_cos_fixed_core::<M>)
+    }
 
+    /// [`sin_cos_fixed`] with the fixed-point part `core`, which maps the bits of the reduced
+    /// argument `r` (`|r| ≤ π/4` and the rounding of the reduction; any bits for NaN and
+    /// infinite `x`) to those of `(sin r, cos r)`: [`sin_cos_fixed_core`], or a backend's own
+    /// form of it, bit for bit the same ([`Math::sin_cos_fixed`]).
+    #[inline(always)]
+    pub fn sin_cos_fixed_with(x: f32, core: impl FnOnce(u32) -> (u32, u32)) -> (f32, f32) {
+        const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
+        let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
+        let (k, r) = if reduced { reduce(x) } else { (0, x) };
+        let (sin, cos) = core(r.to_bits());
+        let (sin, cos) = (f32::from_bits(sin), f32::from_bits(cos));
+        if reduced {
+            quadrant(k, sin, cos)
+        } else {
+            (sin, cos)
+        }
+    }
+
+    /// The bits of `(sin r, cos r)` from those of `r` (`rb`), [`sin_cos_fixed`]'s fixed-point
+    /// part: `|r|` in Q24 from the float's mantissa, truncated, clamped to the end of the
+    /// cells; cell `k = ⌊32·|r|⌋` ([`sin_cos_cells`]) and offset `d` in Q21; five 16 × 16-bit
+    /// products, each rounded as below; two integer-to-float conversions, correctly rounded,
+    /// and the sign of `r` on the sine. Integer arithmetic only, so that a backend's own form
+    /// ([`Math::sin_cos_fixed`]) can equal it bit for bit.
+    #[inline(always)]
+    pub fn sin_cos_fixed_core<M: Math + ?Sized>(rb: u32) -> (u32, u32) {
         // The end of the cells, 26/32 in Q24 (less one): beyond it only the results of a
         // range reduction of huge arguments, for which any bounded value will do.
         const CELLS_END_Q24: u32 = (26 << 19) - 1;
-        let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
-        let (k, r) = if reduced { reduce(x) } else { (0, x) };
-        let rb = r.to_bits();
         // |r| = m·2^(e − 150) with the 24-bit mantissa m: R = |r|·2²⁴ = m >> (126 − e),
         // truncated (2⁻²⁴ is far below the cells' error); 0 for |r| < 2⁻²⁴ and subnormals.
         let e = (rb >> 23) & 0xff;
@@ -831,13 +876,15 @@ pub mod poly {
         let cos_q = join(ca_lo, ca_hi)
             - ((mul_16x16(d, cb) + (1 << 7)) >> 8)
             - ((mul_16x16(d_sq, cc) + (1 << 12)) >> 13);
-        let sin = f32::from_bits(q29_bits(sin_q) | (rb & SIGN));
-        let cos = f32::from_bits(q29_bits(cos_q));
-        if reduced {
-            quadrant(k, sin, cos)
-        } else {
-            (sin, cos)
-        }
+        (q29_bits(sin_q) | (rb & SIGN), q29_bits(cos_q))
+    }
+
+    /// The first of [`sin_cos_fixed`]'s 26 cells `[sa_lo, sa_hi, sb, sc, ca_lo, ca_hi, cb, cc]`
+    /// (the sine's `[a_lo, a_hi, b, c]`, then the cosine's; cell `k` is `k` rows further,
+    /// contiguous), for a backend's own form of [`sin_cos_fixed_core`]; read like any cell
+    /// ([`Math::read_table_cell`]: in program memory on the AVR).
+    pub fn sin_cos_cells() -> super::TableEntry<[u16; 8]> {
+        SIN_COS_CELLS.entry(0)
     }
 
     /// The bits of the float `v·2⁻²⁹` (`v < 2³¹`, positive): one integer-to-float conversion,
