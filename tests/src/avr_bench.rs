@@ -60,7 +60,7 @@ pub enum Backend {
     /// kin-core's `Libm` backend (Rust libm); soft-float primitives from whichever ELF.
     Libm = 2,
     /// The firmware's backend (`avr_libc_math::AvrFast`): avr-libc's `sqrt`, kin-core's
-    /// `poly::atan2_fixed` (in `AvrLibm`'s assembly form) and `poly::sin_cos_fixed`.
+    /// `poly::atan2_fixed` and `poly::sin_cos_fixed` (both in `AvrLibm`'s assembly forms).
     AvrFast = 3,
 }
 
@@ -533,7 +533,7 @@ pub fn measure_motions(fw: &mut BenchFirmware) -> Vec<MotionFigures> {
 }
 
 /// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
-pub const PRIMITIVES: [&str; 17] = [
+pub const PRIMITIVES: [&str; 20] = [
     "add",
     "mul",
     "div",
@@ -551,6 +551,9 @@ pub const PRIMITIVES: [&str; 17] = [
     "poly::sin_cos_deg5",
     "poly::sin_cos_fixed",
     "AvrLibm::atan2_fixed",
+    "AvrLibm::sin_cos_fixed",
+    "poly::sin_cos_fixed sin|cos",
+    "AvrLibm::sin_cos_fixed sin|cos",
 ];
 
 /// Mean cycles of primitive `op` over a few arguments.

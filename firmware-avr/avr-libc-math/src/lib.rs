@@ -21,7 +21,8 @@
 
 #![no_std]
 #![cfg(target_arch = "avr")]
-// `asm!` on the AVR (the `lpm` of `read_table_cell`, the arctangent `atan2_fixed`).
+// `asm!` on the AVR (the `lpm` of `read_table_cell`, the kernels `atan2_fixed` and
+// `sin_cos_fixed`).
 #![feature(asm_experimental_arch)]
 
 use core::arch::asm;
@@ -87,6 +88,13 @@ impl Math for AvrLibm {
     #[inline]
     fn atan2_fixed(y: f32, x: f32) -> f32 {
         atan2_fixed(y, x)
+    }
+
+    /// [`poly::sin_cos_fixed`] with its fixed-point part in assembly (the crate's
+    /// `sin_cos_fixed`): the same bits, in fewer cycles (see `BENCHMARKS.md`).
+    #[inline]
+    fn sin_cos_fixed(x: f32) -> (f32, f32) {
+        sin_cos_fixed(x)
     }
 
     #[inline(always)]
@@ -478,6 +486,356 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
         );
     }
     f32::from_bits((hi as u32) << 16 | lo as u32)
+}
+
+/// [`poly::sin_cos_fixed`] with its fixed-point part [`poly::sin_cos_fixed_core`] in AVR
+/// assembly, bit for bit (the emulator test `avr_sin_cos` checks [`AvrLibm::sin_cos_fixed`]
+/// against the portable kernel on the AVR); the range reduction beyond ±π/4 (software
+/// floats) and the quadrant stay the portable kernel's ([`poly::sin_cos_fixed_with`]).
+///
+/// Never inlined: one copy in flash for all callers.
+#[inline(never)]
+fn sin_cos_fixed(x: f32) -> (f32, f32) {
+    poly::sin_cos_fixed_with(x, sin_cos_fixed_core)
+}
+
+/// [`poly::sin_cos_fixed_core`] in AVR assembly: the bits of `(sin r, cos r)` from those of
+/// `r`:
+///
+/// - `|r|·2²⁴` from the mantissa, shifted bytewise then bitwise, clamped to the cells' end;
+/// - the cell `k` read with `lpm` ([`poly::sin_cos_cells`]), its five 16 × 16-bit products
+///   with `mul`, each rounded as the portable kernel rounds it;
+/// - the sine and the cosine in Q29 to floats (normalised bytewise then bitwise, rounded to
+///   nearest even), one loop for both, and the sign of `r` on the sine.
+///
+/// Hand-written because LLVM's AVR backend turns the mantissa's variable shift into a loop of
+/// 32-bit shifts, spends twice the instructions on the products' byte moves, and calls a
+/// library routine for each conversion.
+#[inline(always)]
+fn sin_cos_fixed_core(rb: u32) -> (u32, u32) {
+    // In 16-bit pairs: byte operands' results cost LLVM a dozen moves to join.
+    let (mut lo, mut hi) = (rb as u16, (rb >> 16) as u16);
+    let (cos_lo, cos_hi): (u16, u16);
+    // SAFETY: register arithmetic, and `lpm` reads of the cell `k ≤ 25` of kin-core's table in
+    // `.progmem.data` (below 64 KB, `lpm`'s reach, as for `lpm_word`). r1, the zero register,
+    // is cleared after the last `mul`.
+    unsafe {
+        asm!(
+            // The sign of r in T; the biased exponent e to r25, the mantissa with its implicit
+            // one to r24:r23:r22 (a subnormal's is then wrong, but shifted out: e = 0).
+            "bst r25, 7",
+            "lsl r24",
+            "rol r25",
+            "sec",
+            "ror r24",
+            // R = m >> (126 − e): the cells' end for e > 126, 0 for a shift beyond 23.
+            "cpi r25, 127",
+            "brsh 2f",
+            "ldi {e}, 126",
+            "sub {e}, r25",
+            "cpi {e}, 24",
+            "brsh 3f",
+            "sbrs {e}, 4",
+            "rjmp 4f",
+            "mov r22, r24",
+            "clr r23",
+            "clr r24",
+            "4:",
+            "sbrs {e}, 3",
+            "rjmp 5f",
+            "mov r22, r23",
+            "mov r23, r24",
+            "clr r24",
+            "5:",
+            "andi {e}, 7",
+            "breq 6f",
+            "7:",
+            "lsr r24",
+            "ror r23",
+            "ror r22",
+            "dec {e}",
+            "brne 7b",
+            // min(R, 26·2¹⁹ − 1).
+            "6:",
+            "cpi r24, 0xd0",
+            "brlo 8f",
+            "2:",
+            "ldi r24, 0xcf",
+            "ldi r23, 0xff",
+            "ldi r22, 0xff",
+            "rjmp 8f",
+            "3:",
+            "clr r22",
+            "clr r23",
+            "clr r24",
+            // R >> 3: the cell k = R >> 19 in r24, d (Q21) in dh:dl; Z += 16·k.
+            "8:",
+            "lsr r24",
+            "ror r23",
+            "ror r22",
+            "lsr r24",
+            "ror r23",
+            "ror r22",
+            "lsr r24",
+            "ror r23",
+            "ror r22",
+            "mov {dl}, r22",
+            "mov {dh}, r23",
+            "ldi {e}, 16",
+            "mul r24, {e}",
+            "add r30, r0",
+            "adc r31, r1",
+            "clr {zero}",
+            // d² >> 16 (Q26) to qh:ql.
+            "mul {dl}, {dl}",
+            "mov {t1}, r1",
+            "mul {dh}, {dh}",
+            "mov {ql}, r0",
+            "mov {qh}, r1",
+            "mul {dl}, {dh}",
+            "add {t1}, r0",
+            "adc {ql}, r1",
+            "adc {qh}, {zero}",
+            "add {t1}, r0",
+            "adc {ql}, r1",
+            "adc {qh}, {zero}",
+            // Sine: a to r25:r22; += (d·b + 2⁶) >> 7 (d·b may reach 2³¹: five bytes).
+            "lpm r22, Z+",
+            "lpm r23, Z+",
+            "lpm r24, Z+",
+            "lpm r25, Z+",
+            "lpm {bl}, Z+",
+            "lpm {bh}, Z+",
+            "mul {dl}, {bl}",
+            "mov {t0}, r0",
+            "mov {t1}, r1",
+            "mul {dh}, {bh}",
+            "mov {t2}, r0",
+            "mov {t3}, r1",
+            "mul {dl}, {bh}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "mul {dh}, {bl}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "ldi {e}, 0x40",
+            "add {t0}, {e}",
+            "adc {t1}, {zero}",
+            "adc {t2}, {zero}",
+            "adc {t3}, {zero}",
+            "clr {bl}",
+            "lsl {t0}",
+            "rol {t1}",
+            "rol {t2}",
+            "rol {t3}",
+            "rol {bl}",
+            "add r22, {t1}",
+            "adc r23, {t2}",
+            "adc r24, {t3}",
+            "adc r25, {bl}",
+            // −= (d²·c + 2¹²) >> 13: bytes 1 to 3 of d²·c (< 2³¹) and the 2¹², three left
+            // shifts, bytes 2 to 4.
+            "lpm {bl}, Z+",
+            "lpm {bh}, Z+",
+            "mul {ql}, {bl}",
+            "mov {t1}, r1",
+            "mul {qh}, {bh}",
+            "mov {t2}, r0",
+            "mov {t3}, r1",
+            "mul {ql}, {bh}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "mul {qh}, {bl}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "ldi {e}, 0x10",
+            "add {t1}, {e}",
+            "adc {t2}, {zero}",
+            "adc {t3}, {zero}",
+            "clr {bl}",
+            "lsl {t1}",
+            "rol {t2}",
+            "rol {t3}",
+            "rol {bl}",
+            "lsl {t1}",
+            "rol {t2}",
+            "rol {t3}",
+            "rol {bl}",
+            "lsl {t1}",
+            "rol {t2}",
+            "rol {t3}",
+            "rol {bl}",
+            "sub r22, {t2}",
+            "sbc r23, {t3}",
+            "sbc r24, {bl}",
+            "sbc r25, {zero}",
+            // Cosine: a to r21:r18; −= (d·b + 2⁷) >> 8 (d·b + 2⁷ < 2³²).
+            "lpm r18, Z+",
+            "lpm r19, Z+",
+            "lpm r20, Z+",
+            "lpm r21, Z+",
+            "lpm {bl}, Z+",
+            "lpm {bh}, Z+",
+            "mul {dl}, {bl}",
+            "mov {t0}, r0",
+            "mov {t1}, r1",
+            "mul {dh}, {bh}",
+            "mov {t2}, r0",
+            "mov {t3}, r1",
+            "mul {dl}, {bh}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "mul {dh}, {bl}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "ldi {e}, 0x80",
+            "add {t0}, {e}",
+            "adc {t1}, {zero}",
+            "adc {t2}, {zero}",
+            "adc {t3}, {zero}",
+            "sub r18, {t1}",
+            "sbc r19, {t2}",
+            "sbc r20, {t3}",
+            "sbc r21, {zero}",
+            // −= (d²·c + 2¹²) >> 13, as for the sine.
+            "lpm {bl}, Z+",
+            "lpm {bh}, Z+",
+            "mul {ql}, {bl}",
+            "mov {t1}, r1",
+            "mul {qh}, {bh}",
+            "mov {t2}, r0",
+            "mov {t3}, r1",
+            "mul {ql}, {bh}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "mul {qh}, {bl}",
+            "add {t1}, r0",
+            "adc {t2}, r1",
+            "adc {t3}, {zero}",
+            "ldi {e}, 0x10",
+            "add {t1}, {e}",
+            "adc {t2}, {zero}",
+            "adc {t3}, {zero}",
+            "clr {bl}",
+            "lsl {t1}",
+            "rol {t2}",
+            "rol {t3}",
+            "rol {bl}",
+            "lsl {t1}",
+            "rol {t2}",
+            "rol {t3}",
+            "rol {bl}",
+            "lsl {t1}",
+            "rol {t2}",
+            "rol {t3}",
+            "rol {bl}",
+            "sub r18, {t2}",
+            "sbc r19, {t3}",
+            "sbc r20, {bl}",
+            "sbc r21, {zero}",
+            "clr r1",
+            // Twice: the value v in r25:r22 (v < 2³¹) to the bits of v·2⁻²⁹ (0 stays +0),
+            // then swapped with r21:r18 (the sine first, then the cosine: each ends where
+            // it started).
+            "ldi {e}, 2",
+            "mov {dh}, {e}",
+            "10:",
+            "mov {t0}, r22",
+            "or {t0}, r23",
+            "or {t0}, r24",
+            "or {t0}, r25",
+            "brne 11f",
+            "clr {e}",
+            "rjmp 19f",
+            // The biased exponent 129 less the shifts that bring v's leading one to bit 31.
+            "11:",
+            "ldi {e}, 129",
+            "12:",
+            "tst r25",
+            "brne 13f",
+            "mov r25, r24",
+            "mov r24, r23",
+            "mov r23, r22",
+            "clr r22",
+            "subi {e}, 8",
+            "rjmp 12b",
+            "13:",
+            "sbrc r25, 7",
+            "rjmp 14f",
+            "lsl r22",
+            "rol r23",
+            "rol r24",
+            "rol r25",
+            "dec {e}",
+            "rjmp 13b",
+            // The mantissa r25:r23, rounded by r22 to nearest even; a carry out of it makes
+            // the mantissa 2²³ of the next exponent.
+            "14:",
+            "lsl r22",
+            "brcc 16f",
+            "brne 15f",
+            "sbrs r23, 0",
+            "rjmp 16f",
+            "15:",
+            "sec",
+            "adc r23, r1",
+            "adc r24, r1",
+            "adc r25, r1",
+            "brcc 16f",
+            "ror r25",
+            "inc {e}",
+            // Pack: exponent e over the mantissa without its leading one.
+            "16:",
+            "lsl r25",
+            "lsr {e}",
+            "ror r25",
+            "19:",
+            "mov r22, r23",
+            "mov r23, r24",
+            "mov r24, r25",
+            "mov r25, {e}",
+            "movw r26, r22",
+            "movw r22, r18",
+            "movw r18, r26",
+            "movw r26, r24",
+            "movw r24, r20",
+            "movw r20, r26",
+            "dec {dh}",
+            "brne 10b",
+            // The sign of r on the sine.
+            "bld r25, 7",
+            inout("r23r22") lo,
+            inout("r25r24") hi,
+            out("r19r18") cos_lo,
+            out("r21r20") cos_hi,
+            out("r27r26") _,
+            dl = out(reg) _,
+            dh = out(reg) _,
+            ql = out(reg) _,
+            qh = out(reg) _,
+            t0 = out(reg) _,
+            t1 = out(reg) _,
+            t2 = out(reg) _,
+            t3 = out(reg) _,
+            bl = out(reg) _,
+            bh = out(reg) _,
+            zero = out(reg) _,
+            e = out(reg_upper) _,
+            inout("Z") poly::sin_cos_cells().addr() => _,
+            options(pure, readonly, nostack),
+        );
+    }
+    (
+        (hi as u32) << 16 | lo as u32,
+        (cos_hi as u32) << 16 | cos_lo as u32,
+    )
 }
 
 /// Repeats `$body` with `$i` bound to each listed index in turn.

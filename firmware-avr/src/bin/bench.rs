@@ -2,7 +2,8 @@
 //!
 //! Backends: 0 = `AvrLibm` (avr-libc math), 1 = kin-core `Fast` (polynomials), 2 = kin-core
 //! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`, kin-core's `poly::atan2_fixed` in
-//! `AvrLibm`'s assembly form and `poly::sin_cos_fixed`), all on avr-libc's float primitives
+//! `AvrLibm`'s assembly form and `poly::sin_cos_fixed` with its fixed-point part in
+//! `AvrLibm`'s assembly), all on avr-libc's float primitives
 //! (`__mulsf3`, …).
 
 #![no_std]
@@ -46,8 +47,11 @@ static BACKENDS: [Backend; 4] = [
 /// (including the matrix); kin-core's kernels for `AvrFast`: 12 `poly::atan2_fixed` (the
 /// portable form, which the firmware does not use),
 /// 13 `poly::atan2_deg9`, 14 `poly::sin_cos_deg5`, 15 `poly::sin_cos_fixed` (sums of both);
-/// 16 `AvrLibm::atan2_fixed` (the firmware's form of kernel 12, the same bits).
-static PRIMS: [bench::PrimFn; 17] = [
+/// 16 `AvrLibm::atan2_fixed` (the firmware's form of kernel 12, the same bits);
+/// 17 `AvrLibm::sin_cos_fixed` (the firmware's form of kernel 15, the same bits; the sum of
+/// both); 18 `poly::sin_cos_fixed` and 19 `AvrLibm::sin_cos_fixed` one result at a time (the
+/// sine for `b = +0`, else the cosine), for the bit-for-bit comparison.
+static PRIMS: [bench::PrimFn; 20] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -85,6 +89,26 @@ static PRIMS: [bench::PrimFn; 17] = [
         s + c
     },
     |a, b| AvrLibm::atan2_fixed(a, b),
+    |a, _| {
+        let (s, c) = AvrLibm::sin_cos_fixed(a);
+        s + c
+    },
+    |a, b| {
+        let (s, c) = poly::sin_cos_fixed::<AvrFast>(a);
+        if b.to_bits() == 0 {
+            s
+        } else {
+            c
+        }
+    },
+    |a, b| {
+        let (s, c) = AvrLibm::sin_cos_fixed(a);
+        if b.to_bits() == 0 {
+            s
+        } else {
+            c
+        }
+    },
 ];
 
 #[avr_device::entry]
