@@ -828,18 +828,26 @@ pub mod poly {
     /// argument `r` (`|r| ≤ π/4` and the rounding of the reduction; any bits for NaN and
     /// infinite `x`) to those of `(sin r, cos r)`: [`sin_cos_fixed_core`], or a backend's own
     /// form of it, bit for bit the same ([`Math::sin_cos_fixed`]).
+    ///
+    /// The range reduction is out of line ([`sin_cos_fixed_reduced`]): the common case, within
+    /// ±π/4, then keeps none of its registers.
     #[inline(always)]
-    pub fn sin_cos_fixed_with(x: f32, core: impl FnOnce(u32) -> (u32, u32)) -> (f32, f32) {
+    pub fn sin_cos_fixed_with<F: FnOnce(u32) -> (u32, u32)>(x: f32, core: F) -> (f32, f32) {
         const FRAC_PI_4_BITS: u32 = 0x3f49_0fdb; // π/4 rounded to f32
-        let reduced = x.to_bits() & ABS > FRAC_PI_4_BITS;
-        let (k, r) = if reduced { reduce(x) } else { (0, x) };
-        let (sin, cos) = core(r.to_bits());
-        let (sin, cos) = (f32::from_bits(sin), f32::from_bits(cos));
-        if reduced {
-            quadrant(k, sin, cos)
+        if x.to_bits() & ABS > FRAC_PI_4_BITS {
+            sin_cos_fixed_reduced(x, core)
         } else {
-            (sin, cos)
+            let (sin, cos) = core(x.to_bits());
+            (f32::from_bits(sin), f32::from_bits(cos))
         }
+    }
+
+    /// [`sin_cos_fixed_with`] beyond ±π/4: the range reduction, `core`, the quadrant.
+    #[inline(never)]
+    fn sin_cos_fixed_reduced<F: FnOnce(u32) -> (u32, u32)>(x: f32, core: F) -> (f32, f32) {
+        let (k, r) = reduce(x);
+        let (sin, cos) = core(r.to_bits());
+        quadrant(k, f32::from_bits(sin), f32::from_bits(cos))
     }
 
     /// The bits of `(sin r, cos r)` from those of `r` (`rb`), [`sin_cos_fixed`]'s fixed-point
