@@ -21,7 +21,8 @@
 //!   stance height, unreachable targets rejected, no link-loss timeout until the host sets one.
 //! - Math: [`avr_libc_math::AvrFast`] (avr-libc's `sqrt`; kin-core's fixed-point arctangent
 //!   `poly::atan2_fixed` in the assembly form of `AvrLibm::atan2_fixed`, bit for bit the same;
-//!   kin-core's sine/cosine `poly::sin_cos_fixed`; the tables read from flash), the fastest
+//!   kin-core's sine/cosine `poly::sin_cos_fixed` with its fixed-point part in the assembly
+//!   of `AvrLibm::sin_cos_fixed`, likewise; the tables read from flash), the fastest
 //!   backend measured (`cargo xtask avr-bench`).
 //! - Outputs stay low until the host sends `SetOutputs { enabled: true }`.
 //! - Watchdog: [`WATCHDOG_TIMEOUT`], fed by the main loop and during EEPROM writes. A hung main

@@ -829,7 +829,7 @@ pub mod poly {
     /// infinite `x`) to those of `(sin r, cos r)`: [`sin_cos_fixed_core`], or a backend's own
     /// form of it, bit for bit the same ([`Math::sin_cos_fixed`]).
     ///
-    /// The range reduction is out of line ([`sin_cos_fixed_reduced`]): the common case, within
+    /// The range reduction is out of line (`sin_cos_fixed_reduced`): the common case, within
     /// ±π/4, then keeps none of its registers.
     #[inline(always)]
     pub fn sin_cos_fixed_with<F: FnOnce(u32) -> (u32, u32)>(x: f32, core: F) -> (f32, f32) {
