@@ -171,7 +171,15 @@ fn main() {
         "get-state" => Request::GetState,
         other => panic!("unknown request kind {other}"),
     };
-    let elf = build::firmware_elf(build::FIRMWARE).unwrap_or_else(|e| panic!("{e}"));
+    // `AVR_PROFILE_1MBAUD=1`: the 1 Mbaud build; `AVR_PROFILE_OUTPUTS=1`: the outputs on (the
+    // request first held, then `SetOutputs`), as while a host streams poses.
+    let flag = |name| std::env::var(name).is_ok_and(|v| v == "1");
+    let bin = if flag("AVR_PROFILE_1MBAUD") {
+        build::FIRMWARE_1MBAUD
+    } else {
+        build::FIRMWARE
+    };
+    let elf = build::firmware_elf(bin).unwrap_or_else(|e| panic!("{e}"));
     let syms = symbols(&elf);
     let mut mcu = Mega2560::new(&elf).unwrap_or_else(|e| panic!("{e}"));
     while mcu.uart_baud().is_none() {
@@ -180,34 +188,73 @@ fn main() {
     mcu.run_cycles(16_000 * 30).expect("runs");
     let mut by_fn: HashMap<String, u64> = HashMap::new();
     let mut total = 0u64;
-    for seq in 0..=n {
-        let request = if seq == 0 {
-            Request::Hello {
-                version: PROTOCOL_VERSION,
-            }
-        } else {
+    let mut setup = vec![Request::Hello {
+        version: PROTOCOL_VERSION,
+    }];
+    if flag("AVR_PROFILE_OUTPUTS") {
+        setup.extend([request, Request::SetOutputs { enabled: true }]);
+    }
+    let first = setup.len() as u32;
+    // `AVR_PROFILE_BACK_TO_BACK=1`: each request as soon as the previous answer ended (as a
+    // host waiting for each answer sends), else after 5 ms of quiet; `AVR_PROFILE_TIMES=1`:
+    // each request's times printed.
+    let back_to_back = flag("AVR_PROFILE_BACK_TO_BACK");
+    let times = flag("AVR_PROFILE_TIMES");
+    mcu.run_cycles(16_000 * 5).expect("runs");
+    for seq in 0..first + n {
+        let counted = seq >= first;
+        let request = if counted {
             request
+        } else {
+            setup[seq as usize]
         };
-        mcu.run_cycles(16_000 * 5).expect("runs");
+        if !back_to_back {
+            mcu.run_cycles(16_000 * 5).expect("runs");
+        }
         let _ = mcu.uart_take();
         mcu.uart_write(&frame(seq as u16, request));
         let start = mcu.cycle();
-        let mut answered = false;
-        // From the request's last byte on the line until the answer's first byte.
-        while !answered && mcu.cycle() < start + 16_000_000 {
+        let (mut last_in, mut first_out, mut end) = (None, None, None);
+        let mut zeros = 0;
+        // From the request's last byte on the line until the answer's first byte (profiled),
+        // then until the answer's closing delimiter.
+        while end.is_none() && mcu.cycle() < start + 16_000_000 {
             let pc = mcu.pc();
-            let counting = mcu.uart_input_pending() == 0;
+            let counting = mcu.uart_input_pending() == 0 && first_out.is_none();
+            if counting && last_in.is_none() {
+                last_in = Some(mcu.cycle());
+            }
             let cycles = mcu.step().expect("runs");
-            if seq > 0 && counting {
+            if counted && counting {
                 *by_fn.entry(charged_name(&mcu, &syms, pc)).or_default() += cycles;
                 total += cycles;
             }
-            // The first byte after the leading delimiter (which may go out early).
-            answered = mcu.uart_take().iter().any(|(_, b)| *b != 0);
+            for (cycle, b) in mcu.uart_take() {
+                // The first byte after the leading delimiter (which may go out early).
+                if b != 0 && first_out.is_none() {
+                    first_out = Some(cycle);
+                }
+                if b == 0 {
+                    zeros += 1;
+                    if zeros == 2 {
+                        end = Some(cycle);
+                    }
+                }
+            }
         }
-        // The rest of the answer drains before the next request.
-        mcu.run_cycles(16_000 * 5).expect("runs");
-        let _ = mcu.uart_take();
+        if times && counted {
+            let (l, f, e) = (
+                last_in.unwrap_or(start),
+                first_out.unwrap_or(0),
+                end.unwrap_or(0),
+            );
+            println!(
+                "request {seq}: bytes in {}, last byte → first answer byte {}, answer out {} cycles",
+                l - start,
+                f.saturating_sub(l),
+                e.saturating_sub(f)
+            );
+        }
     }
     print_rows(
         &format!(

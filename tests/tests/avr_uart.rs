@@ -638,3 +638,81 @@ fn bounded_fuzz_of_the_emulated_firmware_never_drives_a_wrong_pulse() {
     assert_eq!(link.rx_overruns(), 0);
     assert_eq!(link.mcu().resets().count, 0, "no panic, no watchdog reset");
 }
+
+/// Poses streamed as fast as the 1 Mbaud line carries them, each far from the last (body roll
+/// alternating ±0.25 rad), move the twelve pins by at most the joint-speed limiter's step per
+/// servo period: the device never writes a streamed pose past the limiter, whatever the
+/// requests' timing against the PWM periods. Also with a pause of a few periods between poses.
+#[test]
+fn streamed_poses_never_step_a_pin_beyond_the_limiter() {
+    use quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S;
+    use quad_host::emu::CYCLES_PER_US;
+    use quad_protocol::servo::STANDARD_US_PER_RAD;
+    for gap_ms in [0u64, 7, 30] {
+        let mut mcu = Mega2560::new(&elf(build::FIRMWARE_1MBAUD)).unwrap_or_else(|e| panic!("{e}"));
+        while mcu.uart_baud().is_none() {
+            mcu.step().expect("boots");
+        }
+        mcu.run_cycles(16_000 * 30).expect("runs");
+        let pose = |k: u16| Pose::rotation(if k % 2 == 0 { 0.25 } else { -0.25 }, 0.0, 0.0);
+        let mut requests = vec![
+            Request::Hello {
+                version: PROTOCOL_VERSION,
+            },
+            Request::SetBodyPose(pose(0)),
+            Request::SetOutputs { enabled: true },
+        ];
+        requests.extend((1..40).map(|k| Request::SetBodyPose(pose(k))));
+        mcu.capture_pulses(true);
+        for (seq, r) in requests.into_iter().enumerate() {
+            mcu.uart_write(&frame(seq as u16, r));
+            let start = mcu.cycle();
+            let mut delimiters = 0;
+            while delimiters < 2 {
+                assert!(
+                    mcu.cycle() < start + 16_000_000,
+                    "no answer to request {seq}"
+                );
+                mcu.step().expect("runs");
+                delimiters += mcu.uart_take().iter().filter(|(_, b)| *b == 0).count();
+            }
+            mcu.run_cycles(16_000 * gap_ms).expect("runs");
+        }
+        mcu.run_cycles(16_000 * 200).expect("runs");
+        let pulses = mcu.take_pulses();
+        let mut last: [Option<quad_host::emu::Pulse>; 12] = [None; 12];
+        let (mut worst, mut steps) = (0.0f64, 0);
+        for p in &pulses {
+            if let Some(q) = last[p.channel] {
+                steps += 1;
+                let d_us =
+                    (p.high_cycles as f64 - q.high_cycles as f64).abs() / CYCLES_PER_US as f64;
+                // Each edge is seen at the end of an emulator step, and pulses are whole
+                // 0.5 µs timer ticks.
+                let slack_us = (p.rise_step_cycles
+                    + p.fall_step_cycles
+                    + q.rise_step_cycles
+                    + q.fall_step_cycles) as f64
+                    / CYCLES_PER_US as f64
+                    + 0.5;
+                let step = d_us / f64::from(STANDARD_US_PER_RAD);
+                let allowed = f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02
+                    + slack_us / f64::from(STANDARD_US_PER_RAD);
+                worst = worst.max(step);
+                assert!(
+                    step <= allowed,
+                    "gap {gap_ms} ms: channel {} stepped {step:.4} rad in one period (bound {allowed:.4})",
+                    p.channel
+                );
+            }
+            last[p.channel] = Some(*p);
+        }
+        println!(
+            "gap {gap_ms} ms: {steps} pulse-to-pulse steps, largest {worst:.4} rad (limiter {:.4} rad per period)",
+            DEFAULT_JOINT_SPEED_LIMIT_RAD_S * 0.02
+        );
+        assert!(steps > 100, "{steps} steps seen");
+        // The poses are far apart: the limiter is what bounds the steps.
+        assert!(worst > 0.5 * f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02);
+    }
+}
