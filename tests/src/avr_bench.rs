@@ -556,6 +556,29 @@ pub const PRIMITIVES: [&str; 20] = [
     "AvrLibm::sin_cos_fixed sin|cos",
 ];
 
+/// The op id of a primitive of `bench.elf`, by its name in [`PRIMITIVES`].
+///
+/// # Panics
+/// When the firmware has no primitive of that name.
+pub fn primitive_op(name: &str) -> u8 {
+    PRIMITIVES
+        .iter()
+        .position(|&n| n == name)
+        .unwrap_or_else(|| panic!("bench.elf lacks {name}")) as u8
+}
+
+/// A float of the given biased exponent (0: zero or subnormal, 255: infinity or NaN), random
+/// mantissa (none at all one time in eight) and sign: the kernels' bit-exact tests' arguments.
+pub fn random_float(rng: &mut SplitMix64, exponent: u32) -> f32 {
+    let bits = rng.next_u64();
+    let mantissa = if bits & 7 == 0 {
+        0
+    } else {
+        (bits >> 8) as u32 & 0x7f_ffff
+    };
+    f32::from_bits(((bits >> 40) as u32 & 1) << 31 | exponent << 23 | mantissa)
+}
+
 /// Mean cycles of primitive `op` over a few arguments.
 pub fn primitive_cycles(fw: &mut BenchFirmware, op: u8) -> f64 {
     let args = [

@@ -8,33 +8,13 @@
 //! The firmware is built once per test process (`quad_host::emu::build`); the test fails —
 //! never skips — when it cannot be built.
 
-use integration_tests::avr_bench::{BenchFirmware, PRIMITIVES};
+use integration_tests::avr_bench::{primitive_op as op, random_float as float, BenchFirmware};
 use kin_core::math::{poly, SoftFloat};
 use quad_host::emu::build;
 use seeded_rng::SplitMix64 as Rng;
 
 /// Random pairs compared.
 const PAIRS: usize = 20_000;
-
-/// The op id of a primitive of `bench.elf`, by name.
-fn op(name: &str) -> u8 {
-    PRIMITIVES
-        .iter()
-        .position(|&n| n == name)
-        .unwrap_or_else(|| panic!("bench.elf lacks {name}")) as u8
-}
-
-/// A float of the given biased exponent (0: zero or subnormal, 255: infinity or NaN), random
-/// mantissa (none at all one time in eight) and sign.
-fn float(rng: &mut Rng, exponent: u32) -> f32 {
-    let bits = rng.next_u64();
-    let mantissa = if bits & 7 == 0 {
-        0
-    } else {
-        (bits >> 8) as u32 & 0x7f_ffff
-    };
-    f32::from_bits(((bits >> 40) as u32 & 1) << 31 | exponent << 23 | mantissa)
-}
 
 /// One argument pair of a kind chosen at random.
 fn pair(rng: &mut Rng) -> (f32, f32) {
