@@ -62,6 +62,11 @@ fn short_name(name: &str) -> String {
     }
 }
 
+/// True when `pc` is the first instruction of a function of `syms` (a call's entry).
+fn is_entry(syms: &[(u32, u32, String)], pc: u32) -> bool {
+    syms.binary_search_by_key(&pc, |s| s.0).is_ok()
+}
+
 fn name_at(syms: &[(u32, u32, String)], pc: u32) -> &str {
     let i = syms.partition_point(|s| s.0 <= pc);
     match i.checked_sub(1).map(|i| &syms[i]) {
@@ -94,14 +99,24 @@ fn charged_name(mcu: &Mega2560, syms: &[(u32, u32, String)], pc: u32) -> String 
     }
 }
 
-fn print_rows(title: &str, by_fn: HashMap<String, u64>, total: u64, per: u64) {
+fn print_rows(
+    title: &str,
+    by_fn: HashMap<String, u64>,
+    calls: &HashMap<String, u64>,
+    total: u64,
+    per: u64,
+) {
     let mut rows: Vec<_> = by_fn.into_iter().collect();
     rows.sort_by_key(|r| std::cmp::Reverse(r.1));
-    println!("{title}: {} cycles, by function:", total / per);
+    println!(
+        "{title}: {} cycles, by function (cycles, share, calls):",
+        total / per
+    );
     for (name, cycles) in rows.iter().take(40) {
         let short: String = name.chars().take(120).collect();
+        let entered = calls.get(name).copied().unwrap_or(0) as f64 / per as f64;
         println!(
-            "{:>8}  {:>5.1}%  {short}",
+            "{:>8}  {:>5.1}%  {entered:>6.1}  {short}",
             cycles / per,
             100.0 * *cycles as f64 / total as f64
         );
@@ -119,10 +134,12 @@ fn profile_motion(motion: u8, frames: u32) {
     let started = mcu.read_exact(2, 16_000_000 * 20).expect("starts");
     assert_eq!(started, b"m\0", "motion {motion} refused");
     let (port, bit) = quad_host::emu::MARKER_PIN;
-    let mut worst: (u64, HashMap<String, u64>) = (0, HashMap::new());
+    let mut worst: (u64, HashMap<String, u64>, HashMap<String, u64>) =
+        (0, HashMap::new(), HashMap::new());
     for _ in 0..frames {
         mcu.uart_write(b"N");
         let mut frame: HashMap<String, u64> = HashMap::new();
+        let mut calls: HashMap<String, u64> = HashMap::new();
         let mut total = 0;
         let mut got = 0;
         while got < 3 {
@@ -130,18 +147,23 @@ fn profile_motion(motion: u8, frames: u32) {
             let high = mcu.pin(port, bit);
             let cycles = mcu.step().expect("runs");
             if high {
-                *frame.entry(charged_name(&mcu, &syms, pc)).or_default() += cycles;
+                let name = charged_name(&mcu, &syms, pc);
+                if is_entry(&syms, pc) {
+                    *calls.entry(name.clone()).or_default() += 1;
+                }
+                *frame.entry(name).or_default() += cycles;
                 total += cycles;
             }
             got += mcu.uart_take().len();
         }
         if total > worst.0 {
-            worst = (total, frame);
+            worst = (total, frame, calls);
         }
     }
     print_rows(
         &format!("motion {motion}, worst of {frames} frames"),
         worst.1,
+        &worst.2,
         worst.0,
         1,
     );
@@ -187,6 +209,7 @@ fn main() {
     }
     mcu.run_cycles(16_000 * 30).expect("runs");
     let mut by_fn: HashMap<String, u64> = HashMap::new();
+    let mut calls: HashMap<String, u64> = HashMap::new();
     let mut total = 0u64;
     let mut setup = vec![Request::Hello {
         version: PROTOCOL_VERSION,
@@ -226,7 +249,11 @@ fn main() {
             }
             let cycles = mcu.step().expect("runs");
             if counted && counting {
-                *by_fn.entry(charged_name(&mcu, &syms, pc)).or_default() += cycles;
+                let name = charged_name(&mcu, &syms, pc);
+                if is_entry(&syms, pc) {
+                    *calls.entry(name.clone()).or_default() += 1;
+                }
+                *by_fn.entry(name).or_default() += cycles;
                 total += cycles;
             }
             for (cycle, b) in mcu.uart_take() {
@@ -261,6 +288,7 @@ fn main() {
             "{kind}, per request from its last byte handed to the UART to the answer's first byte"
         ),
         by_fn,
+        &calls,
         total,
         u64::from(n),
     );

@@ -639,10 +639,10 @@ fn bounded_fuzz_of_the_emulated_firmware_never_drives_a_wrong_pulse() {
     assert_eq!(link.mcu().resets().count, 0, "no panic, no watchdog reset");
 }
 
-/// Poses streamed as fast as the 1 Mbaud line carries them, each far from the last (body roll
-/// alternating ±0.25 rad), move the twelve pins by at most the joint-speed limiter's step per
-/// servo period: the device never writes a streamed pose past the limiter, whatever the
-/// requests' timing against the PWM periods. Also with a pause of a few periods between poses.
+/// Poses streamed as fast as the 1 Mbaud line carries them (one pose repeated, then poses far
+/// apart: body roll alternating ±0.25 rad) move the twelve pins by at most the joint-speed
+/// limiter's step per servo period: the device never writes a streamed pose past the limiter,
+/// whatever the requests' timing against the PWM periods. Also with a pause between poses.
 #[test]
 fn streamed_poses_never_step_a_pin_beyond_the_limiter() {
     use quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S;
@@ -654,7 +654,15 @@ fn streamed_poses_never_step_a_pin_beyond_the_limiter() {
             mcu.step().expect("boots");
         }
         mcu.run_cycles(16_000 * 30).expect("runs");
-        let pose = |k: u16| Pose::rotation(if k % 2 == 0 { 0.25 } else { -0.25 }, 0.0, 0.0);
+        // The same pose 30 times (requests of one length at a steady cadence), then poses far
+        // apart.
+        let pose = |k: u16| {
+            if k < 30 {
+                Pose::rotation(0.1, -0.05, 0.08)
+            } else {
+                Pose::rotation(if k % 2 == 0 { 0.25 } else { -0.25 }, 0.0, 0.0)
+            }
+        };
         let mut requests = vec![
             Request::Hello {
                 version: PROTOCOL_VERSION,
@@ -662,7 +670,7 @@ fn streamed_poses_never_step_a_pin_beyond_the_limiter() {
             Request::SetBodyPose(pose(0)),
             Request::SetOutputs { enabled: true },
         ];
-        requests.extend((1..40).map(|k| Request::SetBodyPose(pose(k))));
+        requests.extend((1..60).map(|k| Request::SetBodyPose(pose(k))));
         mcu.capture_pulses(true);
         for (seq, r) in requests.into_iter().enumerate() {
             mcu.uart_write(&frame(seq as u16, r));
