@@ -744,11 +744,29 @@ where
         self.limited = limited;
         // A direct setpoint takes over from a running motion.
         self.engine.cancel();
-        if self.outputs_enabled && self.enabling_frame {
+        if self.outputs_enabled && self.in_enabling_frame() {
             self.out_rad = angles_rad;
             self.write_out();
         }
         Ok(())
+    }
+
+    /// True while no frame boundary has passed since the outputs were enabled: the enabling
+    /// frame, whose target is written at once. Ended here as well as by the frame that follows
+    /// it: that frame may not run before the next target comes (it waits while a write is
+    /// pending, and a host that sends a target early in every period keeps one pending at each
+    /// poll), and every target would then be written at once.
+    fn in_enabling_frame(&mut self) -> bool {
+        if self.enabling_frame {
+            let boundary_passed = match self.outputs.periods_begun() {
+                Some(period) => period != self.next_frame,
+                None => self.clock.now_ms().wrapping_sub(self.next_frame) <= i32::MAX as u32,
+            };
+            if boundary_passed {
+                self.enabling_frame = false;
+            }
+        }
+        self.enabling_frame
     }
 
     /// Writes the output angles through the calibration; stops the outputs instead if one maps

@@ -936,3 +936,92 @@ fn nacks_of_unreadable_frames_are_rate_limited() {
     clock.set(quad_device::device::FRAMING_NACK_INTERVAL_MS);
     assert_eq!(feed(&mut dev, &garbage).len(), 1);
 }
+
+/// Outputs whose writes the PWM periods latch, as the firmware's: a write stays pending for the
+/// rest of the period it was made in.
+#[derive(Default)]
+struct Latched {
+    period: std::rc::Rc<std::cell::Cell<u32>>,
+    written_in: Option<u32>,
+    writes: Vec<[u16; 12]>,
+}
+
+impl quad_device::ServoOutputs for Latched {
+    fn set_pulses(&mut self, pulses_half_us: &[u16; 12]) {
+        self.writes.push(*pulses_half_us);
+        self.written_in = Some(self.period.get());
+    }
+    fn set_enabled(&mut self, _enabled: bool) {}
+    fn periods_begun(&self) -> Option<u32> {
+        Some(self.period.get())
+    }
+    fn write_pending(&self) -> bool {
+        self.written_in == Some(self.period.get())
+    }
+}
+
+/// A host that sends a new, distant target early in every PWM period (each request's write is
+/// then still pending when the device next polls) gets its targets through the joint-speed
+/// limiter from the second period after enabling on: only the enabling frame writes a target at
+/// once. (Once, the enabling frame lasted as long as such a stream: the frame that ends it
+/// never ran while a write was pending, and every target was written at once.)
+#[test]
+fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
+    let period = std::rc::Rc::new(std::cell::Cell::new(100u32));
+    let config = Config::fernando2025();
+    let mut dev = Device::new(
+        config,
+        Latched {
+            period: period.clone(),
+            ..Latched::default()
+        },
+        TestClock::default(),
+        Mem::erased(),
+    )
+    .unwrap();
+    let mut seq = 0;
+    let mut ask = |dev: &mut Device<Latched, TestClock, Mem>, request: Request| {
+        seq += 1;
+        let mut wire = Vec::new();
+        dev.receive(&frame(seq, request), |f| wire.extend_from_slice(f));
+        let answers = decode_all(&wire);
+        assert_eq!(answers.len(), 1, "{answers:?}");
+        answers[0]
+    };
+    assert!(matches!(
+        ask(
+            &mut dev,
+            Request::Hello {
+                version: quad_protocol::PROTOCOL_VERSION,
+            },
+        ),
+        DeviceToHost::HelloAck { .. }
+    ));
+    let pose = |k: u32| Pose::rotation(if k % 2 == 0 { 0.25 } else { -0.25 }, 0.0, 0.0);
+    ack(ask(&mut dev, Request::SetBodyPose(pose(0))));
+    ack(ask(&mut dev, Request::SetOutputs { enabled: true }));
+    dev.poll();
+    // The limiter's step in half-µs of the widest gain, with the rounding of both pulses.
+    let gain = dev
+        .calibration()
+        .iter()
+        .map(|c| c.us_per_rad)
+        .fold(0.0f32, f32::max);
+    let bound_half_us = 2.0 * gain * config.joint_speed_limit_rad_s * 0.02 + 1.0;
+    for k in 1..40 {
+        period.set(period.get() + 1);
+        ack(ask(&mut dev, Request::SetBodyPose(pose(k))));
+        dev.poll();
+    }
+    let writes = &dev.outputs().writes;
+    assert!(writes.len() > 10, "{} writes", writes.len());
+    for (w, pair) in writes.windows(2).enumerate() {
+        for ch in 0..12 {
+            let step = (f32::from(pair[1][ch]) - f32::from(pair[0][ch])).abs();
+            assert!(
+                step <= bound_half_us,
+                "write {w}, channel {ch}: {step} half-µs at once (limiter {bound_half_us})"
+            );
+        }
+    }
+}
