@@ -1016,8 +1016,8 @@ fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
     let writes = &dev.outputs().writes;
     assert!(writes.len() > 10, "{} writes", writes.len());
     for (w, pair) in writes.windows(2).enumerate() {
-        for ch in 0..12 {
-            let step = (f32::from(pair[1][ch]) - f32::from(pair[0][ch])).abs();
+        for (ch, (&a, &b)) in pair[0].iter().zip(&pair[1]).enumerate() {
+            let step = (f32::from(b) - f32::from(a)).abs();
             assert!(
                 step <= bound_half_us,
                 "write {w}, channel {ch}: {step} half-µs at once (limiter {bound_half_us})"
