@@ -979,27 +979,10 @@ fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
         Mem::erased(),
     )
     .unwrap();
-    let mut seq = 0;
-    let mut ask = |dev: &mut Device<Latched, TestClock, Mem>, request: Request| {
-        seq += 1;
-        let mut wire = Vec::new();
-        dev.receive(&frame(seq, request), |f| wire.extend_from_slice(f));
-        let answers = decode_all(&wire);
-        assert_eq!(answers.len(), 1, "{answers:?}");
-        answers[0]
-    };
-    assert!(matches!(
-        ask(
-            &mut dev,
-            Request::Hello {
-                version: quad_protocol::PROTOCOL_VERSION,
-            },
-        ),
-        DeviceToHost::HelloAck { .. }
-    ));
+    hello(&mut dev);
     let pose = |k: u32| Pose::rotation(if k % 2 == 0 { 0.25 } else { -0.25 }, 0.0, 0.0);
-    ack(ask(&mut dev, Request::SetBodyPose(pose(0))));
-    ack(ask(&mut dev, Request::SetOutputs { enabled: true }));
+    ack(ask(&mut dev, 1, Request::SetBodyPose(pose(0))));
+    ack(ask(&mut dev, 2, Request::SetOutputs { enabled: true }));
     dev.poll();
     // The limiter's step in half-µs of the widest gain, with the rounding of both pulses.
     let gain = dev
@@ -1010,7 +993,7 @@ fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
     let bound_half_us = 2.0 * gain * config.joint_speed_limit_rad_s * 0.02 + 1.0;
     for k in 1..40 {
         period.set(period.get() + 1);
-        ack(ask(&mut dev, Request::SetBodyPose(pose(k))));
+        ack(ask(&mut dev, 2 + k as u16, Request::SetBodyPose(pose(k))));
         dev.poll();
     }
     let writes = &dev.outputs().writes;

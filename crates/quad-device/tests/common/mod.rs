@@ -111,8 +111,11 @@ pub fn frame(seq: u16, request: Request) -> Vec<u8> {
         .to_vec()
 }
 
-/// Feeds bytes and decodes every answer.
-pub fn feed(dev: &mut Dev, bytes: &[u8]) -> Vec<DeviceToHost> {
+/// Feeds bytes and decodes every answer (any outputs, clock and storage).
+pub fn feed<O: ServoOutputs, C: Clock, S: Storage>(
+    dev: &mut Device<O, C, S>,
+    bytes: &[u8],
+) -> Vec<DeviceToHost> {
     let mut wire = Vec::new();
     dev.receive(bytes, |f| wire.extend_from_slice(f));
     decode_all(&wire)
@@ -136,14 +139,18 @@ pub fn decode_all(wire: &[u8]) -> Vec<DeviceToHost> {
 }
 
 /// Sends one request as a frame and returns its single answer.
-pub fn ask(dev: &mut Dev, seq: u16, request: Request) -> DeviceToHost {
+pub fn ask<O: ServoOutputs, C: Clock, S: Storage>(
+    dev: &mut Device<O, C, S>,
+    seq: u16,
+    request: Request,
+) -> DeviceToHost {
     let answers = feed(dev, &frame(seq, request));
     assert_eq!(answers.len(), 1, "one answer per frame: {answers:?}");
     assert_eq!(answers[0].seq(), Some(seq));
     answers[0]
 }
 
-pub fn hello(dev: &mut Dev) {
+pub fn hello<O: ServoOutputs, C: Clock, S: Storage>(dev: &mut Device<O, C, S>) {
     match ask(
         dev,
         0,
