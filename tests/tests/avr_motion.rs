@@ -22,10 +22,6 @@ use std::time::{Duration, Instant};
 /// Default emulated trot, s.
 const TROT_S: f32 = 6.0;
 
-/// A pulse's width is seen up to one simavr step late at each edge; the steps' lengths are
-/// added to the bound, plus one timer tick of rounding of the pulse itself.
-const TICK_US: f64 = 0.5;
-
 /// A servo period may come late by at most this much (the timer runs the frames, the main
 /// loop only updates the compare values), cycles: 50 µs.
 const PERIOD_SLACK_CYCLES: u64 = 50 * CYCLES_PER_US;
@@ -124,17 +120,12 @@ impl Rig {
                     if period > PERIOD_CYCLES + PERIOD_SLACK_CYCLES {
                         self.late += 1;
                     }
-                    let d_us = (now[c].high_cycles as f64 - last[c].high_cycles as f64).abs()
-                        / CYCLES_PER_US as f64;
-                    let slack_us = (now[c].rise_step_cycles
-                        + now[c].fall_step_cycles
-                        + last[c].rise_step_cycles
-                        + last[c].fall_step_cycles) as f64
-                        / CYCLES_PER_US as f64
-                        + TICK_US;
-                    let step = d_us / self.us_per_rad[c];
-                    let allowed = f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02
-                        + slack_us / self.us_per_rad[c];
+                    let (step, allowed) = integration_tests::pins::step_and_bound_rad(
+                        &last[c],
+                        &now[c],
+                        self.us_per_rad[c],
+                        f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S),
+                    );
                     self.max_step_rad = self.max_step_rad.max(step);
                     self.max_allowed_rad = self.max_allowed_rad.max(allowed);
                     assert!(

@@ -646,7 +646,6 @@ fn bounded_fuzz_of_the_emulated_firmware_never_drives_a_wrong_pulse() {
 #[test]
 fn streamed_poses_never_step_a_pin_beyond_the_limiter() {
     use quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S;
-    use quad_host::emu::CYCLES_PER_US;
     use quad_protocol::servo::STANDARD_US_PER_RAD;
     for gap_ms in [0u64, 7, 30] {
         let mut mcu = Mega2560::new(&elf(build::FIRMWARE_1MBAUD)).unwrap_or_else(|e| panic!("{e}"));
@@ -693,19 +692,12 @@ fn streamed_poses_never_step_a_pin_beyond_the_limiter() {
         for p in &pulses {
             if let Some(q) = last[p.channel] {
                 steps += 1;
-                let d_us =
-                    (p.high_cycles as f64 - q.high_cycles as f64).abs() / CYCLES_PER_US as f64;
-                // Each edge is seen at the end of an emulator step, and pulses are whole
-                // 0.5 µs timer ticks.
-                let slack_us = (p.rise_step_cycles
-                    + p.fall_step_cycles
-                    + q.rise_step_cycles
-                    + q.fall_step_cycles) as f64
-                    / CYCLES_PER_US as f64
-                    + 0.5;
-                let step = d_us / f64::from(STANDARD_US_PER_RAD);
-                let allowed = f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02
-                    + slack_us / f64::from(STANDARD_US_PER_RAD);
+                let (step, allowed) = integration_tests::pins::step_and_bound_rad(
+                    &q,
+                    p,
+                    f64::from(STANDARD_US_PER_RAD),
+                    f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S),
+                );
                 worst = worst.max(step);
                 assert!(
                     step <= allowed,
