@@ -35,8 +35,9 @@ use crate::usart::Usart0;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::Axis;
 use kin_core::{body, leg, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
-use quad_device::engine::{self, Engine, Limiter, Request, Setup, Stage, WalkRequest, FRAME_MS};
-use quad_device::store::Table;
+use quad_device::engine::{
+    self, Engine, Limiter, PulseMaps, Request, Setup, Stage, WalkRequest, FRAME_MS,
+};
 use quad_device::{default_calibration, Config};
 
 /// Stance height of the body-pose benchmark: seed 000 Table 4 body height, m.
@@ -146,7 +147,8 @@ impl MotionBench for NoMotion {
 pub struct EngineBench<M: Math> {
     config: Config,
     solver: body::Solver<M>,
-    calibration: Table,
+    /// The calibration's pulse maps, as the device holds them.
+    pulse_maps: PulseMaps,
     engine: Engine<M>,
     out: [f32; 12],
     pulses: [u16; 12],
@@ -165,7 +167,7 @@ impl<M: Math> EngineBench<M> {
         EngineBench {
             solver: body::Solver::with_math(&config.robot),
             config,
-            calibration,
+            pulse_maps: calibration.map(|c| c.pulse_map().unwrap_or_else(|_| panic!())),
             engine: Engine::new(limiter),
             out,
             pulses: [0; 12],
@@ -179,7 +181,7 @@ impl<M: Math> EngineBench<M> {
         if let Some(target) = tick.target {
             self.engine.limiter().step(&mut self.out, &target);
         }
-        for ((p, c), &a) in self.pulses.iter_mut().zip(&self.calibration).zip(&self.out) {
+        for ((p, c), &a) in self.pulses.iter_mut().zip(&self.pulse_maps).zip(&self.out) {
             *p = c.pulse_half_us(a).unwrap_or(0);
         }
         core::hint::black_box(&self.pulses);
@@ -223,7 +225,7 @@ impl<M: Math> MotionBench for EngineBench<M> {
             solver: &self.solver,
             stance_height_m: h,
             order: self.config.pose_config.order,
-            calibration: &self.calibration,
+            pulse_maps: &self.pulse_maps,
             outputs: Some(&self.out),
             now_ms: self.now_ms,
         };

@@ -5,14 +5,14 @@ use crate::config::{
     validate_pose_config, write_default_calibration, Config, ConfigError, ValidConfig,
     UNBOOTED_CALIBRATION,
 };
-use crate::engine::{self, Engine, Limiter, Setup, FRAME_MS};
+use crate::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS};
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use kin_core::body::{self, BodySolution, Pose};
 use kin_core::motion::gait::Velocity;
 use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
-use quad_protocol::servo::Calibration;
+use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
     check_request_in, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed,
     Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges, Readback,
@@ -88,6 +88,9 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     /// products of the link lengths) would otherwise be computed again for every request.
     solver: body::Solver<M>,
     calibration: Table,
+    /// `calibration`, each validated once and precomputed for mapping angles to pulses
+    /// (recomputed with every change of `calibration`; [`PulseMap::NONE`] until the boot).
+    pulse_maps: PulseMaps,
     /// The request ranges of `config.robot` (the robot never changes).
     ranges: Ranges,
     store: Store,
@@ -169,6 +172,7 @@ where
             clock,
             storage,
             calibration: UNBOOTED_CALIBRATION,
+            pulse_maps: [PulseMap::NONE; 12],
             store: Store::new(config.storage_base),
             ranges: *valid.ranges(),
             solver: body::Solver::<M>::with_math(&config.robot),
@@ -206,6 +210,11 @@ where
                 &self.config.pose_config,
                 &mut self.calibration,
             );
+        }
+        for (m, c) in self.pulse_maps.iter_mut().zip(&self.calibration) {
+            // Each calibration was validated when it was loaded, and the defaults are valid:
+            // no map is left refusing every angle.
+            *m = c.pulse_map().unwrap_or(PulseMap::NONE);
         }
         // The stance may not map within a stored calibration: then nothing is held.
         let _ = self.set_body_pose(&Pose::default());
@@ -355,7 +364,7 @@ where
         let mut pulses_half_us = [0u16; 12];
         // `ServoId::ALL` is in index order: the position is the index, no bounds checks.
         for (i, s) in ServoId::ALL.into_iter().enumerate() {
-            pulses_half_us[i] = self.calibration[i]
+            pulses_half_us[i] = self.pulse_maps[i]
                 .pulse_half_us(angles_rad[i])
                 .map_err(|fault| engine::Error::ServoRange { servo: s, fault })?;
         }
@@ -380,7 +389,7 @@ where
             solver: &self.solver,
             stance_height_m: self.config.pose_config.stance_height_m,
             order: self.config.pose_config.order,
-            calibration: &self.calibration,
+            pulse_maps: &self.pulse_maps,
             outputs: if self.outputs_enabled {
                 Some(&self.out_rad)
             } else {
@@ -728,7 +737,7 @@ where
                 return Err(NackReason::NonFinite);
             }
             pulses_half_us[i] =
-                self.calibration[i]
+                self.pulse_maps[i]
                     .pulse_half_us(a)
                     .map_err(|fault| NackReason::ServoRange {
                         leg: s.leg,
@@ -776,7 +785,7 @@ where
         let mut pulses = [0u16; 12];
         for (p, (c, &a)) in pulses
             .iter_mut()
-            .zip(self.calibration.iter().zip(&self.out_rad))
+            .zip(self.pulse_maps.iter().zip(&self.out_rad))
         {
             match c.pulse_half_us(a) {
                 Ok(v) => *p = v,
@@ -827,11 +836,11 @@ where
 
     #[inline(never)]
     fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), NackReason> {
-        c.validate().map_err(NackReason::BadCalibration)?;
+        let map = c.pulse_map().map_err(NackReason::BadCalibration)?;
         let i = servo.index();
         // Both checks before anything changes: a refusal leaves the held pulses as they were.
         let held_pulse = match &self.held {
-            Some(held) => Some(c.pulse_half_us(held.angles_rad[i]).map_err(|fault| {
+            Some(held) => Some(map.pulse_half_us(held.angles_rad[i]).map_err(|fault| {
                 NackReason::ServoRange {
                     leg: servo.leg,
                     joint: servo.joint,
@@ -842,7 +851,7 @@ where
         };
         if self.outputs_enabled {
             // The outputs may still be on their way to the held angle.
-            c.pulse_half_us(self.out_rad[i])
+            map.pulse_half_us(self.out_rad[i])
                 .map_err(|fault| NackReason::ServoRange {
                     leg: servo.leg,
                     joint: servo.joint,
@@ -854,6 +863,7 @@ where
         }
         if self.calibration[i] != c {
             self.calibration[i] = c;
+            self.pulse_maps[i] = map;
             self.calibration_unsaved = true;
         }
         if self.outputs_enabled {

@@ -84,7 +84,6 @@ pub use limiter::{
     limit_for_servo, Limiter, Ramp, DEFAULT_JOINT_SPEED_LIMIT_RAD_S, NO_LOAD_SPEED_SHARE,
 };
 
-use crate::store::Table;
 use core::fmt;
 use core::marker::PhantomData;
 use kin_core::body::{self, BodyConfig, Pose};
@@ -96,7 +95,7 @@ use kin_core::motion::walker::{Walker, WalkerParams};
 use kin_core::motion::{self, Frame, Param};
 use kin_core::preflight::{Failure, FailureKind};
 use kin_core::{IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
-use quad_protocol::servo;
+use quad_protocol::servo::{self, PulseMap};
 use quad_protocol::ServoId;
 
 /// One servo frame, ms.
@@ -350,6 +349,10 @@ pub struct Status {
     pub fault: Option<Error>,
 }
 
+/// Twelve servo calibrations as their pulse maps, canonical order (the device's calibration
+/// table, [`crate::store::Table`], validated and precomputed).
+pub type PulseMaps = [PulseMap; 12];
+
 /// What the robot and the device are set up with, for starting a motion.
 #[derive(Debug, Clone, Copy)]
 pub struct Setup<'a, M: Math> {
@@ -362,8 +365,9 @@ pub struct Setup<'a, M: Math> {
     pub stance_height_m: f32,
     /// Rotation order of the poses.
     pub order: RotationOrder,
-    /// The servo calibration.
-    pub calibration: &'a Table,
+    /// The servo calibration, each servo's validated and precomputed for mapping angles to
+    /// pulses ([`quad_protocol::servo::Calibration::pulse_map`]).
+    pub pulse_maps: &'a PulseMaps,
     /// The angles on the outputs; `None` while they are off.
     pub outputs: Option<&'a [f32; 12]>,
     /// The device clock, ms.
@@ -500,10 +504,11 @@ pub fn solve_frame<M: Math>(
         .map(|s| s.flat())
 }
 
-/// Checks that `angles` map within every servo's calibrated travel.
+/// Checks that `angles` map within every servo's calibrated travel (`pulse_maps`: each
+/// servo's calibration as its [`PulseMap`]).
 #[inline(never)]
-pub fn check_travel(calibration: &Table, angles: &[f32; 12]) -> Result<(), Error> {
-    for (s, (c, &a)) in ServoId::ALL.iter().zip(calibration.iter().zip(angles)) {
+pub fn check_travel(pulse_maps: &PulseMaps, angles: &[f32; 12]) -> Result<(), Error> {
+    for (s, (c, &a)) in ServoId::ALL.iter().zip(pulse_maps.iter().zip(angles)) {
         c.pulse_half_us(a)
             .map_err(|fault| Error::ServoRange { servo: *s, fault })?;
     }
@@ -520,7 +525,7 @@ fn stance_angles<M: Math>(s: &Setup<'_, M>) -> Result<[f32; 12], Error> {
     };
     // Matched in place, not `map_err(…)?`: one copy of the angles fewer on the way.
     match solve_frame(s.solver, s.order, &frame) {
-        Ok(q) => check_travel(s.calibration, &q).map(|()| q),
+        Ok(q) => check_travel(s.pulse_maps, &q).map(|()| q),
         Err(e) => Err(Error::Ik(e)),
     }
 }
@@ -548,7 +553,7 @@ fn check_sample<'r, M: Math>(
     let q = solved
         .as_ref()
         .map_err(|e| failure(e.leg, FailureKind::Unreachable(e.kind)))?;
-    check_travel(s.calibration, q)?;
+    check_travel(s.pulse_maps, q)?;
     if !singularity {
         return Ok(q);
     }
@@ -730,7 +735,7 @@ impl<M: Math> Engine<M> {
                     None => return Err(Error::OutputsOff),
                 };
                 let rest = rest_angles(setup.robot)?;
-                check_travel(setup.calibration, &rest)?;
+                check_travel(setup.pulse_maps, &rest)?;
                 let target = if kind == Kind::StandUp {
                     stance_angles::<M>(setup)?
                 } else {
