@@ -213,8 +213,10 @@ where
         }
         for (m, c) in self.pulse_maps.iter_mut().zip(&self.calibration) {
             // Each calibration was validated when it was loaded, and the defaults are valid:
-            // no map is left refusing every angle.
-            *m = c.pulse_map().unwrap_or(PulseMap::NONE);
+            // no map is left at `PulseMap::NONE`.
+            if let Ok(map) = c.pulse_map() {
+                *m = map;
+            }
         }
         // The stance may not map within a stored calibration: then nothing is held.
         let _ = self.set_body_pose(&Pose::default());
