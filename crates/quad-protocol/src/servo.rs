@@ -61,7 +61,18 @@ const ROUNDED_LOW_BITS: u32 = 0x4400_0000;
 /// The bits of 8192.0: every `half` from it on lies above any valid travel.
 const ROUNDED_END_BITS: u32 = 0x4600_0000;
 
+/// The high halves of the bits of +∞, 512.0 and 8192.0, whose low halves are zero: the high
+/// half of a float's bits compares with them as its whole bits compare with the whole
+/// constants (two bytes instead of four on an 8-bit CPU).
+const INF_HIGH: u16 = (INF_BITS >> 16) as u16;
+/// See [`INF_HIGH`]; signed, so that every negative float (sign bit set) lies below.
+const ROUNDED_LOW_HIGH: i16 = (ROUNDED_LOW_BITS >> 16) as i16;
+/// See [`INF_HIGH`].
+const ROUNDED_END_HIGH: u16 = (ROUNDED_END_BITS >> 16) as u16;
+
 const _: () = {
+    assert!(INF_BITS & 0xffff == 0 && ROUNDED_LOW_BITS & 0xffff == 0);
+    assert!(ROUNDED_END_BITS & 0xffff == 0);
     assert!(f32::from_bits(ROUNDED_LOW_BITS) == 512.0);
     assert!(f32::from_bits(ROUNDED_END_BITS) == 8192.0);
     // A `half` below 512 rounds to at most 512 ticks, one from 8192 to at least 8192.
@@ -327,19 +338,20 @@ impl PulseMap {
         // The comparisons on the bit patterns, equal to the float comparisons they stand for
         // (each float comparison is a library call on the ATmega2560, which maps twelve pulses
         // per command and per servo frame).
-        if angle_rad.to_bits() & !SIGN_BIT >= INF_BITS {
+        if (angle_rad.to_bits() >> 16) as u16 & 0x7fff >= INF_HIGH {
             return Err(Error::NonFiniteAngle);
         }
         // Finite inputs: the only non-finite outcome is ±∞ from the product, never NaN (had
         // one come, its bits would be refused below: no NaN can turn into a pulse).
         let half = self.center_half_us + self.gain_half_us_per_rad * (angle_rad - self.zero_rad);
         let bits = half.to_bits();
+        let high = (bits >> 16) as u16;
         // `half < 512.0`: the sign bit (any negative value, −0) or below 512's bits.
-        if (bits as i32) < ROUNDED_LOW_BITS as i32 {
+        if (high as i16) < ROUNDED_LOW_HIGH {
             return Err(Error::BelowMin);
         }
         // `half >= 8192.0` (+∞ included).
-        if bits >= ROUNDED_END_BITS {
+        if high >= ROUNDED_END_HIGH {
             return Err(Error::AboveMax);
         }
         let ticks = round_half_up_512_8192(bits);
