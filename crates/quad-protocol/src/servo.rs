@@ -179,9 +179,8 @@ impl Calibration {
     pub fn validate(&self) -> Result<(), Error> {
         // Compared as bit patterns: for non-negative floats their order is that of the values,
         // and every NaN, infinity and negative value (sign bit set) lies above the finite
-        // positive bounds, so it is refused as the float comparisons refuse it. The device
-        // validates a calibration with every pulse it maps; on the ATmega2560 each float
-        // comparison is a library call.
+        // positive bounds, so it is refused as the float comparisons refuse it. On the ATmega2560
+        // each float comparison is a library call.
         if self.zero_rad.to_bits() & !SIGN_BIT > ZERO_RAD_LIMIT.to_bits() {
             return Err(Error::BadZero);
         }
@@ -226,7 +225,9 @@ impl Calibration {
     /// Joint angle → pulse width in half-µs (timer ticks of 0.5 µs).
     ///
     /// `half = 2·(center_us + s·(us_per_rad·(angle_rad − zero_rad)))`, rounded half-up, and
-    /// accepted only within `[2·min_us, 2·max_us]`.
+    /// accepted only within `[2·min_us, 2·max_us]` (module docs). Validates the calibration
+    /// with each call: to map many angles through one calibration, use its
+    /// [`Calibration::pulse_map`].
     ///
     /// # Errors
     /// The calibration's own [`Error`] when it is invalid; [`Error::NonFiniteAngle`];
