@@ -25,6 +25,8 @@
 // `sin_cos_fixed`).
 #![feature(asm_experimental_arch)]
 
+pub mod float;
+
 use core::arch::asm;
 use kin_core::math::{poly, SoftFloat, TableEntry};
 use kin_core::Math;
@@ -40,6 +42,9 @@ macro_rules! link_avr_libc {
         // IK moves its results through memory; the saving is in `BENCHMARKS.md`).
         #[link(name = "c")]
         extern "C" {}
+        // The fast `__addsf3`, `__subsf3`, `__mulsf3` in front of avr-libc's (see `float`):
+        // defined here, in the binary's own code, they are the ones linked.
+        $crate::float_primitives!();
     };
 }
 
