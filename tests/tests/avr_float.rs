@@ -21,8 +21,16 @@ use seeded_rng::SplitMix64 as Rng;
 /// Pairs compared per operation.
 const PAIRS: usize = 100_000;
 
-/// The operations compared: name, the firmware's primitive, avr-libc's, the host's.
-const OPERATIONS: [(&str, &str, &str, fn(f32, f32) -> f32); 3] = [
+/// An operation compared: name, the firmware's primitive, avr-libc's, the host's.
+type Operation = (
+    &'static str,
+    &'static str,
+    &'static str,
+    fn(f32, f32) -> f32,
+);
+
+/// The operations compared.
+const OPERATIONS: [Operation; 3] = [
     ("add", "add", "avr-libc add", |a, b| a + b),
     ("sub", "sub", "avr-libc sub", |a, b| a - b),
     ("mul", "mul", "avr-libc mul", |a, b| a * b),

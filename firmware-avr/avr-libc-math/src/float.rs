@@ -10,18 +10,19 @@
 //! operands untouched (`call __addsf3x` or `call __mulsf3x`, then `jmp __fp_round`, exactly
 //! avr-libc's wrappers), so zeros, subnormals, infinities, NaNs, overflow and underflow keep
 //! avr-libc's results to the bit. Hand-written because these three are the firmware's
-//! commonest calls (a body pose spends about a third of its cycles in them) and the fast
-//! path is measured faster than avr-libc's (see `BENCHMARKS.md`); the library keeps every
-//! special case. The emulator test `avr_float` compares the bits with avr-libc's on seeded
-//! pairs of every kind.
+//! commonest calls (the kinematics' arithmetic) and the fast path is measured faster than
+//! avr-libc's (see `BENCHMARKS.md`); the library keeps every special case. The emulator test
+//! `avr_float` compares the bits with avr-libc's on seeded pairs of every kind.
 //!
 //! Which operands take the fast path (decided from the exponents alone, before any register
 //! is changed, so that the fallback sees the arguments as passed):
 //!
-//! - addition and subtraction: both biased exponents in 25..=253. Then the result can neither
-//!   overflow (an exponent of at most 254 after the carry and the rounding) nor fall below the
-//!   normal range (cancellation removes at most 24 bits), and an exact cancellation is `+0`,
-//!   avr-libc's result for it;
+//! - addition and subtraction: both biased exponents in 25..=253, and the magnitudes not equal
+//!   with different signs (an exact cancellation). Then the result can neither overflow (an
+//!   exponent of at most 254 after the carry and the rounding) nor fall below the normal range
+//!   (cancellation removes at most 24 bits). Also one operand ±0 and the other normal (with
+//!   an exponent in 25..=253 when it is A): the result is the other operand, exactly as
+//!   avr-libc returns it;
 //! - multiplication: both exponents in 1..=254 with a result exponent `eA + eB − 127` in
 //!   1..=252, so the rounded result is normal.
 //!
