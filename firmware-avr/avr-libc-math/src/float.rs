@@ -113,36 +113,39 @@ macro_rules! float_primitives {
             "subi r27, 25",
             "cpi r27, 229",
             "brsh 21b",
-            // |A| against |B| (exponent, then the mantissa bits): the larger to A.
+            // t = eB − eA to r30; the larger magnitude to A (by the exponents, by the
+            // mantissas when these are equal), t then −d with d = eA − eB ≥ 0, and A's
+            // exponent to r31 (r27 is not needed any more).
+            "mov r30, r27",
+            "sub r30, r31",
+            "brlo 1f",
+            "brne 2f",
             "cp r22, r18",
             "cpc r23, r19",
             "cpc r24, r20",
-            "cpc r31, r27",
             "breq 8b",
             "brsh 1f",
+            "2:",
             "movw r0, r22",
             "movw r22, r18",
             "movw r18, r0",
             "movw r0, r24",
             "movw r24, r20",
             "movw r20, r0",
-            "mov r0, r31",
-            "mov r31, r27",
-            "mov r27, r0",
             "clr r1",
+            "mov r31, r27",
+            "neg r30",
             // The result's sign (A's) to T; r21 bit 7: the signs differ (a subtraction).
             "1:",
             "bst r25, 7",
             "eor r21, r25",
             "ori r24, 0x80",
             "ori r20, 0x80",
-            // B's mantissa shifted right by d = eA − eB into r20:r19:r18, the guard byte r27
-            // (the eight bits below), and r26, non-zero when any bit lower still is
-            // (sticky). t = −d (mod 256) to r30.
+            // B's mantissa shifted right by d into r20:r19:r18, the guard byte r27 (the
+            // eight bits below), and r26, non-zero when any bit lower still is (sticky).
             "clr r26",
-            "mov r30, r27",
             "clr r27",
-            "sub r30, r31",
+            "tst r30",
             "breq 5f",
             // The shift by k = d mod 8 bits multiplies each byte by f = 2^(8 − k) (r25): the
             // high byte of the product goes to the byte's place, the low byte to the next
@@ -274,13 +277,13 @@ macro_rules! float_primitives {
             "cpi r27, 254",
             "brsh 19b",
             "add r31, r27",
-            "brcs 1f",
-            "cpi r31, 126",
-            "brlo 19b",
-            "rjmp 2f",
-            "1:",
+            "brcc 1f",
             "cpi r31, 122",
             "brsh 19b",
+            "rjmp 2f",
+            "1:",
+            "cpi r31, 126",
+            "brlo 19b",
             // The sign to T, the exponent eA + eB − 126 = s − 124 (a product in [2^47, 2^48))
             // to r21, the mantissas with their leading ones.
             "2:",
