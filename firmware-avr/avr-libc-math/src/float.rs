@@ -95,7 +95,6 @@ macro_rules! float_primitives {
             "or r26, r19",
             "or r26, r18",
             "brne 9b",
-            "7:",
             "ret",
             "__subsf3:",
             "subi r21, 0x80",
@@ -208,27 +207,26 @@ macro_rules! float_primitives {
             "11:",
             "inc r31",
             "rjmp 10f",
-            // Different signs: A − B − (sticky ≠ 0), the guard byte in r0. The sticky bits'
-            // borrow leaves a positive remainder below the guard byte, which r26 ≠ 0 still
-            // stands for. Then normalised (one place at most unless d ≤ 1; the exponent stays
-            // at least 1 since eA ≥ 25).
+            // Different signs: A − B, the guard byte included, the sticky bits jammed into
+            // its lowest bit first: the difference's bits above that one are then those of
+            // the exact difference rounded down, and r26 ≠ 0 still stands for what lies
+            // below. Then normalised (one place at most unless d ≤ 1, and never more than one
+            // with sticky bits; the exponent stays at least 1 since eA ≥ 25).
             "6:",
-            "clr r0",
-            "cp r1, r26",
-            "sbc r0, r27",
+            "cpse r26, r1",
+            "ori r27, 1",
+            "neg r27",
             "sbc r22, r18",
             "sbc r23, r19",
             "sbc r24, r20",
-            "brmi 13f",
+            "brmi 10f",
             "12:",
             "subi r31, 1",
-            "lsl r0",
+            "lsl r27",
             "rol r22",
             "rol r23",
             "rol r24",
             "brpl 12b",
-            "13:",
-            "mov r27, r0",
             // Pack (exponent r31 + 25 over the mantissa without its leading one, the sign
             // from T), then round to nearest even on the packed bits as `__fp_round` does: up
             // when the guard bit is set and a lower bit is, or the result is odd; a carry
