@@ -4,6 +4,8 @@
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt)]
+// `link_avr_libc!` defines the float primitives with `global_asm!`.
+#![feature(asm_experimental_arch)]
 
 avr_libc_math::link_avr_libc!();
 

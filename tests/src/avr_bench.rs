@@ -533,7 +533,7 @@ pub fn measure_motions(fw: &mut BenchFirmware) -> Vec<MotionFigures> {
 }
 
 /// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
-pub const PRIMITIVES: [&str; 20] = [
+pub const PRIMITIVES: [&str; 24] = [
     "add",
     "mul",
     "div",
@@ -554,6 +554,10 @@ pub const PRIMITIVES: [&str; 20] = [
     "AvrLibm::sin_cos_fixed",
     "poly::sin_cos_fixed sin|cos",
     "AvrLibm::sin_cos_fixed sin|cos",
+    "sub",
+    "avr-libc add",
+    "avr-libc sub",
+    "avr-libc mul",
 ];
 
 /// The op id of a primitive of `bench.elf`, by its name in [`PRIMITIVES`].

@@ -7,12 +7,14 @@
 //! It expands to `#[link(name = "m")] extern "C" {}` *in the binary crate*: rustc passes a
 //! binary's own native libraries before the upstream crates, so `-lm` then precedes Rust's
 //! compiler-builtins on the linker command line. Besides the functions named here, the float
-//! primitives `__addsf3`, `__mulsf3`, `__divsf3`, … of the whole program then come from
-//! avr-libc (faster than compiler-builtins' soft-float, and smaller; the per-primitive cycles
-//! are in `BENCHMARKS.md`). The same attribute in this library crate puts `-lm` *after*
-//! compiler-builtins, and then the `extern "C" fn atan2` below silently binds to
-//! compiler-builtins' weak 64-bit `atan2` — wrong values and a large soft-double
-//! implementation. Check the linked ELF with
+//! primitives `__divsf3`, the comparisons, the conversions, … of the whole program then come
+//! from avr-libc (faster than compiler-builtins' soft-float, and smaller; the per-primitive
+//! cycles are in `BENCHMARKS.md`), and `__addsf3`, `__subsf3`, `__mulsf3` from [`float`]: a
+//! fast path in the binary's own code in front of avr-libc's routines (the binary needs
+//! `#![feature(asm_experimental_arch)]` for them). The `#[link(name = "m")]` attribute in
+//! this library crate would put `-lm` *after* compiler-builtins, and then the
+//! `extern "C" fn atan2` below silently binds to compiler-builtins' weak 64-bit `atan2` —
+//! wrong values and a large soft-double implementation. Check the linked ELF with
 //! `avr-nm firmware.elf | grep -E ' (atan2|sqrt|sin|cos)$'`: each must be `T`, not `W` (the
 //! emulator tests do).
 //!
@@ -24,6 +26,8 @@
 // `asm!` on the AVR (the `lpm` of `read_table_cell`, the kernels `atan2_fixed` and
 // `sin_cos_fixed`).
 #![feature(asm_experimental_arch)]
+
+pub mod float;
 
 use core::arch::asm;
 use kin_core::math::{poly, SoftFloat, TableEntry};
@@ -40,6 +44,9 @@ macro_rules! link_avr_libc {
         // IK moves its results through memory; the saving is in `BENCHMARKS.md`).
         #[link(name = "c")]
         extern "C" {}
+        // The fast `__addsf3`, `__subsf3`, `__mulsf3` in front of avr-libc's (see `float`):
+        // defined here, in the binary's own code, they are the ones linked.
+        $crate::float_primitives!();
     };
 }
 

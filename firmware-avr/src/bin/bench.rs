@@ -9,6 +9,8 @@
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt)]
+// `link_avr_libc!` defines the float primitives with `global_asm!`.
+#![feature(asm_experimental_arch)]
 
 use avr_libc_math::{AvrFast, AvrLibm};
 
@@ -50,8 +52,10 @@ static BACKENDS: [Backend; 4] = [
 /// 16 `AvrLibm::atan2_fixed` (the firmware's form of kernel 12, the same bits);
 /// 17 `AvrLibm::sin_cos_fixed` (the firmware's form of kernel 15, the same bits; the sum of
 /// both); 18 `poly::sin_cos_fixed` and 19 `AvrLibm::sin_cos_fixed` one result at a time (the
-/// sine for `b = +0`, else the cosine), for the bit-for-bit comparison.
-static PRIMS: [bench::PrimFn; 20] = [
+/// sine for `b = +0`, else the cosine), for the bit-for-bit comparison; 20 sub; avr-libc's
+/// own path for the float primitives (`avr_libc_math::float` puts a fast path in front of
+/// it), for the bit-for-bit comparison: 21 add, 22 sub, 23 mul.
+static PRIMS: [bench::PrimFn; 24] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -109,7 +113,35 @@ static PRIMS: [bench::PrimFn; 20] = [
             c
         }
     },
+    |a, b| a - b,
+    // SAFETY (these three): the shims below follow the C calling convention.
+    |a, b| unsafe { libc_addsf3(a, b) },
+    |a, b| unsafe { libc_subsf3(a, b) },
+    |a, b| unsafe { libc_mulsf3(a, b) },
 ];
+
+// avr-libc's `__addsf3`, `__subsf3` and `__mulsf3` as `libm.a` has them (its `addsf3.o` and
+// `mulsf3.o`, which the firmware's own definitions replace): the reference of the test
+// `avr_float`.
+core::arch::global_asm!(
+    ".section .text.libc_float_shims,\"ax\",@progbits",
+    "libc_subsf3:",
+    "subi r21, 0x80",
+    "libc_addsf3:",
+    "clr r26",
+    "clr r27",
+    "call __addsf3x",
+    "jmp __fp_round",
+    "libc_mulsf3:",
+    "call __mulsf3x",
+    "jmp __fp_round",
+);
+
+extern "C" {
+    fn libc_addsf3(a: f32, b: f32) -> f32;
+    fn libc_subsf3(a: f32, b: f32) -> f32;
+    fn libc_mulsf3(a: f32, b: f32) -> f32;
+}
 
 #[avr_device::entry]
 fn main() -> ! {
