@@ -13,7 +13,7 @@
 
 use crate::crc;
 use core::fmt;
-use postcard::ser_flavors::Flavor;
+use postcard::ser_flavors::{Flavor, Slice};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
@@ -110,12 +110,9 @@ impl From<postcard::Error> for Error {
 }
 
 /// A postcard flavor that writes the message's bytes into a slice; [`encode_frame`] then adds
-/// the CRC and the COBS encoding in two passes over them.
-struct PlainSlice<'b> {
-    out: &'b mut [u8],
-    /// Next free position.
-    pos: usize,
-}
+/// the CRC and the COBS encoding in two passes over them. postcard's own [`Slice`] flavor does
+/// the stores; this one only decides what is inlined where.
+struct PlainSlice<'b>(Slice<'b>);
 
 impl Flavor for PlainSlice<'_> {
     type Output = usize;
@@ -125,16 +122,31 @@ impl Flavor for PlainSlice<'_> {
     // inlined copies were most of the answer encoder's code).
     #[inline(never)]
     fn try_push(&mut self, data: u8) -> postcard::Result<()> {
-        *self
-            .out
-            .get_mut(self.pos)
-            .ok_or(postcard::Error::SerializeBufferFull)? = data;
-        self.pos += 1;
-        Ok(())
+        self.0.try_push(data)
+    }
+
+    // postcard writes every multi-byte value (an `f32`'s four bytes, a varint) through this:
+    // one bounds check and one copy per value ([`PlainSlice::extend`]) instead of the
+    // default's `try_push` per byte. Inline, so that a value known to take one byte (the
+    // index of most enum variants) still goes straight to `try_push`.
+    #[inline(always)]
+    fn try_extend(&mut self, data: &[u8]) -> postcard::Result<()> {
+        match data {
+            [byte] => self.try_push(*byte),
+            _ => self.extend(data),
+        }
     }
 
     fn finalize(self) -> postcard::Result<usize> {
-        Ok(self.pos)
+        self.0.finalize().map(|written| written.len())
+    }
+}
+
+impl PlainSlice<'_> {
+    /// Appends `data` (out of line: one copy serves every multi-byte value).
+    #[inline(never)]
+    fn extend(&mut self, data: &[u8]) -> postcard::Result<()> {
+        self.0.try_extend(data)
     }
 }
 
@@ -161,7 +173,7 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
     const { assert!(MAX_DECODED_LEN < COBS_BLOCK) };
     // 0x00, the first code byte, the message, the CRC, 0x00.
     let body = out.get_mut(2..).ok_or(Error::BufferFull)?;
-    let n = postcard::serialize_with_flavor(msg, PlainSlice { out: body, pos: 0 })?;
+    let n = postcard::serialize_with_flavor(msg, PlainSlice(Slice::new(body)))?;
     let end = 2 + n + CRC_LEN;
     if n + CRC_LEN > MAX_DECODED_LEN {
         return Err(Error::Oversize);
