@@ -387,23 +387,14 @@ impl<const N: usize> Accumulator<N> {
                 if self.code == 0 {
                     continue; // empty frame
                 }
-                let remaining = &input[i + 1..];
-                let result = self.finish::<T>();
+                let feed = self.finish::<T>(&input[i + 1..]);
                 self.reset();
-                return match result {
-                    Ok(msg) => {
-                        self.frames_ok = self.frames_ok.wrapping_add(1);
-                        Feed::Frame { msg, remaining }
-                    }
-                    Err(error) => {
-                        self.frames_bad = self.frames_bad.wrapping_add(1);
-                        match error {
-                            Error::Oversize => Feed::Oversize { remaining },
-                            Error::BadCrc => Feed::BadCrc { remaining },
-                            error => Feed::BadFrame { error, remaining },
-                        }
-                    }
-                };
+                if let Feed::Frame { .. } = feed {
+                    self.frames_ok = self.frames_ok.wrapping_add(1);
+                } else {
+                    self.frames_bad = self.frames_bad.wrapping_add(1);
+                }
+                return feed;
             }
             if self.overflow {
                 continue;
@@ -424,13 +415,26 @@ impl<const N: usize> Accumulator<N> {
         Feed::NeedMore
     }
 
-    fn finish<T: DeserializeOwned>(&self) -> Result<T, Error> {
+    /// What the frame in the buffer is, `remaining` the input after its delimiter. Builds the
+    /// [`Feed`] where the message is decoded: the message (up to 50 bytes) is not moved through
+    /// a `Result` first, each move a copy on the AVR.
+    fn finish<'a, T: DeserializeOwned>(&self, remaining: &'a [u8]) -> Feed<'a, T> {
         if self.overflow {
-            return Err(Error::Oversize);
+            return Feed::Oversize { remaining };
         }
-        if self.block_left != 0 {
-            return Err(Error::Cobs);
-        }
-        decode_payload(&self.buf[..self.len])
+        let error = if self.block_left != 0 {
+            Error::Cobs
+        } else {
+            match check_crc(&self.buf[..self.len]) {
+                Err(Error::BadCrc) => return Feed::BadCrc { remaining },
+                Err(error) => error,
+                Ok(body) => match postcard::take_from_bytes::<T>(body) {
+                    Ok((msg, [])) => return Feed::Frame { msg, remaining },
+                    Ok(_) => Error::TrailingBytes,
+                    Err(error) => error.into(),
+                },
+            }
+        };
+        Feed::BadFrame { error, remaining }
     }
 }
