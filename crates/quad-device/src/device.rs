@@ -704,7 +704,7 @@ where
                 let j = s.joint as usize;
                 a == limits.min_rad[j] || a == limits.max_rad[j]
             });
-        self.apply(angles, clamped, limited)
+        self.apply(&angles, clamped, limited)
     }
 
     /// `SetJoints`, on angles the range check has found finite (`check_request`).
@@ -717,14 +717,14 @@ where
                 });
             }
         }
-        self.apply(*angles, false, false)
+        self.apply(angles, false, false)
     }
 
     /// Maps all twelve angles through the calibration; commits and drives only when all map.
     #[inline(never)]
     fn apply(
         &mut self,
-        angles_rad: [f32; 12],
+        angles_rad: &[f32; 12],
         clamped: bool,
         limited: bool,
     ) -> Result<(), NackReason> {
@@ -743,16 +743,26 @@ where
                         fault,
                     })?;
         }
-        self.held = Some(Held {
-            angles_rad,
-            pulses_half_us,
-        });
+        // In place: each array is copied once, into the held target (built on the stack and
+        // then moved into place, it was copied twice).
+        match &mut self.held {
+            Some(held) => {
+                held.angles_rad = *angles_rad;
+                held.pulses_half_us = pulses_half_us;
+            }
+            None => {
+                self.held = Some(Held {
+                    angles_rad: *angles_rad,
+                    pulses_half_us,
+                })
+            }
+        }
         self.clamped = clamped;
         self.limited = limited;
         // A direct setpoint takes over from a running motion.
         self.engine.cancel();
         if self.outputs_enabled && self.in_enabling_frame() {
-            self.out_rad = angles_rad;
+            self.out_rad = *angles_rad;
             self.write_out();
         }
         Ok(())
