@@ -606,21 +606,32 @@ where
             .with(Flags::FAILSAFE_ACTIVE, self.failsafe)
             .with(Flags::CALIBRATION_UNSAVED, self.calibration_unsaved)
             .with(Flags::CALIBRATION_DEFAULT, self.calibration_default);
-        // Built in place: each array is copied once, from the held target when there is one.
-        let mut readback = Readback {
-            angles_rad: [0.0; 12],
-            pulses_half_us: [0; 12],
-            flags,
-            frames_ok: self.acc.frames_ok(),
-            frames_bad: self.acc.frames_bad(),
-        };
-        if let Some(h) = &self.held {
-            readback.angles_rad = h.angles_rad;
-            if self.outputs_enabled {
-                readback.pulses_half_us = h.pulses_half_us;
-            }
+        let (frames_ok, frames_bad) = (self.acc.frames_ok(), self.acc.frames_bad());
+        // One arm per case, so that each array is written once, in place (zeroed first and
+        // then copied over from the held target, they were written twice).
+        match &self.held {
+            Some(h) if self.outputs_enabled => Readback {
+                angles_rad: h.angles_rad,
+                pulses_half_us: h.pulses_half_us,
+                flags,
+                frames_ok,
+                frames_bad,
+            },
+            Some(h) => Readback {
+                angles_rad: h.angles_rad,
+                pulses_half_us: [0; 12],
+                flags,
+                frames_ok,
+                frames_bad,
+            },
+            None => Readback {
+                angles_rad: [0.0; 12],
+                pulses_half_us: [0; 12],
+                flags,
+                frames_ok,
+                frames_bad,
+            },
         }
-        readback
     }
 
     /// The twelve calibrations in RAM.
