@@ -185,15 +185,18 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
     out[2 + n] = hi;
     out[3 + n] = lo;
     // COBS from the end: each zero becomes the distance to the next zero (or the delimiter).
-    let mut next = end;
-    for i in (2..end).rev() {
-        if out[i] == 0 {
-            out[i] = (next - i) as u8;
-            next = i;
+    // The distance is counted along (below 254: the assertion above), not computed from
+    // indices: a byte cursor and an 8-bit count per byte on the AVR.
+    let mut distance: u8 = 1;
+    for byte in out[2..end].iter_mut().rev() {
+        if *byte == 0 {
+            *byte = distance;
+            distance = 0;
         }
+        distance += 1;
     }
     out[0] = DELIMITER;
-    out[1] = (next - 1) as u8;
+    out[1] = distance;
     out[end] = DELIMITER;
     Ok(&out[..=end])
 }
