@@ -131,8 +131,10 @@ impl Flavor for PlainSlice<'_> {
     // index of most enum variants) still goes straight to `try_push`.
     #[inline(always)]
     fn try_extend(&mut self, data: &[u8]) -> postcard::Result<()> {
-        match data {
-            [byte] => self.try_push(*byte),
+        match *data {
+            [byte] => self.try_push(byte),
+            [a, b] => self.extend_array([a, b]),
+            [a, b, c, d] => self.extend_array([a, b, c, d]),
             _ => self.extend(data),
         }
     }
@@ -147,6 +149,13 @@ impl PlainSlice<'_> {
     #[inline(never)]
     fn extend(&mut self, data: &[u8]) -> postcard::Result<()> {
         self.0.try_extend(data)
+    }
+
+    /// [`PlainSlice::extend`] for the common lengths (an `f32`, a two-byte varint): the bytes
+    /// arrive in registers and are stored without a copy loop.
+    #[inline(never)]
+    fn extend_array<const N: usize>(&mut self, data: [u8; N]) -> postcard::Result<()> {
+        self.0.try_extend(&data)
     }
 }
 
