@@ -48,7 +48,7 @@ pub const fn update(crc: u16, byte: u8) -> u16 {
 /// `x << 4`, `x >> 3` (high byte) and `x << 5` (low byte), all 8-bit operations, which the
 /// 8-bit AVR does in one instruction each where the 16-bit shifts take two or more.
 #[inline(always)]
-const fn step(hi: u8, lo: u8, byte: u8) -> (u8, u8) {
+pub(crate) const fn step(hi: u8, lo: u8, byte: u8) -> (u8, u8) {
     let x = hi ^ byte;
     let x = x ^ (x >> 4);
     (lo ^ (x << 4) ^ (x >> 3), (x << 5) ^ x)

@@ -110,7 +110,7 @@ impl From<postcard::Error> for Error {
 }
 
 /// A postcard flavor that writes the message's bytes into a slice; [`encode_frame`] then adds
-/// the CRC and the COBS encoding in two passes over them. postcard's own [`Slice`] flavor does
+/// the CRC and the COBS encoding in one pass over them. postcard's own [`Slice`] flavor does
 /// the stores; this one only decides what is inlined where.
 struct PlainSlice<'b>(Slice<'b>);
 
@@ -165,11 +165,11 @@ const COBS_BLOCK: usize = 254;
 /// Serializes `msg`, appends its CRC, COBS-encodes everything and puts it between two `0x00`
 /// delimiters, in `out`. Returns the frame (a prefix of `out`).
 ///
-/// The message's bytes go into `out` as they are; then one pass computes the CRC and one pass
-/// from the end replaces each `0x00` with the distance to the next (COBS for a frame of fewer
-/// than 254 decoded bytes, which every frame of this protocol is: [`MAX_DECODED_LEN`]). Two
-/// tight loops over the bytes instead of the CRC and COBS steps per serialized byte: fewer
-/// cycles per answer on the ATmega2560.
+/// The message's bytes go into `out` as they are; then one pass over them computes the CRC
+/// and replaces each `0x00` with the distance to the next (COBS for a frame of fewer than 254
+/// decoded bytes, which every frame of this protocol is: [`MAX_DECODED_LEN`]). One tight loop
+/// over the bytes instead of the CRC and COBS steps per serialized byte: fewer cycles per
+/// answer on the ATmega2560.
 ///
 /// # Errors
 /// [`Error::BufferFull`] when `out` is too small ([`MAX_FRAME_LEN`] is always enough for this
@@ -190,23 +190,41 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
     if end >= out.len() {
         return Err(Error::BufferFull);
     }
-    let [hi, lo] = crc::checksum(&out[2..2 + n]).to_be_bytes();
-    out[2 + n] = hi;
-    out[3 + n] = lo;
-    // COBS from the end: each zero becomes the distance to the next zero (or the delimiter).
-    // The distance is counted along (below 254: the assertion above), not computed from
-    // indices: a byte cursor and an 8-bit count per byte on the AVR.
+    // One pass from the start computes the CRC and does the COBS of the message's bytes: each
+    // zero becomes the distance to the next zero (or the delimiter), written into the code
+    // byte that waits for it (`code`) when that zero is met. The distance is counted along
+    // (below 254: the assertion above), an 8-bit count per byte on the AVR.
+    let (head, tail) = out.split_at_mut(2 + n);
+    let [start, first_code, message @ ..] = head else {
+        unreachable!("out holds 2 + n bytes and more")
+    };
+    let [crc_hi, crc_lo, stop, ..] = tail else {
+        unreachable!("end < out.len()")
+    };
+    let [mut hi, mut lo] = crc::INIT.to_be_bytes();
+    let mut code = first_code;
     let mut distance: u8 = 1;
-    for byte in out[2..end].iter_mut().rev() {
+    for byte in message.iter_mut() {
+        (hi, lo) = crc::step(hi, lo, *byte);
         if *byte == 0 {
-            *byte = distance;
+            *code = distance;
+            code = byte;
             distance = 0;
         }
         distance += 1;
     }
-    out[0] = DELIMITER;
-    out[1] = distance;
-    out[end] = DELIMITER;
+    [*crc_hi, *crc_lo] = crc::finish(u16::from_be_bytes([hi, lo])).to_be_bytes();
+    for byte in [crc_hi, crc_lo] {
+        if *byte == 0 {
+            *code = distance;
+            code = byte;
+            distance = 0;
+        }
+        distance += 1;
+    }
+    *code = distance;
+    *start = DELIMITER;
+    *stop = DELIMITER;
     Ok(&out[..=end])
 }
 
