@@ -400,49 +400,73 @@ impl<const N: usize> Accumulator<N> {
         }
     }
 
-    fn push(&mut self, byte: u8) {
-        if self.len < N {
-            self.buf[self.len] = byte;
-            self.len += 1;
-        } else {
-            self.overflow = true;
-        }
-    }
-
     /// Consumes `input` up to and including the first delimiter that ends a non-empty frame,
     /// and reports that frame; or consumes everything and returns [`Feed::NeedMore`].
     pub fn feed<'a, T: DeserializeOwned>(&mut self, input: &'a [u8]) -> Feed<'a, T> {
+        let Some(end) = self.scan(input) else {
+            return Feed::NeedMore;
+        };
+        let feed = self.finish::<T>(&input[end + 1..]);
+        self.reset();
+        if let Feed::Frame { .. } = feed {
+            self.frames_ok = self.frames_ok.wrapping_add(1);
+        } else {
+            self.frames_bad = self.frames_bad.wrapping_add(1);
+        }
+        feed
+    }
+
+    /// Decodes the COBS of `input` into the buffer up to the first delimiter that ends a
+    /// non-empty frame and returns that delimiter's index (the frame is then complete in the
+    /// buffer), or decodes all of `input` and returns `None`.
+    ///
+    /// The state lives in locals through the loop and is stored back once: kept in the
+    /// fields, it was loaded and stored at every byte on the AVR (every received byte passes
+    /// here).
+    fn scan(&mut self, input: &[u8]) -> Option<usize> {
+        let mut len = self.len;
+        let mut block_left = self.block_left;
+        let mut code = self.code;
+        let mut overflow = self.overflow;
+        let mut push = |len: &mut usize, byte: u8| {
+            if let Some(slot) = self.buf.get_mut(*len) {
+                *slot = byte;
+                *len += 1;
+                false
+            } else {
+                true
+            }
+        };
+        let mut end = None;
         for (i, &byte) in input.iter().enumerate() {
             if byte == DELIMITER {
-                if self.code == 0 {
+                if code == 0 {
                     continue; // empty frame
                 }
-                let feed = self.finish::<T>(&input[i + 1..]);
-                self.reset();
-                if let Feed::Frame { .. } = feed {
-                    self.frames_ok = self.frames_ok.wrapping_add(1);
-                } else {
-                    self.frames_bad = self.frames_bad.wrapping_add(1);
-                }
-                return feed;
+                end = Some(i);
+                break;
             }
-            if self.overflow {
+            if overflow {
                 continue;
             }
-            if self.block_left == 0 {
+            if block_left == 0 {
                 // A code byte. The block before it, unless it was a full 0xFF block, ended in
                 // an implicit zero.
-                if self.code != 0 && self.code != 0xFF {
-                    self.push(0);
+                if code != 0 && code != 0xFF {
+                    overflow = push(&mut len, 0);
                 }
-                self.code = byte;
-                self.block_left = byte - 1;
+                code = byte;
+                block_left = byte - 1;
             } else {
-                self.push(byte);
-                self.block_left -= 1;
+                overflow = push(&mut len, byte);
+                block_left -= 1;
             }
         }
-        Feed::NeedMore
+        self.len = len;
+        self.block_left = block_left;
+        self.code = code;
+        self.overflow = overflow;
+        end
     }
 
     /// What the frame in the buffer is, `remaining` the input after its delimiter. Builds the
