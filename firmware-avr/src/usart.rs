@@ -192,6 +192,25 @@ impl Ring {
         self.tail.store(tail.wrapping_add(1));
         Some(byte)
     }
+
+    /// Consumer: moves the bytes waiting (as many as fit in `out`), oldest first, into `out`
+    /// and returns how many; the indices are read and written once for all of them.
+    #[inline(always)]
+    fn pop_into(&self, out: &mut [u8]) -> usize {
+        let tail = self.tail.load();
+        let n = usize::from(self.head.load().wrapping_sub(tail)).min(out.len());
+        compiler_fence(Ordering::Acquire);
+        let mut at = tail;
+        for slot in &mut out[..n] {
+            // SAFETY: the producer published the slots from `tail` to `head` and does not
+            // touch them until `tail` moves past them.
+            *slot = unsafe { (*self.buf.get())[usize::from(at & MASK)] };
+            at = at.wrapping_add(1);
+        }
+        compiler_fence(Ordering::Release);
+        self.tail.store(at);
+        n
+    }
 }
 
 /// Received bytes: produced by `USART0_RX`, consumed by the main loop.
@@ -229,17 +248,10 @@ impl Usart0 {
     }
 
     /// Moves the received bytes, oldest first, into `buf` (as many as fit); returns how many.
-    /// Lock-free: the receive interrupt stays enabled throughout.
+    /// Lock-free: the receive interrupt stays enabled throughout. The bytes that arrive while
+    /// it copies are left for the next call.
     pub fn read_into(&mut self, buf: &mut [u8]) -> usize {
-        let mut n = 0;
-        for slot in buf.iter_mut() {
-            match RX.pop() {
-                Some(b) => *slot = b,
-                None => break,
-            }
-            n += 1;
-        }
-        n
+        RX.pop_into(buf)
     }
 
     /// Queues `bytes` for the transmit interrupt and returns; waits (interrupts on) only while
