@@ -482,11 +482,19 @@ impl<const N: usize> Accumulator<N> {
             match check_crc(&self.buf[..self.len]) {
                 Err(Error::BadCrc) => return Feed::BadCrc { remaining },
                 Err(error) => error,
-                Ok(body) => match postcard::take_from_bytes::<T>(body) {
-                    Ok((msg, [])) => return Feed::Frame { msg, remaining },
-                    Ok(_) => Error::TrailingBytes,
-                    Err(error) => error.into(),
-                },
+                Ok(body) => {
+                    // postcard's `take_from_bytes` without its `(message, rest)` tuple, one
+                    // more move of the message.
+                    let mut de = postcard::Deserializer::from_bytes(body);
+                    match T::deserialize(&mut de) {
+                        Ok(msg) => match de.finalize() {
+                            Ok([]) => return Feed::Frame { msg, remaining },
+                            Ok(_) => Error::TrailingBytes,
+                            Err(error) => error.into(),
+                        },
+                        Err(error) => error.into(),
+                    }
+                }
             }
         };
         Feed::BadFrame { error, remaining }
