@@ -177,6 +177,23 @@ impl Ring {
         true
     }
 
+    /// Producer: appends as many of `bytes` as there is room for and returns how many; the
+    /// room is computed once, and each byte is published as soon as it is stored.
+    #[inline(always)]
+    fn push_from(&self, bytes: &[u8]) -> usize {
+        let mut head = self.head.load();
+        let room = RING_CAPACITY - usize::from(head.wrapping_sub(self.tail.load()));
+        let n = room.min(bytes.len());
+        for &byte in &bytes[..n] {
+            // SAFETY: the slot at `head` is not published to the consumer until `head` moves.
+            unsafe { (*self.buf.get())[usize::from(head & MASK)] = byte };
+            head = head.wrapping_add(1);
+            compiler_fence(Ordering::Release);
+            self.head.store(head);
+        }
+        n
+    }
+
     /// Consumer: takes the oldest byte.
     #[inline(always)]
     fn pop(&self) -> Option<u8> {
@@ -257,17 +274,22 @@ impl Usart0 {
     /// Queues `bytes` for the transmit interrupt and returns; waits (interrupts on) only while
     /// the transmit ring is full.
     pub fn send(&mut self, bytes: &[u8]) {
-        for (i, &b) in bytes.iter().enumerate() {
-            while !TX.push(b) {
-                // Full: make sure the transmitter is draining it.
-                self.start_transmitter();
-            }
-            if i == 0 {
-                // The first byte leaves while the others are queued.
-                self.start_transmitter();
-            }
+        let Some((&first, mut rest)) = bytes.split_first() else {
+            return;
+        };
+        while !TX.push(first) {
+            // Full: make sure the transmitter is draining it.
+            self.start_transmitter();
         }
+        // The first byte leaves while the others are queued.
         self.start_transmitter();
+        while !rest.is_empty() {
+            let n = TX.push_from(rest);
+            rest = &rest[n..];
+            // Draining (and, when the ring was full, waited on: the loop comes back as soon as
+            // the interrupt has made room).
+            self.start_transmitter();
+        }
     }
 
     fn start_transmitter(&mut self) {
