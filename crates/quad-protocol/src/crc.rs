@@ -23,6 +23,11 @@ pub const POLY: u16 = 0x1021;
 /// Final XOR applied to the register to give the CRC ([`finish`]).
 pub const XOROUT: u16 = 0xFFFF;
 
+/// The register after a message and its CRC (big-endian) were fed in ([`INIT`], then
+/// [`update`] per byte): the same for every message, so a receiver that feeds the CRC along
+/// with the message checks it by comparing the register with this value.
+pub const RESIDUE: u16 = 0x1D0F;
+
 /// The CRC of the bytes fed into the register `crc` so far ([`INIT`], then [`update`] per
 /// byte): the register with [`XOROUT`] applied.
 #[inline]
@@ -139,7 +144,7 @@ mod tests {
         let crc = checksum(&data[..9]).to_be_bytes();
         data[9..].copy_from_slice(&crc);
         let register = data.iter().fold(INIT, |c, &b| update(c, b));
-        assert_eq!(register, 0x1D0F);
+        assert_eq!(register, RESIDUE);
     }
 
     #[test]

@@ -3,9 +3,9 @@
 //! - [`encode_frame`] serializes a message into the output buffer, appends the CRC
 //!   ([`crate::crc`]) and COBS-encodes the bytes in place, between two `0x00` delimiters.
 //! - [`Accumulator`] takes received bytes in any chunking, decodes COBS on the fly into a
-//!   bounded buffer of `N` bytes, checks the CRC and deserializes at each delimiter. The caller
-//!   loops on [`Feed::remaining`] until [`Feed::NeedMore`] so that back-to-back frames in one
-//!   read are all seen.
+//!   bounded buffer of `N` bytes, feeding the CRC as the bytes come, and at each delimiter
+//!   checks the CRC and deserializes. The caller loops on [`Feed::remaining`] until
+//!   [`Feed::NeedMore`] so that back-to-back frames in one read are all seen.
 //!
 //! Empty frames (two delimiters in a row) are ignored. Every frame **starts** with a delimiter
 //! too: it ends whatever a receiver holds from line noise or a truncated frame, so the next good
@@ -302,8 +302,11 @@ impl<'a, T> Feed<'a, T> {
     }
 }
 
+/// [`crc::INIT`] as the accumulator keeps it.
+const CRC_INIT: (u8, u8) = (crc::INIT.to_be_bytes()[0], crc::INIT.to_be_bytes()[1]);
+
 /// Receives a byte stream and yields one [`Feed`] per delimiter-terminated frame, with `N`
-/// bytes of buffer for the decoded frame (postcard bytes + CRC). Memory: `N` bytes plus 13 bytes
+/// bytes of buffer for the decoded frame (postcard bytes + CRC). Memory: `N` bytes plus 15 bytes
 /// of state on the AVR (16-bit `usize`).
 ///
 /// ```
@@ -341,6 +344,9 @@ pub struct Accumulator<const N: usize> {
     /// Code byte of the current block; 0 = no byte of this frame seen yet.
     code: u8,
     overflow: bool,
+    /// The CRC register over the decoded bytes so far (high, low byte), fed as they come:
+    /// at the delimiter it is [`crc::RESIDUE`] when the frame's CRC matches.
+    crc: (u8, u8),
     frames_ok: u32,
     frames_bad: u32,
 }
@@ -360,6 +366,7 @@ impl<const N: usize> Accumulator<N> {
             block_left: 0,
             code: 0,
             overflow: false,
+            crc: CRC_INIT,
             frames_ok: 0,
             frames_bad: 0,
         }
@@ -371,6 +378,7 @@ impl<const N: usize> Accumulator<N> {
         self.block_left = 0;
         self.code = 0;
         self.overflow = false;
+        self.crc = CRC_INIT;
     }
 
     /// Frames that ended in [`Feed::Frame`] (wrapping).
@@ -422,21 +430,15 @@ impl<const N: usize> Accumulator<N> {
     ///
     /// The state lives in locals through the loop and is stored back once: kept in the
     /// fields, it was loaded and stored at every byte on the AVR (every received byte passes
-    /// here).
+    /// here). The CRC is fed here too, byte by byte as the frame arrives, rather than over
+    /// the whole frame once its delimiter is there: the work leaves the time between a
+    /// request's last byte and its answer.
     fn scan(&mut self, input: &[u8]) -> Option<usize> {
         let mut len = self.len;
         let mut block_left = self.block_left;
         let mut code = self.code;
         let mut overflow = self.overflow;
-        let mut push = |len: &mut usize, byte: u8| {
-            if let Some(slot) = self.buf.get_mut(*len) {
-                *slot = byte;
-                *len += 1;
-                false
-            } else {
-                true
-            }
-        };
+        let (mut hi, mut lo) = self.crc;
         let mut end = None;
         for (i, &byte) in input.iter().enumerate() {
             if byte == DELIMITER {
@@ -449,23 +451,35 @@ impl<const N: usize> Accumulator<N> {
             if overflow {
                 continue;
             }
-            if block_left == 0 {
+            let decoded = if block_left == 0 {
                 // A code byte. The block before it, unless it was a full 0xFF block, ended in
                 // an implicit zero.
-                if code != 0 && code != 0xFF {
-                    overflow = push(&mut len, 0);
-                }
+                let implicit_zero = code != 0 && code != 0xFF;
                 code = byte;
                 block_left = byte - 1;
+                if !implicit_zero {
+                    continue;
+                }
+                0
             } else {
-                overflow = push(&mut len, byte);
                 block_left -= 1;
+                byte
+            };
+            // One place that stores a decoded byte (and one copy of the CRC step).
+            match self.buf.get_mut(len) {
+                Some(slot) => {
+                    *slot = decoded;
+                    len += 1;
+                    (hi, lo) = crc::step(hi, lo, decoded);
+                }
+                None => overflow = true,
             }
         }
         self.len = len;
         self.block_left = block_left;
         self.code = code;
         self.overflow = overflow;
+        self.crc = (hi, lo);
         end
     }
 
@@ -479,7 +493,18 @@ impl<const N: usize> Accumulator<N> {
         let error = if self.block_left != 0 {
             Error::Cobs
         } else {
-            match check_crc(&self.buf[..self.len]) {
+            // The register over the message and its CRC is the residue exactly when the CRC
+            // matches (two bytes fed into a CRC register map one to one onto its values), as
+            // `check_crc` finds it.
+            let (hi, lo) = self.crc;
+            let checked = match self.buf[..self.len].split_last_chunk::<CRC_LEN>() {
+                Some((body @ [_, ..], _)) if u16::from_be_bytes([hi, lo]) == crc::RESIDUE => {
+                    Ok(body)
+                }
+                Some(([_, ..], _)) => Err(Error::BadCrc),
+                _ => Err(Error::TooShort),
+            };
+            match checked {
                 Err(Error::BadCrc) => return Feed::BadCrc { remaining },
                 Err(error) => error,
                 Ok(body) => {
