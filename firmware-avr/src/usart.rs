@@ -177,6 +177,26 @@ impl Ring {
         true
     }
 
+    /// Consumer: hands the waiting bytes that lie in one piece (from the oldest up to the
+    /// newest or the end of the buffer, whichever comes first), at most `max`, to `f` where
+    /// they lie, then drops them from the ring.
+    #[inline(always)]
+    fn consume<R>(&self, max: usize, f: impl FnOnce(&[u8]) -> R) -> R {
+        let tail = self.tail.load();
+        let waiting = usize::from(self.head.load().wrapping_sub(tail));
+        compiler_fence(Ordering::Acquire);
+        let start = usize::from(tail & MASK);
+        let n = waiting.min(RING_CAPACITY - start).min(max);
+        // SAFETY: `start + n <= RING_CAPACITY`; the producer published these `n` slots and
+        // does not write them until `tail` moves past them, after `f` returns.
+        let bytes =
+            unsafe { core::slice::from_raw_parts(self.buf.get().cast::<u8>().add(start), n) };
+        let r = f(bytes);
+        compiler_fence(Ordering::Release);
+        self.tail.store(tail.wrapping_add(n as u8));
+        r
+    }
+
     /// Producer: appends as many of `bytes` as there is room for and returns how many; the
     /// room is computed once, and each byte is published as soon as it is stored.
     #[inline(always)]
@@ -269,6 +289,17 @@ impl Usart0 {
     /// it copies are left for the next call.
     pub fn read_into(&mut self, buf: &mut [u8]) -> usize {
         RX.pop_into(buf)
+    }
+
+    /// Hands up to `max` received bytes to `f` where they lie in the receive ring, oldest
+    /// first, and then drops them (when the waiting bytes wrap around the ring's end, the part
+    /// up to it: the rest comes with the next call). No copy; lock-free as
+    /// [`Usart0::read_into`]. The bytes keep their slots while `f` runs: `max` bounds the
+    /// room they take from bytes that arrive meanwhile. An associated function, so that `f`
+    /// may send through the [`Usart0`]: the main loop is the ring's only consumer (do not
+    /// call it from an interrupt handler).
+    pub fn with_received<R>(max: usize, f: impl FnOnce(&[u8]) -> R) -> R {
+        RX.consume(max, f)
     }
 
     /// Queues `bytes` for the transmit interrupt and returns; waits (interrupts on) only while
