@@ -107,18 +107,23 @@ fn new_device(servos: Servos, clock: Clock, eeprom: Eeprom) -> BoardDevice {
 /// 8 instructions per access) — it doubled the firmware's flash.
 #[inline(never)]
 fn serve(device: &mut BoardDevice, usart: &mut Usart0, hold_cycles: u32) {
-    let mut chunk = [0u8; CHUNK];
-    let n = if hold_cycles == 0 {
-        usart.read_into(&mut chunk)
+    if hold_cycles == 0 {
+        // The bytes are read where they lie in the receive ring: no copy.
+        Usart0::with_received(CHUNK, |bytes| {
+            if !bytes.is_empty() {
+                device.receive(bytes, |frame| usart.send(frame));
+            }
+        });
     } else {
-        avr_device::interrupt::free(|_| {
+        let mut chunk = [0u8; CHUNK];
+        let n = avr_device::interrupt::free(|_| {
             let n = usart.read_into(&mut chunk);
             avr_device::asm::delay_cycles(hold_cycles);
             n
-        })
-    };
-    if n > 0 {
-        device.receive(&chunk[..n], |frame| usart.send(frame));
+        });
+        if n > 0 {
+            device.receive(&chunk[..n], |frame| usart.send(frame));
+        }
     }
     device.poll();
 }

@@ -9,6 +9,7 @@
 //! | [`servo`] | 12 servo outputs on the output-compare units of Timer1/3/4/5 (50 Hz, 0.5 µs ticks), applied between pulses without waiting, `embedded_hal::pwm::SetDutyCycle` per channel, `quad_device::ServoOutputs` |
 //! | [`clock`] | millisecond clock on Timer2 (`quad_device::Clock`) |
 //! | [`eeprom`] | the EEPROM as calibration storage (`quad_device::Storage`) |
+//! | [`mem`] | `memcpy` and `memset`, four bytes per loop step |
 //! | [`usart`] | USART0: receive and transmit by interrupt through lock-free rings |
 //! | [`watchdog`] | watchdog enable/feed and the reset cause |
 //! | [`stack`] | SRAM painting at boot and the high-water mark of the stack |
@@ -34,6 +35,7 @@ pub mod app;
 pub mod bench;
 pub mod clock;
 pub mod eeprom;
+pub mod mem;
 pub mod servo;
 pub mod stack;
 pub mod usart;

@@ -177,6 +177,43 @@ impl Ring {
         true
     }
 
+    /// Consumer: hands the waiting bytes that lie in one piece (from the oldest up to the
+    /// newest or the end of the buffer, whichever comes first), at most `max`, to `f` where
+    /// they lie, then drops them from the ring.
+    #[inline(always)]
+    fn consume<R>(&self, max: usize, f: impl FnOnce(&[u8]) -> R) -> R {
+        let tail = self.tail.load();
+        let waiting = usize::from(self.head.load().wrapping_sub(tail));
+        compiler_fence(Ordering::Acquire);
+        let start = usize::from(tail & MASK);
+        let n = waiting.min(RING_CAPACITY - start).min(max);
+        // SAFETY: `start + n <= RING_CAPACITY`; the producer published these `n` slots and
+        // does not write them until `tail` moves past them, after `f` returns.
+        let bytes =
+            unsafe { core::slice::from_raw_parts(self.buf.get().cast::<u8>().add(start), n) };
+        let r = f(bytes);
+        compiler_fence(Ordering::Release);
+        self.tail.store(tail.wrapping_add(n as u8));
+        r
+    }
+
+    /// Producer: appends as many of `bytes` as there is room for and returns how many; the
+    /// room is computed once, and each byte is published as soon as it is stored.
+    #[inline(always)]
+    fn push_from(&self, bytes: &[u8]) -> usize {
+        let mut head = self.head.load();
+        let room = RING_CAPACITY - usize::from(head.wrapping_sub(self.tail.load()));
+        let n = room.min(bytes.len());
+        for &byte in &bytes[..n] {
+            // SAFETY: the slot at `head` is not published to the consumer until `head` moves.
+            unsafe { (*self.buf.get())[usize::from(head & MASK)] = byte };
+            head = head.wrapping_add(1);
+            compiler_fence(Ordering::Release);
+            self.head.store(head);
+        }
+        n
+    }
+
     /// Consumer: takes the oldest byte.
     #[inline(always)]
     fn pop(&self) -> Option<u8> {
@@ -191,6 +228,25 @@ impl Ring {
         compiler_fence(Ordering::Release);
         self.tail.store(tail.wrapping_add(1));
         Some(byte)
+    }
+
+    /// Consumer: moves the bytes waiting (as many as fit in `out`), oldest first, into `out`
+    /// and returns how many; the indices are read and written once for all of them.
+    #[inline(always)]
+    fn pop_into(&self, out: &mut [u8]) -> usize {
+        let tail = self.tail.load();
+        let n = usize::from(self.head.load().wrapping_sub(tail)).min(out.len());
+        compiler_fence(Ordering::Acquire);
+        let mut at = tail;
+        for slot in &mut out[..n] {
+            // SAFETY: the producer published the slots from `tail` to `head` and does not
+            // touch them until `tail` moves past them.
+            *slot = unsafe { (*self.buf.get())[usize::from(at & MASK)] };
+            at = at.wrapping_add(1);
+        }
+        compiler_fence(Ordering::Release);
+        self.tail.store(at);
+        n
     }
 }
 
@@ -229,33 +285,42 @@ impl Usart0 {
     }
 
     /// Moves the received bytes, oldest first, into `buf` (as many as fit); returns how many.
-    /// Lock-free: the receive interrupt stays enabled throughout.
+    /// Lock-free: the receive interrupt stays enabled throughout. The bytes that arrive while
+    /// it copies are left for the next call.
     pub fn read_into(&mut self, buf: &mut [u8]) -> usize {
-        let mut n = 0;
-        for slot in buf.iter_mut() {
-            match RX.pop() {
-                Some(b) => *slot = b,
-                None => break,
-            }
-            n += 1;
-        }
-        n
+        RX.pop_into(buf)
+    }
+
+    /// Hands up to `max` received bytes to `f` where they lie in the receive ring, oldest
+    /// first, and then drops them (when the waiting bytes wrap around the ring's end, the part
+    /// up to it: the rest comes with the next call). No copy; lock-free as
+    /// [`Usart0::read_into`]. The bytes keep their slots while `f` runs: `max` bounds the
+    /// room they take from bytes that arrive meanwhile. An associated function, so that `f`
+    /// may send through the [`Usart0`]: the main loop is the ring's only consumer (do not
+    /// call it from an interrupt handler).
+    pub fn with_received<R>(max: usize, f: impl FnOnce(&[u8]) -> R) -> R {
+        RX.consume(max, f)
     }
 
     /// Queues `bytes` for the transmit interrupt and returns; waits (interrupts on) only while
     /// the transmit ring is full.
     pub fn send(&mut self, bytes: &[u8]) {
-        for (i, &b) in bytes.iter().enumerate() {
-            while !TX.push(b) {
-                // Full: make sure the transmitter is draining it.
-                self.start_transmitter();
-            }
-            if i == 0 {
-                // The first byte leaves while the others are queued.
-                self.start_transmitter();
-            }
+        let Some((&first, mut rest)) = bytes.split_first() else {
+            return;
+        };
+        while !TX.push(first) {
+            // Full: make sure the transmitter is draining it.
+            self.start_transmitter();
         }
+        // The first byte leaves while the others are queued.
         self.start_transmitter();
+        while !rest.is_empty() {
+            let n = TX.push_from(rest);
+            rest = &rest[n..];
+            // Draining (and, when the ring was full, waited on: the loop comes back as soon as
+            // the interrupt has made room).
+            self.start_transmitter();
+        }
     }
 
     fn start_transmitter(&mut self) {

@@ -249,15 +249,16 @@ where
     /// not be encoded) and the bytes left; `None` when no frame ended in `bytes`. Not generic
     /// over the caller's closure, so that the firmware has one instance of it.
     fn receive_one<'a>(&mut self, bytes: &'a [u8]) -> Option<(usize, &'a [u8])> {
-        let (reason, remaining) = match feed_request(&mut self.acc, bytes) {
+        // The request is read where the decoder put it (bound by reference, not moved out).
+        let (reason, remaining) = match &feed_request(&mut self.acc, bytes) {
             Feed::NeedMore => return None,
             Feed::Frame { msg, remaining } => {
-                let answer = self.handle(msg);
+                let answer = self.handle_ref(msg);
                 return Some((self.encode(&answer), remaining));
             }
-            Feed::BadCrc { remaining } => (NackReason::BadCrc, remaining),
-            Feed::BadFrame { remaining, .. } => (NackReason::BadFrame, remaining),
-            Feed::Oversize { remaining } => (NackReason::Oversize, remaining),
+            Feed::BadCrc { remaining } => (NackReason::BadCrc, *remaining),
+            Feed::BadFrame { remaining, .. } => (NackReason::BadFrame, *remaining),
+            Feed::Oversize { remaining } => (NackReason::Oversize, *remaining),
         };
         let now = self.clock.now_ms();
         let due = self
@@ -457,11 +458,17 @@ where
 
     /// Handles one decoded request (what [`Device::receive`] does for every valid frame) and
     /// returns the answer.
-    #[inline(never)]
     pub fn handle(&mut self, msg: HostToDevice) -> DeviceToHost {
+        self.handle_ref(&msg)
+    }
+
+    /// [`Device::handle`] on a borrowed request: [`Device::receive`] hands it the request
+    /// where the decoder left it (a copy of up to 50 bytes fewer per request on the AVR).
+    #[inline(never)]
+    fn handle_ref(&mut self, msg: &HostToDevice) -> DeviceToHost {
         self.last_valid_ms = self.clock.now_ms();
         self.failsafe_armed = true;
-        let answer = self.answer(&msg);
+        let answer = self.answer(msg);
         // Latched until an answer reports it (only the readback carries the flags).
         if answer.readback().is_some() {
             self.failsafe = false;
@@ -610,21 +617,32 @@ where
             .with(Flags::FAILSAFE_ACTIVE, self.failsafe)
             .with(Flags::CALIBRATION_UNSAVED, self.calibration_unsaved)
             .with(Flags::CALIBRATION_DEFAULT, self.calibration_default);
-        // Built in place: each array is copied once, from the held target when there is one.
-        let mut readback = Readback {
-            angles_rad: [0.0; 12],
-            pulses_half_us: [0; 12],
-            flags,
-            frames_ok: self.acc.frames_ok(),
-            frames_bad: self.acc.frames_bad(),
-        };
-        if let Some(h) = &self.held {
-            readback.angles_rad = h.angles_rad;
-            if self.outputs_enabled {
-                readback.pulses_half_us = h.pulses_half_us;
-            }
+        let (frames_ok, frames_bad) = (self.acc.frames_ok(), self.acc.frames_bad());
+        // One arm per case, so that each array is written once, in place (zeroed first and
+        // then copied over from the held target, they were written twice).
+        match &self.held {
+            Some(h) if self.outputs_enabled => Readback {
+                angles_rad: h.angles_rad,
+                pulses_half_us: h.pulses_half_us,
+                flags,
+                frames_ok,
+                frames_bad,
+            },
+            Some(h) => Readback {
+                angles_rad: h.angles_rad,
+                pulses_half_us: [0; 12],
+                flags,
+                frames_ok,
+                frames_bad,
+            },
+            None => Readback {
+                angles_rad: [0.0; 12],
+                pulses_half_us: [0; 12],
+                flags,
+                frames_ok,
+                frames_bad,
+            },
         }
-        readback
     }
 
     /// The twelve calibrations in RAM.
@@ -708,7 +726,7 @@ where
                 let j = s.joint as usize;
                 a == limits.min_rad[j] || a == limits.max_rad[j]
             });
-        self.apply(angles, clamped, limited)
+        self.apply(&angles, clamped, limited)
     }
 
     /// `SetJoints`, on angles the range check has found finite (`check_request`).
@@ -721,14 +739,14 @@ where
                 });
             }
         }
-        self.apply(*angles, false, false)
+        self.apply(angles, false, false)
     }
 
     /// Maps all twelve angles through the calibration; commits and drives only when all map.
     #[inline(never)]
     fn apply(
         &mut self,
-        angles_rad: [f32; 12],
+        angles_rad: &[f32; 12],
         clamped: bool,
         limited: bool,
     ) -> Result<(), NackReason> {
@@ -747,16 +765,26 @@ where
                         fault,
                     })?;
         }
-        self.held = Some(Held {
-            angles_rad,
-            pulses_half_us,
-        });
+        // In place: each array is copied once, into the held target (built on the stack and
+        // then moved into place, it was copied twice).
+        match &mut self.held {
+            Some(held) => {
+                held.angles_rad = *angles_rad;
+                held.pulses_half_us = pulses_half_us;
+            }
+            None => {
+                self.held = Some(Held {
+                    angles_rad: *angles_rad,
+                    pulses_half_us,
+                })
+            }
+        }
         self.clamped = clamped;
         self.limited = limited;
         // A direct setpoint takes over from a running motion.
         self.engine.cancel();
         if self.outputs_enabled && self.in_enabling_frame() {
-            self.out_rad = angles_rad;
+            self.out_rad = *angles_rad;
             self.write_out();
         }
         Ok(())

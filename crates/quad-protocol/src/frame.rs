@@ -3,9 +3,9 @@
 //! - [`encode_frame`] serializes a message into the output buffer, appends the CRC
 //!   ([`crate::crc`]) and COBS-encodes the bytes in place, between two `0x00` delimiters.
 //! - [`Accumulator`] takes received bytes in any chunking, decodes COBS on the fly into a
-//!   bounded buffer of `N` bytes, checks the CRC and deserializes at each delimiter. The caller
-//!   loops on [`Feed::remaining`] until [`Feed::NeedMore`] so that back-to-back frames in one
-//!   read are all seen.
+//!   bounded buffer of `N` bytes, feeding the CRC as the bytes come, and at each delimiter
+//!   checks the CRC and deserializes. The caller loops on [`Feed::remaining`] until
+//!   [`Feed::NeedMore`] so that back-to-back frames in one read are all seen.
 //!
 //! Empty frames (two delimiters in a row) are ignored. Every frame **starts** with a delimiter
 //! too: it ends whatever a receiver holds from line noise or a truncated frame, so the next good
@@ -13,7 +13,7 @@
 
 use crate::crc;
 use core::fmt;
-use postcard::ser_flavors::Flavor;
+use postcard::ser_flavors::{Flavor, Slice};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
@@ -110,12 +110,9 @@ impl From<postcard::Error> for Error {
 }
 
 /// A postcard flavor that writes the message's bytes into a slice; [`encode_frame`] then adds
-/// the CRC and the COBS encoding in two passes over them.
-struct PlainSlice<'b> {
-    out: &'b mut [u8],
-    /// Next free position.
-    pos: usize,
-}
+/// the CRC and the COBS encoding in one pass over them. postcard's own [`Slice`] flavor does
+/// the stores; this one only decides what is inlined where.
+struct PlainSlice<'b>(Slice<'b>);
 
 impl Flavor for PlainSlice<'_> {
     type Output = usize;
@@ -125,16 +122,40 @@ impl Flavor for PlainSlice<'_> {
     // inlined copies were most of the answer encoder's code).
     #[inline(never)]
     fn try_push(&mut self, data: u8) -> postcard::Result<()> {
-        *self
-            .out
-            .get_mut(self.pos)
-            .ok_or(postcard::Error::SerializeBufferFull)? = data;
-        self.pos += 1;
-        Ok(())
+        self.0.try_push(data)
+    }
+
+    // postcard writes every multi-byte value (an `f32`'s four bytes, a varint) through this:
+    // one bounds check and one copy per value ([`PlainSlice::extend`]) instead of the
+    // default's `try_push` per byte. Inline, so that a value known to take one byte (the
+    // index of most enum variants) still goes straight to `try_push`.
+    #[inline(always)]
+    fn try_extend(&mut self, data: &[u8]) -> postcard::Result<()> {
+        match *data {
+            [byte] => self.try_push(byte),
+            [a, b] => self.extend_array([a, b]),
+            [a, b, c, d] => self.extend_array([a, b, c, d]),
+            _ => self.extend(data),
+        }
     }
 
     fn finalize(self) -> postcard::Result<usize> {
-        Ok(self.pos)
+        self.0.finalize().map(|written| written.len())
+    }
+}
+
+impl PlainSlice<'_> {
+    /// Appends `data` (out of line: one copy serves every multi-byte value).
+    #[inline(never)]
+    fn extend(&mut self, data: &[u8]) -> postcard::Result<()> {
+        self.0.try_extend(data)
+    }
+
+    /// [`PlainSlice::extend`] for the common lengths (an `f32`, a two-byte varint): the bytes
+    /// arrive in registers and are stored without a copy loop.
+    #[inline(never)]
+    fn extend_array<const N: usize>(&mut self, data: [u8; N]) -> postcard::Result<()> {
+        self.0.try_extend(&data)
     }
 }
 
@@ -144,11 +165,11 @@ const COBS_BLOCK: usize = 254;
 /// Serializes `msg`, appends its CRC, COBS-encodes everything and puts it between two `0x00`
 /// delimiters, in `out`. Returns the frame (a prefix of `out`).
 ///
-/// The message's bytes go into `out` as they are; then one pass computes the CRC and one pass
-/// from the end replaces each `0x00` with the distance to the next (COBS for a frame of fewer
-/// than 254 decoded bytes, which every frame of this protocol is: [`MAX_DECODED_LEN`]). Two
-/// tight loops over the bytes instead of the CRC and COBS steps per serialized byte: fewer
-/// cycles per answer on the ATmega2560.
+/// The message's bytes go into `out` as they are; then one pass over them computes the CRC
+/// and replaces each `0x00` with the distance to the next (COBS for a frame of fewer than 254
+/// decoded bytes, which every frame of this protocol is: [`MAX_DECODED_LEN`]). One tight loop
+/// over the bytes instead of the CRC and COBS steps per serialized byte: fewer cycles per
+/// answer on the ATmega2560.
 ///
 /// # Errors
 /// [`Error::BufferFull`] when `out` is too small ([`MAX_FRAME_LEN`] is always enough for this
@@ -161,7 +182,7 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
     const { assert!(MAX_DECODED_LEN < COBS_BLOCK) };
     // 0x00, the first code byte, the message, the CRC, 0x00.
     let body = out.get_mut(2..).ok_or(Error::BufferFull)?;
-    let n = postcard::serialize_with_flavor(msg, PlainSlice { out: body, pos: 0 })?;
+    let n = postcard::serialize_with_flavor(msg, PlainSlice(Slice::new(body)))?;
     let end = 2 + n + CRC_LEN;
     if n + CRC_LEN > MAX_DECODED_LEN {
         return Err(Error::Oversize);
@@ -169,20 +190,41 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
     if end >= out.len() {
         return Err(Error::BufferFull);
     }
-    let [hi, lo] = crc::checksum(&out[2..2 + n]).to_be_bytes();
-    out[2 + n] = hi;
-    out[3 + n] = lo;
-    // COBS from the end: each zero becomes the distance to the next zero (or the delimiter).
-    let mut next = end;
-    for i in (2..end).rev() {
-        if out[i] == 0 {
-            out[i] = (next - i) as u8;
-            next = i;
+    // One pass from the start computes the CRC and does the COBS of the message's bytes: each
+    // zero becomes the distance to the next zero (or the delimiter), written into the code
+    // byte that waits for it (`code`) when that zero is met. The distance is counted along
+    // (below 254: the assertion above), an 8-bit count per byte on the AVR.
+    let (head, tail) = out.split_at_mut(2 + n);
+    let [start, first_code, message @ ..] = head else {
+        unreachable!("out holds 2 + n bytes and more")
+    };
+    let [crc_hi, crc_lo, stop, ..] = tail else {
+        unreachable!("end < out.len()")
+    };
+    let [mut hi, mut lo] = crc::INIT.to_be_bytes();
+    let mut code = first_code;
+    let mut distance: u8 = 1;
+    for byte in message.iter_mut() {
+        (hi, lo) = crc::step(hi, lo, *byte);
+        if *byte == 0 {
+            *code = distance;
+            code = byte;
+            distance = 0;
         }
+        distance += 1;
     }
-    out[0] = DELIMITER;
-    out[1] = (next - 1) as u8;
-    out[end] = DELIMITER;
+    [*crc_hi, *crc_lo] = crc::finish(u16::from_be_bytes([hi, lo])).to_be_bytes();
+    for byte in [crc_hi, crc_lo] {
+        if *byte == 0 {
+            *code = distance;
+            code = byte;
+            distance = 0;
+        }
+        distance += 1;
+    }
+    *code = distance;
+    *start = DELIMITER;
+    *stop = DELIMITER;
     Ok(&out[..=end])
 }
 
@@ -260,8 +302,11 @@ impl<'a, T> Feed<'a, T> {
     }
 }
 
+/// [`crc::INIT`] as the accumulator keeps it.
+const CRC_INIT: (u8, u8) = (crc::INIT.to_be_bytes()[0], crc::INIT.to_be_bytes()[1]);
+
 /// Receives a byte stream and yields one [`Feed`] per delimiter-terminated frame, with `N`
-/// bytes of buffer for the decoded frame (postcard bytes + CRC). Memory: `N` bytes plus 13 bytes
+/// bytes of buffer for the decoded frame (postcard bytes + CRC). Memory: `N` bytes plus 15 bytes
 /// of state on the AVR (16-bit `usize`).
 ///
 /// ```
@@ -299,6 +344,9 @@ pub struct Accumulator<const N: usize> {
     /// Code byte of the current block; 0 = no byte of this frame seen yet.
     code: u8,
     overflow: bool,
+    /// The CRC register over the decoded bytes so far (high, low byte), fed as they come:
+    /// at the delimiter it is [`crc::RESIDUE`] when the frame's CRC matches.
+    crc: (u8, u8),
     frames_ok: u32,
     frames_bad: u32,
 }
@@ -318,6 +366,7 @@ impl<const N: usize> Accumulator<N> {
             block_left: 0,
             code: 0,
             overflow: false,
+            crc: CRC_INIT,
             frames_ok: 0,
             frames_bad: 0,
         }
@@ -329,6 +378,7 @@ impl<const N: usize> Accumulator<N> {
         self.block_left = 0;
         self.code = 0;
         self.overflow = false;
+        self.crc = CRC_INIT;
     }
 
     /// Frames that ended in [`Feed::Frame`] (wrapping).
@@ -358,67 +408,120 @@ impl<const N: usize> Accumulator<N> {
         }
     }
 
-    fn push(&mut self, byte: u8) {
-        if self.len < N {
-            self.buf[self.len] = byte;
-            self.len += 1;
-        } else {
-            self.overflow = true;
-        }
-    }
-
     /// Consumes `input` up to and including the first delimiter that ends a non-empty frame,
     /// and reports that frame; or consumes everything and returns [`Feed::NeedMore`].
     pub fn feed<'a, T: DeserializeOwned>(&mut self, input: &'a [u8]) -> Feed<'a, T> {
-        for (i, &byte) in input.iter().enumerate() {
-            if byte == DELIMITER {
-                if self.code == 0 {
-                    continue; // empty frame
-                }
-                let remaining = &input[i + 1..];
-                let result = self.finish::<T>();
-                self.reset();
-                return match result {
-                    Ok(msg) => {
-                        self.frames_ok = self.frames_ok.wrapping_add(1);
-                        Feed::Frame { msg, remaining }
-                    }
-                    Err(error) => {
-                        self.frames_bad = self.frames_bad.wrapping_add(1);
-                        match error {
-                            Error::Oversize => Feed::Oversize { remaining },
-                            Error::BadCrc => Feed::BadCrc { remaining },
-                            error => Feed::BadFrame { error, remaining },
-                        }
-                    }
-                };
-            }
-            if self.overflow {
-                continue;
-            }
-            if self.block_left == 0 {
-                // A code byte. The block before it, unless it was a full 0xFF block, ended in
-                // an implicit zero.
-                if self.code != 0 && self.code != 0xFF {
-                    self.push(0);
-                }
-                self.code = byte;
-                self.block_left = byte - 1;
-            } else {
-                self.push(byte);
-                self.block_left -= 1;
-            }
+        let Some(end) = self.scan(input) else {
+            return Feed::NeedMore;
+        };
+        let feed = self.finish::<T>(&input[end + 1..]);
+        self.reset();
+        if let Feed::Frame { .. } = feed {
+            self.frames_ok = self.frames_ok.wrapping_add(1);
+        } else {
+            self.frames_bad = self.frames_bad.wrapping_add(1);
         }
-        Feed::NeedMore
+        feed
     }
 
-    fn finish<T: DeserializeOwned>(&self) -> Result<T, Error> {
+    /// Decodes the COBS of `input` into the buffer up to the first delimiter that ends a
+    /// non-empty frame and returns that delimiter's index (the frame is then complete in the
+    /// buffer), or decodes all of `input` and returns `None`.
+    ///
+    /// The state lives in locals through the loop and is stored back once: kept in the
+    /// fields, it was loaded and stored at every byte on the AVR (every received byte passes
+    /// here). The CRC is fed here too, byte by byte as the frame arrives, rather than over
+    /// the whole frame once its delimiter is there: the work leaves the time between a
+    /// request's last byte and its answer.
+    fn scan(&mut self, input: &[u8]) -> Option<usize> {
+        let mut len = self.len;
+        let mut block_left = self.block_left;
+        let mut code = self.code;
+        let mut overflow = self.overflow;
+        let (mut hi, mut lo) = self.crc;
+        let mut end = None;
+        for (i, &byte) in input.iter().enumerate() {
+            if byte == DELIMITER {
+                if code == 0 {
+                    continue; // empty frame
+                }
+                end = Some(i);
+                break;
+            }
+            if overflow {
+                continue;
+            }
+            let decoded = if block_left == 0 {
+                // A code byte. The block before it, unless it was a full 0xFF block, ended in
+                // an implicit zero.
+                let implicit_zero = code != 0 && code != 0xFF;
+                code = byte;
+                block_left = byte - 1;
+                if !implicit_zero {
+                    continue;
+                }
+                0
+            } else {
+                block_left -= 1;
+                byte
+            };
+            // One place that stores a decoded byte (and one copy of the CRC step).
+            match self.buf.get_mut(len) {
+                Some(slot) => {
+                    *slot = decoded;
+                    len += 1;
+                    (hi, lo) = crc::step(hi, lo, decoded);
+                }
+                None => overflow = true,
+            }
+        }
+        self.len = len;
+        self.block_left = block_left;
+        self.code = code;
+        self.overflow = overflow;
+        self.crc = (hi, lo);
+        end
+    }
+
+    /// What the frame in the buffer is, `remaining` the input after its delimiter. Builds the
+    /// [`Feed`] where the message is decoded: the message (up to 50 bytes) is not moved through
+    /// a `Result` first, each move a copy on the AVR.
+    fn finish<'a, T: DeserializeOwned>(&self, remaining: &'a [u8]) -> Feed<'a, T> {
         if self.overflow {
-            return Err(Error::Oversize);
+            return Feed::Oversize { remaining };
         }
-        if self.block_left != 0 {
-            return Err(Error::Cobs);
-        }
-        decode_payload(&self.buf[..self.len])
+        let error = if self.block_left != 0 {
+            Error::Cobs
+        } else {
+            // The register over the message and its CRC is the residue exactly when the CRC
+            // matches (two bytes fed into a CRC register map one to one onto its values), as
+            // `check_crc` finds it.
+            let (hi, lo) = self.crc;
+            let checked = match self.buf[..self.len].split_last_chunk::<CRC_LEN>() {
+                Some((body @ [_, ..], _)) if u16::from_be_bytes([hi, lo]) == crc::RESIDUE => {
+                    Ok(body)
+                }
+                Some(([_, ..], _)) => Err(Error::BadCrc),
+                _ => Err(Error::TooShort),
+            };
+            match checked {
+                Err(Error::BadCrc) => return Feed::BadCrc { remaining },
+                Err(error) => error,
+                Ok(body) => {
+                    // postcard's `take_from_bytes` without its `(message, rest)` tuple, one
+                    // more move of the message.
+                    let mut de = postcard::Deserializer::from_bytes(body);
+                    match T::deserialize(&mut de) {
+                        Ok(msg) => match de.finalize() {
+                            Ok([]) => return Feed::Frame { msg, remaining },
+                            Ok(_) => Error::TrailingBytes,
+                            Err(error) => error.into(),
+                        },
+                        Err(error) => error.into(),
+                    }
+                }
+            }
+        };
+        Feed::BadFrame { error, remaining }
     }
 }

@@ -90,7 +90,20 @@ fn first_beyond(values: &[f32], bounds: &[f32]) -> Result<Option<usize>, NackRea
     Ok(values
         .iter()
         .zip(bounds.iter().cycle())
-        .position(|(v, &bound)| v.abs() > bound))
+        .position(|(&v, &bound)| magnitude_beyond(v, bound)))
+}
+
+/// `|v| > bound` for a finite `v`, compared by the bits where that is the same: the bits of
+/// two floats without sign bit order as their values (a NaN bound without sign bit lies above
+/// every finite `|v|`, and `>` against a NaN is false). An integer compare on the AVR instead
+/// of a soft-float call per value; a bound with its sign bit set takes the float compare.
+#[inline]
+fn magnitude_beyond(v: f32, bound: f32) -> bool {
+    if bound.is_sign_negative() {
+        v.abs() > bound
+    } else {
+        v.abs().to_bits() > bound.to_bits()
+    }
 }
 
 /// Checks every field of `request` for `robot` (see the module docs for the ranges).
@@ -228,6 +241,45 @@ mod tests {
 
     /// Computed at compile time, as a device with a constant robot does.
     const RANGES: Ranges = Ranges::of(&ROBOT);
+
+    #[test]
+    fn the_bitwise_magnitude_compare_is_the_float_compare() {
+        let mut rng = seeded_rng::SplitMix64::new(7);
+        let special = [
+            0.0,
+            -0.0,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            PI,
+            -PI,
+            1.0,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ];
+        for case in 0..200_000 {
+            let mut any = || f32::from_bits(rng.next_u64() as u32);
+            let v = match case % 4 {
+                0 => special[case / 4 % special.len()],
+                _ => any(),
+            };
+            let bound = match case % 3 {
+                0 => special[case / 3 % special.len()],
+                1 => f32::from_bits(v.abs().to_bits().wrapping_add(case as u32 % 3) - 1),
+                _ => any(),
+            };
+            if v.is_finite() {
+                assert_eq!(
+                    magnitude_beyond(v, bound),
+                    v.abs() > bound,
+                    "{v:e} {bound:e}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn ranges_computed_once_check_as_the_robot_does() {

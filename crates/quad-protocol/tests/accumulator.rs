@@ -419,6 +419,74 @@ fn encoded_frames_are_the_reference_cobs_of_payload_and_crc() {
     assert_eq!(encode_frame(&too_long[..], &mut buf), Err(Error::Oversize));
 }
 
+/// The frame encoder writes the bytes postcard's own slice serializer writes, for answers
+/// whose values take every varint width (1 to 5 bytes) and any `f32` bits: each frame is the
+/// reference COBS of `postcard::to_slice`'s bytes and their CRC.
+#[test]
+fn encoded_answers_carry_postcards_own_bytes() {
+    let mut rng = seeded_rng::SplitMix64::new(11);
+    // A value of a random varint width: its top bit at a random position.
+    let varint = |rng: &mut seeded_rng::SplitMix64| {
+        let bits = rng.next_u64() % 33;
+        (rng.next_u64() & ((1u64 << bits) - 1)) as u32
+    };
+    for case in 0..2000 {
+        let mut readback = Readback {
+            angles_rad: [0.0; 12],
+            pulses_half_us: [0; 12],
+            flags: Flags(rng.next_u64() as u8),
+            frames_ok: varint(&mut rng),
+            frames_bad: varint(&mut rng),
+        };
+        for (a, p) in readback
+            .angles_rad
+            .iter_mut()
+            .zip(&mut readback.pulses_half_us)
+        {
+            *a = f32::from_bits(rng.next_u64() as u32);
+            *p = varint(&mut rng) as u16;
+        }
+        let seq = varint(&mut rng) as u16;
+        let msg = match case % 4 {
+            0 => DeviceToHost::Ack { seq, readback },
+            1 => DeviceToHost::Configured {
+                seq,
+                setting: Setting::LinkTimeout(LinkTimeout {
+                    timeout_ms: varint(&mut rng) as u16,
+                    action: LinkLossAction::Disable,
+                }),
+                readback,
+            },
+            2 => DeviceToHost::MotionAck {
+                seq,
+                status: MotionStatus {
+                    kind: Some(MotionKind::Walk),
+                    stage: MotionStage::Run,
+                    t_s: f32::from_bits(rng.next_u64() as u32),
+                    phase: f32::from_bits(rng.next_u64() as u32),
+                    fault: None,
+                },
+                readback,
+            },
+            _ => DeviceToHost::Nack {
+                seq: Some(seq),
+                reason: NackReason::UnknownVersion {
+                    supported: varint(&mut rng) as u16,
+                },
+            },
+        };
+        let mut tmp = [0u8; MAX_FRAME_LEN];
+        let payload = postcard::to_slice(&msg, &mut tmp).unwrap().to_vec();
+        let mut decoded = payload.clone();
+        decoded.extend_from_slice(&ref_crc(&payload).to_be_bytes());
+        let mut want = vec![0u8];
+        want.extend(ref_cobs_encode(&decoded));
+        want.push(0);
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        assert_eq!(encode_frame(&msg, &mut buf).unwrap(), &want[..], "{msg:?}");
+    }
+}
+
 #[test]
 fn largest_messages_fit_the_declared_bounds() {
     // Worst-case varints everywhere.
