@@ -25,7 +25,12 @@ const MAX_ANGLE_ERR_DEG: f64 = 0.01;
 fn leg_ik_and_body_pose_stay_within_their_cycle_figures() {
     let elf = build::firmware_elf(build::BENCH).unwrap_or_else(|e| panic!("{e}"));
     let mut fw = BenchFirmware::boot(&elf);
-    let figures = measure_backend(&mut fw, FIRMWARE_BACKEND, "bench.elf", &avr_bench::targets());
+    let figures = measure_backend(
+        &mut fw,
+        FIRMWARE_BACKEND,
+        "bench.elf",
+        &avr_bench::targets(),
+    );
     println!(
         "{}: leg IK max {} cycles, body pose max {} cycles, max angle error {:.2e}°",
         figures.name, figures.leg_max_cycles, figures.body_max_cycles, figures.max_angle_err_deg
