@@ -125,15 +125,14 @@ macro_rules! float_primitives {
             "breq 8b",
             "brsh 1f",
             "2:",
-            "movw r0, r22",
-            "movw r22, r18",
-            "movw r18, r0",
-            "movw r0, r24",
-            "movw r24, r20",
-            "movw r20, r0",
-            "clr r1",
             "mov r31, r27",
             "neg r30",
+            "movw r26, r22",
+            "movw r22, r18",
+            "movw r18, r26",
+            "movw r26, r24",
+            "movw r24, r20",
+            "movw r20, r26",
             // The result's sign (A's) to T; r21 bit 7: the signs differ (a subtraction).
             "1:",
             "bst r25, 7",
@@ -146,6 +145,8 @@ macro_rules! float_primitives {
             "clr r27",
             "tst r30",
             "breq 5f",
+            "cpi r30, 254",
+            "brsh 7f",
             // The shift by k = d mod 8 bits multiplies each byte by f = 2^(8 − k) (r25): the
             // high byte of the product goes to the byte's place, the low byte to the next
             // lower one. f = 2^(t mod 8), from the low bits of t.
@@ -207,6 +208,19 @@ macro_rules! float_primitives {
             "11:",
             "inc r31",
             "rjmp 10f",
+            // d = 1 or 2: shifted bit by bit, d = 1 (t odd) once.
+            "7:",
+            "lsr r20",
+            "ror r19",
+            "ror r18",
+            "ror r27",
+            "sbrc r30, 0",
+            "rjmp 5b",
+            "lsr r20",
+            "ror r19",
+            "ror r18",
+            "ror r27",
+            "rjmp 5b",
             // Different signs: A − B, the guard byte included, the sticky bits jammed into
             // its lowest bit first: the difference's bits above that one are then those of
             // the exact difference rounded down, and r26 ≠ 0 still stands for what lies
