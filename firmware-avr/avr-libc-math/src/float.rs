@@ -193,19 +193,19 @@ macro_rules! float_primitives {
             "5:",
             "sbrc r21, 7",
             "rjmp 6f",
-            // Same signs: the sum; a carry out shifts it right one place (the bit leaving
-            // the guard byte joins the sticky one).
+            // Same signs: the sum; a carry out shifts it right one place, the guard byte
+            // joining the sticky one first (the rounding asks only whether any bit below the
+            // guard bit is set, in either: its bits that stay in the guard byte may be there
+            // twice, the one leaving it is kept).
             "add r22, r18",
             "adc r23, r19",
             "adc r24, r20",
             "brcc 10f",
+            "or r26, r27",
             "ror r24",
             "ror r23",
             "ror r22",
             "ror r27",
-            "brcc 11f",
-            "ori r26, 1",
-            "11:",
             "inc r31",
             "rjmp 10f",
             // d = 1 or 2: shifted bit by bit, d = 1 (t odd) once.
@@ -308,10 +308,11 @@ macro_rules! float_primitives {
             // The 48-bit product p of r24:r23:r22 (a2 a1 a0) and r20:r19:r18 (b2 b1 b0),
             // bytes p5..p0. a0·b0 and a1·b1 do not overlap: moved to p1:p0 (r27:r26) and
             // p3:p2 (r31:r30). a1·b0 and a0·b1 then complete the product of the low halves,
-            // which fits in p3..p0: no carry leaves p3. p1 and p0 are needed only as the
-            // sticky r26 = p1 | p0. The other products are added from the low place up, p4
-            // (r18, once b0 is used up) and p5 (r19, once b1 is) starting as the first carry
-            // into them; the last carry into p4 and the one into p5 fit (p < 2^48).
+            // which fits in p3..p0: no carry leaves p3. p1 and p0 stay as they are, needed
+            // only as sticky bits by the rounding. The other products are added from the low
+            // place up, p4 (r18, once b0 is used up) and p5 (r19, once b1 is) starting as the
+            // first carry into them; the last carry into p4 and the one into p5 fit
+            // (p < 2^48).
             "mul r22, r18",
             "movw r26, r0",
             "mul r23, r19",
@@ -324,7 +325,6 @@ macro_rules! float_primitives {
             "add r27, r0",
             "adc r30, r1",
             "adc r31, r21",
-            "or r26, r27",
             "mul r24, r18",
             "add r30, r0",
             "adc r31, r1",
@@ -348,7 +348,7 @@ macro_rules! float_primitives {
             "adc r19, r1",
             "clr r1",
             // A product in [2^46, 2^47): one place left, exponent − 1. The mantissa to
-            // r24:r23:r22, the guard byte stays r30 (p1's top bit is in the sticky r26).
+            // r24:r23:r22, the guard byte stays r30 (p1's top bit remains a sticky one).
             "sbrc r19, 7",
             "rjmp 4f",
             "lsl r30",
@@ -360,7 +360,8 @@ macro_rules! float_primitives {
             "mov r24, r19",
             "mov r23, r18",
             "mov r22, r31",
-            // Pack and round as for the sum.
+            // Pack and round as for the sum, the sticky bits p1 | p0 only when the guard
+            // bit is set.
             "lsl r24",
             "lsr r25",
             "ror r24",
@@ -369,6 +370,7 @@ macro_rules! float_primitives {
             "ret",
             "lsl r30",
             "or r30, r26",
+            "or r30, r27",
             "brne 14f",
             "sbrs r22, 0",
             "ret",
