@@ -72,7 +72,7 @@ macro_rules! float_primitives {
             "8:",
             "mov r0, r25",
             "eor r0, r21",
-            "brpl 1f",
+            "brpl 3f",
             "rjmp 9b",
             // A outside 25..=253: A = ±0 with B normal gives B (avr-libc's result, as
             // `0 + B` is exact), anything else avr-libc's path.
@@ -114,7 +114,8 @@ macro_rules! float_primitives {
             "brsh 21b",
             // t = eB − eA to r30; the larger magnitude to A (by the exponents, by the
             // mantissas when these are equal), t then −d with d = eA − eB ≥ 0, and A's
-            // exponent to r31 (r27 is not needed any more).
+            // exponent to r31 (r27 is not needed any more). d = 0 and d > 0 part here, each
+            // with its own copy of the set-up below.
             "mov r30, r27",
             "sub r30, r31",
             "brlo 1f",
@@ -123,7 +124,21 @@ macro_rules! float_primitives {
             "cpc r23, r19",
             "cpc r24, r20",
             "breq 8b",
-            "brsh 1f",
+            "brsh 3f",
+            "movw r26, r22",
+            "movw r22, r18",
+            "movw r18, r26",
+            "movw r26, r24",
+            "movw r24, r20",
+            "movw r20, r26",
+            "3:",
+            "bst r25, 7",
+            "eor r21, r25",
+            "ori r24, 0x80",
+            "ori r20, 0x80",
+            "clr r26",
+            "clr r27",
+            "rjmp 5f",
             "2:",
             "mov r31, r27",
             "neg r30",
@@ -143,8 +158,6 @@ macro_rules! float_primitives {
             // eight bits below), and r26, non-zero when any bit lower still is (sticky).
             "clr r26",
             "clr r27",
-            "tst r30",
-            "breq 5f",
             "cpi r30, 254",
             "brsh 7f",
             // The shift by k = d mod 8 bits multiplies each byte by f = 2^(8 − k) (r25): the
