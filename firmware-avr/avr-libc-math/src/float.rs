@@ -238,7 +238,9 @@ macro_rules! float_primitives {
             // its lowest bit first: the difference's bits above that one are then those of
             // the exact difference rounded down, and r26 ≠ 0 still stands for what lies
             // below. Then normalised (one place at most unless d ≤ 1, and never more than one
-            // with sticky bits; the exponent stays at least 1 since eA ≥ 25).
+            // with sticky bits; the exponent stays at least 1 since eA ≥ 25): the first place
+            // with the guard byte, further ones without it (d ≤ 1 leaves at most its top bit
+            // set, shifted out by the first).
             "6:",
             "cpse r26, r1",
             "ori r27, 1",
@@ -247,10 +249,15 @@ macro_rules! float_primitives {
             "sbc r23, r19",
             "sbc r24, r20",
             "brmi 10f",
-            "12:",
             "subi r31, 1",
             "lsl r27",
             "rol r22",
+            "rol r23",
+            "rol r24",
+            "brmi 10f",
+            "12:",
+            "subi r31, 1",
+            "lsl r22",
             "rol r23",
             "rol r24",
             "brpl 12b",
