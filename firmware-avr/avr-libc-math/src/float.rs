@@ -170,28 +170,10 @@ macro_rules! float_primitives {
             "lsl r25",
             "sbrc r30, 2",
             "swap r25",
+            // d < 8: only the bits, from the lowest byte (the guard byte is zero); d ≥ 8
+            // takes the bytes first (4:, out of line: the rarer case).
             "cpi r30, 249",
-            "brsh 3f",
-            // d ≥ 8: whole bytes first, what leaves the guard byte joining the sticky one
-            // (d ≥ 32 as d = 32: all of B sticky), then the k bits, the guard byte's low
-            // product to the sticky one. d < 8: only the bits, from the lowest byte (the
-            // guard byte is zero).
-            "cpi r30, 225",
-            "brsh 2f",
-            "ldi r30, 224",
-            "2:",
-            "or r26, r27",
-            "mov r27, r18",
-            "mov r18, r19",
-            "mov r19, r20",
-            "clr r20",
-            "subi r30, 0xf8",
-            "breq 5f",
-            "cpi r30, 249",
-            "brlo 2b",
-            "mul r27, r25",
-            "or r26, r0",
-            "mov r27, r1",
+            "brlo 4f",
             "3:",
             "mul r18, r25",
             "or r27, r0",
@@ -221,6 +203,27 @@ macro_rules! float_primitives {
             "ror r27",
             "inc r31",
             "rjmp 10f",
+            // d ≥ 8: whole bytes first, what leaves the guard byte joining the sticky one
+            // (d ≥ 32 as d = 32: all of B sticky), then the k bits, the guard byte's low
+            // product to the sticky one.
+            "4:",
+            "cpi r30, 225",
+            "brsh 2f",
+            "ldi r30, 224",
+            "2:",
+            "or r26, r27",
+            "mov r27, r18",
+            "mov r18, r19",
+            "mov r19, r20",
+            "clr r20",
+            "subi r30, 0xf8",
+            "breq 5b",
+            "cpi r30, 249",
+            "brlo 2b",
+            "mul r27, r25",
+            "or r26, r0",
+            "mov r27, r1",
+            "rjmp 3b",
             // d = 1 or 2: shifted bit by bit, d = 1 (t odd) once.
             "7:",
             "lsr r20",
