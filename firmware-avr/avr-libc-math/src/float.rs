@@ -114,8 +114,7 @@ macro_rules! float_primitives {
             "brsh 21b",
             // t = eB − eA to r30; the larger magnitude to A (by the exponents, by the
             // mantissas when these are equal), t then −d with d = eA − eB ≥ 0, and A's
-            // exponent to r31 (r27 is not needed any more). d = 0 and d > 0 part here, each
-            // with its own copy of the set-up below.
+            // exponent to r31 (r27 is not needed any more). d = 0 and d > 0 part here.
             "mov r30, r27",
             "sub r30, r31",
             "brlo 1f",
@@ -127,7 +126,7 @@ macro_rules! float_primitives {
             "brsh 3f",
             // d = 0: the guard and sticky bytes stay zero, the sum (commutative) needs no
             // swap, the difference is taken the right way round (B − A into B's registers,
-            // then moved, when B is the larger).
+            // then moved, when B is the larger) and normalised as below (61:).
             "ori r24, 0x80",
             "ori r20, 0x80",
             "clr r26",
