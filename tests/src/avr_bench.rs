@@ -533,7 +533,7 @@ pub fn measure_motions(fw: &mut BenchFirmware) -> Vec<MotionFigures> {
 }
 
 /// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
-pub const PRIMITIVES: [&str; 24] = [
+pub const PRIMITIVES: [&str; 25] = [
     "add",
     "mul",
     "div",
@@ -558,6 +558,7 @@ pub const PRIMITIVES: [&str; 24] = [
     "avr-libc add",
     "avr-libc sub",
     "avr-libc mul",
+    "avr-libc sqrt",
 ];
 
 /// The op id of a primitive of `bench.elf`, by its name in [`PRIMITIVES`].
