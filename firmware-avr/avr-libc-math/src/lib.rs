@@ -64,15 +64,16 @@ extern "C" {
     fn cos(x: f32) -> f32;
 }
 
-/// avr-libc's `sqrt`, `atan2`, `sin` and `cos` (all within 2 ulp of the correctly rounded
-/// result for the arguments the kinematics passes).
+/// avr-libc's `sqrt` (its bits, from [`mod@sqrt`]: correctly rounded), `atan2`, `sin` and
+/// `cos` (within 2 ulp of the correctly rounded result for the arguments the kinematics
+/// passes).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct AvrLibm;
 
 impl Math for AvrLibm {
     #[inline]
     fn sqrt(x: f32) -> f32 {
-        // SAFETY: a pure function of its argument; avr-libc's `sqrt` has no preconditions.
+        // SAFETY: a pure function of its argument, without preconditions (`mod@sqrt`).
         unsafe { sqrt(x) }
     }
 
@@ -867,8 +868,8 @@ fn lpm_word(z: &mut *const u8) -> u16 {
 
 /// The firmware's backend: kin-core's [`SoftFloat`] (the kernels, comparisons and leg staging
 /// for CPUs without floating-point hardware; the host tests run the same choices) over
-/// avr-libc's `sqrt` and [`AvrLibm`]'s reads of the kernels' tables from flash, with all float
-/// arithmetic on avr-libc's primitives. The fastest mix
+/// [`AvrLibm`]'s `sqrt` (avr-libc's bits) and its reads of the kernels' tables from flash,
+/// with all float arithmetic on avr-libc's primitives. The fastest mix
 /// measured in simavr (see `BENCHMARKS.md`).
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by

@@ -10,10 +10,11 @@
 //! subtract and update it on two bytes only. Positive subnormals are normalised and take the
 //! same path. Every other argument — ±0, negative numbers, infinities, NaNs — runs avr-libc's
 //! own opening sequence (`__fp_splitA`, then `__fp_mpack` or `__fp_nan`, as its `sqrt` does),
-//! so those results stay avr-libc's to the bit. Hand-written because `sqrt` is the
-//! kinematics' third commonest float call, and no library offers an AVR square root faster
-//! than avr-libc's. The emulator test `avr_sqrt` compares the bits with avr-libc's `sqrt` (its
-//! `sqrt.o` linked under another name into the benchmark firmware) and with IEEE's.
+//! so those results stay avr-libc's to the bit. Hand-written because every leg and body solve
+//! calls `sqrt` and this version is measured faster than avr-libc's (see `BENCHMARKS.md`),
+//! which stays the reference. The emulator test `avr_sqrt` compares the bits with avr-libc's
+//! `sqrt` (its `sqrt.o` linked under another name into the benchmark firmware) and with the
+//! IEEE square root.
 //!
 //! # The recurrence
 //!
@@ -22,8 +23,9 @@
 //! `Q = ⌊√X⌋` has 24 bits; the result's exponent is `(e + 127) / 2` (rounded down). Step `j`
 //! (root bits from the top) keeps `S = 2U`, the partial remainder scaled to 25 bits (24 bits
 //! and the carry), and the trial `T = P + 2^(22 − j)` where `P` holds the root bits found so
-//! far in place: the root bit is `S ≥ T`, then `U ← S − T` when it is set, and `T` moves on by
-//! adding `K = 2^(22 − j) + 2^(21 − j)` (bit set) or by `T ^ K` (bit clear). The square root
+//! far in place: the root bit is `S ≥ T`; the next `S` is `2·(S − T)` when it is set, `2·S`
+//! when not, and `T` moves on by adding `K = 2^(22 − j) + 2^(21 − j)` (bit set: the bit joins
+//! `P`, the marker moves down) or to `T ^ K` (bit clear: the marker moves down). The square root
 //! of a float is never a rounding midpoint (`(2Q + 1)²` is odd), so rounding to nearest is one
 //! more root bit, without a sticky bit: rounded up when `√X ≥ Q + ½`, which the recurrence
 //! decides with the same trial as its last bit.
@@ -41,10 +43,10 @@
 //! # Registers
 //!
 //! The avr-gcc convention: the argument and the result in r25:r22; r0, r18–r27, r30, r31 and
-//! the flags (T included) are clobbered, r1 is zero on return. The avr-libc members the
-//! firmware links call no `sqrt`.
+//! the flags (T included) are clobbered, r1 is zero on return, as with avr-libc's `sqrt`. No
+//! avr-libc member the firmware links calls `sqrt`.
 
-/// Defines `sqrt` (see the [module docs](crate::sqrt)) in the crate that invokes it;
+/// Defines `sqrt` (see the [module docs](mod@crate::sqrt)) in the crate that invokes it;
 /// [`link_avr_libc!`](crate::link_avr_libc) does, once per binary. Needs
 /// `#![feature(asm_experimental_arch)]` in that crate.
 #[macro_export]

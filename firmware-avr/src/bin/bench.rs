@@ -1,7 +1,7 @@
 //! Cycle benchmark on avr-libc's float routines (see `firmware_avr::bench`).
 //!
 //! Backends: 0 = `AvrLibm` (avr-libc math), 1 = kin-core `Fast` (polynomials), 2 = kin-core
-//! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`, kin-core's `poly::atan2_fixed` in
+//! `Libm` (Rust libm), 3 = `AvrFast` (`sqrt` with avr-libc's bits, kin-core's `poly::atan2_fixed` in
 //! `AvrLibm`'s assembly form and `poly::sin_cos_fixed` with its fixed-point part in
 //! `AvrLibm`'s assembly), all on avr-libc's float primitives
 //! (`__mulsf3`, …).
