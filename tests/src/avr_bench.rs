@@ -53,13 +53,13 @@ const REQUEST_TIMEOUT_CYCLES: u64 = 20_000_000;
 /// The math backends the benchmark firmware serves (its backend ids).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Backend {
-    /// avr-libc's `sqrt`, `atan2`, `sin`, `cos` (`avr_libc_math::AvrLibm`).
+    /// avr-libc's `sqrt` (its bits), `atan2`, `sin`, `cos` (`avr_libc_math::AvrLibm`).
     AvrLibm = 0,
     /// kin-core's polynomial backend `Fast` on avr-libc's float primitives.
     Fast = 1,
     /// kin-core's `Libm` backend (Rust libm); soft-float primitives from whichever ELF.
     Libm = 2,
-    /// The firmware's backend (`avr_libc_math::AvrFast`): avr-libc's `sqrt`, kin-core's
+    /// The firmware's backend (`avr_libc_math::AvrFast`): `sqrt` with avr-libc's bits, kin-core's
     /// `poly::atan2_fixed` and `poly::sin_cos_fixed` (both in `AvrLibm`'s assembly forms).
     AvrFast = 3,
 }
@@ -533,7 +533,7 @@ pub fn measure_motions(fw: &mut BenchFirmware) -> Vec<MotionFigures> {
 }
 
 /// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
-pub const PRIMITIVES: [&str; 24] = [
+pub const PRIMITIVES: [&str; 25] = [
     "add",
     "mul",
     "div",
@@ -558,6 +558,7 @@ pub const PRIMITIVES: [&str; 24] = [
     "avr-libc add",
     "avr-libc sub",
     "avr-libc mul",
+    "avr-libc sqrt",
 ];
 
 /// The op id of a primitive of `bench.elf`, by its name in [`PRIMITIVES`].

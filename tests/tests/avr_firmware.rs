@@ -170,7 +170,8 @@ fn avr_libc_float_routines_are_linked_not_weak_fallbacks() {
     for name in ["sqrt", "__mulsf3", "__addsf3", "__divsf3"] {
         let kind = kind_of(name).unwrap_or_else(|| panic!("{name} not in the firmware"));
         // `__addsf3`/`__mulsf3` are avr-libc-math's fast paths in front of avr-libc's own
-        // routines (`avr_float` checks which); the others avr-libc's. Never a weak fallback.
+        // routines (`avr_float` checks which), `sqrt` avr-libc-math's with avr-libc's bits
+        // (`avr_sqrt`); the others avr-libc's. Never a weak fallback.
         assert_eq!(
             kind, "T",
             "{name} must be a strong symbol (avr-libc's or avr-libc-math's)"

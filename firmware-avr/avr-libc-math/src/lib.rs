@@ -10,7 +10,8 @@
 //! primitives `__divsf3`, the comparisons, the conversions, … of the whole program then come
 //! from avr-libc (faster than compiler-builtins' soft-float, and smaller; the per-primitive
 //! cycles are in `BENCHMARKS.md`), and `__addsf3`, `__subsf3`, `__mulsf3` from [`float`]: a
-//! fast path in the binary's own code in front of avr-libc's routines (the binary needs
+//! fast path in the binary's own code in front of avr-libc's routines, and `sqrt` from
+//! [`mod@sqrt`]: avr-libc's bits in fewer cycles (the binary needs
 //! `#![feature(asm_experimental_arch)]` for them). The `#[link(name = "m")]` attribute in
 //! this library crate would put `-lm` *after* compiler-builtins, and then the
 //! `extern "C" fn atan2` below silently binds to compiler-builtins' weak 64-bit `atan2` —
@@ -28,6 +29,7 @@
 #![feature(asm_experimental_arch)]
 
 pub mod float;
+pub mod sqrt;
 
 use core::arch::asm;
 use kin_core::math::{poly, SoftFloat, TableEntry};
@@ -47,10 +49,14 @@ macro_rules! link_avr_libc {
         // The fast `__addsf3`, `__subsf3`, `__mulsf3` in front of avr-libc's (see `float`):
         // defined here, in the binary's own code, they are the ones linked.
         $crate::float_primitives!();
+        // `sqrt` with avr-libc's bits, faster (see `sqrt`): defined here, `libm.a`'s
+        // `sqrt.o` is never extracted.
+        $crate::sqrt_primitive!();
     };
 }
 
-// Resolved by avr-libc's libm.a, which the binary links through `link_avr_libc!`.
+// Resolved by avr-libc's libm.a, which the binary links through `link_avr_libc!` (`sqrt` by
+// the binary's own definition from `sqrt_primitive!`, avr-libc's results to the bit).
 extern "C" {
     fn sqrt(x: f32) -> f32;
     fn atan2(y: f32, x: f32) -> f32;
@@ -58,15 +64,16 @@ extern "C" {
     fn cos(x: f32) -> f32;
 }
 
-/// avr-libc's `sqrt`, `atan2`, `sin` and `cos` (all within 2 ulp of the correctly rounded
-/// result for the arguments the kinematics passes).
+/// avr-libc's `sqrt` (its bits, from [`mod@sqrt`]: correctly rounded), `atan2`, `sin` and
+/// `cos` (within 2 ulp of the correctly rounded result for the arguments the kinematics
+/// passes).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct AvrLibm;
 
 impl Math for AvrLibm {
     #[inline]
     fn sqrt(x: f32) -> f32 {
-        // SAFETY: a pure function of its argument; avr-libc's `sqrt` has no preconditions.
+        // SAFETY: a pure function of its argument, without preconditions (`mod@sqrt`).
         unsafe { sqrt(x) }
     }
 
@@ -861,8 +868,8 @@ fn lpm_word(z: &mut *const u8) -> u16 {
 
 /// The firmware's backend: kin-core's [`SoftFloat`] (the kernels, comparisons and leg staging
 /// for CPUs without floating-point hardware; the host tests run the same choices) over
-/// avr-libc's `sqrt` and [`AvrLibm`]'s reads of the kernels' tables from flash, with all float
-/// arithmetic on avr-libc's primitives. The fastest mix
+/// [`AvrLibm`]'s `sqrt` (avr-libc's bits) and its reads of the kernels' tables from flash,
+/// with all float arithmetic on avr-libc's primitives. The fastest mix
 /// measured in simavr (see `BENCHMARKS.md`).
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by

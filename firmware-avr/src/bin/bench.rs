@@ -1,7 +1,7 @@
 //! Cycle benchmark on avr-libc's float routines (see `firmware_avr::bench`).
 //!
 //! Backends: 0 = `AvrLibm` (avr-libc math), 1 = kin-core `Fast` (polynomials), 2 = kin-core
-//! `Libm` (Rust libm), 3 = `AvrFast` (avr-libc `sqrt`, kin-core's `poly::atan2_fixed` in
+//! `Libm` (Rust libm), 3 = `AvrFast` (`sqrt` with avr-libc's bits, kin-core's `poly::atan2_fixed` in
 //! `AvrLibm`'s assembly form and `poly::sin_cos_fixed` with its fixed-point part in
 //! `AvrLibm`'s assembly), all on avr-libc's float primitives
 //! (`__mulsf3`, …).
@@ -54,8 +54,9 @@ static BACKENDS: [Backend; 4] = [
 /// both); 18 `poly::sin_cos_fixed` and 19 `AvrLibm::sin_cos_fixed` one result at a time (the
 /// sine for `b = +0`, else the cosine), for the bit-for-bit comparison; 20 sub; avr-libc's
 /// own path for the float primitives (`avr_libc_math::float` puts a fast path in front of
-/// it), for the bit-for-bit comparison: 21 add, 22 sub, 23 mul.
-static PRIMS: [bench::PrimFn; 24] = [
+/// it), for the bit-for-bit comparison: 21 add, 22 sub, 23 mul; 24 avr-libc's own `sqrt`
+/// (`avr_libc_math::sqrt` replaces it; 3 is the firmware's), for the same comparison.
+static PRIMS: [bench::PrimFn; 25] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -118,6 +119,8 @@ static PRIMS: [bench::PrimFn; 24] = [
     |a, b| unsafe { libc_addsf3(a, b) },
     |a, b| unsafe { libc_subsf3(a, b) },
     |a, b| unsafe { libc_mulsf3(a, b) },
+    // SAFETY: a C function of one `double` (32-bit on the AVR), no preconditions.
+    |a, _| unsafe { avr_libc_sqrt(a) },
 ];
 
 // avr-libc's `__addsf3`, `__subsf3` and `__mulsf3` as `libm.a` has them (its `addsf3.o` and
@@ -141,6 +144,9 @@ extern "C" {
     fn libc_addsf3(a: f32, b: f32) -> f32;
     fn libc_subsf3(a: f32, b: f32) -> f32;
     fn libc_mulsf3(a: f32, b: f32) -> f32;
+    // avr-libc's own `sqrt` (`libm.a`'s `sqrt.o`, which the firmware's definition
+    // replaces), linked under this name by the build script: the reference of `avr_sqrt`.
+    fn avr_libc_sqrt(x: f32) -> f32;
 }
 
 #[avr_device::entry]
