@@ -266,16 +266,15 @@ impl<M: Math> Solver<M> {
             rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
         let c = config.pivot_m;
         let offset = pose.translation() + c;
-        let mut out = [Vec3::ZERO; 4];
-        for (i, leg) in LegId::ALL.into_iter().enumerate() {
-            out[i] = foot_in_hip(
+        // Built foot by foot: no zeroed array filled afterwards.
+        core::array::from_fn(|i| {
+            foot_in_hip(
                 &r,
                 feet_in_world[i] - offset,
                 c,
-                leg.at_corner(self.hip_fl_m),
-            );
-        }
-        out
+                LegId::ALL[i].at_corner(self.hip_fl_m),
+            )
+        })
     }
 
     #[inline(always)]
