@@ -401,10 +401,7 @@ impl<M: Math> Solver<M> {
             // solve (the closed form saves a tenth of a body solve's float operations but is
             // a second copy of them; BENCHMARKS.md has both figures).
             let front_left = Vec3::new(self.hip_fl_m.x, self.stance_lateral_m, -stance_height_m);
-            let mut feet = [Vec3::ZERO; 4];
-            for (f, leg) in feet.iter_mut().zip(LegId::ALL) {
-                *f = leg.at_corner(front_left);
-            }
+            let feet = core::array::from_fn(|i| LegId::ALL[i].at_corner(front_left));
             return self.inverse_shared(pose, config, &feet, policy);
         }
         check_finite(pose, config)?;
