@@ -119,13 +119,25 @@ impl BodySolution {
     }
 
     /// The twelve angles flattened `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`.
-    #[inline]
+    #[inline(never)]
     pub fn flat(&self) -> [f32; 12] {
-        let mut out = [0.0; 12];
-        for (o, l) in out.chunks_exact_mut(3).zip(&self.legs) {
-            o.copy_from_slice(&l.angles.to_array());
-        }
-        out
+        // From the fields: no zeroed array filled afterwards.
+        let [a, b, c, d] = &self.legs;
+        let [a, b, c, d] = [a.angles, b.angles, c.angles, d.angles];
+        [
+            a.abduction_rad,
+            a.hip_rad,
+            a.knee_rad,
+            b.abduction_rad,
+            b.hip_rad,
+            b.knee_rad,
+            c.abduction_rad,
+            c.hip_rad,
+            c.knee_rad,
+            d.abduction_rad,
+            d.hip_rad,
+            d.knee_rad,
+        ]
     }
 
     /// True when any leg was clamped.
