@@ -487,9 +487,8 @@ impl<M: Math> Solver<M> {
                 clamped: None,
             }; 4],
         };
-        for (i, leg) in LegId::ALL.into_iter().enumerate() {
-            self.leg
-                .inverse_into(leg, &local[i], policy, &mut out.legs[i])?;
+        for ((s, foot), leg) in out.legs.iter_mut().zip(local).zip(&LegId::ALL) {
+            self.leg.inverse_into(*leg, foot, policy, s)?;
         }
         Ok(out)
     }
