@@ -119,13 +119,25 @@ impl BodySolution {
     }
 
     /// The twelve angles flattened `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`.
-    #[inline]
+    #[inline(never)]
     pub fn flat(&self) -> [f32; 12] {
-        let mut out = [0.0; 12];
-        for (o, l) in out.chunks_exact_mut(3).zip(&self.legs) {
-            o.copy_from_slice(&l.angles.to_array());
-        }
-        out
+        // From the fields: no zeroed array filled afterwards.
+        let [a, b, c, d] = &self.legs;
+        let [a, b, c, d] = [a.angles, b.angles, c.angles, d.angles];
+        [
+            a.abduction_rad,
+            a.hip_rad,
+            a.knee_rad,
+            b.abduction_rad,
+            b.hip_rad,
+            b.knee_rad,
+            c.abduction_rad,
+            c.hip_rad,
+            c.knee_rad,
+            d.abduction_rad,
+            d.hip_rad,
+            d.knee_rad,
+        ]
     }
 
     /// True when any leg was clamped.
@@ -148,12 +160,25 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
     core::array::from_fn(|i| JointAngles::new(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]))
 }
 
-/// One foot in its hip frame: `Rᵀ·v + c − hip` (`v` the foot less the translation and the
-/// pivot). Out of line: one copy of its float operations for the four feet.
+/// The per-request values of the feet-to-hips transform: `R`, the translation plus the pivot
+/// `c` (`offset`), `c`, and the front left hip mount.
+struct FeetToHips<'a> {
+    r: Mat3,
+    offset: Vec3,
+    c: &'a Vec3,
+    hip_fl: &'a Vec3,
+}
+
+/// One foot in its hip frame, written into `out`: `Rᵀ·(foot − offset) + c − hip` (`hip` the
+/// mount of `leg`: the front left one moved to its corner). Out of line: one copy of its
+/// float operations for the four feet. Its inputs by reference and its result written in
+/// place, so that the caller's loop passes addresses only (no vectors copied into its frame
+/// and out of a returned temporary).
 #[inline(never)]
-fn foot_in_hip(r: &Mat3, v: Vec3, c: Vec3, hip: Vec3) -> Vec3 {
-    let p = r.transpose_mul_vec(v);
-    Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z)
+fn foot_in_hip(t: &FeetToHips, foot: &Vec3, out: &mut Vec3, leg: LegId) {
+    let p = t.r.transpose_mul_vec(*foot - t.offset);
+    let (c, hip) = (t.c, leg.at_corner(*t.hip_fl));
+    *out = Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z);
 }
 
 /// Full-body IK on math backend `M` with the robot's constants prepared once (the leg IK's
@@ -246,36 +271,36 @@ impl<M: Math> Solver<M> {
         feet_in_world: &[Vec3; 4],
     ) -> [Vec3; 4] {
         if M::SHARE_FLOAT_CODE {
-            self.feet_in_hips_shared(pose, config, feet_in_world)
+            let mut out = [Vec3::ZERO; 4];
+            self.feet_in_hips_shared(pose, config, feet_in_world, &mut out);
+            out
         } else {
             self.feet_in_hips_inline(pose, config, feet_in_world)
         }
     }
 
-    /// [`Solver::feet_in_hips`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]): the
-    /// general solve and the stance solve ([`Solver::inverse_at_stance`]) share it, and its
-    /// feet go one at a time through one copy of the per-foot transform.
+    /// [`Solver::feet_in_hips`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]), written
+    /// into `out`: the general solve and the stance solve ([`Solver::inverse_at_stance`])
+    /// share it, and its feet go one at a time through one copy of the per-foot transform,
+    /// each straight into its place in `out`.
     #[inline(never)]
     fn feet_in_hips_shared(
         &self,
         pose: &Pose,
         config: &BodyConfig,
         feet_in_world: &[Vec3; 4],
-    ) -> [Vec3; 4] {
-        let r: Mat3 =
-            rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
-        let c = config.pivot_m;
-        let offset = pose.translation() + c;
-        let mut out = [Vec3::ZERO; 4];
-        for (i, leg) in LegId::ALL.into_iter().enumerate() {
-            out[i] = foot_in_hip(
-                &r,
-                feet_in_world[i] - offset,
-                c,
-                leg.at_corner(self.hip_fl_m),
-            );
+        out: &mut [Vec3; 4],
+    ) {
+        let c = &config.pivot_m;
+        let t = FeetToHips {
+            r: rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad),
+            offset: pose.translation() + *c,
+            c,
+            hip_fl: &self.hip_fl_m,
+        };
+        for ((foot, o), leg) in feet_in_world.iter().zip(out.iter_mut()).zip(&LegId::ALL) {
+            foot_in_hip(&t, foot, o, *leg);
         }
-        out
     }
 
     #[inline(always)]
@@ -402,10 +427,7 @@ impl<M: Math> Solver<M> {
             // solve (the closed form saves a tenth of a body solve's float operations but is
             // a second copy of them; BENCHMARKS.md has both figures).
             let front_left = Vec3::new(self.hip_fl_m.x, self.stance_lateral_m, -stance_height_m);
-            let mut feet = [Vec3::ZERO; 4];
-            for (f, leg) in feet.iter_mut().zip(LegId::ALL) {
-                *f = leg.at_corner(front_left);
-            }
+            let feet = core::array::from_fn(|i| LegId::ALL[i].at_corner(front_left));
             return self.inverse_shared(pose, config, &feet, policy);
         }
         check_finite(pose, config)?;
@@ -465,9 +487,8 @@ impl<M: Math> Solver<M> {
                 clamped: None,
             }; 4],
         };
-        for (i, leg) in LegId::ALL.into_iter().enumerate() {
-            self.leg
-                .inverse_into(leg, &local[i], policy, &mut out.legs[i])?;
+        for ((s, foot), leg) in out.legs.iter_mut().zip(local).zip(&LegId::ALL) {
+            self.leg.inverse_into(*leg, foot, policy, s)?;
         }
         Ok(out)
     }

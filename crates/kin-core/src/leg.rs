@@ -29,7 +29,7 @@
 //! The paper's angles θ1, θ2, θ3 relate to the crate's abduction, hip and knee as
 //! [`crate::paper::to_seed000`] says (θ2 = 3π/2 − hip, θ3 = −knee).
 
-use crate::math::{finite, DefaultMath, Math};
+use crate::math::{finite, interval_keys, DefaultMath, Math};
 use crate::robot::{Joint, JointAngles, JointLimits, KneeBend, LegGeometry, LegId, Robot};
 use crate::vec::Vec3;
 use core::fmt;
@@ -275,6 +275,8 @@ pub fn forward_dh(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
 pub struct Solver<M: Math = DefaultMath> {
     geometry: LegGeometry,
     limits: JointLimits,
+    /// The limits' [`crate::math::interval_keys`], computed once for [`Math::within_keys`].
+    limit_keys: [(i32, i32); 3],
     knee_bend: KneeBend,
     c: Consts,
     math: PhantomData<M>,
@@ -435,6 +437,14 @@ impl<M: Math> Solver<M> {
         Solver {
             geometry: robot.leg,
             limits: robot.limits,
+            limit_keys: {
+                let (lo, hi) = (&robot.limits.min_rad, &robot.limits.max_rad);
+                [
+                    interval_keys(lo[0], hi[0]),
+                    interval_keys(lo[1], hi[1]),
+                    interval_keys(lo[2], hi[2]),
+                ]
+            },
             knee_bend: robot.knee_bend,
             c: Consts::of(&robot.leg),
             math: PhantomData,
@@ -453,6 +463,16 @@ impl<M: Math> Solver<M> {
     #[inline]
     pub fn geometry(&self) -> &LegGeometry {
         &self.geometry
+    }
+
+    /// True when all three angles lie within their limits (false for any NaN), compared by
+    /// the backend with the limits' keys computed once ([`Math::within_keys`]).
+    #[inline(always)]
+    fn admits_all(&self, q: JointAngles) -> bool {
+        let (lo, hi, k) = (&self.limits.min_rad, &self.limits.max_rad, &self.limit_keys);
+        M::within_keys(q.abduction_rad, lo[0], hi[0], k[0])
+            & M::within_keys(q.hip_rad, lo[1], hi[1], k[1])
+            & M::within_keys(q.knee_rad, lo[2], hi[2], k[2])
     }
 
     /// `s·d_lat`: the leg plane's offset with the side sign of `leg`.
@@ -519,7 +539,7 @@ impl<M: Math> Solver<M> {
             .solve(self.side_d_lat(leg), target, policy)
             .map_err(err)?;
         // Within the limits also means finite: a NaN fails every comparison.
-        let within = self.limits.admits_all::<M>(angles);
+        let within = self.admits_all(angles);
         let kind = match (within, projected) {
             (true, None) => {
                 return Ok(LegSolution {
@@ -707,7 +727,7 @@ impl<M: Math> Solver<M> {
         // Within the limits (a NaN fails every comparison, so this also rejects non-finite
         // angles).
         for a in &out {
-            ok &= self.limits.admits_all::<M>(*a);
+            ok &= self.admits_all(*a);
         }
         if ok {
             Some(out)

@@ -84,6 +84,15 @@ pub trait Math {
     fn within(x: f32, lo: f32, hi: f32) -> bool {
         (x >= lo) & (x <= hi)
     }
+    /// `lo <= x && x <= hi` (as [`Math::within`]) for a fixed interval whose
+    /// [`interval_keys`] `keys` the caller computed once: the default compares the floats,
+    /// a backend that compares bit patterns ([`SoftFloat`]) compares `x`'s key with `keys`
+    /// (no per-call work on the bounds).
+    #[inline(always)]
+    fn within_keys(x: f32, lo: f32, hi: f32, keys: (i32, i32)) -> bool {
+        let _ = keys;
+        Self::within(x, lo, hi)
+    }
     /// Reads one cell of a fixed-point kernel's table ([`poly::atan2_fixed`],
     /// [`poly::sin_cos_fixed`]): `N` consecutive 16-bit words, see [`TableEntry`]. The only
     /// per-target part of those kernels: the default is a plain load, right wherever the tables
@@ -309,6 +318,11 @@ impl<S: Math> Math for SoftFloat<S> {
     #[inline(always)]
     fn within(x: f32, lo: f32, hi: f32) -> bool {
         bits::within(x, bits::interval(lo, hi))
+    }
+
+    #[inline(always)]
+    fn within_keys(x: f32, _lo: f32, _hi: f32, keys: (i32, i32)) -> bool {
+        bits::within(x, keys)
     }
 
     #[inline(always)]
@@ -939,6 +953,13 @@ pub mod poly {
     }
 }
 
+/// The keys of the closed interval `[lo, hi]` for [`Math::within_keys`]: integers that order
+/// as the floats do (−0 = +0), `(i32::MAX, i32::MIN)` (admitting nothing) when a bound is NaN.
+#[inline]
+pub const fn interval_keys(lo: f32, hi: f32) -> (i32, i32) {
+    bits::interval(lo, hi)
+}
+
 /// `x.is_finite()` from the exponent bits, on every target (core's `is_finite` is a float
 /// comparison, a library call on CPUs without floating-point hardware).
 #[inline(always)]
@@ -1002,8 +1023,10 @@ mod bits {
     /// Keys `(lo, hi)` of a closed interval for [`within`]; an interval with a NaN bound
     /// admits nothing, as the float comparisons do.
     #[inline]
-    pub(super) fn interval(lo: f32, hi: f32) -> (i32, i32) {
-        let nan = |v: f32| v.to_bits() & 0x7fff_ffff > INF;
+    pub(super) const fn interval(lo: f32, hi: f32) -> (i32, i32) {
+        const fn nan(v: f32) -> bool {
+            v.to_bits() & 0x7fff_ffff > INF
+        }
         if nan(lo) || nan(hi) {
             (i32::MAX, i32::MIN)
         } else {
@@ -1580,6 +1603,17 @@ mod tests {
                         bits::within(x, bits::interval(a, b)),
                         x >= a && x <= b,
                         "{a:e} <= {x:e} <= {b:e}"
+                    );
+                    let keys = interval_keys(a, b);
+                    assert_eq!(
+                        SoftFloat::<Libm>::within_keys(x, a, b, keys),
+                        x >= a && x <= b,
+                        "{a:e} <= {x:e} <= {b:e}, keys"
+                    );
+                    assert_eq!(
+                        Fast::within_keys(x, a, b, keys),
+                        x >= a && x <= b,
+                        "{a:e} <= {x:e} <= {b:e}, default"
                     );
                 }
             }

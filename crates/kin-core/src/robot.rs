@@ -1,7 +1,7 @@
 //! Robot description: leg identities, leg geometry, hip mounts, joint limits, knee bend, and the
 //! two presets taken from the papers.
 
-use crate::math::{finite_ordered, nonneg_finite, positive_finite, Math};
+use crate::math::{finite_ordered, nonneg_finite, positive_finite};
 use crate::vec::Vec3;
 use core::fmt;
 
@@ -227,16 +227,6 @@ impl JointLimits {
     pub fn admits(&self, joint: Joint, angle_rad: f32) -> bool {
         let j = joint as usize;
         angle_rad >= self.min_rad[j] && angle_rad <= self.max_rad[j]
-    }
-
-    /// True when all three angles lie within their limits (false for any NaN), compared by
-    /// backend `M` (all backends agree with the float operators; some compare faster).
-    #[inline(always)]
-    pub(crate) fn admits_all<M: Math>(&self, q: JointAngles) -> bool {
-        let (lo, hi) = (&self.min_rad, &self.max_rad);
-        M::within(q.abduction_rad, lo[0], hi[0])
-            & M::within(q.hip_rad, lo[1], hi[1])
-            & M::within(q.knee_rad, lo[2], hi[2])
     }
 
     /// `angles` with each angle clamped into its joint's interval.

@@ -751,7 +751,8 @@ where
         limited: bool,
     ) -> Result<(), NackReason> {
         let mut pulses_half_us = [0u16; 12];
-        for (i, s) in ServoId::ALL.into_iter().enumerate() {
+        // By reference: `into_iter` would copy the servo table into this frame first.
+        for (i, s) in ServoId::ALL.iter().enumerate() {
             let a = angles_rad[i];
             if !a.is_finite() {
                 return Err(NackReason::NonFinite);
