@@ -3,6 +3,7 @@
 //! - [`avr_bench`]: the firmware's IK cycle benchmark (`cargo xtask avr-bench`).
 //! - [`budget`]: the firmware's flash and SRAM against its budget (`cargo xtask ci budget`).
 //! - [`pins`]: a servo pin's step between two pulses against the joint-speed limiter.
+//! - [`symbols`]: which routines a firmware ELF links (`avr-nm`).
 //!
 //! Building the firmware and running it in simavr is `quad_host::emu` (one implementation
 //! for these tests and `quadctl`).
@@ -10,3 +11,4 @@
 pub mod avr_bench;
 pub mod budget;
 pub mod pins;
+pub mod symbols;

@@ -8,6 +8,7 @@
 //! built. All times are simulated.
 
 use integration_tests::avr_bench::{self, STACK_PAINT, STANCE_HEIGHT_M};
+use integration_tests::symbols;
 use kin_core::body::{self, Pose};
 use kin_core::{BodyConfig, ReachPolicy, RotationOrder};
 use quad_host::client::{
@@ -148,42 +149,23 @@ fn assert_pins(got: &[Pulse; 12], want_ticks: &[u16; 12], what: &str) {
     }
 }
 
-fn symbols(elf: &std::path::Path) -> String {
-    let out = Command::new("avr-nm")
-        .arg(elf)
-        .output()
-        .expect("avr-nm (binutils-avr) runs");
-    assert!(out.status.success());
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
 #[test]
 fn avr_libc_float_routines_are_linked_not_weak_fallbacks() {
-    let symbols = symbols(&firmware(build::FIRMWARE));
-    let kind_of = |name: &str| {
-        symbols.lines().find_map(|l| {
-            let mut f = l.split_whitespace();
-            let (_, kind, sym) = (f.next()?, f.next()?, f.next()?);
-            (sym == name).then(|| kind.to_string())
-        })
-    };
+    let symbols = symbols::of_elf(&firmware(build::FIRMWARE));
+    let kind_of = |name: &str| symbols::named(&symbols, name).first().map(|s| s.kind);
     for name in ["sqrt", "__mulsf3", "__addsf3", "__divsf3"] {
         let kind = kind_of(name).unwrap_or_else(|| panic!("{name} not in the firmware"));
         // `__addsf3`/`__mulsf3` are avr-libc-math's fast paths in front of avr-libc's own
         // routines (`avr_float` checks which), `sqrt` avr-libc-math's with avr-libc's bits
         // (`avr_sqrt`); the others avr-libc's. Never a weak fallback.
         assert_eq!(
-            kind, "T",
+            kind, 'T',
             "{name} must be a strong symbol (avr-libc's or avr-libc-math's)"
         );
     }
     // Functions the backend may or may not use: never compiler-builtins' 64-bit fallbacks.
     for name in ["atan2", "sin", "cos", "acos"] {
-        assert_ne!(
-            kind_of(name).as_deref(),
-            Some("W"),
-            "{name} is a weak fallback"
-        );
+        assert_ne!(kind_of(name), Some('W'), "{name} is a weak fallback");
     }
 }
 

@@ -18,9 +18,9 @@
 //! never skip — when it cannot be built.
 
 use integration_tests::avr_bench::{primitive_op as op, BenchFirmware};
+use integration_tests::symbols;
 use quad_host::emu::build;
 use seeded_rng::SplitMix64 as Rng;
-use std::process::Command;
 
 /// Pairs compared per operation.
 const PAIRS: usize = 100_000;
@@ -220,28 +220,16 @@ fn float_primitives_are_avr_libc_bit_for_bit() {
 fn the_fast_primitives_are_linked_not_avr_libc_wrappers() {
     for bin in [build::FIRMWARE, build::BENCH] {
         let elf = build::firmware_elf(bin).unwrap_or_else(|e| panic!("{e}"));
-        let out = Command::new("avr-nm")
-            .arg("-S")
-            .arg(&elf)
-            .output()
-            .expect("avr-nm runs (Debian binutils-avr)");
-        let symbols = String::from_utf8_lossy(&out.stdout);
+        let symbols = symbols::of_elf(&elf);
         for name in ["__addsf3", "__subsf3", "__mulsf3"] {
-            let found: Vec<_> = symbols
-                .lines()
-                .filter(|l| l.split_whitespace().last() == Some(name))
-                .collect();
+            let found = symbols::named(&symbols, name);
             assert_eq!(found.len(), 1, "{bin}: {name} defined once: {found:?}");
             // avr-libc's members are 8 to 14 bytes (`__addsf3` has no size at all); the fast
             // path is longer.
-            let size = found[0]
-                .split_whitespace()
-                .nth(1)
-                .and_then(|s| u32::from_str_radix(s, 16).ok())
-                .filter(|_| found[0].split_whitespace().count() == 4);
+            let size = found[0].size_bytes;
             assert!(
                 size.is_some_and(|s| s > 64),
-                "{bin}: {name} is not the fast path: {}",
+                "{bin}: {name} is not the fast path: {:?}",
                 found[0]
             );
         }

@@ -16,9 +16,9 @@
 //! never skips — when it cannot be built.
 
 use integration_tests::avr_bench::{primitive_op as op, BenchFirmware};
+use integration_tests::symbols;
 use quad_host::emu::build;
 use seeded_rng::SplitMix64 as Rng;
-use std::process::Command;
 
 /// Seeded arguments compared (besides the fixed special cases).
 const ARGUMENTS: usize = 100_000;
@@ -166,19 +166,14 @@ fn sqrt_is_avr_libc_bit_for_bit_and_correctly_rounded() {
 fn the_firmware_links_its_own_sqrt_not_avr_libcs() {
     for bin in [build::FIRMWARE, build::BENCH] {
         let elf = build::firmware_elf(bin).unwrap_or_else(|e| panic!("{e}"));
-        let out = Command::new("avr-nm")
-            .arg(&elf)
-            .output()
-            .expect("avr-nm runs (Debian binutils-avr)");
-        let symbols = String::from_utf8_lossy(&out.stdout);
-        let kinds = |name: &str| -> Vec<String> {
-            symbols
-                .lines()
-                .filter(|l| l.split_whitespace().last() == Some(name))
-                .filter_map(|l| l.split_whitespace().nth(1).map(str::to_string))
+        let symbols = symbols::of_elf(&elf);
+        let kinds = |name: &str| -> Vec<char> {
+            symbols::named(&symbols, name)
+                .iter()
+                .map(|s| s.kind)
                 .collect()
         };
-        assert_eq!(kinds("sqrt"), ["T"], "{bin}: sqrt defined once, strongly");
+        assert_eq!(kinds("sqrt"), ['T'], "{bin}: sqrt defined once, strongly");
         // avr-libc's `sqrt.o` defines `sqrt` and `sqrtf` at one address: its `sqrtf` absent,
         // the member was not extracted (the firmware's `sqrt` replaces it).
         assert!(
