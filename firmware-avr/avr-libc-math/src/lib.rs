@@ -516,6 +516,32 @@ fn sin_cos_fixed(x: f32) -> (f32, f32) {
     })
 }
 
+/// `d·b` of [`sin_cos_fixed_core`]'s cell into `r26:r27:{t2}:{t3}` (low to high), from the
+/// next two table bytes at `Z` (`b`) and `d` in `{dh}:{dl}`: four 8 × 8-bit products
+/// (`{zero}` as in that block). The same lines for the sine and the cosine.
+macro_rules! linear_product {
+    () => {
+        concat!(
+            "lpm {bl}, Z+\n",
+            "lpm {bh}, Z+\n",
+            "mul {dl}, {bl}\n",
+            "mov r26, r0\n",
+            "mov r27, r1\n",
+            "mul {dh}, {bh}\n",
+            "mov {t2}, r0\n",
+            "mov {t3}, r1\n",
+            "mul {dl}, {bh}\n",
+            "add r27, r0\n",
+            "adc {t2}, r1\n",
+            "adc {t3}, {zero}\n",
+            "mul {dh}, {bl}\n",
+            "add r27, r0\n",
+            "adc {t2}, r1\n",
+            "adc {t3}, {zero}\n",
+        )
+    };
+}
+
 /// `(d²·c + 2¹²) >> 13` of [`sin_cos_fixed_core`]'s cell into `{t2}:{t3}:{bl}` (low to high),
 /// from the next two table bytes at `Z` (`c`) and `d²` in `{qh}:{ql}`: bytes 1 to 3 of `d²·c`
 /// (< 2³¹) with the 2¹², three left shifts (`{zero}` and `{e}` as in that block). The same
@@ -668,22 +694,7 @@ extern "C" fn sin_cos_fixed_core(rb: u32) -> u64 {
             "lpm r23, Z+",
             "lpm r24, Z+",
             "lpm r25, Z+",
-            "lpm {bl}, Z+",
-            "lpm {bh}, Z+",
-            "mul {dl}, {bl}",
-            "mov r26, r0",
-            "mov r27, r1",
-            "mul {dh}, {bh}",
-            "mov {t2}, r0",
-            "mov {t3}, r1",
-            "mul {dl}, {bh}",
-            "add r27, r0",
-            "adc {t2}, r1",
-            "adc {t3}, {zero}",
-            "mul {dh}, {bl}",
-            "add r27, r0",
-            "adc {t2}, r1",
-            "adc {t3}, {zero}",
+            linear_product!(),
             "ldi {e}, 0x40",
             "add r26, {e}",
             "adc r27, {zero}",
@@ -711,22 +722,7 @@ extern "C" fn sin_cos_fixed_core(rb: u32) -> u64 {
             "lpm r19, Z+",
             "lpm r20, Z+",
             "lpm r21, Z+",
-            "lpm {bl}, Z+",
-            "lpm {bh}, Z+",
-            "mul {dl}, {bl}",
-            "mov r26, r0",
-            "mov r27, r1",
-            "mul {dh}, {bh}",
-            "mov {t2}, r0",
-            "mov {t3}, r1",
-            "mul {dl}, {bh}",
-            "add r27, r0",
-            "adc {t2}, r1",
-            "adc {t3}, {zero}",
-            "mul {dh}, {bl}",
-            "add r27, r0",
-            "adc {t2}, r1",
-            "adc {t3}, {zero}",
+            linear_product!(),
             "ldi {e}, 0x80",
             "add r26, {e}",
             "adc r27, {zero}",
