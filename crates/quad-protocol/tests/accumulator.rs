@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{ref_cobs_decode, ref_cobs_encode, ref_crc};
+use common::{ref_cobs_decode, ref_cobs_encode, ref_crc, ref_frame};
 use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 use proptest::prelude::*;
 use quad_protocol::frame::Error;
@@ -299,14 +299,7 @@ fn every_single_bit_flip_on_the_wire_loses_only_that_frame() {
 
 #[test]
 fn typed_decode_errors() {
-    fn with_crc(body: &[u8]) -> Vec<u8> {
-        let mut data = body.to_vec();
-        data.extend(ref_crc(body).to_be_bytes());
-        let mut stream = vec![0];
-        stream.extend(ref_cobs_encode(&data));
-        stream.push(0);
-        stream
-    }
+    let with_crc = ref_frame;
     let cases: [(Vec<u8>, Event<HostToDevice>); 6] = [
         // Request variant 200 (varint c8 01): a newer minor's request.
         (
@@ -401,11 +394,7 @@ fn encoded_frames_are_the_reference_cobs_of_payload_and_crc() {
         if payload.len() + 2 > MAX_DECODED_LEN {
             continue;
         }
-        let mut decoded = payload.clone();
-        decoded.extend_from_slice(&ref_crc(&payload).to_be_bytes());
-        let mut want = vec![0u8];
-        want.extend(ref_cobs_encode(&decoded));
-        want.push(0);
+        let want = ref_frame(&payload);
         let mut buf = [0u8; MAX_FRAME_LEN];
         assert_eq!(
             encode_frame(&msg, &mut buf).unwrap(),
@@ -477,11 +466,7 @@ fn encoded_answers_carry_postcards_own_bytes() {
         };
         let mut tmp = [0u8; MAX_FRAME_LEN];
         let payload = postcard::to_slice(&msg, &mut tmp).unwrap().to_vec();
-        let mut decoded = payload.clone();
-        decoded.extend_from_slice(&ref_crc(&payload).to_be_bytes());
-        let mut want = vec![0u8];
-        want.extend(ref_cobs_encode(&decoded));
-        want.push(0);
+        let want = ref_frame(&payload);
         let mut buf = [0u8; MAX_FRAME_LEN];
         assert_eq!(encode_frame(&msg, &mut buf).unwrap(), &want[..], "{msg:?}");
     }
