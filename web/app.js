@@ -25,6 +25,8 @@ const panel = {
   preview: null,
   posesSent: 0,
   lastSent: null,
+  // No pose or stance change in flight or waiting to be sent.
+  get idle() { return !inFlight && pending === null; },
   notSent: 0,
   errors: [],
   done: [],

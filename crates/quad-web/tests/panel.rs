@@ -13,6 +13,11 @@ use std::time::Duration;
 /// dozen requests in seconds.
 const WAIT: Duration = Duration::from_secs(60);
 
+/// True once nothing is in flight or waiting and the device's readback of the last pose the
+/// page sent is drawn.
+const SETTLED: &str = "panel.idle && panel.lastSent && panel.state.pose_id === panel.lastSent.id \
+                       && panel.renderedPoseId === panel.lastSent.id";
+
 fn f64s(v: &Value) -> Vec<f64> {
     v.as_array()
         .unwrap_or_else(|| panic!("an array: {v}"))
@@ -26,11 +31,7 @@ fn f64s(v: &Value) -> Vec<f64> {
 async fn roll_steps(b: &Browser, steps: usize) -> Vec<f64> {
     let key = Key::Right.to_string();
     b.keys("s-roll", &key.repeat(steps)).await;
-    b.wait(
-        "panel.lastSent && panel.state.pose_id === panel.lastSent.id && panel.renderedPoseId === panel.lastSent.id",
-        WAIT,
-    )
-    .await;
+    b.wait(SETTLED, WAIT).await;
     f64s(&b.js("panel.renderedAngles").await)
 }
 
@@ -82,6 +83,9 @@ async fn sim_panel() {
     keep_screenshot(&b.screenshot().await, "panel-unreachable.png", &dir);
     b.keys("s-stance", &Key::Left.to_string().repeat(60)).await;
     b.wait("panel.preview.reachable === true", WAIT).await;
+    // The slider's way back sends poses; the bad-input checks below start from the last one's
+    // readback, not from one still in flight.
+    b.wait(SETTLED, WAIT).await;
 
     // Bad input from a page: each gets a clear error, nothing moves, the server keeps serving.
     let bad = [
