@@ -121,23 +121,13 @@ impl BodySolution {
     /// The twelve angles flattened `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`.
     #[inline(never)]
     pub fn flat(&self) -> [f32; 12] {
-        // From the fields: no zeroed array filled afterwards.
-        let [a, b, c, d] = &self.legs;
-        let [a, b, c, d] = [a.angles, b.angles, c.angles, d.angles];
-        [
-            a.abduction_rad,
-            a.hip_rad,
-            a.knee_rad,
-            b.abduction_rad,
-            b.hip_rad,
-            b.knee_rad,
-            c.abduction_rad,
-            c.hip_rad,
-            c.knee_rad,
-            d.abduction_rad,
-            d.hip_rad,
-            d.knee_rad,
-        ]
+        // A loop (little code) that stores the angles one by one (no copy routine called).
+        let mut out = [0.0; 12];
+        for (o, leg) in out.chunks_exact_mut(3).zip(&self.legs) {
+            let a = &leg.angles;
+            (o[0], o[1], o[2]) = (a.abduction_rad, a.hip_rad, a.knee_rad);
+        }
+        out
     }
 
     /// True when any leg was clamped.
@@ -163,7 +153,7 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
 /// The per-request values of the feet-to-hips transform: `R`, the translation plus the pivot
 /// `c` (`offset`), `c`, and the front left hip mount.
 struct FeetToHips<'a> {
-    r: Mat3,
+    r: &'a Mat3,
     offset: Vec3,
     c: &'a Vec3,
     hip_fl: &'a Vec3,
@@ -179,6 +169,38 @@ fn foot_in_hip(t: &FeetToHips, foot: &Vec3, out: &mut Vec3, leg: LegId) {
     let p = t.r.transpose_mul_vec(*foot - t.offset);
     let (c, hip) = (t.c, leg.at_corner(*t.hip_fl));
     *out = Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z);
+}
+
+/// `out = k·rᵢ`, row `i` of `r` scaled: out of line where float operations are library calls
+/// ([`Math::SHARE_FLOAT_CODE`]).
+#[inline(always)]
+fn scaled_row<M: Math>(r: &Mat3, i: usize, k: f32, out: &mut Vec3) {
+    if M::SHARE_FLOAT_CODE {
+        scaled_row_shared(r, i, k, out);
+    } else {
+        *out = Vec3::from_array(r.rows[i]) * k;
+    }
+}
+
+#[inline(never)]
+fn scaled_row_shared(r: &Mat3, i: usize, k: f32, out: &mut Vec3) {
+    *out = Vec3::from_array(r.rows[i]) * k;
+}
+
+/// `acc += b`: out of line where float operations are library calls
+/// ([`Math::SHARE_FLOAT_CODE`]).
+#[inline(always)]
+fn add_assign<M: Math>(acc: &mut Vec3, b: &Vec3) {
+    if M::SHARE_FLOAT_CODE {
+        add_assign_shared(acc, b);
+    } else {
+        *acc = *acc + *b;
+    }
+}
+
+#[inline(never)]
+fn add_assign_shared(acc: &mut Vec3, b: &Vec3) {
+    *acc = *acc + *b;
 }
 
 /// Full-body IK on math backend `M` with the robot's constants prepared once (the leg IK's
@@ -292,8 +314,9 @@ impl<M: Math> Solver<M> {
         out: &mut [Vec3; 4],
     ) {
         let c = &config.pivot_m;
+        let r = rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
         let t = FeetToHips {
-            r: rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad),
+            r: &r,
             offset: pose.translation() + *c,
             c,
             hip_fl: &self.hip_fl_m,
@@ -334,46 +357,57 @@ impl<M: Math> Solver<M> {
     }
 
     /// The feet of the nominal stance of height `stance_height_m`
-    /// (`foot_in_world = hip_in_body + (0, s·d_lat, −H)`) in each leg's hip frame: the
-    /// transform of [`Solver::feet_in_hips`] in closed form. With `R`'s rows `r₀, r₁, r₂`,
-    /// `foot_in_hip = sx·(L/2·r₀ − (L/2, 0, 0)) + s·((W/2 + d_lat)·r₁ − (0, W/2, 0)) − K` for the
-    /// front/rear sign `sx`, the side sign `s` and `K = Rᵀ·(t + c + (0, 0, H)) − c`: fewer
-    /// operations than the general transform (counted in `BENCHMARKS.md`).
-    #[inline]
+    /// (`foot_in_world = hip_in_body + (0, s·d_lat, −H)`) in each leg's hip frame, written into
+    /// `out`: the transform of [`Solver::feet_in_hips`] in closed form. With `R`'s rows
+    /// `r₀, r₁, r₂`, `foot_in_hip = sx·(L/2·r₀ − (L/2, 0, 0)) + s·((W/2 + d_lat)·r₁ − (0, W/2, 0)) − K`
+    /// for the front/rear sign `sx`, the side sign `s` and `K = Rᵀ·(g + (0, 0, H)) − c`,
+    /// `g = t + c`: 9 multiplications and 27 additions (15 and 33 with a horizontal
+    /// translation or pivot) where the general transform of the four stance feet takes 36 and
+    /// 59. Where float operations are library calls ([`Math::SHARE_FLOAT_CODE`]) its vector
+    /// operations are out of line (`BENCHMARKS.md` has the cycles and the flash).
+    #[inline(never)]
     fn stance_feet_in_hips(
         &self,
         pose: &Pose,
         config: &BodyConfig,
         stance_height_m: f32,
-    ) -> [Vec3; 4] {
-        let r: Mat3 =
-            rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
-        // The rows read where they are used: a copy of the matrix (`rows.map`) would take
-        // another 36 bytes of the stack frame.
-        let row = |i: usize| Vec3::from_array(r.rows[i]);
-        let c = config.pivot_m;
-        let pivot = !is_zero(c);
-        let t = pose.translation();
-        // K = Rᵀ·(t + c) + H·r₂ − c.
-        let k = if !pivot && is_zero(t) {
-            row(2) * stance_height_m
-        } else {
-            let g = if pivot { t + c } else { t };
-            // `− c` whether or not there is a pivot (`c = ±0` then): a test here made the
-            // compiler copy the product above into both of its arms.
-            r.transpose_mul_vec(Vec3::new(g.x, g.y, g.z + stance_height_m)) - c
-        };
+        out: &mut [Vec3; 4],
+    ) {
+        let c = &config.pivot_m;
+        let g = pose.translation() + *c;
+        let r = rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+        // The four feet are built in place, the slots holding the shared terms on the way
+        // (few vectors in the frame: cheap addressing where the frame is addressed by a
+        // short displacement).
+        let [fl, fr, rl, rr] = out;
+        let mut b = Vec3::ZERO;
+        // −K = Rᵀ·(−g − (0, 0, H)) + c to FR, as the rows of R scaled by the components:
+        // −(g_z + H)·r₂ (−H·r₂ without translation and pivot), −g_x·r₀, −g_y·r₁ and c added.
+        scaled_row::<M>(&r, 2, -(g.z + stance_height_m), fr);
+        if !is_zero(Vec3::new(g.x, g.y, 0.0)) {
+            scaled_row::<M>(&r, 0, -g.x, &mut b);
+            add_assign::<M>(fr, &b);
+            scaled_row::<M>(&r, 1, -g.y, &mut b);
+            add_assign::<M>(fr, &b);
+        }
+        add_assign::<M>(fr, c);
+        // a = L/2·r₀ − (L/2, 0, 0) to FL, −a to RL; then the front's a − K and the rear's −a − K.
         let hl = self.hip_fl_m.x;
-        let a = row(0) * hl;
-        let a = Vec3::new(a.x - hl, a.y, a.z);
-        // Front: a − K ± b; rear: −(a + K) ± b (left +, right −). In this order, `a` and `K`
-        // are dead before `b` is computed (fewer values held across the float calls of CPUs
-        // without floating-point hardware).
-        let front = a - k;
-        let rear = -(a + k);
-        let b = row(1) * self.stance_lateral_m;
-        let b = Vec3::new(b.x, b.y - self.hip_fl_m.y, b.z);
-        [front + b, front - b, rear + b, rear - b]
+        scaled_row::<M>(&r, 0, hl, fl);
+        fl.x -= hl;
+        *rl = -*fl;
+        add_assign::<M>(fl, fr);
+        add_assign::<M>(rl, fr);
+        *fr = *fl;
+        *rr = *rl;
+        // ± b, b = (W/2 + d_lat)·r₁ − (0, W/2, 0): left +, right −.
+        scaled_row::<M>(&r, 1, self.stance_lateral_m, &mut b);
+        b.y -= self.hip_fl_m.y;
+        add_assign::<M>(fl, &b);
+        add_assign::<M>(rl, &b);
+        let b = -b;
+        add_assign::<M>(fr, &b);
+        add_assign::<M>(rr, &b);
     }
 
     /// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
@@ -422,16 +456,9 @@ impl<M: Math> Solver<M> {
         stance_height_m: f32,
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
-        if M::SHARE_FLOAT_CODE {
-            // One copy of the body solve in the program: the stance feet through the general
-            // solve (the closed form saves a tenth of a body solve's float operations but is
-            // a second copy of them; BENCHMARKS.md has both figures).
-            let front_left = Vec3::new(self.hip_fl_m.x, self.stance_lateral_m, -stance_height_m);
-            let feet = core::array::from_fn(|i| LegId::ALL[i].at_corner(front_left));
-            return self.inverse_shared(pose, config, &feet, policy);
-        }
         check_finite(pose, config)?;
-        let local = self.stance_feet_in_hips(pose, config, stance_height_m);
+        let mut local = [Vec3::ZERO; 4];
+        self.stance_feet_in_hips(pose, config, stance_height_m, &mut local);
         self.legs(&local, policy)
     }
 
@@ -598,7 +625,8 @@ mod tests {
                         config.pivot_m =
                             Vec3::new(rng.uniform(-0.1, 0.1), 0.0, rng.uniform(-0.1, 0.1));
                     }
-                    let fast = solver.stance_feet_in_hips(&pose, &config, height_m);
+                    let mut fast = [Vec3::ZERO; 4];
+                    solver.stance_feet_in_hips(&pose, &config, height_m, &mut fast);
                     let general = solver.feet_in_hips(&pose, &config, &feet);
                     for (a, b) in fast.iter().zip(&general) {
                         let d = *a - *b;
