@@ -680,7 +680,7 @@ const stick = { active: false, x: 0, y: 0 };
 const keys = new Set();
 const MAX_V = 0.2; // m/s
 const MAX_YAW = 0.5; // rad/s
-// At least 10 Hz with room to spare: the device stops a walk whose velocity is not refreshed
+// 20 Hz, with room to spare: the device stops a walk whose velocity is not refreshed
 // within its timeout (500 ms by default). At most a few commands awaiting their answer, so that
 // a slow server or device gets recent velocities rather than a growing queue of old ones, while
 // a round trip longer than the period (a busy machine) does not lower the rate.
