@@ -121,7 +121,8 @@ impl BodySolution {
     /// The twelve angles flattened `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`.
     #[inline(never)]
     pub fn flat(&self) -> [f32; 12] {
-        // A loop (little code) that stores the angles one by one (no copy routine called).
+        // A loop: little code (the field-by-field array literal wrote the result in place,
+        // 264 cycles faster on the AVR, for 188 B more; BENCHMARKS.md).
         let mut out = [0.0; 12];
         for (o, leg) in out.chunks_exact_mut(3).zip(&self.legs) {
             let a = &leg.angles;
@@ -153,7 +154,7 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
 /// The per-request values of the feet-to-hips transform: `R`, the translation plus the pivot
 /// `c` (`offset`), `c`, and the front left hip mount.
 struct FeetToHips<'a> {
-    r: &'a Mat3,
+    r: Mat3,
     offset: Vec3,
     c: &'a Vec3,
     hip_fl: &'a Vec3,
@@ -314,9 +315,8 @@ impl<M: Math> Solver<M> {
         out: &mut [Vec3; 4],
     ) {
         let c = &config.pivot_m;
-        let r = rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
         let t = FeetToHips {
-            r: &r,
+            r: rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad),
             offset: pose.translation() + *c,
             c,
             hip_fl: &self.hip_fl_m,
