@@ -2,7 +2,8 @@
 //! `avr_libc_sqrt`: the firmware defines `sqrt` itself (`avr_libc_math::sqrt`), so `libm.a`'s
 //! `sqrt.o` is never linked as it stands; the emulator test `avr_sqrt` compares the two bit for
 //! bit. The member is taken from the `libm.a` that avr-gcc links and renamed with
-//! `avr-objcopy`; the other binaries are left alone.
+//! `avr-objcopy`; the other binaries are left alone. Links every binary with the linker's
+//! relaxation (`--relax`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -26,6 +27,11 @@ fn main() {
     if !std::env::var("TARGET").is_ok_and(|t| t.starts_with("avr")) {
         return;
     }
+    // Every binary: the linker's relaxation turns each `call`/`jmp` whose target lies within
+    // ±4 KB into `rcall`/`rjmp` (2 bytes and a cycle fewer; measured in `BENCHMARKS.md`).
+    // Safe with LLVM's objects: every branch, local ones included, carries a relocation, which
+    // the linker moves with the code it shortens.
+    println!("cargo:rustc-link-arg=-Wl,--relax");
     let out_dir = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let libm = run("avr-gcc", &["-mmcu=atmega2560", "-print-file-name=libm.a"]);
     let libm = String::from_utf8(libm).expect("a UTF-8 path");
