@@ -32,9 +32,10 @@
 
 use crate::pac;
 use crate::usart::Usart0;
+use core::marker::PhantomData;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::Axis;
-use kin_core::{body, leg, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
+use kin_core::{body, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
 use quad_device::engine::{
     self, Engine, Limiter, PulseMaps, Request, Setup, Stage, WalkRequest, FRAME_MS,
 };
@@ -49,47 +50,91 @@ pub const MARKER: u8 = 0;
 /// The robot of the benchmark.
 pub const ROBOT: Robot = Robot::shahriar2023();
 
-/// Solves one leg with the given backend.
-pub type LegFn = fn(&Robot, LegId, Vec3) -> Result<[f32; 3], IkError>;
-/// Solves one body pose with the given backend.
-pub type BodyFn = fn(&Robot, &Pose) -> Result<[f32; 12], IkError>;
-
 /// One float primitive under test, `op(a, b)` (unary ones ignore `b`).
 pub type PrimFn = fn(f32, f32) -> f32;
 
-/// A math backend under test.
-pub struct Backend {
+/// The IK of one math backend under test.
+pub trait Solve {
+    /// One leg IK under [`ReachPolicy::Reject`]: the abduction, hip and knee angles.
+    fn leg(&self, leg_id: LegId, foot_in_hip: Vec3) -> Result<[f32; 3], IkError>;
+    /// One body pose at the stance of [`STANCE_HEIGHT_M`] under [`ReachPolicy::Reject`]: the
+    /// twelve angles.
+    fn body(&self, pose: &Pose) -> Result<[f32; 12], IkError>;
+}
+
+/// A math backend under test: the id the host selects it by, and its IK.
+pub struct Backend<'a> {
     /// The id the host selects it by.
     pub id: u8,
-    /// Its leg IK.
-    pub leg: LegFn,
-    /// Its body IK.
-    pub body: BodyFn,
+    /// Its IK.
+    pub solve: &'a dyn Solve,
 }
 
-/// kin-core's leg IK on backend `M`.
-#[inline(never)]
-pub fn leg_with<M: Math>(
-    robot: &Robot,
-    leg_id: LegId,
-    foot_in_hip: Vec3,
-) -> Result<[f32; 3], IkError> {
-    leg::Solver::<M>::with_math(robot)
-        .inverse(leg_id, foot_in_hip, ReachPolicy::Reject)
-        .map(|s| s.angles.to_array())
+/// kin-core's IK on backend `M` as the firmware runs it: the solver built once (the device
+/// builds its own at boot), its constants read from memory at every solve.
+pub struct Prepared<M: Math> {
+    solver: body::Solver<M>,
 }
 
-/// kin-core's body IK at the stance on backend `M`.
-#[inline(never)]
-pub fn body_with<M: Math>(robot: &Robot, pose: &Pose) -> Result<[f32; 12], IkError> {
-    body::Solver::<M>::with_math(robot)
-        .inverse_at_stance(
-            pose,
-            &BodyConfig::default(),
-            STANCE_HEIGHT_M,
-            ReachPolicy::Reject,
-        )
-        .map(|s| s.flat())
+impl<M: Math> Prepared<M> {
+    /// The solver of `robot`, built now.
+    pub fn new(robot: &Robot) -> Self {
+        Prepared {
+            solver: body::Solver::with_math(robot),
+        }
+    }
+}
+
+impl<M: Math> Solve for Prepared<M> {
+    #[inline(never)]
+    fn leg(&self, leg_id: LegId, foot_in_hip: Vec3) -> Result<[f32; 3], IkError> {
+        self.solver
+            .leg()
+            .inverse(leg_id, foot_in_hip, ReachPolicy::Reject)
+            .map(|s| s.angles.to_array())
+    }
+
+    #[inline(never)]
+    fn body(&self, pose: &Pose) -> Result<[f32; 12], IkError> {
+        self.solver
+            .inverse_at_stance(
+                pose,
+                &BodyConfig::default(),
+                STANCE_HEIGHT_M,
+                ReachPolicy::Reject,
+            )
+            .map(|s| s.flat())
+    }
+}
+
+/// kin-core's IK on backend `M` with the solver built from the robot inside every timed call
+/// (the robot behind [`core::hint::black_box`], so that its constants are computed each time):
+/// the benchmark's form before it measured the firmware's [`Prepared`] one.
+pub struct PerCall<M: Math> {
+    robot: Robot,
+    math: PhantomData<M>,
+}
+
+impl<M: Math> PerCall<M> {
+    /// The IK of `robot`, its solver built per call.
+    pub const fn new(robot: Robot) -> Self {
+        PerCall {
+            robot,
+            math: PhantomData,
+        }
+    }
+}
+
+impl<M: Math> Solve for PerCall<M> {
+    #[inline(never)]
+    fn leg(&self, leg_id: LegId, foot_in_hip: Vec3) -> Result<[f32; 3], IkError> {
+        Prepared::<M>::new(core::hint::black_box(&self.robot)).leg(leg_id, foot_in_hip)
+    }
+
+    #[inline(never)]
+    fn body(&self, pose: &Pose) -> Result<[f32; 12], IkError> {
+        Prepared::<M>::new(core::hint::black_box(&self.robot)).body(pose)
+    }
 }
 
 const STATUS_OK: u8 = 0;
@@ -263,7 +308,7 @@ impl<M: Math> MotionBench for EngineBench<M> {
 pub fn serve(
     usart: &mut Usart0,
     porta: &pac::PORTA,
-    backends: &[Backend],
+    backends: &[Backend<'_>],
     prims: &[PrimFn],
     motion: &mut dyn MotionBench,
 ) -> ! {
@@ -272,7 +317,6 @@ pub fn serve(
     porta
         .ddra()
         .modify(|r, w| unsafe { w.bits(r.bits() | 1 << MARKER) });
-    let robot = ROBOT;
     usart.write(b'R');
     loop {
         match read_byte(usart) {
@@ -289,9 +333,9 @@ pub fn serve(
                 usart.write(b'l');
                 match backends.iter().find(|b| b.id == backend) {
                     Some(b) => {
-                        let robot = core::hint::black_box(&robot);
+                        let solve = core::hint::black_box(b.solve);
                         marker(porta, true);
-                        let r = (b.leg)(robot, leg_id, foot);
+                        let r = solve.leg(leg_id, foot);
                         marker(porta, false);
                         send_result(usart, r.as_ref().map(|a| &a[..]), 3);
                     }
@@ -308,9 +352,9 @@ pub fn serve(
                 usart.write(b'b');
                 match backends.iter().find(|b| b.id == backend) {
                     Some(b) => {
-                        let robot = core::hint::black_box(&robot);
+                        let solve = core::hint::black_box(b.solve);
                         marker(porta, true);
-                        let r = (b.body)(robot, &pose);
+                        let r = solve.body(&pose);
                         marker(porta, false);
                         send_result(usart, r.as_ref().map(|a| &a[..]), 12);
                     }

@@ -6,6 +6,7 @@
 //!
 //! ```text
 //! cargo run -p integration-tests --example avr_profile -- [set-body-pose|set-feet|get-state] [N]
+//! cargo run -p integration-tests --example avr_profile -- bench-body [roll pitch yaw x y z]
 //! ```
 //!
 //! Interrupt handlers are charged as functions of their own; idle polling in the main loop
@@ -169,9 +170,59 @@ fn profile_motion(motion: u8, frames: u32) {
     );
 }
 
+/// The benchmark's body pose (`bench.elf`, request `B` on the firmware's backend, id 3, its
+/// solver built at boot) at the rotation `(roll, pitch, yaw)` and translation `(x, y, z)`,
+/// charged by function while its marker pin is high.
+fn profile_bench_body(pose: [f32; 6]) {
+    let elf = build::firmware_elf(build::BENCH).unwrap_or_else(|e| panic!("{e}"));
+    let syms = symbols(&elf);
+    let mut mcu = Mega2560::new(&elf).unwrap_or_else(|e| panic!("{e}"));
+    mcu.read_exact(1, 16_000_000).expect("boots");
+    let mut req = vec![b'B', 3];
+    for v in pose {
+        req.extend(v.to_le_bytes());
+    }
+    mcu.uart_write(&req);
+    let (port, bit) = quad_host::emu::MARKER_PIN;
+    let mut by_fn: HashMap<String, u64> = HashMap::new();
+    let mut calls: HashMap<String, u64> = HashMap::new();
+    let mut total = 0;
+    let mut got = 0;
+    // The echo byte, the status and twelve angles.
+    while got < 2 + 12 * 4 {
+        let pc = mcu.pc();
+        let high = mcu.pin(port, bit);
+        let cycles = mcu.step().expect("runs");
+        if high {
+            let name = charged_name(&mcu, &syms, pc);
+            if is_entry(&syms, pc) {
+                *calls.entry(name.clone()).or_default() += 1;
+            }
+            *by_fn.entry(name).or_default() += cycles;
+            total += cycles;
+        }
+        got += mcu.uart_take().len();
+    }
+    print_rows(
+        &format!("bench body pose {pose:?}"),
+        by_fn,
+        &calls,
+        total,
+        1,
+    );
+}
+
 fn main() {
     let mut args = std::env::args().skip(1);
     let kind = args.next().unwrap_or_else(|| "set-body-pose".to_owned());
+    if kind == "bench-body" {
+        let mut pose = [0.1, -0.05, 0.08, 0.02, -0.01, 0.01];
+        for (v, a) in pose.iter_mut().zip(args) {
+            *v = a.parse().expect("a number");
+        }
+        profile_bench_body(pose);
+        return;
+    }
     if let Some(motion) = kind.strip_prefix("motion-") {
         let frames = args
             .next()

@@ -62,6 +62,9 @@ pub enum Backend {
     /// The firmware's backend (`avr_libc_math::AvrFast`): `sqrt` with avr-libc's bits, kin-core's
     /// `poly::atan2_fixed` and `poly::sin_cos_fixed` (both in `AvrLibm`'s assembly forms).
     AvrFast = 3,
+    /// [`Backend::AvrFast`] with its solver built from the robot inside every timed call (the
+    /// others, as the firmware, build theirs once at boot).
+    AvrFastPerCall = 4,
 }
 
 impl Backend {
@@ -72,6 +75,7 @@ impl Backend {
             Backend::Fast => "kin-core Fast",
             Backend::Libm => "kin-core Libm",
             Backend::AvrFast => "AvrFast",
+            Backend::AvrFastPerCall => "AvrFast, solver per call",
         }
     }
 }
@@ -627,6 +631,7 @@ pub fn run() -> Report {
         Backend::Fast,
         Backend::Libm,
         Backend::AvrFast,
+        Backend::AvrFastPerCall,
     ] {
         backends.push(measure_backend(&mut fw, b, "bench.elf", &targets));
     }
@@ -647,7 +652,7 @@ pub fn run() -> Report {
         .collect();
     let chosen = backends
         .iter()
-        .find(|b| b.name.starts_with(FIRMWARE_BACKEND.name()))
+        .find(|b| b.name == format!("{} (bench.elf)", FIRMWARE_BACKEND.name()))
         .expect("the firmware's backend was measured");
     let sizes = elf_sizes(&firmware);
     let (_, stack) = firmware_memory(&firmware, &targets.poses[..4]);

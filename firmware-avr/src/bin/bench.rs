@@ -4,7 +4,8 @@
 //! `Libm` (Rust libm), 3 = `AvrFast` (`sqrt` with avr-libc's bits, kin-core's `poly::atan2_fixed` in
 //! `AvrLibm`'s assembly form and `poly::sin_cos_fixed` with its fixed-point part in
 //! `AvrLibm`'s assembly), all on avr-libc's float primitives
-//! (`__mulsf3`, …).
+//! (`__mulsf3`, …), each with its solver built once at boot ([`bench::Prepared`]); 4 = `AvrFast`
+//! with its solver built in every call ([`bench::PerCall`]).
 
 #![no_std]
 #![no_main]
@@ -15,33 +16,10 @@
 use avr_libc_math::{AvrFast, AvrLibm};
 
 avr_libc_math::link_avr_libc!();
-use firmware_avr::bench::{self, Backend};
+use firmware_avr::bench::{self, Backend, PerCall, Prepared};
 use firmware_avr::usart::{self, Baud, Usart0};
 use kin_core::math::{poly, Fast, Libm};
 use kin_core::{BodyConfig, Math, Pose, RotationOrder};
-
-static BACKENDS: [Backend; 4] = [
-    Backend {
-        id: 0,
-        leg: bench::leg_with::<AvrLibm>,
-        body: bench::body_with::<AvrLibm>,
-    },
-    Backend {
-        id: 1,
-        leg: bench::leg_with::<Fast>,
-        body: bench::body_with::<Fast>,
-    },
-    Backend {
-        id: 2,
-        leg: bench::leg_with::<Libm>,
-        body: bench::body_with::<Libm>,
-    },
-    Backend {
-        id: 3,
-        leg: bench::leg_with::<AvrFast>,
-        body: bench::body_with::<AvrFast>,
-    },
-];
 
 /// Primitives: 0 add, 1 mul, 2 div, 3 sqrt, 4 atan2, 5 sin, 6 cos, 7 less-than,
 /// 8 `Fast::atan2`, 9 `Fast::sin_cos` (sum of both); parts of the body IK on `AvrFast`:
@@ -157,7 +135,32 @@ fn main() -> ! {
     // SAFETY: the handlers are defined below and touch only their own state.
     unsafe { avr_device::interrupt::enable() };
     let mut motion = bench::EngineBench::<AvrFast>::new();
-    bench::serve(&mut usart, &dp.PORTA, &BACKENDS, &PRIMS, &mut motion)
+    // The solvers built at boot, as the firmware builds its own; the robot behind
+    // `black_box`, so that their constants are read from memory as the device reads them.
+    let robot = core::hint::black_box(bench::ROBOT);
+    let backends = [
+        Backend {
+            id: 0,
+            solve: &Prepared::<AvrLibm>::new(&robot),
+        },
+        Backend {
+            id: 1,
+            solve: &Prepared::<Fast>::new(&robot),
+        },
+        Backend {
+            id: 2,
+            solve: &Prepared::<Libm>::new(&robot),
+        },
+        Backend {
+            id: 3,
+            solve: &Prepared::<AvrFast>::new(&robot),
+        },
+        Backend {
+            id: 4,
+            solve: &PerCall::<AvrFast>::new(bench::ROBOT),
+        },
+    ];
+    bench::serve(&mut usart, &dp.PORTA, &backends, &PRIMS, &mut motion)
 }
 
 #[avr_device::interrupt(atmega2560)]

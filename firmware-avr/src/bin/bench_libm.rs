@@ -5,16 +5,10 @@
 #![no_main]
 #![feature(abi_avr_interrupt)]
 
-use firmware_avr::bench::{self, Backend};
+use firmware_avr::bench::{self, Backend, Prepared};
 use firmware_avr::usart::{self, Baud, Usart0};
 use kin_core::math::Libm;
 use kin_core::Math;
-
-static BACKENDS: [Backend; 1] = [Backend {
-    id: 2,
-    leg: bench::leg_with::<Libm>,
-    body: bench::body_with::<Libm>,
-}];
 
 /// Primitives (compiler-builtins and Rust libm): 0 add, 1 mul, 2 div, 3 sqrt, 4 atan2.
 static PRIMS: [bench::PrimFn; 5] = [
@@ -32,10 +26,16 @@ fn main() -> ! {
     let mut usart = Usart0::new(dp.USART0, Baud::B1000000);
     // SAFETY: the handler is defined below and touches only its own state.
     unsafe { avr_device::interrupt::enable() };
+    // The solver built at boot, as the firmware builds its own.
+    let robot = core::hint::black_box(bench::ROBOT);
+    let backends = [Backend {
+        id: 2,
+        solve: &Prepared::<Libm>::new(&robot),
+    }];
     bench::serve(
         &mut usart,
         &dp.PORTA,
-        &BACKENDS,
+        &backends,
         &PRIMS,
         &mut bench::NoMotion,
     )

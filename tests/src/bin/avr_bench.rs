@@ -7,12 +7,12 @@ use integration_tests::avr_bench;
 fn main() {
     let report = avr_bench::run();
     println!(
-        "{:<34} {:>9} {:>10} {:>10} {:>11} {:>12} {:>14}",
+        "{:<38} {:>9} {:>10} {:>10} {:>11} {:>12} {:>14}",
         "backend (ELF)", "leg max", "leg mean", "body max", "body mean", "err max °", "vs host rad"
     );
     for b in &report.backends {
         println!(
-            "{:<34} {:>9} {:>10.0} {:>10} {:>11.0} {:>12.2e} {:>14.2e}",
+            "{:<38} {:>9} {:>10.0} {:>10} {:>11.0} {:>12.2e} {:>14.2e}",
             b.name,
             b.leg_max_cycles,
             b.leg_mean_cycles,
@@ -44,7 +44,7 @@ fn main() {
         );
     }
     println!(
-        "targets: {} body poses + {} leg targets (seed {:#x}); cycles at 16 MHz; bench.elf stack {} B",
+        "targets: {} body poses + {} leg targets (seed {:#x}); cycles at 16 MHz; solvers built once at boot, as the firmware builds its own, except where marked; bench.elf stack {} B",
         avr_bench::N_TARGETS,
         avr_bench::N_TARGETS,
         avr_bench::SEED,
