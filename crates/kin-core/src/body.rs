@@ -172,35 +172,15 @@ fn foot_in_hip(t: &FeetToHips, foot: &Vec3, out: &mut Vec3, leg: LegId) {
     *out = Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z);
 }
 
-/// `out = k·rᵢ`, row `i` of `r` scaled: out of line where float operations are library calls
-/// ([`Math::SHARE_FLOAT_CODE`]).
+/// `out = k·rᵢ`, row `i` of `r` scaled.
 #[inline(always)]
-fn scaled_row<M: Math>(r: &Mat3, i: usize, k: f32, out: &mut Vec3) {
-    if M::SHARE_FLOAT_CODE {
-        scaled_row_shared(r, i, k, out);
-    } else {
-        *out = Vec3::from_array(r.rows[i]) * k;
-    }
-}
-
-#[inline(never)]
-fn scaled_row_shared(r: &Mat3, i: usize, k: f32, out: &mut Vec3) {
+fn scaled_row(r: &Mat3, i: usize, k: f32, out: &mut Vec3) {
     *out = Vec3::from_array(r.rows[i]) * k;
 }
 
-/// `acc += b`: out of line where float operations are library calls
-/// ([`Math::SHARE_FLOAT_CODE`]).
+/// `acc += b`.
 #[inline(always)]
-fn add_assign<M: Math>(acc: &mut Vec3, b: &Vec3) {
-    if M::SHARE_FLOAT_CODE {
-        add_assign_shared(acc, b);
-    } else {
-        *acc = *acc + *b;
-    }
-}
-
-#[inline(never)]
-fn add_assign_shared(acc: &mut Vec3, b: &Vec3) {
+fn add_assign(acc: &mut Vec3, b: &Vec3) {
     *acc = *acc + *b;
 }
 
@@ -363,8 +343,8 @@ impl<M: Math> Solver<M> {
     /// for the front/rear sign `sx`, the side sign `s` and `K = Rᵀ·(g + (0, 0, H)) − c`,
     /// `g = t + c`: 9 multiplications and 27 additions (15 and 33 with a horizontal
     /// translation or pivot) where the general transform of the four stance feet takes 36 and
-    /// 59. Where float operations are library calls ([`Math::SHARE_FLOAT_CODE`]) its vector
-    /// operations are out of line (`BENCHMARKS.md` has the cycles and the flash).
+    /// 59. Its vector operations are inline on every backend, the AVR's included (out of line
+    /// they saved 542 B of its flash and cost 1,272 cycles; `BENCHMARKS.md`).
     #[inline(never)]
     fn stance_feet_in_hips(
         &self,
@@ -383,31 +363,31 @@ impl<M: Math> Solver<M> {
         let mut b = Vec3::ZERO;
         // −K = Rᵀ·(−g − (0, 0, H)) + c to FR, as the rows of R scaled by the components:
         // −(g_z + H)·r₂ (−H·r₂ without translation and pivot), −g_x·r₀, −g_y·r₁ and c added.
-        scaled_row::<M>(&r, 2, -(g.z + stance_height_m), fr);
+        scaled_row(&r, 2, -(g.z + stance_height_m), fr);
         if !is_zero(Vec3::new(g.x, g.y, 0.0)) {
-            scaled_row::<M>(&r, 0, -g.x, &mut b);
-            add_assign::<M>(fr, &b);
-            scaled_row::<M>(&r, 1, -g.y, &mut b);
-            add_assign::<M>(fr, &b);
+            scaled_row(&r, 0, -g.x, &mut b);
+            add_assign(fr, &b);
+            scaled_row(&r, 1, -g.y, &mut b);
+            add_assign(fr, &b);
         }
-        add_assign::<M>(fr, c);
+        add_assign(fr, c);
         // a = L/2·r₀ − (L/2, 0, 0) to FL, −a to RL; then the front's a − K and the rear's −a − K.
         let hl = self.hip_fl_m.x;
-        scaled_row::<M>(&r, 0, hl, fl);
+        scaled_row(&r, 0, hl, fl);
         fl.x -= hl;
         *rl = -*fl;
-        add_assign::<M>(fl, fr);
-        add_assign::<M>(rl, fr);
+        add_assign(fl, fr);
+        add_assign(rl, fr);
         *fr = *fl;
         *rr = *rl;
         // ± b, b = (W/2 + d_lat)·r₁ − (0, W/2, 0): left +, right −.
-        scaled_row::<M>(&r, 1, self.stance_lateral_m, &mut b);
+        scaled_row(&r, 1, self.stance_lateral_m, &mut b);
         b.y -= self.hip_fl_m.y;
-        add_assign::<M>(fl, &b);
-        add_assign::<M>(rl, &b);
+        add_assign(fl, &b);
+        add_assign(rl, &b);
         let b = -b;
-        add_assign::<M>(fr, &b);
-        add_assign::<M>(rr, &b);
+        add_assign(fr, &b);
+        add_assign(rr, &b);
     }
 
     /// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
