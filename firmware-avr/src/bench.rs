@@ -28,7 +28,8 @@
 //! Status 0 = solved, 1 = unreachable, 2 = unknown backend. Boot sends `R` once ready.
 //! Robot: [`kin_core::Robot::shahriar2023`] with its knee bend and limits; body poses about
 //! the body centre in rotation order zyx, feet held at the stance of height
-//! [`STANCE_HEIGHT_M`]; [`kin_core::ReachPolicy::Reject`].
+//! [`STANCE_HEIGHT_M`]; [`kin_core::ReachPolicy::Reject`]. Each backend's solver is built once
+//! at boot, as the firmware builds its own ([`Prepared`]), except the one of [`PerCall`].
 
 use crate::pac;
 use crate::usart::Usart0;

@@ -13,12 +13,12 @@
 //! | [`usart`] | USART0: receive and transmit by interrupt through lock-free rings |
 //! | [`watchdog`] | watchdog enable/feed and the reset cause |
 //! | [`stack`] | SRAM painting at boot and the high-water mark of the stack |
-//! | [`bench`] | the cycle benchmark's request loop (used by the `bench` binaries only) |
+//! | [`mod@bench`] | the cycle benchmark's request loop (used by the `bench` binaries only) |
 //!
 //! The CPU clock is [`F_CPU_HZ`] (the Mega's 16 MHz crystal).
 //!
 //! Binaries: `firmware` (115,200 baud) and `firmware-1mbaud` (1,000,000 baud) run [`app::run`];
-//! `bench` and `bench-libm` serve the cycle benchmark ([`bench`]).
+//! `bench` and `bench-libm` serve the cycle benchmark ([`mod@bench`]).
 //!
 //! Interrupt handlers must be defined in the binary crate (a handler in a library is not
 //! pulled in by the linker): each binary forwards `USART0_RX` to [`usart::on_rx_interrupt`],

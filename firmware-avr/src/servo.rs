@@ -192,7 +192,7 @@ fn stage(ticks: &[u16; CHANNELS], enabled: bool) {
     BUSY.set(0);
 }
 
-/// Applies the staged state if one is pending and the moment is quiet (see [`stage`]); call
+/// Applies the staged state if one is pending and the moment is quiet (see `stage`); call
 /// from the `TIMER2_COMPA` interrupt (with interrupts re-enabled: this takes longer than one
 /// byte time at 1 Mbaud and needs no protection from the receive interrupt).
 #[inline(never)]
@@ -410,7 +410,7 @@ fn apply_connections(dp: &pac::Peripherals, t: usize, (v, low): (u8, u8)) {
 }
 
 /// The four 16-bit timers as servo outputs. After [`Servos::new`] it holds the outputs' target
-/// state; the registers are written when the state is applied ([`stage`]).
+/// state; the registers are written when the state is applied (`stage`).
 pub struct Servos {
     _tc1: pac::TC1,
     _tc3: pac::TC3,
