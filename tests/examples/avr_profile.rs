@@ -124,41 +124,59 @@ fn print_rows(
     }
 }
 
-/// The worst frame of an onboard motion in the benchmark firmware (`bench.elf`, motion ids of
-/// `firmware_avr::bench`), charged by function while its marker pin is high.
-fn profile_motion(motion: u8, frames: u32) {
+/// Cycles charged by function while the benchmark firmware's marker pin is high, until
+/// `answer_len` bytes of its answer have come: (total, cycles by function, calls by function).
+fn charge_marked(
+    mcu: &mut Mega2560,
+    syms: &[(u32, u32, String)],
+    answer_len: usize,
+) -> (u64, HashMap<String, u64>, HashMap<String, u64>) {
+    let (port, bit) = quad_host::emu::MARKER_PIN;
+    let mut by_fn: HashMap<String, u64> = HashMap::new();
+    let mut calls: HashMap<String, u64> = HashMap::new();
+    let mut total = 0;
+    let mut got = 0;
+    while got < answer_len {
+        let pc = mcu.pc();
+        let high = mcu.pin(port, bit);
+        let cycles = mcu.step().expect("runs");
+        if high {
+            let name = charged_name(mcu, syms, pc);
+            if is_entry(syms, pc) {
+                *calls.entry(name.clone()).or_default() += 1;
+            }
+            *by_fn.entry(name).or_default() += cycles;
+            total += cycles;
+        }
+        got += mcu.uart_take().len();
+    }
+    (total, by_fn, calls)
+}
+
+/// The benchmark firmware (`bench.elf`) booted in simavr, with its symbols.
+fn boot_bench() -> (Mega2560, Vec<(u32, u32, String)>) {
     let elf = build::firmware_elf(build::BENCH).unwrap_or_else(|e| panic!("{e}"));
     let syms = symbols(&elf);
     let mut mcu = Mega2560::new(&elf).unwrap_or_else(|e| panic!("{e}"));
     mcu.read_exact(1, 16_000_000).expect("boots");
+    (mcu, syms)
+}
+
+/// The worst frame of an onboard motion in the benchmark firmware (`bench.elf`, motion ids of
+/// `firmware_avr::bench`), charged by function while its marker pin is high.
+fn profile_motion(motion: u8, frames: u32) {
+    let (mut mcu, syms) = boot_bench();
     mcu.uart_write(&[b'M', motion]);
     let started = mcu.read_exact(2, 16_000_000 * 20).expect("starts");
     assert_eq!(started, b"m\0", "motion {motion} refused");
-    let (port, bit) = quad_host::emu::MARKER_PIN;
     let mut worst: (u64, HashMap<String, u64>, HashMap<String, u64>) =
         (0, HashMap::new(), HashMap::new());
     for _ in 0..frames {
         mcu.uart_write(b"N");
-        let mut frame: HashMap<String, u64> = HashMap::new();
-        let mut calls: HashMap<String, u64> = HashMap::new();
-        let mut total = 0;
-        let mut got = 0;
-        while got < 3 {
-            let pc = mcu.pc();
-            let high = mcu.pin(port, bit);
-            let cycles = mcu.step().expect("runs");
-            if high {
-                let name = charged_name(&mcu, &syms, pc);
-                if is_entry(&syms, pc) {
-                    *calls.entry(name.clone()).or_default() += 1;
-                }
-                *frame.entry(name).or_default() += cycles;
-                total += cycles;
-            }
-            got += mcu.uart_take().len();
-        }
-        if total > worst.0 {
-            worst = (total, frame, calls);
+        // `n`, the status and the stage.
+        let frame = charge_marked(&mut mcu, &syms, 3);
+        if frame.0 > worst.0 {
+            worst = frame;
         }
     }
     print_rows(
@@ -174,35 +192,14 @@ fn profile_motion(motion: u8, frames: u32) {
 /// solver built at boot) at the rotation `(roll, pitch, yaw)` and translation `(x, y, z)`,
 /// charged by function while its marker pin is high.
 fn profile_bench_body(pose: [f32; 6]) {
-    let elf = build::firmware_elf(build::BENCH).unwrap_or_else(|e| panic!("{e}"));
-    let syms = symbols(&elf);
-    let mut mcu = Mega2560::new(&elf).unwrap_or_else(|e| panic!("{e}"));
-    mcu.read_exact(1, 16_000_000).expect("boots");
+    let (mut mcu, syms) = boot_bench();
     let mut req = vec![b'B', 3];
     for v in pose {
         req.extend(v.to_le_bytes());
     }
     mcu.uart_write(&req);
-    let (port, bit) = quad_host::emu::MARKER_PIN;
-    let mut by_fn: HashMap<String, u64> = HashMap::new();
-    let mut calls: HashMap<String, u64> = HashMap::new();
-    let mut total = 0;
-    let mut got = 0;
-    // The echo byte, the status and twelve angles.
-    while got < 2 + 12 * 4 {
-        let pc = mcu.pc();
-        let high = mcu.pin(port, bit);
-        let cycles = mcu.step().expect("runs");
-        if high {
-            let name = charged_name(&mcu, &syms, pc);
-            if is_entry(&syms, pc) {
-                *calls.entry(name.clone()).or_default() += 1;
-            }
-            *by_fn.entry(name).or_default() += cycles;
-            total += cycles;
-        }
-        got += mcu.uart_take().len();
-    }
+    // `b`, the status and twelve angles.
+    let (total, by_fn, calls) = charge_marked(&mut mcu, &syms, 2 + 12 * 4);
     print_rows(
         &format!("bench body pose {pose:?}"),
         by_fn,
