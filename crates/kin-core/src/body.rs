@@ -172,18 +172,6 @@ fn foot_in_hip(t: &FeetToHips, foot: &Vec3, out: &mut Vec3, leg: LegId) {
     *out = Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z);
 }
 
-/// `out = k·rᵢ`, row `i` of `r` scaled.
-#[inline(always)]
-fn scaled_row(r: &Mat3, i: usize, k: f32, out: &mut Vec3) {
-    *out = Vec3::from_array(r.rows[i]) * k;
-}
-
-/// `acc += b`.
-#[inline(always)]
-fn add_assign(acc: &mut Vec3, b: &Vec3) {
-    *acc = *acc + *b;
-}
-
 /// Full-body IK on math backend `M` with the robot's constants prepared once (the leg IK's
 /// [`leg::Solver`], the hip mounts). A caller that solves many poses of one robot keeps one:
 ///
@@ -360,34 +348,31 @@ impl<M: Math> Solver<M> {
         // (few vectors in the frame: cheap addressing where the frame is addressed by a
         // short displacement).
         let [fl, fr, rl, rr] = out;
-        let mut b = Vec3::ZERO;
         // −K = Rᵀ·(−g − (0, 0, H)) + c to FR, as the rows of R scaled by the components:
         // −(g_z + H)·r₂ (−H·r₂ without translation and pivot), −g_x·r₀, −g_y·r₁ and c added.
-        scaled_row(&r, 2, -(g.z + stance_height_m), fr);
+        *fr = Vec3::from_array(r.rows[2]) * -(g.z + stance_height_m);
         if !is_zero(Vec3::new(g.x, g.y, 0.0)) {
-            scaled_row(&r, 0, -g.x, &mut b);
-            add_assign(fr, &b);
-            scaled_row(&r, 1, -g.y, &mut b);
-            add_assign(fr, &b);
+            *fr = *fr + Vec3::from_array(r.rows[0]) * -g.x;
+            *fr = *fr + Vec3::from_array(r.rows[1]) * -g.y;
         }
-        add_assign(fr, c);
+        *fr = *fr + *c;
         // a = L/2·r₀ − (L/2, 0, 0) to FL, −a to RL; then the front's a − K and the rear's −a − K.
         let hl = self.hip_fl_m.x;
-        scaled_row(&r, 0, hl, fl);
+        *fl = Vec3::from_array(r.rows[0]) * hl;
         fl.x -= hl;
         *rl = -*fl;
-        add_assign(fl, fr);
-        add_assign(rl, fr);
+        *fl = *fl + *fr;
+        *rl = *rl + *fr;
         *fr = *fl;
         *rr = *rl;
         // ± b, b = (W/2 + d_lat)·r₁ − (0, W/2, 0): left +, right −.
-        scaled_row(&r, 1, self.stance_lateral_m, &mut b);
+        let mut b = Vec3::from_array(r.rows[1]) * self.stance_lateral_m;
         b.y -= self.hip_fl_m.y;
-        add_assign(fl, &b);
-        add_assign(rl, &b);
+        *fl = *fl + b;
+        *rl = *rl + b;
         let b = -b;
-        add_assign(fr, &b);
-        add_assign(rr, &b);
+        *fr = *fr + b;
+        *rr = *rr + b;
     }
 
     /// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
