@@ -304,6 +304,11 @@ impl Usart0 {
 
     /// Queues `bytes` for the transmit interrupt and returns; waits (interrupts on) only while
     /// the transmit ring is full.
+    ///
+    /// Never inlined: the answer encoder hands its frame over in pieces from two places
+    /// (`quad_protocol::encode_frame_in_pieces`), and the compiler, which sees the one sender,
+    /// would otherwise copy this function into each.
+    #[inline(never)]
     pub fn send(&mut self, bytes: &[u8]) {
         let Some((&first, mut rest)) = bytes.split_first() else {
             return;

@@ -35,11 +35,10 @@ use std::time::Duration;
 const BYTE_CYCLES_AT_1MBAUD: u64 = 160;
 
 /// A `SetBodyPose`'s last byte → its answer's first byte, beyond the body IK itself (as the
-/// firmware runs it: its solver built at boot), at most (cycles; 1.1 ms at 16 MHz). The aim is
-/// 1 ms: met at 115,200 baud (0.999 ms), missed at 1 Mbaud (1.07 ms), where more of the
-/// request's bytes are decoded after its last byte (BENCHMARKS.md). The former figures, 0.87 /
-/// 0.93 ms, subtracted the benchmark's IK with its solver built in the call (0.14 ms more).
-const ROUND_TRIP_OVER_IK_CYCLES: u64 = 17_600;
+/// firmware runs it: its solver built at boot), at most (cycles; 1 ms at 16 MHz). Measured
+/// 0.91 ms at 115,200 baud and 0.96 ms at 1 Mbaud (BENCHMARKS.md), where more of the request's
+/// bytes are decoded after its last byte.
+const ROUND_TRIP_OVER_IK_CYCLES: u64 = 16_000;
 
 /// Body poses per second with full readback at 1 Mbaud, two requests in flight, at least.
 const POSES_PER_S_AT_1MBAUD: f64 = 200.0;
@@ -377,8 +376,8 @@ fn request_to_first_answer_byte_per_request_type_and_poses_per_second() {
                     ik_cycles as f64 / 16_000.0,
                     cycles.saturating_sub(ik_cycles) as f64 / 16_000.0
                 );
-                // The IK + 1.1 ms: decoding, the pulse mapping, the readback and the answer's
-                // encoding take the rest (BENCHMARKS.md).
+                // The IK + 1 ms: decoding, the pulse mapping, the readback and the answer's
+                // serialization take the rest (BENCHMARKS.md).
                 assert!(
                     cycles <= ik_cycles + ROUND_TRIP_OVER_IK_CYCLES,
                     "{bin}: {cycles} cycles > body IK {ik_cycles} + {ROUND_TRIP_OVER_IK_CYCLES}"

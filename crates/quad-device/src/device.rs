@@ -14,9 +14,9 @@ use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
-    check_request_in, encode_frame, is_compatible, Accumulator, DeviceInfo, DeviceToHost, Feed,
-    Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges, Readback,
-    Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    check_request_in, encode_frame_in_pieces, is_compatible, Accumulator, DeviceInfo, DeviceToHost,
+    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges,
+    Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -231,30 +231,28 @@ where
 
     /// Feeds received bytes (any chunking) and sends one answer frame through `tx` for every
     /// frame that ends in them, in order (nacks of unreadable frames rate-limited, see
-    /// [`FRAMING_NACK_INTERVAL_MS`]).
+    /// [`FRAMING_NACK_INTERVAL_MS`]). Each answer frame reaches `tx` in consecutive pieces
+    /// ([`encode_frame_in_pieces`]): its first bytes as soon as they are final, so that a
+    /// transmitter starts while the rest is encoded; one frame's pieces all come before the
+    /// next frame's.
     pub fn receive(&mut self, mut bytes: &[u8], mut tx: impl FnMut(&[u8])) {
-        while let Some((frame_len, remaining)) = self.receive_one(bytes) {
+        while let Some(remaining) = self.receive_one(bytes, &mut tx) {
             bytes = remaining;
-            if frame_len == 0 {
-                continue;
-            }
-            if let Some(frame) = self.acc.scratch().and_then(|b| b.get(..frame_len)) {
-                tx(frame);
-            }
         }
     }
 
-    /// Consumes `bytes` up to the end of the first frame in them, handles it and encodes the
-    /// answer into the accumulator's buffer (free between frames): its length (0 when it could
-    /// not be encoded) and the bytes left; `None` when no frame ended in `bytes`. Not generic
-    /// over the caller's closure, so that the firmware has one instance of it.
-    fn receive_one<'a>(&mut self, bytes: &'a [u8]) -> Option<(usize, &'a [u8])> {
+    /// Consumes `bytes` up to the end of the first frame in them, handles it and sends its
+    /// answer through `tx` (encoded in the accumulator's buffer, free between frames): the
+    /// bytes left, `None` when no frame ended in `bytes`. Not generic over the caller's
+    /// closure, so that the firmware has one instance of it.
+    fn receive_one<'a>(&mut self, bytes: &'a [u8], tx: &mut dyn FnMut(&[u8])) -> Option<&'a [u8]> {
         // The request is read where the decoder put it (bound by reference, not moved out).
         let (reason, remaining) = match &feed_request(&mut self.acc, bytes) {
             Feed::NeedMore => return None,
             Feed::Frame { msg, remaining } => {
                 let answer = self.handle_ref(msg);
-                return Some((self.encode(&answer), remaining));
+                self.encode(&answer, tx);
+                return Some(remaining);
             }
             Feed::BadCrc { remaining } => (NackReason::BadCrc, *remaining),
             Feed::BadFrame { remaining, .. } => (NackReason::BadFrame, *remaining),
@@ -264,20 +262,19 @@ where
         let due = self
             .last_framing_nack_ms
             .is_none_or(|t| now.wrapping_sub(t) >= FRAMING_NACK_INTERVAL_MS);
-        if !due {
-            return Some((0, remaining));
+        if due {
+            self.last_framing_nack_ms = Some(now);
+            self.encode(&nack(None, reason), tx);
         }
-        self.last_framing_nack_ms = Some(now);
-        Some((self.encode(&nack(None, reason)), remaining))
+        Some(remaining)
     }
 
-    /// Encodes `answer` into the accumulator's buffer (free between frames); its length, 0 when
-    /// it could not be encoded.
-    fn encode(&mut self, answer: &DeviceToHost) -> usize {
+    /// Encodes `answer` into the accumulator's buffer (free between frames) and sends it
+    /// through `tx`, in pieces; nothing is sent when it cannot be encoded.
+    fn encode(&mut self, answer: &DeviceToHost, tx: &mut dyn FnMut(&[u8])) {
         // The buffer holds the largest answer (`TX_LEN`); a failure would only drop this answer.
-        match self.acc.scratch() {
-            Some(buf) => encode_answer(answer, buf),
-            None => 0,
+        if let Some(buf) = self.acc.scratch() {
+            encode_answer(answer, buf, tx);
         }
     }
 
@@ -928,11 +925,12 @@ pub fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<
     acc.feed::<HostToDevice>(bytes)
 }
 
-/// The device's answer encoder: [`encode_frame`] (postcard) of `answer` into `out`; the
-/// frame's length, 0 when it does not fit.
+/// The device's answer encoder: [`encode_frame_in_pieces`] (postcard) of `answer` into `out`,
+/// handed to `tx` in pieces as they are final; the frame's length, 0 (and nothing sent) when
+/// it does not fit.
 #[inline(never)]
-pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8]) -> usize {
-    encode_frame(answer, out).map_or(0, <[u8]>::len)
+pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8], tx: &mut dyn FnMut(&[u8])) -> usize {
+    encode_frame_in_pieces(answer, out, tx).unwrap_or(0)
 }
 
 /// [`check_request_in`], out of line: inlined into [`Device::answer`], its copies of the request's

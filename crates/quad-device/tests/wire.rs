@@ -313,11 +313,28 @@ fn device_decode(frame: &[u8]) -> Feed<'static, HostToDevice> {
     }
 }
 
-/// The device's answer frame of `answer`.
+/// The device's answer frame of `answer`: its pieces, joined, are the frame left in the
+/// buffer.
 fn device_encode(answer: &DeviceToHost) -> Vec<u8> {
     let mut buf = [0u8; RX_LEN];
-    let n = encode_answer(answer, &mut buf);
+    let mut pieces: Vec<Vec<u8>> = Vec::new();
+    let n = encode_answer(answer, &mut buf, &mut |p: &[u8]| pieces.push(p.to_vec()));
     assert!(n > 0, "{answer:?} fits the device's buffer");
+    assert_eq!(pieces.concat(), buf[..n], "{answer:?}");
+    // Two pieces when the message holds a zero: the first ends before it, where the first
+    // code byte points. One when it holds none.
+    let first = &pieces[0];
+    match pieces.len() {
+        2 => {
+            assert_eq!(
+                usize::from(first[1]),
+                first.len() - 1,
+                "{answer:?}: {first:02x?}"
+            );
+            assert!(!first[2..].contains(&0), "{answer:?}: {first:02x?}");
+        }
+        n => assert_eq!(n, 1, "{answer:?}: {pieces:02x?}"),
+    }
     buf[..n].to_vec()
 }
 

@@ -165,11 +165,7 @@ const COBS_BLOCK: usize = 254;
 /// Serializes `msg`, appends its CRC, COBS-encodes everything and puts it between two `0x00`
 /// delimiters, in `out`. Returns the frame (a prefix of `out`).
 ///
-/// The message's bytes go into `out` as they are; then one pass over them computes the CRC
-/// and replaces each `0x00` with the distance to the next (COBS for a frame of fewer than 254
-/// decoded bytes, which every frame of this protocol is: [`MAX_DECODED_LEN`]). One tight loop
-/// over the bytes instead of the CRC and COBS steps per serialized byte: fewer cycles per
-/// answer on the ATmega2560.
+/// [`encode_frame_in_pieces`] with nobody to hand the pieces to: the same bytes.
 ///
 /// # Errors
 /// [`Error::BufferFull`] when `out` is too small ([`MAX_FRAME_LEN`] is always enough for this
@@ -179,6 +175,35 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
     msg: &T,
     out: &'b mut [u8],
 ) -> Result<&'b [u8], Error> {
+    let len = encode_frame_in_pieces(msg, out, |_| {})?;
+    Ok(&out[..len])
+}
+
+/// [`encode_frame`], handing the frame to `emit` as soon as its first bytes are final: when
+/// the message holds a `0x00`, in two consecutive pieces — the leading delimiter, the first
+/// COBS code byte and the message's bytes before its first zero, then the rest — else in one.
+/// Returns the frame's length; the whole frame is also in `out`. Nothing is emitted when
+/// encoding fails.
+///
+/// Why: a COBS code byte is the distance to the next `0x00`, so the first byte after the
+/// delimiter is known as soon as the message's first zero is found, before the CRC. A
+/// transmitter can start with the first piece while the CRC and the rest of the COBS are
+/// computed: on the ATmega2560 the first answer byte leaves after a scan for the first zero
+/// instead of after the CRC of the whole message.
+///
+/// The message's bytes go into `out` as they are; a scan finds the first zero; then one pass
+/// over them computes the CRC and replaces each `0x00` with the distance to the next (COBS for
+/// a frame of fewer than 254 decoded bytes, which every frame of this protocol is:
+/// [`MAX_DECODED_LEN`]). One tight loop over the bytes instead of the CRC and COBS steps per
+/// serialized byte: fewer cycles per answer on the ATmega2560.
+///
+/// # Errors
+/// As [`encode_frame`].
+pub fn encode_frame_in_pieces<T: Serialize + ?Sized>(
+    msg: &T,
+    out: &mut [u8],
+    mut emit: impl FnMut(&[u8]),
+) -> Result<usize, Error> {
     const { assert!(MAX_DECODED_LEN < COBS_BLOCK) };
     // 0x00, the first code byte, the message, the CRC, 0x00.
     let body = out.get_mut(2..).ok_or(Error::BufferFull)?;
@@ -190,12 +215,21 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
     if end >= out.len() {
         return Err(Error::BufferFull);
     }
+    out[0] = DELIMITER;
+    // The message's first zero: the first block ends there, and the first code byte is its
+    // distance (below 254: the assertion above).
+    let first = out[2..2 + n].iter().position(|&b| b == 0);
+    if let Some(zero_at) = first {
+        out[1] = zero_at as u8 + 1;
+        emit(&out[..2 + zero_at]);
+    }
     // One pass from the start computes the CRC and does the COBS of the message's bytes: each
     // zero becomes the distance to the next zero (or the delimiter), written into the code
-    // byte that waits for it (`code`) when that zero is met. The distance is counted along
-    // (below 254: the assertion above), an 8-bit count per byte on the AVR.
+    // byte that waits for it (`code`) when that zero is met (the first code byte again, with
+    // the same value, when it was emitted already). The distance is counted along, an 8-bit
+    // count per byte on the AVR.
     let (head, tail) = out.split_at_mut(2 + n);
-    let [start, first_code, message @ ..] = head else {
+    let [_, first_code, message @ ..] = head else {
         unreachable!("out holds 2 + n bytes and more")
     };
     let [crc_hi, crc_lo, stop, ..] = tail else {
@@ -223,9 +257,9 @@ pub fn encode_frame<'b, T: Serialize + ?Sized>(
         distance += 1;
     }
     *code = distance;
-    *start = DELIMITER;
     *stop = DELIMITER;
-    Ok(&out[..=end])
+    emit(&out[first.map_or(0, |zero_at| 2 + zero_at)..=end]);
+    Ok(end + 1)
 }
 
 /// Checks the CRC of a decoded frame (postcard bytes ‖ CRC) and deserializes its message.

@@ -37,7 +37,8 @@ pub mod servo;
 pub mod wire;
 
 pub use frame::{
-    decode_payload, encode_frame, Accumulator, Feed, DELIMITER, MAX_DECODED_LEN, MAX_FRAME_LEN,
+    decode_payload, encode_frame, encode_frame_in_pieces, Accumulator, Feed, DELIMITER,
+    MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 pub use msg::{
     DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet, LinkLossAction,

@@ -9,9 +9,9 @@ use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 use proptest::prelude::*;
 use quad_protocol::frame::Error;
 use quad_protocol::{
-    encode_frame, servo, Accumulator, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction,
-    LinkTimeout, MotionKind, MotionStage, MotionStatus, NackReason, PoseConfig, Readback, Request,
-    ServoId, Setting, MAX_DECODED_LEN, MAX_FRAME_LEN,
+    encode_frame, encode_frame_in_pieces, servo, Accumulator, DeviceToHost, Feed, Flags,
+    HostToDevice, LinkLossAction, LinkTimeout, MotionKind, MotionStage, MotionStatus, NackReason,
+    PoseConfig, Readback, Request, ServoId, Setting, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
 use serde::Serialize;
 
@@ -401,6 +401,27 @@ fn encoded_frames_are_the_reference_cobs_of_payload_and_crc() {
             &want[..],
             "{bytes:?}"
         );
+        // In pieces: the same frame, cut after the first block (the first code byte and the
+        // bytes it covers) when the message holds a zero, else whole; nothing emitted when the
+        // buffer is too small.
+        let mut pieces: Vec<Vec<u8>> = Vec::new();
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let n = encode_frame_in_pieces(&msg, &mut buf, |p| pieces.push(p.to_vec())).unwrap();
+        assert_eq!(n, want.len());
+        assert_eq!(pieces.concat(), want, "{bytes:?}");
+        if payload.contains(&0) {
+            assert_eq!(pieces.len(), 2, "{bytes:?}");
+            assert_eq!(pieces[0].len(), usize::from(want[1]) + 1, "{bytes:?}");
+        } else {
+            assert_eq!(pieces.len(), 1, "{bytes:?}");
+        }
+        let mut small = vec![0u8; want.len() - 1];
+        let mut emitted = false;
+        assert_eq!(
+            encode_frame_in_pieces(&msg, &mut small, |_| emitted = true),
+            Err(Error::BufferFull)
+        );
+        assert!(!emitted);
     }
     // A payload of MAX_DECODED_LEN − 1 bytes: with its CRC one byte beyond the bound.
     let too_long = [7u8; MAX_DECODED_LEN - 2];

@@ -244,7 +244,6 @@ pub struct SimLink {
     fifo: VecDeque<u64>,
     clock: Rc<Cell<u64>>,
     device: SimDevice,
-    answers: Vec<Vec<u8>>,
     stats: LineStats,
 }
 
@@ -274,7 +273,6 @@ impl SimLink {
             fifo: VecDeque::new(),
             clock: shared,
             device,
-            answers: Vec::new(),
             stats: LineStats::default(),
         })
     }
@@ -331,9 +329,11 @@ impl SimLink {
             }
             self.fifo.push_back(t_take);
             self.poll_at(t_take);
-            let answers = &mut self.answers;
-            self.device.receive(&[byte], |f| answers.push(f.to_vec()));
-            for answer in std::mem::take(&mut self.answers) {
+            // One byte ends at most one frame: every piece sent is of the same answer.
+            let mut answer = Vec::new();
+            self.device
+                .receive(&[byte], |piece| answer.extend_from_slice(piece));
+            if !answer.is_empty() {
                 let start = (t_take + compute_ns).max(self.d2h.free_ns);
                 self.dev_free_ns = start;
                 self.stats.d2h_bytes += answer.len() as u64;
