@@ -131,10 +131,12 @@ impl Math for AvrLibm {
 /// [`AvrLibm::atan2_fixed`] against the portable kernel on the AVR):
 ///
 /// - the octant and the magnitudes `num ≤ den` from the bits;
-/// - the quotient `T = ⌊t·2²¹⌋` ([`poly::atan_ratio_q21`]) by a restoring division of the
-///   24-bit mantissas that stops after the `22 − (e_d − eₙ)` quotient bits `T` keeps (the
-///   shift of the quotient comes free), one compare-and-subtract per bit in three-byte
-///   registers;
+/// - the quotient `T = ⌊t·2²¹⌋` ([`poly::atan_ratio_q21`]) of the 24-bit mantissas on the
+///   hardware multiplier, exact: a reciprocal estimate of the denominator (a linear seed and
+///   one Newton step, never above the reciprocal), then the `22 − (e_d − eₙ)` quotient bits
+///   `T` keeps as base-256 digits (one to three, the first aligned so that the shift of the
+///   quotient comes free), each estimated from the remainder's top bytes and the reciprocal,
+///   subtracted from the remainder, and made exact by at most two corrections;
 /// - the cell `k = T >> 16` read with `lpm` ([`poly::atan_cells`]) and its three
 ///   16 × 16-bit products with `mul`, each rounded as the portable kernel rounds it;
 /// - the octant's angle in Q29, its conversion to a float (normalised bytewise then bitwise,
@@ -208,7 +210,14 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "clr {q1}",
             "clr {q2}",
             "cpi r21, 255",
-            "breq 7f",
+            "brne 5f",
+            // den infinite (or NaN): T = 2²¹ when num is too, else 0.
+            "cpi r25, 255",
+            "brne 4f",
+            "ldi {q2}, 0x20",
+            "4:",
+            "rjmp 6f",
+            "5:",
             // Subnormals at exponent 1; s = ed − en, T = 0 (so p = 0) when s ≥ 22.
             "cpi r21, 1",
             "adc r21, r1",
@@ -219,69 +228,126 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "brlo 5f",
             "rjmp 8f",
             "5:",
-            "ldi {cnt}, 22",
+            // T = ⌊mn·2^(21−s) / md⌋ in base-256 digits: 21 − s = 8·j + a, the first digit
+            // ⌊mn·2^a / md⌋ (a + 1 bits), then j digits of 8 bits; cnt = j + 1, r21 = a.
+            "ldi {cnt}, 21",
             "sub {cnt}, r21",
-            // The quotient's bits go in inverted (the carry of a compare that fails is 1), into
-            // ones that end as the leading zeros.
-            "com {q0}",
-            "com {q1}",
-            "com {q2}",
-            // Two bits a pass (⌈N/2⌉ passes for N bits), the first bit (mn ≥ md, mn < 2·md,
-            // no shift) at the compare of the pass's first half (N even) or second (N odd).
-            // Each bit: a remainder ≥ 2²⁴ > md after the shift is subtracted at once (the
-            // low 24 bits' borrow is then set, hence the `clc`).
+            "mov r21, {cnt}",
+            "andi r21, 7",
             "lsr {cnt}",
-            "brcc 2f",
+            "lsr {cnt}",
+            "lsr {cnt}",
             "inc {cnt}",
-            "rjmp 12f",
+            // den subnormal (md < 2²³; then num is too, s = 0 and mn ≤ md): both shifted left
+            // until md's bit 23 is set, the quotient unchanged.
+            "rjmp 2f",
+            "1:",
+            "lsl r18",
+            "rol r19",
+            "rol r20",
+            "lsl r22",
+            "rol r23",
+            "rol r24",
+            "2:",
+            "sbrs r20, 7",
+            "rjmp 1b",
+            // The remainder R = mn·2^a to r25:r24:r23:r22: R < 2⁸·md (mn < 2·md, a ≤ 7; s = 0:
+            // mn ≤ md, a = 5), so the first digit is < 2⁸ too.
+            "clr r25",
+            "rjmp 2f",
             "1:",
             "lsl r22",
             "rol r23",
             "rol r24",
-            "brcs 3f",
+            "rol r25",
+            "2:",
+            "subi r21, 1",
+            "brcc 1b",
+            // w ≈ 2³⁹/md in p1:p0 (2¹⁵ < w < 2¹⁶), never above it, within 2⁻⁷·⁸ of it: one
+            // Newton step w = y·(2 − y·md/2³¹)·2⁸ from the linear seed y = 103 − ⌊239·d2/2⁸⌋
+            // ≈ 2³¹/md (relative error ≤ 6.5 %; d2 = md's top byte, ≥ 128), y in q2, q0 = 0 as
+            // the zero. Checked for every md: `w ≤ 2³⁹/md` (the digits below rely on it) and
+            // the error bound.
+            "ldi {q2}, 239",
+            "mul r20, {q2}",
+            "ldi {q2}, 103",
+            "sub {q2}, r1",
+            // P = (⌊md/2⁸⌋ + 1)·y ≥ md·y/2⁸ (the excess keeps w from above), P >> 8 to r1:p2.
+            "mul r19, {q2}",
+            "add r0, {q2}",
+            "adc r1, {q0}",
+            "mov {p2}, r1",
+            "mul r20, {q2}",
+            "add {p2}, r0",
+            "adc r1, {q0}",
+            // z = 2¹⁶ − 1 − (P >> 8) ≈ 2¹⁵·(2 − y·md/2³¹) to p1:p2 (positive: 2¹⁵ ± 7 %).
+            "com {p2}",
+            "com r1",
+            "mov {p1}, r1",
+            // w = ⌊y·z / 2⁷⌋ (y·z < 2²³), the low byte of y·z's low product dropped.
+            "mul {q2}, {p2}",
+            "mov {p0}, r1",
+            "mul {q2}, {p1}",
+            "add r0, {p0}",
+            "adc r1, {q0}",
+            "lsl r0",
+            "rol r1",
+            "mov {p0}, r0",
+            "mov {p1}, r1",
+            // One digit a pass, r21 the zero: the estimate q̂ = ⌊(R3:R2 · w) / 2²³⌋ from three
+            // products (the low ones dropped) into q0 after the digits move up a byte; q̂ is
+            // never above the digit ⌊R/md⌋ (w ≤ 2³⁹/md, every part truncated) and at most 2
+            // below it (256·2⁻⁷·⁸ + the dropped parts < 2).
+            "clr r21",
+            "1:",
+            "mov {q2}, {q1}",
+            "mov {q1}, {q0}",
+            "mul r25, {p1}",
+            "mov {p2}, r0",
+            "mov {q0}, r1",
+            "mul r25, {p0}",
+            "add {p2}, r1",
+            "adc {q0}, r21",
+            "mul r24, {p1}",
+            "add {p2}, r1",
+            "adc {q0}, r21",
+            "lsl {p2}",
+            "rol {q0}",
+            // R −= q̂·md (R ≥ 0 stays, < 3·md).
+            "mul {q0}, r18",
+            "sub r22, r0",
+            "sbc r23, r1",
+            "sbc r24, r21",
+            "sbc r25, r21",
+            "mul {q0}, r19",
+            "sub r23, r0",
+            "sbc r24, r1",
+            "sbc r25, r21",
+            "mul {q0}, r20",
+            "sub r24, r0",
+            "sbc r25, r1",
+            // The exact digit: while R ≥ md, R −= md and q̂ += 1 (at most twice).
             "2:",
             "cp r22, r18",
             "cpc r23, r19",
             "cpc r24, r20",
-            "brcs 4f",
+            "cpc r25, r21",
+            "brcs 3f",
+            "sub r22, r18",
+            "sbc r23, r19",
+            "sbc r24, r20",
+            "sbc r25, r21",
+            "inc {q0}",
+            "rjmp 2b",
+            // R < md: R·2⁸ for the next digit.
             "3:",
-            "sub r22, r18",
-            "sbc r23, r19",
-            "sbc r24, r20",
-            "clc",
-            "4:",
-            "rol {q0}",
-            "rol {q1}",
-            "rol {q2}",
-            "lsl r22",
-            "rol r23",
-            "rol r24",
-            "brcs 13f",
-            "12:",
-            "cp r22, r18",
-            "cpc r23, r19",
-            "cpc r24, r20",
-            "brcs 14f",
-            "13:",
-            "sub r22, r18",
-            "sbc r23, r19",
-            "sbc r24, r20",
-            "clc",
-            "14:",
-            "rol {q0}",
-            "rol {q1}",
-            "rol {q2}",
+            "mov r25, r24",
+            "mov r24, r23",
+            "mov r23, r22",
+            "clr r22",
             "dec {cnt}",
             "brne 1b",
-            "com {q0}",
-            "com {q1}",
-            "com {q2}",
-            "rjmp 6f",
-            // den infinite (or NaN): T = 2²¹ when num is too, else 0.
-            "7:",
-            "cpi r25, 255",
-            "brne 6f",
-            "ldi {q2}, 0x20",
+            "clr r1",
             // The cell k = q2 ≤ 32: Z += 8·k (9 bits), a to p3:p2:p1:p0, b to e1:e0, c to
             // e3:e2; d = q1:q0.
             "6:",
