@@ -228,31 +228,26 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "brlo 5f",
             "rjmp 8f",
             "5:",
-            // T = ⌊mn·2^(21−s) / md⌋ in base-256 digits: 21 − s = 8·j + a, the first digit
-            // ⌊mn·2^a / md⌋ (a + 1 bits), then j digits of 8 bits; cnt = j + 1, r21 = a.
+            // T = ⌊mn·2^t / md⌋, t = 21 − s, in base-256 digits: t = 8·j + a, the first digit
+            // ⌊mn·2^a / md⌋ (a + 1 bits), then j digits of 8 bits; t in cnt, a in r21.
             "ldi {cnt}, 21",
             "sub {cnt}, r21",
-            "mov r21, {cnt}",
-            "andi r21, 7",
-            "lsr {cnt}",
-            "lsr {cnt}",
-            "lsr {cnt}",
-            "inc {cnt}",
-            // den subnormal (md < 2²³; then num is too, s = 0 and mn ≤ md): both shifted left
-            // until md's bit 23 is set, the quotient unchanged.
+            // den subnormal (md < 2²³; then num is too, s = 0 and mn ≤ md): md shifted left
+            // until its bit 23 is set, t one more each time (the same T, in more digits whose
+            // leading ones are 0).
             "rjmp 2f",
             "1:",
             "lsl r18",
             "rol r19",
             "rol r20",
-            "lsl r22",
-            "rol r23",
-            "rol r24",
+            "inc {cnt}",
             "2:",
             "sbrs r20, 7",
             "rjmp 1b",
+            "mov r21, {cnt}",
+            "andi r21, 7",
             // The remainder R = mn·2^a to r25:r24:r23:r22: R < 2⁸·md (mn < 2·md, a ≤ 7; s = 0:
-            // mn ≤ md, a = 5), so the first digit is < 2⁸ too.
+            // mn ≤ md), so the first digit is < 2⁸ too.
             "clr r25",
             "rjmp 2f",
             "1:",
@@ -263,24 +258,24 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "2:",
             "subi r21, 1",
             "brcc 1b",
-            // w ≈ 2³⁹/md in p1:p0 (2¹⁵ < w < 2¹⁶), never above it, within 2⁻⁷·⁸ of it: one
-            // Newton step w = y·(2 − y·md/2³¹)·2⁸ from the linear seed y = 103 − ⌊239·d2/2⁸⌋
-            // ≈ 2³¹/md (relative error ≤ 6.5 %; d2 = md's top byte, ≥ 128), y in q2, q0 = 0 as
-            // the zero. Checked for every md: `w ≤ 2³⁹/md` (the digits below rely on it) and
-            // the error bound.
+            // w ≈ 2³⁹/md in p1:p0 (2¹⁵ < w < 2¹⁶), never above it, at most 2⁻⁷·⁸ below it
+            // (relative): one Newton step w = y·(2 − y·md/2³¹)·2⁸ from the linear seed
+            // y = 103 − ⌊239·d2/2⁸⌋ ≈ 2³¹/md (relative error ≤ 6.5 %; d2 = md's top byte,
+            // ≥ 128), y in q2, q0 = 0 as the zero. Both bounds checked for every md (w depends
+            // on md >> 8 only): the digits below rely on `w ≤ 2³⁹/md`.
             "ldi {q2}, 239",
             "mul r20, {q2}",
             "ldi {q2}, 103",
             "sub {q2}, r1",
-            // P = (⌊md/2⁸⌋ + 1)·y ≥ md·y/2⁸ (the excess keeps w from above), P >> 8 to r1:p2.
+            // P = ⌊md/2⁸⌋·y, P >> 8 plus one to r1:p2 (the one makes up for md's low byte: with
+            // the Newton step's own deficit, it keeps w from above 2³⁹/md).
             "mul r19, {q2}",
-            "add r0, {q2}",
-            "adc r1, {q0}",
             "mov {p2}, r1",
             "mul r20, {q2}",
-            "add {p2}, r0",
+            "sec",
+            "adc {p2}, r0",
             "adc r1, {q0}",
-            // z = 2¹⁶ − 1 − (P >> 8) ≈ 2¹⁵·(2 − y·md/2³¹) to p1:p2 (positive: 2¹⁵ ± 7 %).
+            // z = 2¹⁶ − 1 − r1:p2 ≈ 2¹⁵·(2 − y·md/2³¹) to p1:p2 (positive: 2¹⁵ ± 7 %).
             "com {p2}",
             "com r1",
             "mov {p1}, r1",
@@ -339,14 +334,14 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "sbc r25, r21",
             "inc {q0}",
             "rjmp 2b",
-            // R < md: R·2⁸ for the next digit.
+            // R < md: R·2⁸ for the next digit, while t − 8·(digits done) ≥ 0.
             "3:",
             "mov r25, r24",
             "mov r24, r23",
             "mov r23, r22",
             "clr r22",
-            "dec {cnt}",
-            "brne 1b",
+            "subi {cnt}, 8",
+            "brcc 1b",
             "clr r1",
             // The cell k = q2 ≤ 32: Z += 8·k (9 bits), a to p3:p2:p1:p0, b to e1:e0, c to
             // e3:e2; d = q1:q0.
