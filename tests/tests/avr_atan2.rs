@@ -168,3 +168,34 @@ fn asm_atan2_fixed_is_the_portable_kernel_bit_for_bit() {
         cycles_asm as f64 / n
     );
 }
+
+/// The asm kernel's reciprocal estimate `w ≈ 2³⁹/md` (its division's only approximation),
+/// step for step in integers as the assembly computes it, for every denominator mantissa
+/// (`w` depends on `md >> 8` only, each value checked against the largest `md` it stands for):
+/// never above `2³⁹/md` (a digit estimate above the digit would make the remainder negative),
+/// and at most 2⁻⁷·⁸ below it relative (a digit estimate at most two below the digit: the
+/// kernel's corrections). A change of the assembly's constants needs this model changed too;
+/// the fixed pairs of the emulator test above fail when the first bound does not hold.
+#[test]
+fn the_asm_reciprocal_estimate_is_never_above_and_close() {
+    let mut worst = 0.0f64;
+    for dh in 0x8000u32..0x1_0000 {
+        let (d2, d1) = (dh >> 8, dh & 0xff);
+        // The linear seed y ≈ 2³¹/md (a byte: 103 − the high byte of 239·d2, mod 2⁸).
+        let y = 103u32.wrapping_sub((239 * d2) >> 8) & 0xff;
+        // P >> 8 of P = (md >> 8)·y, plus one; z = 2¹⁶ − 1 − that.
+        let p = (((d1 * y) >> 8) + d2 * y + 1) & 0xffff;
+        let z = !p & 0xffff;
+        // w = (y·z) >> 7 without the low byte of y·(z's low byte).
+        let w = (y * (z >> 8) + ((y * (z & 0xff)) >> 8)) << 1;
+        assert!(w < 1 << 16, "md >> 8 = {dh:#x}: w = {w:#x}");
+        let largest = (dh as u64) << 8 | 0xff;
+        assert!(
+            w as u64 * largest <= 1 << 39,
+            "md >> 8 = {dh:#x}: w = {w} above 2^39/md"
+        );
+        let below = 1.0 - w as f64 * (dh as f64 * 256.0) / 2f64.powi(39);
+        worst = worst.max(below);
+    }
+    assert!(worst <= 2f64.powf(-7.8), "w is {worst:e} below 2^39/md");
+}
