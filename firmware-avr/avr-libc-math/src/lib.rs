@@ -135,7 +135,8 @@ impl Math for AvrLibm {
 ///   hardware multiplier, exact: a reciprocal estimate of the denominator (a linear seed and
 ///   one Newton step, never above the reciprocal), then the `22 − (e_d − eₙ)` quotient bits
 ///   `T` keeps as base-256 digits (one to three, the first aligned so that the shift of the
-///   quotient comes free), each estimated from the remainder's top bytes and the reciprocal,
+///   quotient comes free; a subnormal denominator's quotient in up to six, the leading ones
+///   0), each estimated from the remainder's top bytes and the reciprocal,
 ///   subtracted from the remainder, and made exact by at most two corrections;
 /// - the cell `k = T >> 16` read with `lpm` ([`poly::atan_cells`]) and its three
 ///   16 × 16-bit products with `mul`, each rounded as the portable kernel rounds it;
@@ -254,7 +255,7 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "2:",
             "subi r21, 1",
             "brcc 1b",
-            // w ≈ 2³⁹/md in p1:p0 (2¹⁵ < w < 2¹⁶), never above it, at most 2⁻⁷·⁸ below it
+            // w ≈ 2³⁹/md in p1:p0 (< 2¹⁶), never above it, at most 2⁻⁷·⁸ below it
             // (relative): one Newton step w = y·(2 − y·md/2³¹)·2⁸ from the linear seed
             // y = 103 − ⌊239·d2/2⁸⌋ ≈ 2³¹/md (relative error ≤ 6.5 %; d2 = md's top byte,
             // ≥ 128), y in q2, q0 = 0 as the zero. Both bounds checked for every md (w depends
