@@ -2,7 +2,9 @@
 //! the portable `poly::atan2_fixed` compiled for the AVR, bit for bit, in simavr: both are
 //! primitives of the benchmark firmware (`bench.elf`), run on the same seeded random pairs (all
 //! quadrants, wide exponent ranges, tiny and huge ratios, equal magnitudes, signed zeros,
-//! subnormals, infinities, NaNs). The portable kernel's bits are also those of the host's
+//! subnormals, infinities, NaNs, and the denominators that test the asm kernel's division:
+//! its least precise reciprocal estimates, and fixed pairs that need its estimate never to
+//! be above the reciprocal). The portable kernel's bits are also those of the host's
 //! (`SoftFloat`): integer arithmetic and one correctly rounded conversion on both.
 //!
 //! The firmware is built once per test process (`quad_host::emu::build`); the test fails —
@@ -24,7 +26,7 @@ fn pair(rng: &mut Rng) -> (f32, f32) {
         let d = exp(rng, 0, 2 * spread) as i64 - spread as i64;
         (e as i64 + d).clamp(0, 255) as u32
     };
-    match pick % 8 {
+    match pick % 9 {
         // Any exponents, infinities and NaNs included.
         0 => {
             let (ea, eb) = (exp(rng, 0, 255), exp(rng, 0, 255));
@@ -71,6 +73,20 @@ fn pair(rng: &mut Rng) -> (f32, f32) {
                 (other, special)
             }
         }
+        // Denominators where the asm kernel's reciprocal estimate is least precise (mantissas
+        // 0xc4f000 to 0xc4ffff with the implicit one), exponent differences 0 to 5 (three
+        // quotient digits): about one pair in 250 has a digit that needs two corrections.
+        8 => {
+            let e = exp(rng, 100, 140);
+            let den = f32::from_bits(e << 23 | 0x44_f000 | (pick >> 8) as u32 & 0xfff);
+            let en = e - exp(rng, 0, 5);
+            let num = float(rng, en);
+            if pick & 1 << 20 == 0 {
+                (num, den)
+            } else {
+                (-den, num)
+            }
+        }
         // Huge ratios near the top of the range.
         _ => {
             let (ea, eb) = (exp(rng, 200, 254), exp(rng, 0, 254));
@@ -105,6 +121,20 @@ fn asm_atan2_fixed_is_the_portable_kernel_bit_for_bit() {
         (0.3, 0.2),
         (0.4, -0.2),
     ];
+    // Denominators where a reciprocal estimate above 2³⁹/md would make the asm kernel's digit
+    // estimate one too large (a remainder just below 255·md; found with a model of the
+    // estimate without its safety term): each of these fails then.
+    fixed_cases.extend(
+        [
+            (0x3d11_3802, 0x3f91_c9ee),
+            (0x3991_8103, 0x3f91_c9f0),
+            (0x3dd7_d606, 0x3f91_c9fb),
+            (0x3f23_fa1f, 0x3f91_c9ff),
+            (0x3911_381f, 0x3f91_c9fe),
+            (0x3e12_c8fc, 0x3f91_c9ff),
+        ]
+        .map(|(y, x)| (f32::from_bits(y), f32::from_bits(x))),
+    );
     fixed_cases.extend((0..PAIRS).map(|_| pair(&mut rng)));
     let (mut cycles_portable, mut cycles_asm) = (0u64, 0u64);
     for &(y, x) in &fixed_cases {
@@ -137,4 +167,35 @@ fn asm_atan2_fixed_is_the_portable_kernel_bit_for_bit() {
         cycles_portable as f64 / n,
         cycles_asm as f64 / n
     );
+}
+
+/// The asm kernel's reciprocal estimate `w ≈ 2³⁹/md` (its division's only approximation),
+/// step for step in integers as the assembly computes it, for every denominator mantissa
+/// (`w` depends on `md >> 8` only, each value checked against the largest `md` it stands for):
+/// never above `2³⁹/md` (a digit estimate above the digit would make the remainder negative),
+/// and at most 2⁻⁷·⁸ below it relative (a digit estimate at most two below the digit: the
+/// kernel's corrections). A change of the assembly's constants needs this model changed too;
+/// the fixed pairs of the emulator test above fail when the first bound does not hold.
+#[test]
+fn the_asm_reciprocal_estimate_is_never_above_and_close() {
+    let mut worst = 0.0f64;
+    for dh in 0x8000u32..0x1_0000 {
+        let (d2, d1) = (dh >> 8, dh & 0xff);
+        // The linear seed y ≈ 2³¹/md (a byte: 103 − the high byte of 239·d2, mod 2⁸).
+        let y = 103u32.wrapping_sub((239 * d2) >> 8) & 0xff;
+        // P >> 8 of P = (md >> 8)·y, plus one; z = 2¹⁶ − 1 − that.
+        let p = (((d1 * y) >> 8) + d2 * y + 1) & 0xffff;
+        let z = !p & 0xffff;
+        // w = (y·z) >> 7 without the low byte of y·(z's low byte).
+        let w = (y * (z >> 8) + ((y * (z & 0xff)) >> 8)) << 1;
+        assert!(w < 1 << 16, "md >> 8 = {dh:#x}: w = {w:#x}");
+        let largest = (dh as u64) << 8 | 0xff;
+        assert!(
+            w as u64 * largest <= 1 << 39,
+            "md >> 8 = {dh:#x}: w = {w} above 2^39/md"
+        );
+        let below = 1.0 - w as f64 * (dh as f64 * 256.0) / 2f64.powi(39);
+        worst = worst.max(below);
+    }
+    assert!(worst <= 2f64.powf(-7.8), "w is {worst:e} below 2^39/md");
 }
