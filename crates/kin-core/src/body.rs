@@ -378,16 +378,14 @@ impl<M: Math> Solver<M> {
         *rl = -*fl;
         *fl = *fl + *fr;
         *rl = *rl + *fr;
-        *fr = *fl;
-        *rr = *rl;
-        // ± b, b = (W/2 + d_lat)·r₁ − (0, W/2, 0): left +, right −.
+        // ± b, b = (W/2 + d_lat)·r₁ − (0, W/2, 0): the right feet (a − K − b, −a − K − b)
+        // from the left ones before these take theirs (+ b), so that no vector is copied.
         let mut b = Vec3::from_array(r.rows[1]) * self.stance_lateral_m;
         b.y -= self.hip_fl_m.y;
+        *fr = *fl + -b;
+        *rr = *rl + -b;
         *fl = *fl + b;
         *rl = *rl + b;
-        let b = -b;
-        *fr = *fr + b;
-        *rr = *rr + b;
     }
 
     /// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
@@ -514,7 +512,10 @@ impl<M: Math> Solver<M> {
         out: &mut BodySolution,
     ) -> Result<(), IkError> {
         check_finite(pose, config)?;
-        let mut local = [Vec3::ZERO; 4];
+        // Four zeros written out, not a repeat expression: the compiler then sees that the
+        // stance transform writes every foot before it reads one and drops the zeroing (the
+        // repeat expression's per-vector zeroing loop stayed).
+        let mut local = [Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
         self.stance_feet_in_hips(pose, config, stance_height_m, &mut local);
         self.legs(&local, policy, out)
     }
