@@ -298,12 +298,19 @@ impl<M: Math> Solver<M> {
         out: &mut [Vec3; 4],
     ) {
         let c = &config.pivot_m;
-        let t = FeetToHips {
-            r: rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad),
+        let mut t = FeetToHips {
+            r: Mat3::ZERO,
             offset: pose.translation() + *c,
             c,
             hip_fl: &self.hip_fl_m,
         };
+        rotation::matrix_into::<M>(
+            config.order,
+            pose.roll_rad,
+            pose.pitch_rad,
+            pose.yaw_rad,
+            &mut t.r,
+        );
         for ((foot, o), leg) in feet_in_world.iter().zip(out.iter_mut()).zip(&LegId::ALL) {
             foot_in_hip(&t, foot, o, *leg);
         }
@@ -358,7 +365,14 @@ impl<M: Math> Solver<M> {
     ) {
         let c = &config.pivot_m;
         let g = pose.translation() + *c;
-        let r = rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+        let mut r = Mat3::ZERO;
+        rotation::matrix_into::<M>(
+            config.order,
+            pose.roll_rad,
+            pose.pitch_rad,
+            pose.yaw_rad,
+            &mut r,
+        );
         // The four feet are built in place, the slots holding the shared terms on the way
         // (few vectors in the frame: cheap addressing where the frame is addressed by a
         // short displacement).
