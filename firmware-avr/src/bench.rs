@@ -97,14 +97,16 @@ impl<M: Math> Solve for Prepared<M> {
 
     #[inline(never)]
     fn body(&self, pose: &Pose) -> Result<[f32; 12], IkError> {
-        self.solver
-            .inverse_at_stance(
-                pose,
-                &BodyConfig::default(),
-                STANCE_HEIGHT_M,
-                ReachPolicy::Reject,
-            )
-            .map(|s| s.flat())
+        // As the device solves a pose: into a solution in its own frame, read in place.
+        let mut solution = body::BodySolution::default();
+        self.solver.inverse_at_stance_into(
+            pose,
+            &BodyConfig::default(),
+            STANCE_HEIGHT_M,
+            ReachPolicy::Reject,
+            &mut solution,
+        )?;
+        Ok(solution.angles_rad)
     }
 }
 

@@ -7,8 +7,8 @@
 //! - `foot_in_hip = Rᵀ·(foot_in_world − t − c) + c − hip_in_body` (inverse)
 //! - `foot_in_world = R·(hip_in_body + foot_in_hip − c) + c + t` (forward)
 
-use crate::leg::{self, IkError, LegSolution, ReachPolicy};
-use crate::math::{finite, DefaultMath, Math};
+use crate::leg::{self, Clamp, IkError, LegSolution, ReachPolicy};
+use crate::math::{DefaultMath, Math};
 use crate::robot::{JointAngles, LegId, Robot};
 use crate::rotation::{self, RotationOrder};
 use crate::vec::{Mat3, Vec3};
@@ -105,35 +105,50 @@ impl BodyConfig {
 /// Twelve joint angles, in leg order FL, FR, RL, RR.
 pub type BodyAngles = [JointAngles; 4];
 
-/// Result of a full-body IK.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Result of a full-body IK, stored flat: the twelve angles in the order the servos take them
+/// (the solve writes each leg's angles straight into its place, and a consumer reads them there
+/// without a copy), and each leg's clamp. [`BodySolution::default`] (all zero, no clamp) is an
+/// empty one for [`Solver::inverse_into`] and [`Solver::inverse_at_stance_into`] to fill.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BodySolution {
-    /// Per-leg solutions in order FL, FR, RL, RR.
-    pub legs: [LegSolution; 4],
+    /// The twelve angles `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`, rad (legs in
+    /// order FL, FR, RL, RR).
+    pub angles_rad: [f32; 12],
+    /// Per leg in order FL, FR, RL, RR: `Some` when [`ReachPolicy::Clamp`] moved its target.
+    pub clamped: [Option<Clamp>; 4],
 }
 
 impl BodySolution {
-    /// The twelve angles.
-    pub fn angles(&self) -> BodyAngles {
-        self.legs.map(|l| l.angles)
+    /// The solution of leg `leg`.
+    pub fn leg(&self, leg: LegId) -> LegSolution {
+        let i = leg.index();
+        let a = &self.angles_rad;
+        LegSolution {
+            angles: JointAngles::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]),
+            clamped: self.clamped[i],
+        }
     }
 
-    /// The twelve angles flattened `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`.
-    #[inline(never)]
+    /// The four legs' solutions, in order FL, FR, RL, RR.
+    pub fn legs(&self) -> [LegSolution; 4] {
+        LegId::ALL.map(|leg| self.leg(leg))
+    }
+
+    /// The twelve angles, per leg.
+    pub fn angles(&self) -> BodyAngles {
+        unflatten(&self.angles_rad)
+    }
+
+    /// The twelve angles flattened `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`: a copy
+    /// of [`BodySolution::angles_rad`] (which a caller that only reads them reads in place).
+    #[inline]
     pub fn flat(&self) -> [f32; 12] {
-        // A loop: little code (the field-by-field array literal wrote the result in place,
-        // 264 cycles faster on the AVR, for 188 B more; BENCHMARKS.md).
-        let mut out = [0.0; 12];
-        for (o, leg) in out.chunks_exact_mut(3).zip(&self.legs) {
-            let a = &leg.angles;
-            (o[0], o[1], o[2]) = (a.abduction_rad, a.hip_rad, a.knee_rad);
-        }
-        out
+        self.angles_rad
     }
 
     /// True when any leg was clamped.
     pub fn any_clamped(&self) -> bool {
-        self.legs.iter().any(|l| l.clamped.is_some())
+        self.clamped.iter().any(Option::is_some)
     }
 }
 
@@ -283,12 +298,19 @@ impl<M: Math> Solver<M> {
         out: &mut [Vec3; 4],
     ) {
         let c = &config.pivot_m;
-        let t = FeetToHips {
-            r: rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad),
+        let mut t = FeetToHips {
+            r: Mat3::ZERO,
             offset: pose.translation() + *c,
             c,
             hip_fl: &self.hip_fl_m,
         };
+        rotation::matrix_into::<M>(
+            config.order,
+            pose.roll_rad,
+            pose.pitch_rad,
+            pose.yaw_rad,
+            &mut t.r,
+        );
         for ((foot, o), leg) in feet_in_world.iter().zip(out.iter_mut()).zip(&LegId::ALL) {
             foot_in_hip(&t, foot, o, *leg);
         }
@@ -343,7 +365,14 @@ impl<M: Math> Solver<M> {
     ) {
         let c = &config.pivot_m;
         let g = pose.translation() + *c;
-        let r = rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+        let mut r = Mat3::ZERO;
+        rotation::matrix_into::<M>(
+            config.order,
+            pose.roll_rad,
+            pose.pitch_rad,
+            pose.yaw_rad,
+            &mut r,
+        );
         // The four feet are built in place, the slots holding the shared terms on the way
         // (few vectors in the frame: cheap addressing where the frame is addressed by a
         // short displacement).
@@ -363,21 +392,20 @@ impl<M: Math> Solver<M> {
         *rl = -*fl;
         *fl = *fl + *fr;
         *rl = *rl + *fr;
-        *fr = *fl;
-        *rr = *rl;
-        // ± b, b = (W/2 + d_lat)·r₁ − (0, W/2, 0): left +, right −.
+        // ± b, b = (W/2 + d_lat)·r₁ − (0, W/2, 0): the right feet (a − K − b, −a − K − b)
+        // from the left ones before these take theirs (+ b), so that no vector is copied.
         let mut b = Vec3::from_array(r.rows[1]) * self.stance_lateral_m;
         b.y -= self.hip_fl_m.y;
+        *fr = *fl + -b;
+        *rr = *rl + -b;
         *fl = *fl + b;
         *rl = *rl + b;
-        let b = -b;
-        *fr = *fr + b;
-        *rr = *rr + b;
     }
 
     /// Full-body IK: all-or-nothing. The first leg (in order FL, FR, RL, RR) that cannot reach
     /// rejects the pose and is named in the error; a non-finite pose or pivot is
-    /// [`leg::Unreachable::NonFinite`] named on FL.
+    /// [`leg::Unreachable::NonFinite`] named on FL. ([`Solver::inverse_into`] writes the
+    /// solution into a caller's.)
     #[inline]
     pub fn inverse(
         &self,
@@ -386,16 +414,45 @@ impl<M: Math> Solver<M> {
         feet_in_world: &[Vec3; 4],
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
+        let mut out = BodySolution::default();
+        self.inverse_into(pose, config, feet_in_world, policy, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Solver::inverse`] written into `out`, where the caller reads it in place: no solution
+    /// built in a temporary and copied out (a returned solution goes through memory on CPUs
+    /// such as the AVR, and is copied there once more). The same results; on an error `out`
+    /// may hold some legs of this solve and is to be ignored.
+    ///
+    /// ```
+    /// use kin_core::{body, BodyConfig, BodySolution, Pose, ReachPolicy, Robot};
+    /// let robot = Robot::shahriar2023();
+    /// let solver = body::Solver::new(&robot);
+    /// let (pose, config) = (Pose::rotation(0.1, 0.0, 0.0), BodyConfig::default());
+    /// let feet = robot.stance_feet(0.277);
+    /// let mut solution = BodySolution::default();
+    /// solver.inverse_into(&pose, &config, &feet, ReachPolicy::Reject, &mut solution)?;
+    /// assert_eq!(Ok(solution), solver.inverse(&pose, &config, &feet, ReachPolicy::Reject));
+    /// # Ok::<(), kin_core::IkError>(())
+    /// ```
+    #[inline]
+    pub fn inverse_into(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        feet_in_world: &[Vec3; 4],
+        policy: ReachPolicy,
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
         if M::SHARE_FLOAT_CODE {
-            return self.inverse_shared(pose, config, feet_in_world, policy);
+            return self.inverse_shared(pose, config, feet_in_world, policy, out);
         }
         check_finite(pose, config)?;
         let local = self.feet_in_hips(pose, config, feet_in_world);
-        self.legs(&local, policy)
+        self.legs(&local, policy, out)
     }
 
-    /// [`Solver::inverse`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]), which the
-    /// stance solve shares.
+    /// [`Solver::inverse_into`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]).
     #[inline(never)]
     fn inverse_shared(
         &self,
@@ -403,16 +460,18 @@ impl<M: Math> Solver<M> {
         config: &BodyConfig,
         feet_in_world: &[Vec3; 4],
         policy: ReachPolicy,
-    ) -> Result<BodySolution, IkError> {
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
         check_finite(pose, config)?;
         let local = self.feet_in_hips(pose, config, feet_in_world);
-        self.legs(&local, policy)
+        self.legs(&local, policy, out)
     }
 
     /// Body pose with the feet held at the nominal stance of height `stance_height_m`
     /// ([`Robot::stance_feet`]), through the closed-form transform of the stance feet (the
     /// same angles as [`Solver::inverse`] with those feet up to f32 rounding). Errors as
-    /// [`Solver::inverse`].
+    /// [`Solver::inverse`]. ([`Solver::inverse_at_stance_into`] writes the solution into a
+    /// caller's.)
     #[inline]
     pub fn inverse_at_stance(
         &self,
@@ -421,10 +480,58 @@ impl<M: Math> Solver<M> {
         stance_height_m: f32,
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
+        let mut out = BodySolution::default();
+        self.inverse_at_stance_into(pose, config, stance_height_m, policy, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Solver::inverse_at_stance`] written into `out`, where the caller reads it in place (as
+    /// [`Solver::inverse_into`]; on an error `out` is to be ignored).
+    #[inline]
+    pub fn inverse_at_stance_into(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        stance_height_m: f32,
+        policy: ReachPolicy,
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
+        if M::SHARE_FLOAT_CODE {
+            return self.inverse_at_stance_shared(pose, config, stance_height_m, policy, out);
+        }
+        self.inverse_at_stance_inline(pose, config, stance_height_m, policy, out)
+    }
+
+    /// [`Solver::inverse_at_stance_into`] as one out-of-line copy
+    /// ([`Math::SHARE_FLOAT_CODE`]): the finiteness check once, not at every caller.
+    #[inline(never)]
+    fn inverse_at_stance_shared(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        stance_height_m: f32,
+        policy: ReachPolicy,
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
+        self.inverse_at_stance_inline(pose, config, stance_height_m, policy, out)
+    }
+
+    #[inline(always)]
+    fn inverse_at_stance_inline(
+        &self,
+        pose: &Pose,
+        config: &BodyConfig,
+        stance_height_m: f32,
+        policy: ReachPolicy,
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
         check_finite(pose, config)?;
-        let mut local = [Vec3::ZERO; 4];
+        // Four zeros written out, not a repeat expression: the compiler then sees that the
+        // stance transform writes every foot before it reads one and drops the zeroing (the
+        // repeat expression's per-vector zeroing loop stayed).
+        let mut local = [Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
         self.stance_feet_in_hips(pose, config, stance_height_m, &mut local);
-        self.legs(&local, policy)
+        self.legs(&local, policy, out)
     }
 
     /// The body at the zero pose with its feet at `feet_in_body` (body frame, m): each foot
@@ -440,67 +547,84 @@ impl<M: Math> Solver<M> {
         for (p, leg) in local.iter_mut().zip(LegId::ALL) {
             *p = *p - leg.at_corner(self.hip_fl_m);
         }
-        self.legs(&local, policy)
+        let mut out = BodySolution::default();
+        self.legs(&local, policy, &mut out)?;
+        Ok(out)
     }
 
-    /// The four leg solves of feet in their hips' frames: staged across the legs when the
-    /// backend asks for it ([`Math::STAGE_LEGS`]), else (and to name the first failure) one
-    /// after the other through one out-of-line leg solve; the same results either way.
+    /// The four leg solves of feet in their hips' frames, written into `out`: staged across
+    /// the legs when the backend asks for it ([`Math::STAGE_LEGS`]), else (and to name the
+    /// first failure) one after the other through one out-of-line leg solve, each leg's
+    /// angles straight into their place in `out`; the same results either way.
     #[inline(always)]
-    fn legs(&self, local: &[Vec3; 4], policy: ReachPolicy) -> Result<BodySolution, IkError> {
+    fn legs(
+        &self,
+        local: &[Vec3; 4],
+        policy: ReachPolicy,
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
         if M::SHARE_FLOAT_CODE {
-            return self.legs_shared(local, policy);
+            return self.legs_shared(local, policy, out);
         }
-        self.legs_inline(local, policy)
+        self.legs_inline(local, policy, out)
     }
 
     /// [`Solver::legs`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]): the general, the
     /// stance and the feet-in-body solves share it.
     #[inline(never)]
-    fn legs_shared(&self, local: &[Vec3; 4], policy: ReachPolicy) -> Result<BodySolution, IkError> {
-        self.legs_inline(local, policy)
+    fn legs_shared(
+        &self,
+        local: &[Vec3; 4],
+        policy: ReachPolicy,
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
+        self.legs_inline(local, policy, out)
     }
 
     #[inline(always)]
-    fn legs_inline(&self, local: &[Vec3; 4], policy: ReachPolicy) -> Result<BodySolution, IkError> {
+    fn legs_inline(
+        &self,
+        local: &[Vec3; 4],
+        policy: ReachPolicy,
+        out: &mut BodySolution,
+    ) -> Result<(), IkError> {
         if M::STAGE_LEGS && policy == ReachPolicy::Reject {
             if let Some(angles) = self.leg.inverse_all_reject(local) {
-                return Ok(BodySolution {
-                    legs: angles.map(|angles| LegSolution {
-                        angles,
-                        clamped: None,
-                    }),
-                });
+                out.angles_rad = flatten(&angles);
+                out.clamped = [None; 4];
+                return Ok(());
             }
         }
-        let mut out = BodySolution {
-            legs: [LegSolution {
-                angles: JointAngles::default(),
-                clamped: None,
-            }; 4],
-        };
-        for ((s, foot), leg) in out.legs.iter_mut().zip(local).zip(&LegId::ALL) {
-            self.leg.inverse_into(*leg, foot, policy, s)?;
+        let legs = out.angles_rad.chunks_exact_mut(3).zip(&mut out.clamped);
+        for ((angles, clamped), (foot, leg)) in legs.zip(local.iter().zip(&LegId::ALL)) {
+            // Chunks of exactly three: the conversion cannot fail (and compiles to nothing).
+            if let Ok(angles) = angles.try_into() {
+                self.leg.inverse_into(*leg, foot, policy, angles, clamped)?;
+            }
         }
-        Ok(out)
+        Ok(())
     }
 }
 
 /// `NonFinite` (named on FL) when the pose or the pivot is not finite: the first check of
-/// [`Solver::inverse`] and [`Solver::inverse_at_stance`].
-#[inline(always)]
+/// [`Solver::inverse`] and [`Solver::inverse_at_stance`]. Out of line: one copy of its nine
+/// checks for the two solves.
+#[inline(never)]
 fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
-    let p = config.pivot_m;
-    // Field by field, without copying the pose into an array first.
+    let p = &config.pivot_m;
+    // Field by field, without copying the pose into an array first; all nine checked
+    // together (`&`, no branch per value), each by its exponent byte (bits 30..23): finite
+    // when short of all ones.
+    let finite = |x: f32| (x.to_bits() >> 23) as u8 != u8::MAX;
     let ok = finite(pose.roll_rad)
-        && finite(pose.pitch_rad)
-        && finite(pose.yaw_rad)
-        && finite(pose.x_m)
-        && finite(pose.y_m)
-        && finite(pose.z_m)
-        && finite(p.x)
-        && finite(p.y)
-        && finite(p.z);
+        & finite(pose.pitch_rad)
+        & finite(pose.yaw_rad)
+        & finite(pose.x_m)
+        & finite(pose.y_m)
+        & finite(pose.z_m)
+        & finite(p.x)
+        & finite(p.y)
+        & finite(p.z);
     if ok {
         Ok(())
     } else {
@@ -705,7 +829,7 @@ mod tests {
                         match (body, one_by_one) {
                             (Ok(b), Ok(l)) => {
                                 solved += 1;
-                                for (x, y) in b.legs.iter().zip(&l) {
+                                for (x, y) in b.legs().iter().zip(&l) {
                                     assert_eq!(
                                         x.angles.to_array().map(f32::to_bits),
                                         y.angles.to_array().map(f32::to_bits)

@@ -574,20 +574,24 @@ impl<M: Math> Solver<M> {
         Ok(LegSolution { angles, clamped })
     }
 
-    /// [`Solver::inverse`] kept out of line, its solution written into `out`: the body IK's
-    /// legs one after the other through one copy of the leg solve ([`Math::STAGE_LEGS`]
-    /// false, and the fallback that names the first failing leg). Only the small error comes
-    /// back by value (a returned solution would be copied once more on CPUs that return it
-    /// through memory).
+    /// [`Solver::inverse`] kept out of line, its solution written into `angles_rad`
+    /// (`[abduction, hip, knee]`) and `clamped`, the leg's places in the body IK's flat
+    /// solution: the body IK's legs one after the other through one copy of the leg solve
+    /// ([`Math::STAGE_LEGS`] false, and the fallback that names the first failing leg). Only
+    /// the small error comes back by value (a returned solution would be copied once more on
+    /// CPUs that return it through memory). On an error neither place is written.
     #[inline(never)]
     pub(crate) fn inverse_into(
         &self,
         leg: LegId,
         foot_in_hip: &Vec3,
         policy: ReachPolicy,
-        out: &mut LegSolution,
+        angles_rad: &mut [f32; 3],
+        clamped: &mut Option<Clamp>,
     ) -> Result<(), IkError> {
-        *out = self.inverse_inline(leg, *foot_in_hip, policy)?;
+        let s = self.inverse_inline(leg, *foot_in_hip, policy)?;
+        *angles_rad = s.angles.to_array();
+        *clamped = s.clamped;
         Ok(())
     }
 

@@ -148,6 +148,22 @@ fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32)
 /// ```
 #[inline]
 pub fn matrix<M: Math>(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
+    let mut m = Mat3::ZERO;
+    matrix_into::<M>(order, roll_rad, pitch_rad, yaw_rad, &mut m);
+    m
+}
+
+/// [`matrix`] written into `out` (every entry): the general closed form, where a backend
+/// shares its float code, writes its entries by the order's axes straight into place (a
+/// returned matrix went through a zeroed temporary filled by index and a copy).
+#[inline]
+pub fn matrix_into<M: Math>(
+    order: RotationOrder,
+    roll_rad: f32,
+    pitch_rad: f32,
+    yaw_rad: f32,
+    out: &mut Mat3,
+) {
     // The three `sin_cos` once, ahead of the order's arm: one copy of the kernels, not one per
     // arm. One arm per order with the axes as constants, so that each compiles to its own
     // closed form without index arithmetic; where float operations are library calls, one
@@ -161,15 +177,17 @@ pub fn matrix<M: Math>(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_
             usize::from(k),
             order.is_even(),
             &sc,
+            &mut out.rows,
         );
     }
+    let rows = &mut out.rows;
     match order {
-        RotationOrder::Zyx => zyx_of(&sc),
-        RotationOrder::Zxy => zxy_of(&sc),
-        RotationOrder::Xyz => closed_form(0, 1, 2, true, &sc),
-        RotationOrder::Xzy => closed_form(0, 2, 1, false, &sc),
-        RotationOrder::Yxz => closed_form(1, 0, 2, false, &sc),
-        RotationOrder::Yzx => closed_form(1, 2, 0, true, &sc),
+        RotationOrder::Zyx => *out = zyx_of(&sc),
+        RotationOrder::Zxy => *out = zxy_of(&sc),
+        RotationOrder::Xyz => closed_form(0, 1, 2, true, &sc, rows),
+        RotationOrder::Xzy => closed_form(0, 2, 1, false, &sc, rows),
+        RotationOrder::Yxz => closed_form(1, 0, 2, false, &sc, rows),
+        RotationOrder::Yzx => closed_form(1, 2, 0, true, &sc, rows),
     }
 }
 
@@ -273,7 +291,8 @@ fn zxy_of(sc: &[(f32, f32); 3]) -> Mat3 {
 /// (0 = x, 1 = y, 2 = z; `even`: `(i, j, k)` is a cyclic permutation of `(x, y, z)`), with
 /// `(sin, cos)` of the roll, pitch and yaw angles in `sc` (`a`, `b`, `c` are the angles of axes
 /// `i`, `j`, `k`). The general Tait–Bryan closed form, with `ε = ±1` by the parity of the
-/// order (for zyx and zxy it is [`zyx`] and [`zxy`], bit for bit):
+/// order (for zyx and zxy it is [`zyx`] and [`zxy`], bit for bit), written into `rows` (all
+/// nine entries, the axes being distinct):
 ///
 /// | | column i | column j | column k |
 /// |---|---|---|---|
@@ -281,11 +300,17 @@ fn zxy_of(sc: &[(f32, f32); 3]) -> Mat3 {
 /// | row j | ε·ca·sc + sa·sb·cc | ca·cc − ε·sa·sb·sc | −ε·sa·cb |
 /// | row k | sa·sc − ε·ca·sb·cc | ε·sa·cc + ca·sb·sc | ca·cb |
 #[inline(always)]
-fn closed_form(i: usize, j: usize, k: usize, even: bool, sc: &[(f32, f32); 3]) -> Mat3 {
+fn closed_form(
+    i: usize,
+    j: usize,
+    k: usize,
+    even: bool,
+    sc: &[(f32, f32); 3],
+    rows: &mut [[f32; 3]; 3],
+) {
     let ((sa, ca), (sb, cb), (s_c, c_c)) = (sc[i], sc[j], sc[k]);
     let e = |x: f32| if even { x } else { -x };
     let (sa_sb, ca_sb) = (sa * sb, ca * sb);
-    let mut rows = [[0.0f32; 3]; 3];
     rows[i][i] = cb * c_c;
     rows[i][j] = e(-(cb * s_c));
     rows[i][k] = e(sb);
@@ -295,7 +320,6 @@ fn closed_form(i: usize, j: usize, k: usize, even: bool, sc: &[(f32, f32); 3]) -
     rows[k][i] = sa * s_c - e(ca_sb * c_c);
     rows[k][j] = e(sa * c_c) + ca_sb * s_c;
     rows[k][k] = ca * cb;
-    Mat3 { rows }
 }
 
 /// Angular velocity of the body, in the world frame, for Euler-angle rates in `order`:
@@ -328,7 +352,9 @@ mod tests {
         let [i, j, k] = order.axes();
         // Cyclic orders (xyz, yzx, zxy) are the even permutations.
         let even = (j + 3 - i) % 3 == 1;
-        closed_form(i as usize, j as usize, k as usize, even, sc)
+        let mut m = Mat3::ZERO;
+        closed_form(i as usize, j as usize, k as usize, even, sc, &mut m.rows);
+        m
     }
 
     /// Every order's matrix (the written-out [`zyx`] and [`zxy`] included) equals the general

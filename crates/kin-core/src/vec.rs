@@ -114,6 +114,11 @@ pub struct Mat3 {
 }
 
 impl Mat3 {
+    /// The zero matrix.
+    pub const ZERO: Mat3 = Mat3 {
+        rows: [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
+    };
+
     /// The identity matrix.
     pub const IDENTITY: Mat3 = Mat3 {
         rows: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],

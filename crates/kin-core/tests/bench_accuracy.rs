@@ -111,8 +111,7 @@ fn body_ik_then_f64_fk_within_1_um_on_every_benchmark_pose() {
             pose.yaw_rad as f64,
         );
         for leg in LegId::ALL {
-            let foot_in_hip =
-                foot_in_hip_f64(&robot, leg, angles_f64(sol.legs[leg.index()].angles));
+            let foot_in_hip = foot_in_hip_f64(&robot, leg, angles_f64(sol.leg(leg).angles));
             let foot_in_world =
                 r * (to_f64(robot.hip_in_body(leg)) + foot_in_hip) + to_f64(pose.translation());
             worst = worst.max((foot_in_world - to_f64(feet[leg.index()])).norm());

@@ -303,9 +303,9 @@ fn nominal_stance_is_zero_abduction() {
                 ReachPolicy::Reject,
             )
             .unwrap();
-        for (l, s) in LegId::ALL.iter().zip(sol.legs) {
+        for (l, s) in LegId::ALL.iter().map(|&l| (l, sol.leg(l))) {
             assert!(s.angles.abduction_rad.abs() < 1e-6, "{l}: {s:?}");
-            let foot = leg::forward(&robot.leg, *l, s.angles);
+            let foot = leg::forward(&robot.leg, l, s.angles);
             assert!((foot.z + h).abs() < 1e-6 && foot.x.abs() < 1e-6);
         }
     }

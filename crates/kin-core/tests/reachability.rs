@@ -237,8 +237,8 @@ fn body_rejects_pose_and_names_the_leg() {
         )
         .unwrap();
     assert!(sol.any_clamped());
-    assert!(sol.legs[LegId::FL.index()].clamped.is_none());
-    assert!(sol.legs[LegId::RL.index()].clamped.is_some());
+    assert!(sol.leg(LegId::FL).clamped.is_none());
+    assert!(sol.leg(LegId::RL).clamped.is_some());
 }
 
 /// Planar distance of a foot from the hip-flexion joint, and its distance from the abduction
@@ -434,7 +434,7 @@ proptest! {
         let feet: [Vec3; 4] = std::array::from_fn(|i| Vec3::new(feet[3*i], feet[3*i+1], feet[3*i+2]));
         for policy in [ReachPolicy::Reject, ReachPolicy::Clamp] {
             if let Ok(sol) = body::Solver::new(&robot).inverse(&pose, &config, &feet, policy) {
-                for l in sol.legs {
+                for l in sol.legs() {
                     prop_assert!(l.angles.is_finite());
                 }
             }
@@ -443,7 +443,7 @@ proptest! {
         let stance = robot.stance_feet(0.3);
         for policy in [ReachPolicy::Reject, ReachPolicy::Clamp] {
             if let Ok(sol) = body::Solver::new(&robot).inverse(&pose, &config, &stance, policy) {
-                for l in sol.legs {
+                for l in sol.legs() {
                     prop_assert!(l.angles.is_finite());
                 }
             }

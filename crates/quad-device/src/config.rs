@@ -263,7 +263,7 @@ pub(crate) fn write_default_calibration<M: Math>(
     for (leg, calibrations) in table.chunks_exact_mut(3).enumerate() {
         for (joint, c) in calibrations.iter_mut().enumerate() {
             let zero_rad = match &stance {
-                Ok(s) => s.legs[leg].angles.to_array()[joint],
+                Ok(s) => s.angles_rad[3 * leg + joint],
                 Err(_) => 0.0,
             };
             let right = matches!(LegId::from_index(leg), Some(LegId::FR | LegId::RR));

@@ -10,7 +10,7 @@ use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::store::{Store, Table};
 use kin_core::body::{self, BodySolution, Pose};
 use kin_core::motion::gait::Velocity;
-use kin_core::{BodyConfig, DefaultMath, IkError, Math, Vec3};
+use kin_core::{BodyConfig, DefaultMath, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
@@ -683,12 +683,16 @@ where
     #[inline(never)]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
         let c = &self.config.pose_config;
-        let solution = self.solver.inverse_at_stance(
+        // Solved into this frame's solution and read there (no solution returned through
+        // memory, no flattened copy of its angles).
+        let mut solution = BodySolution::default();
+        self.solver.inverse_at_stance_into(
             pose,
             &BodyConfig::about_centre(c.order),
             c.stance_height_m,
             c.policy,
-        );
+            &mut solution,
+        )?;
         self.apply_solution(&solution)
     }
 
@@ -699,31 +703,29 @@ where
         // Through the general solve at the zero pose (the body frame is the world frame):
         // its one out-of-line copy, not a second for the feet in the body frame.
         let pc = &self.config.pose_config;
-        let solution = self.solver.inverse(
+        let mut solution = BodySolution::default();
+        self.solver.inverse_into(
             &Pose::default(),
             &BodyConfig::about_centre(pc.order),
             &feet,
             pc.policy,
-        );
+            &mut solution,
+        )?;
         self.apply_solution(&solution)
     }
 
-    fn apply_solution(
-        &mut self,
-        solution: &Result<BodySolution, IkError>,
-    ) -> Result<(), NackReason> {
-        // Borrowed: the solution is read where the solve left it, not copied into this frame.
-        let solution = solution.as_ref().map_err(|&e| NackReason::from(e))?;
-        let angles = solution.flat();
+    /// Applies a body solve's angles, read where the solve left them (no copy).
+    fn apply_solution(&mut self, solution: &BodySolution) -> Result<(), NackReason> {
+        let angles = &solution.angles_rad;
         let clamped = solution.any_clamped();
         // A clamp to the joint limits puts the angle exactly on a bound.
         let limits = &self.config.robot.limits;
         let limited = clamped
-            && ServoId::ALL.iter().zip(&angles).any(|(s, &a)| {
+            && ServoId::ALL.iter().zip(angles).any(|(s, &a)| {
                 let j = s.joint as usize;
                 a == limits.min_rad[j] || a == limits.max_rad[j]
             });
-        self.apply(&angles, clamped, limited)
+        self.apply(angles, clamped, limited)
     }
 
     /// `SetJoints`, on angles the range check has found finite (`check_request`).

@@ -86,7 +86,7 @@ pub use limiter::{
 
 use core::fmt;
 use core::marker::PhantomData;
-use kin_core::body::{self, BodyConfig, Pose};
+use kin_core::body::{self, BodyConfig, BodySolution, Pose};
 use kin_core::jacobian::SINGULARITY_THRESHOLD;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
@@ -494,14 +494,16 @@ pub fn solve_frame<M: Math>(
     order: RotationOrder,
     frame: &Frame,
 ) -> Result<[f32; 12], IkError> {
-    solver
-        .inverse(
-            &frame.pose,
-            &BodyConfig::about_centre(order),
-            &frame.feet_in_world,
-            ReachPolicy::Reject,
-        )
-        .map(|s| s.flat())
+    // Solved into a solution here, its angles read from it (none returned and then copied).
+    let mut solution = BodySolution::default();
+    solver.inverse_into(
+        &frame.pose,
+        &BodyConfig::about_centre(order),
+        &frame.feet_in_world,
+        ReachPolicy::Reject,
+        &mut solution,
+    )?;
+    Ok(solution.angles_rad)
 }
 
 /// Checks that `angles` map within every servo's calibrated travel (`pulse_maps`: each

@@ -276,7 +276,7 @@ fn write_table(
         Ok(solution) => {
             writeln!(out, "  leg  abduction_deg   hip_deg  knee_deg")?;
             for leg in LegId::ALL {
-                let q = solution.legs[leg.index()].angles;
+                let q = solution.leg(leg).angles;
                 writeln!(
                     out,
                     "  {leg}   {:>13} {:>9} {:>9}",
