@@ -35,7 +35,7 @@
 //! device.boot();                                      // calibration from EEPROM, stance held
 //! loop {
 //!     let n = usart.read_into(&mut chunk);            // bytes queued by the USART RX interrupt
-//!     device.receive(&chunk[..n], |frame| usart.write_all(frame));
+//!     device.receive(&chunk[..n], |piece| usart.send(piece)); // answers, in pieces as they are final
 //!     device.poll();                                  // link-loss failsafe, motion frame
 //! }
 //! ```
