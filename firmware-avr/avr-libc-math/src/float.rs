@@ -155,12 +155,7 @@ macro_rules! float_primitives {
             "2:",
             "mov r31, r27",
             "neg r30",
-            "movw r26, r22",
-            "movw r22, r18",
-            "movw r18, r26",
-            "movw r26, r24",
-            "movw r24, r20",
-            "movw r20, r26",
+            $crate::swap_operands!(),
             // The result's sign (A's) to T; r21 bit 7: the signs differ (a subtraction).
             "1:",
             "bst r25, 7",

@@ -28,6 +28,19 @@
 // `sin_cos_fixed`).
 #![feature(asm_experimental_arch)]
 
+/// The AVR assembly that swaps the two float operands, r25:r24:r23:r22 and r21:r20:r19:r18,
+/// through r27:r26 (six `movw`): one text for the `asm!` templates of the kernels that order
+/// their operands by magnitude (the arctangent, the sine/cosine, the float addition). The
+/// `asm!` block must declare r27:r26 clobbered or hold nothing there. Exported (hidden) for
+/// [`float_primitives!`], which expands in the binaries.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! swap_operands {
+    () => {
+        "movw r26, r22\nmovw r22, r18\nmovw r18, r26\nmovw r26, r24\nmovw r24, r20\nmovw r20, r26"
+    };
+}
+
 pub mod float;
 pub mod sqrt;
 
@@ -178,12 +191,7 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "cpc r21, r25",
             "brsh 5f",
             "inc {o}",
-            "movw r26, r22",
-            "movw r22, r18",
-            "movw r18, r26",
-            "movw r26, r24",
-            "movw r24, r20",
-            "movw r20, r26",
+            swap_operands!(),
             "5:",
             // den = 0 (num = 0 too): p = 0.
             "cp r18, r1",
@@ -853,12 +861,7 @@ extern "C" fn sin_cos_fixed_core(rb: u32) -> u64 {
             "mov r23, r24",
             "mov r24, r25",
             "mov r25, {e}",
-            "movw r26, r22",
-            "movw r22, r18",
-            "movw r18, r26",
-            "movw r26, r24",
-            "movw r24, r20",
-            "movw r20, r26",
+            swap_operands!(),
             "dec {dh}",
             "brne 10b",
             // The sign of r on the sine.
