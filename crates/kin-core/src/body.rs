@@ -8,7 +8,7 @@
 //! - `foot_in_world = R·(hip_in_body + foot_in_hip − c) + c + t` (forward)
 
 use crate::leg::{self, Clamp, IkError, LegSolution, ReachPolicy};
-use crate::math::{DefaultMath, Math};
+use crate::math::{finite, DefaultMath, Math};
 use crate::robot::{JointAngles, LegId, Robot};
 use crate::rotation::{self, RotationOrder};
 use crate::vec::{Mat3, Vec3};
@@ -414,9 +414,7 @@ impl<M: Math> Solver<M> {
         feet_in_world: &[Vec3; 4],
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
-        let mut out = BodySolution::default();
-        self.inverse_into(pose, config, feet_in_world, policy, &mut out)?;
-        Ok(out)
+        by_value(|out| self.inverse_into(pose, config, feet_in_world, policy, out))
     }
 
     /// [`Solver::inverse`] written into `out`, where the caller reads it in place: no solution
@@ -480,9 +478,7 @@ impl<M: Math> Solver<M> {
         stance_height_m: f32,
         policy: ReachPolicy,
     ) -> Result<BodySolution, IkError> {
-        let mut out = BodySolution::default();
-        self.inverse_at_stance_into(pose, config, stance_height_m, policy, &mut out)?;
-        Ok(out)
+        by_value(|out| self.inverse_at_stance_into(pose, config, stance_height_m, policy, out))
     }
 
     /// [`Solver::inverse_at_stance`] written into `out`, where the caller reads it in place (as
@@ -547,9 +543,7 @@ impl<M: Math> Solver<M> {
         for (p, leg) in local.iter_mut().zip(LegId::ALL) {
             *p = *p - leg.at_corner(self.hip_fl_m);
         }
-        let mut out = BodySolution::default();
-        self.legs(&local, policy, &mut out)?;
-        Ok(out)
+        by_value(|out| self.legs(&local, policy, out))
     }
 
     /// The four leg solves of feet in their hips' frames, written into `out`: staged across
@@ -606,6 +600,17 @@ impl<M: Math> Solver<M> {
     }
 }
 
+/// The solution that `solve` writes into an empty one ([`BodySolution::default`]), by value:
+/// the by-value forms of the solves that write into a caller's.
+#[inline(always)]
+fn by_value(
+    solve: impl FnOnce(&mut BodySolution) -> Result<(), IkError>,
+) -> Result<BodySolution, IkError> {
+    let mut out = BodySolution::default();
+    solve(&mut out)?;
+    Ok(out)
+}
+
 /// `NonFinite` (named on FL) when the pose or the pivot is not finite: the first check of
 /// [`Solver::inverse`] and [`Solver::inverse_at_stance`]. Out of line: one copy of its nine
 /// checks for the two solves.
@@ -613,9 +618,7 @@ impl<M: Math> Solver<M> {
 fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = &config.pivot_m;
     // Field by field, without copying the pose into an array first; all nine checked
-    // together (`&`, no branch per value), each by its exponent byte (bits 30..23): finite
-    // when short of all ones.
-    let finite = |x: f32| (x.to_bits() >> 23) as u8 != u8::MAX;
+    // together (`&`, no branch per value).
     let ok = finite(pose.roll_rad)
         & finite(pose.pitch_rad)
         & finite(pose.yaw_rad)

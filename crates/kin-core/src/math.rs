@@ -961,10 +961,12 @@ pub const fn interval_keys(lo: f32, hi: f32) -> (i32, i32) {
 }
 
 /// `x.is_finite()` from the exponent bits, on every target (core's `is_finite` is a float
-/// comparison, a library call on CPUs without floating-point hardware).
+/// comparison, a library call on CPUs without floating-point hardware): finite when the
+/// exponent (bits 30..23) is short of all ones, tested as one byte (a byte compare on an 8-bit
+/// CPU rather than a 32-bit mask).
 #[inline(always)]
 pub(crate) const fn finite(x: f32) -> bool {
-    x.to_bits() & bits::INF != bits::INF
+    (x.to_bits() >> 23) as u8 != u8::MAX
 }
 
 /// `x.is_finite() && x > 0.0` from the bits: the patterns of the positive subnormals to the
