@@ -135,6 +135,18 @@ fn asm_atan2_fixed_is_the_portable_kernel_bit_for_bit() {
         ]
         .map(|(y, x)| (f32::from_bits(y), f32::from_bits(x))),
     );
+    // Ratios just below 2⁻⁵ (cell 0's last offsets, where d·b reaches 2³¹: the asm kernel
+    // once dropped that bit, a knee 2⁻⁵ rad off), in all four sign combinations and swapped.
+    for ulps in 0..64u32 {
+        let t = f32::from_bits(0x3d00_0000 - 1 - ulps * 3);
+        for (y, x) in [(t, 1.0f32), (1.0, t)] {
+            for signs in 0..4u32 {
+                let sy = if signs & 1 == 0 { y } else { -y };
+                let sx = if signs & 2 == 0 { x } else { -x };
+                fixed_cases.push((sy, sx));
+            }
+        }
+    }
     fixed_cases.extend((0..PAIRS).map(|_| pair(&mut rng)));
     let (mut cycles_portable, mut cycles_asm) = (0u64, 0u64);
     for &(y, x) in &fixed_cases {

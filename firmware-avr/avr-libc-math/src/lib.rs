@@ -365,7 +365,9 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "lpm r20, Z+",
             "lpm r21, Z+",
             "clr {cnt}",
-            // d·b to n3:n2:n1:n0; p += (d·b + 2⁶) >> 7 (d·b < 2³¹).
+            // d·b to n3:n2:n1:n0; p += (d·b + 2⁶) >> 7 in five bytes: cell 0's b is above
+            // 2¹⁵ (32,774), so for d ≥ 65,526 (t just below 2⁻⁵) d·b reaches 2³¹ and its
+            // bit 31 is bit 24 of the sum (a four-byte shift lost it: p 2⁻⁵ low).
             "mul r26, r18",
             "movw r22, r0",
             "mul r27, r19",
@@ -383,14 +385,16 @@ fn atan2_fixed(y: f32, x: f32) -> f32 {
             "adc r23, {cnt}",
             "adc r24, {cnt}",
             "adc r25, {cnt}",
+            "clr {q2}",
             "lsl r22",
             "rol r23",
             "rol r24",
             "rol r25",
+            "rol {q2}",
             "add r14, r23",
             "adc r15, r24",
             "adc {p2}, r25",
-            "adc {p3}, {cnt}",
+            "adc {p3}, {q2}",
             // d² >> 16 to n3:n2.
             "mul r26, r26",
             "mov r23, r1",
