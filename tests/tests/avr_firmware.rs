@@ -258,6 +258,26 @@ fn flash_and_sram_fit_the_board() {
     );
 }
 
+/// The tables the firmware reads with `lpm` are seen by the budget's check (kin-core's kernel
+/// cells, by name) and lie in the lowest 64 KB of flash, in every firmware build.
+#[test]
+fn tables_read_with_lpm_lie_in_the_lowest_64_kb() {
+    for bin in [build::FIRMWARE, build::FIRMWARE_1MBAUD, build::BENCH] {
+        let path = firmware(bin);
+        let objects = elf::Elf::read(&path)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .flash_objects();
+        for table in ["ATAN_CELLS", "SIN_COS_CELLS"] {
+            assert!(
+                objects.iter().any(|o| o.name.contains(table) && o.size_bytes > 0),
+                "{bin}: no {table} among the flash objects {objects:?}"
+            );
+        }
+        let beyond = integration_tests::budget::lpm_reach_violations(&path);
+        assert!(beyond.is_empty(), "{bin}: beyond lpm's reach: {beyond:?}");
+    }
+}
+
 #[test]
 fn handshake_then_outputs_stay_low_until_enabled() {
     for baud in BAUDS {

@@ -53,6 +53,24 @@ pub struct ElfSizes {
     pub sram_static_bytes: u64,
 }
 
+/// A data object in flash ([`Elf::flash_objects`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FlashObject {
+    /// The symbol's name (mangled, as the symbol table has it).
+    pub name: String,
+    /// Its flash byte address.
+    pub addr: u32,
+    /// Its size, bytes.
+    pub size_bytes: u32,
+}
+
+impl FlashObject {
+    /// The first byte address past the object.
+    pub fn end(&self) -> u32 {
+        self.addr + self.size_bytes
+    }
+}
+
 /// A parsed ELF: its bytes and section headers.
 pub struct Elf {
     bytes: Vec<u8>,
@@ -148,6 +166,43 @@ impl Elf {
                 .then(|| u32_at(e + 4))
                 .flatten()
         })
+    }
+
+    /// The data objects that the linker placed in flash (`OBJECT` symbols of `.text`: tables
+    /// the firmware reads with `lpm`, such as kin-core's kernel cells), in symbol-table order.
+    pub fn flash_objects(&self) -> Vec<FlashObject> {
+        const STT_OBJECT: u8 = 1;
+        let Some(text) = self.sections.iter().position(|s| s.0 == ".text") else {
+            return Vec::new();
+        };
+        let Some((_, symoff, symsize, link)) = self.sections.iter().find(|s| s.0 == ".symtab")
+        else {
+            return Vec::new();
+        };
+        let Some(&(_, stroff, _, _)) = self.sections.get(*link) else {
+            return Vec::new();
+        };
+        let b = &self.bytes;
+        let u32_at = |o: usize| {
+            b.get(o..o + 4)
+                .map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+        };
+        (0..symsize / 16)
+            .filter_map(|i| {
+                let e = symoff + 16 * i;
+                let info = *b.get(e + 12)?;
+                let shndx = b
+                    .get(e + 14..e + 16)
+                    .map(|s| u16::from_le_bytes([s[0], s[1]]))?;
+                (info & 0xf == STT_OBJECT && usize::from(shndx) == text).then(|| {
+                    Some(FlashObject {
+                        name: cstr(b, stroff + u32_at(e)? as usize),
+                        addr: u32_at(e + 4)?,
+                        size_bytes: u32_at(e + 8)?,
+                    })
+                })?
+            })
+            .collect()
     }
 
     /// The SRAM address of a data symbol (`.data`/`.bss` or a linker symbol such as
