@@ -15,6 +15,7 @@
 //! | body pose at the stance | `B`, backend u8, roll pitch yaw x y z f32 | `b`, status u8, 12 × f32 |
 //! | memory | `S` | `s`, static SRAM u16, max stack u16 |
 //! | one primitive | `F`, op u8, a b f32 | `f`, status u8, result f32 |
+//! | a kernel over the batch in SRAM | `K`, kernel u8, count u16 | `k`, status u8 |
 //! | start an onboard motion (untimed) | `M`, motion u8 | `m`, status u8 |
 //! | one servo frame of it | `N` | `n`, status u8, stage u8 |
 //!
@@ -24,6 +25,12 @@
 //! firmware's configuration) and its approach ramp is run before the timed frames. A timed
 //! frame is what `Device::poll` does at a servo frame boundary: the engine's tick (the motion
 //! and its body IK), the limiter step of the twelve outputs and their calibrated pulses.
+//!
+//! `K` is the kernels' test harness: the host writes up to [`KERNEL_BATCH_LEN`] argument pairs
+//! straight into [`KERNEL_BATCH`] (in simavr's memory, not over the UART), the firmware
+//! replaces each pair by the two results of kernel `kernel` of its table ([`KernelFn`]) and
+//! answers; the host reads the results from memory. Status 2 for an unknown kernel or a count
+//! beyond the batch.
 //!
 //! Status 0 = solved, 1 = unreachable, 2 = unknown backend. Boot sends `R` once ready.
 //! Robot: [`kin_core::Robot::shahriar2023`] with its knee bend and limits; body poses about
@@ -53,6 +60,33 @@ pub const ROBOT: Robot = Robot::shahriar2023();
 
 /// One float primitive under test, `op(a, b)` (unary ones ignore `b`).
 pub type PrimFn = fn(f32, f32) -> f32;
+
+/// One kernel of the test harness (`K`): the two results of its arguments `(a, b)`, as bits
+/// (a kernel of one result, or of one argument, ignores the rest).
+pub type KernelFn = fn(u32, u32) -> (u32, u32);
+
+/// Argument pairs of one harness batch ([`KERNEL_BATCH`]).
+pub const KERNEL_BATCH_LEN: usize = 128;
+
+/// The harness batch: argument pairs written by the host, replaced by the results. Exported
+/// under its own name, so that the host finds it in the ELF's symbols.
+#[no_mangle]
+pub static mut KERNEL_BATCH: [[u32; 2]; KERNEL_BATCH_LEN] = [[0; 2]; KERNEL_BATCH_LEN];
+
+/// Runs `kernel` over the first `count` pairs of [`KERNEL_BATCH`], in place.
+fn run_kernel_batch(kernel: KernelFn, count: usize) {
+    let batch = core::ptr::addr_of_mut!(KERNEL_BATCH).cast::<[u32; 2]>();
+    for i in 0..count.min(KERNEL_BATCH_LEN) {
+        // SAFETY: `i` is within the batch; volatile, because the host writes the pairs behind
+        // the program's back; the firmware's only other code runs no harness batch.
+        unsafe {
+            let slot = batch.add(i);
+            let [a, b] = core::ptr::read_volatile(slot);
+            let (r0, r1) = kernel(a, b);
+            core::ptr::write_volatile(slot, [r0, r1]);
+        }
+    }
+}
 
 /// The IK of one math backend under test.
 pub trait Solve {
@@ -313,6 +347,7 @@ pub fn serve(
     porta: &pac::PORTA,
     backends: &[Backend<'_>],
     prims: &[PrimFn],
+    kernels: &[KernelFn],
     motion: &mut dyn MotionBench,
 ) -> ! {
     // SAFETY: any DDRA value is valid; PA0 becomes an output, low.
@@ -378,6 +413,21 @@ pub fn serve(
                     }
                     None => send_status(usart, STATUS_UNKNOWN_BACKEND, 1),
                 }
+            }
+            b'K' => {
+                let kernel = read_byte(usart) as usize;
+                let count = u16::from_le_bytes([read_byte(usart), read_byte(usart)]) as usize;
+                let status = match kernels.get(kernel) {
+                    Some(&f) if count <= KERNEL_BATCH_LEN => {
+                        marker(porta, true);
+                        run_kernel_batch(core::hint::black_box(f), count);
+                        marker(porta, false);
+                        STATUS_OK
+                    }
+                    _ => STATUS_UNKNOWN_BACKEND,
+                };
+                usart.write(b'k');
+                usart.write(status);
             }
             b'M' => {
                 let m = read_byte(usart);

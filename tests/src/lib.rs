@@ -10,5 +10,7 @@
 
 pub mod avr_bench;
 pub mod budget;
+pub mod kernel_edges;
+pub mod kernels;
 pub mod pins;
 pub mod symbols;

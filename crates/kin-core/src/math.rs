@@ -857,8 +857,17 @@ pub mod poly {
     }
 
     /// [`sin_cos_fixed_with`] beyond ±π/4: the range reduction, `core`, the quadrant.
+    ///
+    /// A NaN or infinite `x` takes `core`'s value for the quiet NaN in quadrant 0: the
+    /// reduction would turn it into a NaN whose payload (and so the quadrant read from its low
+    /// bits) is the software-float library's choice, which differs between avr-libc and a
+    /// host; this way every target gives the same bounded bits.
     #[inline(never)]
     fn sin_cos_fixed_reduced<F: FnOnce(u32) -> (u32, u32)>(x: f32, core: F) -> (f32, f32) {
+        if !super::finite(x) {
+            let (sin, cos) = core(f32::NAN.to_bits());
+            return (f32::from_bits(sin), f32::from_bits(cos));
+        }
         let (k, r) = reduce(x);
         let (sin, cos) = core(r.to_bits());
         quadrant(k, f32::from_bits(sin), f32::from_bits(cos))

@@ -744,6 +744,38 @@ impl Mega2560 {
         unsafe { *avr.data.add(usize::from(addr)) }
     }
 
+    /// Writes `bytes` into the data space from `addr` on (SRAM, as a debugger would: no
+    /// instruction runs).
+    ///
+    /// # Panics
+    /// When the range extends beyond RAMEND.
+    pub fn write_data(&mut self, addr: u16, bytes: &[u8]) {
+        let avr = self.avr();
+        let end = usize::from(addr) + bytes.len();
+        assert!(
+            end <= usize::from(avr.ramend) + 1,
+            "write of {} bytes at {addr:#06x} beyond RAMEND {:#06x}",
+            bytes.len(),
+            avr.ramend
+        );
+        // SAFETY: `data` holds RAMEND + 1 bytes; the range is within (checked above), and no
+        // instruction runs while the bytes are copied.
+        unsafe {
+            core::ptr::copy_nonoverlapping(
+                bytes.as_ptr(),
+                avr.data.add(usize::from(addr)),
+                bytes.len(),
+            );
+        }
+    }
+
+    /// `len` bytes of the data space from `addr` on ([`Mega2560::data`] each).
+    pub fn data_bytes(&self, addr: u16, len: usize) -> Vec<u8> {
+        (0..len)
+            .map(|i| self.data(addr.wrapping_add(i as u16)))
+            .collect()
+    }
+
     /// WDTCSR, the watchdog control register.
     pub fn wdtcsr(&self) -> u8 {
         self.data(WDTCSR)
