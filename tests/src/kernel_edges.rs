@@ -426,42 +426,57 @@ fn leak(s: String) -> &'static str {
     Box::leak(s.into_boxed_str())
 }
 
+/// One class's part of a share ([`plan`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Part {
+    /// The class's index.
+    pub class: usize,
+    /// How many of its values.
+    pub count: u64,
+    /// The seed of its random picks.
+    pub seed: u64,
+}
+
 /// A share of a kernel's classes: `evaluations` values in all (or every value, when the
 /// classes hold fewer), spread evenly: a class smaller than its share entirely, the rest of
-/// the budget spread over the larger ones; of a larger class its first half-share of indices
-/// (the values nearest its edges, every variant) and seeded random indices from the rest.
-/// Returns `(class index, argument pairs)` per class, in class order.
-pub fn plan(classes: &[Class], evaluations: u64, seed: u64) -> Vec<(usize, Vec<[u32; 2]>)> {
+/// the budget spread over the larger ones. [`sample`] draws each part's values.
+pub fn plan(classes: &[Class], evaluations: u64, seed: u64) -> Vec<Part> {
     // Shares: the smallest classes first, each taking at most an even part of what is left.
     let mut order: Vec<usize> = (0..classes.len()).collect();
     order.sort_by_key(|&c| classes[c].size);
-    let mut shares = vec![0u64; classes.len()];
+    let mut counts = vec![0u64; classes.len()];
     let mut left = evaluations;
     for (n, &c) in order.iter().enumerate() {
         let even = left.div_ceil((classes.len() - n) as u64);
-        shares[c] = classes[c].size.min(even);
-        left -= shares[c].min(left);
+        counts[c] = classes[c].size.min(even);
+        left -= counts[c].min(left);
     }
     let mut rng = SplitMix64::new(seed);
-    classes
-        .iter()
-        .zip(shares)
+    counts
+        .into_iter()
         .enumerate()
-        .map(|(c, (class, share))| {
-            let args: Vec<[u32; 2]> = if class.random {
-                let base = rng.next_u64() >> 24;
-                (0..share).map(|i| class.get(base + i)).collect()
-            } else if class.size <= share {
-                (0..class.size).map(|i| class.get(i)).collect()
-            } else {
-                let near = share / 2;
-                let rest = class.size - near;
-                (0..near)
-                    .map(|i| class.get(i))
-                    .chain((near..share).map(|_| class.get(near + rng.next_u64() % rest)))
-                    .collect()
-            };
-            (c, args)
+        .map(|(class, count)| Part {
+            class,
+            count,
+            seed: rng.next_u64(),
         })
         .collect()
+}
+
+/// The values of `part` of `class`: a random class's `count` values from a seeded offset; an
+/// edge class entirely when it holds no more, else its first `count / 2` indices (the values
+/// nearest its edges, every variant) and seeded random indices from the rest.
+pub fn sample<'a>(class: &'a Class, part: &Part) -> impl Iterator<Item = [u32; 2]> + 'a {
+    let mut rng = SplitMix64::new(part.seed);
+    let base = rng.next_u64() >> 24;
+    let (count, near) = (part.count, part.count / 2);
+    (0..count).map(move |i| {
+        if class.random {
+            class.get(base + i)
+        } else if class.size <= count || i < near {
+            class.get(i)
+        } else {
+            class.get(near + rng.next_u64() % (class.size - near))
+        }
+    })
 }

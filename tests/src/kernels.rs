@@ -266,12 +266,13 @@ pub struct KernelReport {
 }
 
 /// Runs `kernel` on `harness` over the share `plan` of `classes` ([`crate::kernel_edges`]),
-/// calling `progress` after each class; keeps the first 20 findings.
+/// calling `progress` after every 2¹⁶ evaluations and after each class; keeps the first 20
+/// findings.
 pub fn run_plan(
     harness: &mut Harness,
     kernel: Kernel,
     classes: &[crate::kernel_edges::Class],
-    plan: &[(usize, Vec<[u32; 2]>)],
+    plan: &[crate::kernel_edges::Part],
     mut progress: impl FnMut(&KernelReport),
 ) -> KernelReport {
     let started = Instant::now();
@@ -279,26 +280,27 @@ pub fn run_plan(
         kernel: kernel.name().to_string(),
         ..KernelReport::default()
     };
-    for (c, args) in plan {
-        let class = &classes[*c];
-        let mut mismatches = 0;
-        for chunk in args.chunks(1 << 16) {
-            let findings = harness.check(kernel, class.name, chunk);
-            mismatches += findings.len() as u64;
+    for part in plan {
+        let class = &classes[part.class];
+        report.classes.push((class.name.to_string(), 0, 0));
+        let mut values = crate::kernel_edges::sample(class, part).peekable();
+        while values.peek().is_some() {
+            let chunk: Vec<[u32; 2]> = values.by_ref().take(1 << 16).collect();
+            let findings = harness.check(kernel, class.name, &chunk);
+            let row = report.classes.last_mut().expect("pushed above");
+            row.1 += chunk.len() as u64;
+            row.2 += findings.len() as u64;
+            report.evaluations += chunk.len() as u64;
+            report.mismatches += findings.len() as u64;
             for f in findings {
                 if report.first_findings.len() < 20 {
                     report.first_findings.push(f.to_string());
                 }
             }
+            report.evaluations_per_s =
+                report.evaluations as f64 / started.elapsed().as_secs_f64().max(1e-9);
+            progress(&report);
         }
-        report.evaluations += args.len() as u64;
-        report.mismatches += mismatches;
-        report
-            .classes
-            .push((class.name.to_string(), args.len() as u64, mismatches));
-        report.evaluations_per_s =
-            report.evaluations as f64 / started.elapsed().as_secs_f64().max(1e-9);
-        progress(&report);
     }
     report
 }

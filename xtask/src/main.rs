@@ -9,11 +9,14 @@
 //! | `clippy`       | `cargo clippy --workspace --all-targets -- -D warnings`               |
 //! | `avr-kin-core` | no_std build of kin-core, quad-protocol and quad-device for `avr-none` (atmega2560), nightly + build-std=core |
 //! | `firmware`     | `cargo build --release` in `firmware-avr/` (when that directory exists) |
-//! | `budget`       | the firmware's flash ≤ 64 KB and SRAM (static + worst stack in simavr) ≤ 4 KB: figures and margins (`integration_tests::budget`) |
+//! | `budget`       | the firmware's flash ≤ 128 KB and SRAM (static + worst stack in simavr) ≤ 6 KB: figures and margins; tables read with `lpm` in the lowest 64 KB (`integration_tests::budget`) |
 //! | `test`         | `cargo test --workspace`                                              |
 //! | `doc`          | `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`     |
 //!
 //! `cargo xtask ci --list` prints the steps; `cargo xtask ci STEP...` runs only those.
+//!
+//! `cargo xtask kernel-campaign [ARGS...]` runs the long campaign of the AVR kernels against
+//! their twins (the `deps` step, then `integration-tests`' `kernel-campaign`).
 //!
 //! `cargo xtask demo [ARGS...]` is the main job on a fresh machine: the same `deps` step, then
 //! `cargo run --release -p quadctl -- demo ARGS...`.
@@ -28,6 +31,34 @@ use std::env;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 use std::time::{Duration, Instant};
+
+/// `cargo xtask kernel-campaign [ARGS...]`: the long campaign of the AVR kernels against their
+/// twins (`integration_tests` binary `kernel-campaign`; its docs list the arguments), after the
+/// `deps` step.
+fn kernel_campaign(args: &[String]) -> ExitCode {
+    let steps = [
+        deps_step(),
+        Step::new(
+            "kernel-campaign",
+            &[
+                "cargo",
+                "run",
+                "--release",
+                "-p",
+                "integration-tests",
+                "--bin",
+                "kernel-campaign",
+                "--",
+            ],
+        )
+        .with_args(args),
+    ];
+    run_steps(
+        &workspace_root(),
+        &steps.iter().collect::<Vec<_>>(),
+        "kernel-campaign",
+    )
+}
 
 /// Target CPU of the robot's controller board (Arduino Mega 2560).
 const AVR_TARGET_CPU: &str = "atmega2560";
@@ -327,7 +358,7 @@ fn demo(args: &[String]) -> ExitCode {
 }
 
 const USAGE: &str =
-    "usage: cargo xtask ci [--list | STEP...] | cargo xtask demo [DEMO ARGS...] | cargo xtask avr-bench";
+    "usage: cargo xtask ci [--list | STEP...] | cargo xtask demo [DEMO ARGS...] | cargo xtask avr-bench | cargo xtask kernel-campaign [ARGS...]";
 
 fn main() -> ExitCode {
     let args: Vec<String> = env::args().skip(1).collect();
@@ -335,6 +366,7 @@ fn main() -> ExitCode {
         Some((cmd, rest)) if cmd == "ci" => ci(rest),
         Some((cmd, rest)) if cmd == "demo" => demo(rest),
         Some((cmd, rest)) if cmd == "avr-bench" => avr_bench::run(&workspace_root(), rest),
+        Some((cmd, rest)) if cmd == "kernel-campaign" => kernel_campaign(rest),
         Some((cmd, _)) if cmd == "-h" || cmd == "--help" => {
             println!("{USAGE}");
             ExitCode::SUCCESS

@@ -1,0 +1,170 @@
+//! `cargo xtask kernel-campaign`: the long campaign of the AVR kernels against their twins
+//! (`integration_tests::kernels`, classes of `integration_tests::kernel_edges`): per kernel,
+//! a share of `--evaluations` values of its classes (every value of a class that fits, the
+//! values nearest the edges first), seeded by `--seed`. Each kernel's run appends one JSON line
+//! to the ledger (`--ledger`, default `target/kernel-campaign/ledger.jsonl`); the last lines
+//! printed are the ledger's totals per kernel as a Markdown table (the benchmark page's).
+//!
+//! Usage: `kernel-campaign [--kernel NAME]... [--evaluations N] [--seed S] [--ledger PATH]`
+//! (kernels: the firmware's six by default: atan2_fixed, sin_cos_fixed, add, sub, mul, sqrt).
+//! Exit status 1 when a kernel differs from its twin (the findings printed in hex).
+
+use integration_tests::kernel_edges::{classes, plan};
+use integration_tests::kernels::{run_plan, Harness, Kernel};
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// The firmware's kernels, run by default.
+const FIRMWARE_KERNELS: [Kernel; 6] = [
+    Kernel::Atan2Fixed,
+    Kernel::SinCosFixed,
+    Kernel::Add,
+    Kernel::Sub,
+    Kernel::Mul,
+    Kernel::Sqrt,
+];
+
+/// One ledger line.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Entry {
+    kernel: String,
+    seed: u64,
+    evaluations: u64,
+    mismatches: u64,
+    seconds: f64,
+    evaluations_per_s: f64,
+    classes: Vec<(String, u64, u64)>,
+}
+
+fn usage(e: &str) -> ExitCode {
+    eprintln!("kernel-campaign: {e}\nusage: kernel-campaign [--kernel NAME]... [--evaluations N] [--seed S] [--ledger PATH]");
+    ExitCode::from(2)
+}
+
+fn main() -> ExitCode {
+    let mut kernels = Vec::new();
+    let mut evaluations: u64 = 100_000_000;
+    let mut seed: u64 = 1;
+    let mut ledger = PathBuf::from("target/kernel-campaign/ledger.jsonl");
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = |name: &str| args.next().ok_or_else(|| format!("{name} needs a value"));
+        let parsed = match a.as_str() {
+            "--kernel" => value("--kernel").and_then(|v| {
+                Kernel::named(&v)
+                    .map(|k| kernels.push(k))
+                    .ok_or_else(|| format!("--kernel {v}: no such kernel"))
+            }),
+            "--evaluations" => value("--evaluations").and_then(|v| {
+                v.replace('_', "")
+                    .parse()
+                    .map(|n| evaluations = n)
+                    .map_err(|e| format!("--evaluations {v}: {e}"))
+            }),
+            "--seed" => value("--seed").and_then(|v| {
+                v.parse()
+                    .map(|n| seed = n)
+                    .map_err(|e| format!("--seed {v}: {e}"))
+            }),
+            "--ledger" => value("--ledger").map(|v| ledger = v.into()),
+            other => Err(format!("unknown argument {other}")),
+        };
+        if let Err(e) = parsed {
+            return usage(&e);
+        }
+    }
+    if kernels.is_empty() {
+        kernels = FIRMWARE_KERNELS.to_vec();
+    }
+    if let Some(dir) = ledger.parent() {
+        std::fs::create_dir_all(dir).expect("the ledger's directory");
+    }
+    let mut failed = false;
+    for kernel in kernels {
+        let classes = classes(kernel);
+        let share = plan(&classes, evaluations, seed ^ (kernel as u64) << 56);
+        let mut harness = Harness::boot();
+        let started = Instant::now();
+        let mut next_report = 0.0;
+        let report = run_plan(&mut harness, kernel, &classes, &share, |r| {
+            let t = started.elapsed().as_secs_f64();
+            if t >= next_report {
+                eprintln!(
+                    "{}: {} of {evaluations} evaluations ({:.1} %), {} mismatches, {:.0}/s, {:.0} s",
+                    r.kernel,
+                    r.evaluations,
+                    100.0 * r.evaluations as f64 / evaluations as f64,
+                    r.mismatches,
+                    r.evaluations_per_s,
+                    t
+                );
+                next_report = t + 30.0;
+            }
+        });
+        let entry = Entry {
+            kernel: report.kernel.clone(),
+            seed,
+            evaluations: report.evaluations,
+            mismatches: report.mismatches,
+            seconds: started.elapsed().as_secs_f64(),
+            evaluations_per_s: report.evaluations_per_s,
+            classes: report.classes.clone(),
+        };
+        let mut file = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&ledger)
+            .expect("the ledger opens");
+        writeln!(file, "{}", serde_json::to_string(&entry).expect("JSON")).expect("ledger write");
+        for f in &report.first_findings {
+            eprintln!("FINDING {f}");
+        }
+        failed |= report.mismatches > 0;
+    }
+    print_totals(&ledger);
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// The ledger's totals per kernel, as a Markdown table.
+fn print_totals(ledger: &PathBuf) {
+    let text = std::fs::read_to_string(ledger).unwrap_or_default();
+    let mut totals: Vec<(String, u64, u64, u64, f64, Vec<u64>)> = Vec::new();
+    for line in text.lines() {
+        let Ok(e) = serde_json::from_str::<Entry>(line) else {
+            continue;
+        };
+        match totals.iter_mut().find(|t| t.0 == e.kernel) {
+            Some(t) => {
+                t.1 += e.evaluations;
+                t.2 += e.mismatches;
+                t.3 += 1;
+                t.4 += e.seconds;
+                t.5.push(e.evaluations_per_s as u64);
+            }
+            None => totals.push((
+                e.kernel,
+                e.evaluations,
+                e.mismatches,
+                1,
+                e.seconds,
+                vec![e.evaluations_per_s as u64],
+            )),
+        }
+    }
+    println!("| kernel | runs | evaluations | mismatches | hours | evaluations/s (median run) |");
+    println!("|---|---|---|---|---|---|");
+    for (kernel, n, bad, runs, seconds, mut rates) in totals {
+        rates.sort_unstable();
+        println!(
+            "| {kernel} | {runs} | {n} | {bad} | {:.2} | {} |",
+            seconds / 3600.0,
+            rates[rates.len() / 2]
+        );
+    }
+}
