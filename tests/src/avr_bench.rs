@@ -149,18 +149,34 @@ fn fk64(robot: &Robot, leg: LegId, q: Vector3<f64>) -> Vector3<f64> {
 
 /// The f64 joint angles that put the foot of `leg` at `foot_in_hip` (f64), by Newton
 /// iterations from `start` (the same IK branch).
+///
+/// # Panics
+/// When the iterations do not converge ([`reference_leg_checked`] returns `None`).
 pub fn reference_leg(
     robot: &Robot,
     leg: LegId,
     foot_in_hip: Vector3<f64>,
     start: [f32; 3],
 ) -> [f64; 3] {
+    reference_leg_checked(robot, leg, foot_in_hip, start)
+        .unwrap_or_else(|| panic!("f64 reference did not converge for {leg} at {foot_in_hip:?}"))
+}
+
+/// [`reference_leg`], `None` when 60 iterations leave a residual of at least
+/// [`REFERENCE_RESIDUAL_M`] or meet a singular Jacobian (a target at a singularity, where the
+/// iterations converge slowly or not at all).
+pub fn reference_leg_checked(
+    robot: &Robot,
+    leg: LegId,
+    foot_in_hip: Vector3<f64>,
+    start: [f32; 3],
+) -> Option<[f64; 3]> {
     let mut q = Vector3::new(start[0] as f64, start[1] as f64, start[2] as f64);
     const H: f64 = 1e-6;
-    for _ in 0..20 {
+    for _ in 0..60 {
         let r = fk64(robot, leg, q) - foot_in_hip;
         if r.norm() < REFERENCE_RESIDUAL_M {
-            return [q.x, q.y, q.z];
+            return Some([q.x, q.y, q.z]);
         }
         let mut j = Matrix3::zeros();
         for c in 0..3 {
@@ -169,12 +185,9 @@ pub fn reference_leg(
             let col = (fk64(robot, leg, q + dq) - fk64(robot, leg, q - dq)) / (2.0 * H);
             j.set_column(c, &col);
         }
-        let inv = j
-            .try_inverse()
-            .expect("reference targets are away from singularities");
-        q -= inv * r;
+        q -= j.try_inverse()? * r;
     }
-    panic!("f64 reference did not converge for {leg} at {foot_in_hip:?}");
+    None
 }
 
 /// The f64 reference of a body pose at the stance (rotation order zyx about the body centre).

@@ -22,6 +22,10 @@ use std::time::{Duration, Instant};
 /// Argument pairs of one batch: `firmware_avr::bench::KERNEL_BATCH_LEN`.
 pub const BATCH_LEN: usize = 128;
 
+/// Records of one pose batch: `firmware_avr::bench::POSE_BATCH_LEN` (52-byte records in the
+/// same 1,024 bytes).
+pub const POSE_BATCH_LEN: usize = BATCH_LEN * 8 / 52;
+
 /// Cycles allowed for one batch (128 evaluations of the slowest kernel, with a wide margin).
 const BATCH_TIMEOUT_CYCLES: u64 = 50_000_000;
 
@@ -210,6 +214,39 @@ impl Harness {
             }));
         }
         self.evaluations += args.len() as u64;
+        self.busy += started.elapsed();
+        out
+    }
+
+    /// The records of the pose batch (`firmware_avr::bench::PoseRecord`) solved by the
+    /// firmware's backend `backend`, in order.
+    ///
+    /// # Panics
+    /// When the firmware does not answer a batch.
+    pub fn run_poses(&mut self, backend: u8, records: &[[u32; 13]]) -> Vec<[u32; 13]> {
+        let started = Instant::now();
+        let mut out = Vec::with_capacity(records.len());
+        for chunk in records.chunks(POSE_BATCH_LEN) {
+            let bytes: Vec<u8> = chunk
+                .iter()
+                .flatten()
+                .flat_map(|w| w.to_le_bytes())
+                .collect();
+            self.emu.write_data(self.batch_addr, &bytes);
+            self.emu.uart_write(&[b'P', backend, chunk.len() as u8]);
+            let answer = self
+                .emu
+                .read_exact(2, BATCH_TIMEOUT_CYCLES)
+                .unwrap_or_else(|got| panic!("no answer to a pose batch: {got:?}"));
+            assert_eq!(answer, b"p\0", "pose batch refused");
+            let results = self.emu.data_bytes(self.batch_addr, 52 * chunk.len());
+            out.extend(results.chunks_exact(52).map(|r| {
+                std::array::from_fn(|i| {
+                    u32::from_le_bytes([r[4 * i], r[4 * i + 1], r[4 * i + 2], r[4 * i + 3]])
+                })
+            }));
+        }
+        self.evaluations += records.len() as u64;
         self.busy += started.elapsed();
         out
     }

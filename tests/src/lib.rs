@@ -10,6 +10,7 @@
 
 pub mod avr_bench;
 pub mod budget;
+pub mod end_to_end;
 pub mod kernel_edges;
 pub mod kernels;
 pub mod pins;

@@ -5,10 +5,15 @@
 //! to the ledger (`--ledger`, default `target/kernel-campaign/ledger.jsonl`); the last lines
 //! printed are the ledger's totals per kernel as a Markdown table (the benchmark page's).
 //!
-//! Usage: `kernel-campaign [--kernel NAME]... [--evaluations N] [--seed S] [--ledger PATH]`
-//! (kernels: the firmware's six by default: atan2_fixed, sin_cos_fixed, add, sub, mul, sqrt).
-//! Exit status 1 when a kernel differs from its twin (the findings printed in hex).
+//! Usage: `kernel-campaign [--kernel NAME]... [--evaluations N] [--poses N] [--seed S]
+//! [--ledger PATH]` (kernels: the firmware's six by default: atan2_fixed, sin_cos_fixed, add,
+//! sub, mul, sqrt; with `--poses` and no `--kernel`, none). `--poses N` also runs `N` random
+//! body poses and foot targets through the firmware's IK end to end
+//! (`integration_tests::end_to_end`), its figures as a ledger line of kernel `end-to-end`.
+//! Exit status 1 when a kernel differs from its twin (the findings printed in hex) or the
+//! end-to-end run has a verdict difference or an outlier.
 
+use integration_tests::end_to_end;
 use integration_tests::kernel_edges::{classes, plan};
 use integration_tests::kernels::{run_plan, Harness, Kernel};
 use std::io::Write;
@@ -47,6 +52,7 @@ fn main() -> ExitCode {
     let mut kernels = Vec::new();
     let mut evaluations: u64 = 100_000_000;
     let mut seed: u64 = 1;
+    let mut poses: u64 = 0;
     let mut ledger = PathBuf::from("target/kernel-campaign/ledger.jsonl");
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -63,6 +69,12 @@ fn main() -> ExitCode {
                     .map(|n| evaluations = n)
                     .map_err(|e| format!("--evaluations {v}: {e}"))
             }),
+            "--poses" => value("--poses").and_then(|v| {
+                v.replace('_', "")
+                    .parse()
+                    .map(|n| poses = n)
+                    .map_err(|e| format!("--poses {v}: {e}"))
+            }),
             "--seed" => value("--seed").and_then(|v| {
                 v.parse()
                     .map(|n| seed = n)
@@ -75,7 +87,7 @@ fn main() -> ExitCode {
             return usage(&e);
         }
     }
-    if kernels.is_empty() {
+    if kernels.is_empty() && poses == 0 {
         kernels = FIRMWARE_KERNELS.to_vec();
     }
     if let Some(dir) = ledger.parent() {
@@ -112,16 +124,55 @@ fn main() -> ExitCode {
             evaluations_per_s: report.evaluations_per_s,
             classes: report.classes.clone(),
         };
-        let mut file = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&ledger)
-            .expect("the ledger opens");
-        writeln!(file, "{}", serde_json::to_string(&entry).expect("JSON")).expect("ledger write");
+        append(&ledger, &entry);
         for f in &report.first_findings {
             eprintln!("FINDING {f}");
         }
         failed |= report.mismatches > 0;
+    }
+    if poses > 0 {
+        let mut harness = Harness::boot();
+        let started = Instant::now();
+        let mut next_report = 0.0;
+        let fig = end_to_end::run(&mut harness, poses, seed, |f| {
+            let t = started.elapsed().as_secs_f64();
+            if t >= next_report {
+                eprintln!(
+                    "end-to-end: {} of {poses} cases, {} outliers, {} verdict differences, {:.0} s",
+                    f.cases, f.outliers, f.verdict_differences, t
+                );
+                next_report = t + 30.0;
+            }
+        });
+        println!("{}", serde_json::to_string_pretty(&fig).expect("JSON"));
+        let entry = Entry {
+            kernel: "end-to-end".to_string(),
+            seed,
+            evaluations: fig.cases,
+            mismatches: fig.outliers + fig.verdict_differences,
+            seconds: started.elapsed().as_secs_f64(),
+            evaluations_per_s: fig.cases as f64 / started.elapsed().as_secs_f64().max(1e-9),
+            classes: vec![
+                ("solved".to_string(), fig.solved, 0),
+                (
+                    "bit-identical to the host".to_string(),
+                    fig.bit_identical,
+                    0,
+                ),
+                (
+                    "referenced against f64".to_string(),
+                    fig.referenced,
+                    fig.outliers,
+                ),
+                (
+                    format!("max error vs f64 {:.3e} rad", fig.max_error_rad),
+                    fig.referenced,
+                    fig.outliers,
+                ),
+            ],
+        };
+        append(&ledger, &entry);
+        failed |= fig.outliers + fig.verdict_differences > 0;
     }
     print_totals(&ledger);
     if failed {
@@ -129,6 +180,16 @@ fn main() -> ExitCode {
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// Appends `entry` to the ledger as one JSON line.
+fn append(ledger: &PathBuf, entry: &Entry) {
+    let mut file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(ledger)
+        .expect("the ledger opens");
+    writeln!(file, "{}", serde_json::to_string(entry).expect("JSON")).expect("ledger write");
 }
 
 /// The ledger's totals per kernel, as a Markdown table.
