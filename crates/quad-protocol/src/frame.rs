@@ -383,6 +383,8 @@ pub struct Accumulator<const N: usize> {
     crc: (u8, u8),
     frames_ok: u32,
     frames_bad: u32,
+    /// The CRC of the last good frame ([`Accumulator::frame_crc`]).
+    frame_crc: Option<u16>,
 }
 
 impl<const N: usize> Default for Accumulator<N> {
@@ -403,6 +405,7 @@ impl<const N: usize> Accumulator<N> {
             crc: CRC_INIT,
             frames_ok: 0,
             frames_bad: 0,
+            frame_crc: None,
         }
     }
 
@@ -413,6 +416,13 @@ impl<const N: usize> Accumulator<N> {
         self.code = 0;
         self.overflow = false;
         self.crc = CRC_INIT;
+    }
+
+    /// The CRC (as its trailer carries it) of the last frame [`Accumulator::feed`] reported as
+    /// [`Feed::Frame`]: what, with the sequence number, tells an exact repeat of a request
+    /// from a new one. `None` before the first.
+    pub const fn frame_crc(&self) -> Option<u16> {
+        self.frame_crc
     }
 
     /// Frames that ended in [`Feed::Frame`] (wrapping).
@@ -449,6 +459,11 @@ impl<const N: usize> Accumulator<N> {
             return Feed::NeedMore;
         };
         let feed = self.finish::<T>(&input[end + 1..]);
+        if let Feed::Frame { .. } = feed {
+            self.frame_crc = self.buf[..self.len]
+                .last_chunk::<CRC_LEN>()
+                .map(|&t| u16::from_be_bytes(t));
+        }
         self.reset();
         if let Feed::Frame { .. } = feed {
             self.frames_ok = self.frames_ok.wrapping_add(1);

@@ -746,3 +746,31 @@ proptest! {
         }
     }
 }
+
+/// `frame_crc` is the trailer of the last good frame (the CRC of its message), kept across
+/// bad frames and partial input, `None` before the first.
+#[test]
+fn frame_crc_is_the_last_good_frames_trailer() {
+    let mut acc = Accumulator::<MAX_DECODED_LEN>::new();
+    assert_eq!(acc.frame_crc(), None);
+    for msg in messages() {
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let frame = encode_frame(&msg, &mut buf).expect("encodes").to_vec();
+        let mut payload = [0u8; MAX_DECODED_LEN];
+        let body = postcard::to_slice(&msg, &mut payload)
+            .expect("serializes")
+            .to_vec();
+        let (head, tail) = frame.split_at(frame.len() / 2);
+        assert!(matches!(acc.feed::<HostToDevice>(head), Feed::NeedMore));
+        assert!(matches!(acc.feed::<HostToDevice>(tail), Feed::Frame { .. }));
+        assert_eq!(acc.frame_crc(), Some(ref_crc(&body)), "{msg:?}");
+        // A frame with a bad CRC leaves it.
+        let mut bad = frame.clone();
+        bad[2] ^= 0x40;
+        assert!(!matches!(
+            acc.feed::<HostToDevice>(&bad),
+            Feed::Frame { .. }
+        ));
+        assert_eq!(acc.frame_crc(), Some(ref_crc(&body)));
+    }
+}
