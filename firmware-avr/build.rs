@@ -28,7 +28,8 @@ fn main() {
         return;
     }
     // Every binary: the linker's relaxation turns each `call`/`jmp` whose target lies within
-    // ±4 KB into `rcall`/`rjmp` (2 bytes and a cycle fewer; measured in `BENCHMARKS.md`).
+    // ±4 KB into `rcall`/`rjmp` (2 bytes and a cycle fewer; measured in
+    // `docs/benchmark-journal.md`).
     // Safe with LLVM's objects: every branch, local ones included, carries a relocation, which
     // the linker moves with the code it shortens.
     println!("cargo:rustc-link-arg=-Wl,--relax");

@@ -377,7 +377,7 @@ fn request_to_first_answer_byte_per_request_type_and_poses_per_second() {
                     cycles.saturating_sub(ik_cycles) as f64 / 16_000.0
                 );
                 // The IK + 1 ms: decoding, the pulse mapping, the readback and the answer's
-                // serialization take the rest (BENCHMARKS.md).
+                // serialization take the rest (docs/benchmark-journal.md).
                 assert!(
                     cycles <= ik_cycles + ROUND_TRIP_OVER_IK_CYCLES,
                     "{bin}: {cycles} cycles > body IK {ik_cycles} + {ROUND_TRIP_OVER_IK_CYCLES}"

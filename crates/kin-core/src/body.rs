@@ -354,7 +354,7 @@ impl<M: Math> Solver<M> {
     /// `g = t + c`: 9 multiplications and 27 additions (15 and 33 with a horizontal
     /// translation or pivot) where the general transform of the four stance feet takes 36 and
     /// 59. Its vector operations are inline on every backend, the AVR's included (out of line
-    /// they saved 542 B of its flash and cost 1,272 cycles; `BENCHMARKS.md`).
+    /// they saved 542 B of its flash and cost 1,272 cycles; `docs/benchmark-journal.md`).
     #[inline(never)]
     fn stance_feet_in_hips(
         &self,

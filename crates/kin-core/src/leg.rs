@@ -715,7 +715,8 @@ impl<M: Math> Solver<M> {
         // The knee's and the hip's `atan2` arguments as `([knee_y, hip_y], [knee_x, hip_x])`:
         // pairs of the two joints, which the compiler keeps in registers and evaluates
         // side by side; as one 4-tuple per leg they went through the stack with loads and
-        // stores of different widths (store-forwarding stalls; see `BENCHMARKS.md`).
+        // stores of different widths (store-forwarding stalls; see
+        // `docs/benchmark-journal.md`).
         let mut planar = [([0.0f32; 2], [0.0f32; 2]); 4];
         for (i, p) in feet_in_hip.iter().enumerate() {
             let (knee_y, knee_x) = self.c.knee_yx::<M>(g, self.knee_bend, dist2[i], false);

@@ -49,9 +49,10 @@
 //! ## Why not nalgebra inside
 //! On the ATmega2560, a program that builds the zyx body rotation and rotates four vectors
 //! links to about three times the flash with nalgebra's `Rotation3::from_euler_angles` than
-//! with this crate's [`rotation::matrix`] (measured in `BENCHMARKS.md`, "nalgebra on the
-//! ATmega2560"). The gap is nalgebra's sine/cosine, which goes through libm's f64 `sincosf` and
-//! cannot be swapped for a cheaper backend; the matrix code itself is the same size either way.
+//! with this crate's [`rotation::matrix`] (measured in `docs/benchmark-journal.md`, "nalgebra
+//! on the ATmega2560"). The gap is nalgebra's sine/cosine, which goes through libm's f64
+//! `sincosf` and cannot be swapped for a cheaper backend; the matrix code itself is the same
+//! size either way.
 //! So the hand-written [`Vec3`]/[`Mat3`] stay — they also keep every operation visible and
 //! every backend swappable — and nalgebra (f64) is the independent oracle of the tests.
 

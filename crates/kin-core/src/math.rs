@@ -240,8 +240,8 @@ impl Math for Libm {
 /// Polynomial backend for hosts: [`poly::atan2_deg15`], [`poly::sin_cos_deg9`], `libm` for
 /// `sqrt` (one instruction on hosts). It keeps the default [`Math::atan2_3`]: the compiler
 /// schedules (and partly vectorizes) the independent scalar calls faster than an explicit
-/// four-lane `atan2` on the measured x86-64 host (see `BENCHMARKS.md`), and the float
-/// operators for comparisons.
+/// four-lane `atan2` on the measured x86-64 host (see `docs/benchmark-journal.md`), and the
+/// float operators for comparisons.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Fast;
 
@@ -695,8 +695,8 @@ pub mod poly {
     /// ([`atan_ratio_q21`]), then atan(t) from a table of 32 quadratic cells
     /// (`ATAN_CELL_A_Q29`) in 16-bit fixed point (three 16 × 16-bit products), the octant
     /// added in fixed point, and one integer-to-float conversion: on the ATmega2560 far fewer
-    /// cycles than [`atan2_deg9`] in software floats (see `BENCHMARKS.md`). Absolute error
-    /// ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the truncation of `t` to 2⁻²¹ and the
+    /// cycles than [`atan2_deg9`] in software floats (see `docs/benchmark-journal.md`). Absolute
+    /// error ≤ 2e-6 rad (tests; the cells' 9.4e-7 plus the truncation of `t` to 2⁻²¹ and the
     /// rounding of the result). `atan2(±0, ±0)` as libm (±0 or ±π); exact on the axes. The
     /// backend `M` reads the tables ([`Math::read_table_cell`]: in flash on the AVR), the
     /// kernel's only per-target part; [`SoftFloat`](super::SoftFloat) passes its own.
@@ -825,7 +825,8 @@ pub mod poly {
     /// (`SIN_CELL_A_Q29`, `COS_CELL_A_Q29`) in 16-bit fixed point (five 16 × 16-bit
     /// products for both), two integer-to-float conversions: on the ATmega2560 far fewer
     /// cycles than [`sin_cos_deg5`]'s twelve software-float operations (see
-    /// `BENCHMARKS.md`). Absolute error ≤ 1e-6 (tests; the cells' 8.4e-7 in this arithmetic).
+    /// `docs/benchmark-journal.md`). Absolute error ≤ 1e-6 (tests; the cells' 8.4e-7 in this
+    /// arithmetic).
     /// `sin_cos_fixed(0) = (0, 1)`; odd in the sine, even in the cosine. The backend `M` reads
     /// the tables, as for [`atan2_fixed`].
     ///

@@ -46,8 +46,8 @@
 //! is decoded), the calibration table, the held target and the output angles and pulses, the
 //! configuration with the robot, the motion [`engine`] (the running motion's parameters and
 //! state, one ramp, the limiter) and a few flags. Saving or loading the calibration streams one record at a time. Its
-//! size on the ATmega2560 and the firmware's flash and SRAM are in `BENCHMARKS.md`; `cargo
-//! xtask ci budget` checks them against the budget.
+//! size on the ATmega2560 is in `docs/benchmark-journal.md`, the firmware's flash and SRAM in
+//! `BENCHMARKS.md`; `cargo xtask ci budget` checks them against the budget.
 
 #![no_std]
 #![forbid(unsafe_code)]

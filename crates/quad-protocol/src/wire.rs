@@ -13,7 +13,7 @@
 //!   [`reach_policy`]); `wire_fields!` fixes the field order of a foreign struct ([`pose`]).
 //! - [`array`](mod@array) and [`shared`] change no byte, only the code that writes and reads
 //!   them: the twelve-value arrays in a loop, the varint integers through one out-of-line call
-//!   (sizes on the ATmega2560 in BENCHMARKS.md).
+//!   (sizes on the ATmega2560 in docs/benchmark-journal.md).
 //!
 //! Every table is an exhaustive `match`: a variant or field added to kin-core does not compile
 //! until it has its place on the wire. The implementations follow serde's data model as the

@@ -11,8 +11,8 @@
 //! avr-libc's wrappers), so zeros, subnormals, infinities, NaNs, overflow and underflow keep
 //! avr-libc's results to the bit. Hand-written because these three are the firmware's
 //! commonest calls (the kinematics' arithmetic) and the fast path is measured faster than
-//! avr-libc's (see `BENCHMARKS.md`); the library keeps every special case. The emulator test
-//! `avr_float` compares the bits with avr-libc's on seeded pairs of every kind.
+//! avr-libc's (see `docs/benchmark-journal.md`); the library keeps every special case. The
+//! emulator test `avr_float` compares the bits with avr-libc's on seeded pairs of every kind.
 //!
 //! Which operands take the fast path (decided from the exponents alone, before any register
 //! is changed, so that the fallback sees the arguments as passed):

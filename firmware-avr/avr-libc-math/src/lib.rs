@@ -9,9 +9,9 @@
 //! compiler-builtins on the linker command line. Besides the functions named here, the float
 //! primitives `__divsf3`, the comparisons, the conversions, … of the whole program then come
 //! from avr-libc (faster than compiler-builtins' soft-float, and smaller; the per-primitive
-//! cycles are in `BENCHMARKS.md`), and `__addsf3`, `__subsf3`, `__mulsf3` from [`float`]: a
-//! fast path in the binary's own code in front of avr-libc's routines, and `sqrt` from
-//! [`mod@sqrt`]: avr-libc's bits in fewer cycles (the binary needs
+//! cycles are in `docs/benchmark-journal.md`), and `__addsf3`, `__subsf3`, `__mulsf3` from
+//! [`float`]: a fast path in the binary's own code in front of avr-libc's routines, and `sqrt`
+//! from [`mod@sqrt`]: avr-libc's bits in fewer cycles (the binary needs
 //! `#![feature(asm_experimental_arch)]` for them). The `#[link(name = "m")]` attribute in
 //! this library crate would put `-lm` *after* compiler-builtins, and then the
 //! `extern "C" fn atan2` below silently binds to compiler-builtins' weak 64-bit `atan2` —
@@ -56,7 +56,7 @@ macro_rules! link_avr_libc {
         #[link(name = "m")]
         extern "C" {}
         // avr-libc's assembly `memcpy`/`memset` instead of compiler-builtins' byte loops (the
-        // IK moves its results through memory; the saving is in `BENCHMARKS.md`).
+        // IK moves its results through memory; the saving is in `docs/benchmark-journal.md`).
         #[link(name = "c")]
         extern "C" {}
         // The fast `__addsf3`, `__subsf3`, `__mulsf3` in front of avr-libc's (see `float`):
@@ -111,14 +111,14 @@ impl Math for AvrLibm {
     // the kernel computes with; and it has had no release for the toolchains since 2023.
 
     /// [`poly::atan2_fixed`] in assembly (the crate's `atan2_fixed`): the same bits, in fewer
-    /// cycles (see `BENCHMARKS.md`).
+    /// cycles (see `docs/benchmark-journal.md`).
     #[inline]
     fn atan2_fixed(y: f32, x: f32) -> f32 {
         atan2_fixed(y, x)
     }
 
     /// [`poly::sin_cos_fixed`] with its fixed-point part in assembly (the crate's
-    /// `sin_cos_fixed`): the same bits, in fewer cycles (see `BENCHMARKS.md`).
+    /// `sin_cos_fixed`): the same bits, in fewer cycles (see `docs/benchmark-journal.md`).
     #[inline]
     fn sin_cos_fixed(x: f32) -> (f32, f32) {
         sin_cos_fixed(x)
@@ -927,9 +927,9 @@ fn lpm_word(z: &mut *const u8) -> u16 {
 /// for CPUs without floating-point hardware; the host tests run the same choices) over
 /// [`AvrLibm`]'s `sqrt` (avr-libc's bits) and its reads of the kernels' tables from flash,
 /// with all float arithmetic on avr-libc's primitives. The fastest mix
-/// measured in simavr (see `BENCHMARKS.md`).
+/// measured in simavr (see `docs/benchmark-journal.md`).
 ///
 /// Against the host's [`kin_core::DefaultMath`] the angles of a leg or body solve differ by
 /// at most about 4e-6 rad (the fixed-point arctangent's error plus rounding); see the readback
-/// bound in `BENCHMARKS.md`.
+/// bound in `docs/benchmark-journal.md`.
 pub type AvrFast = SoftFloat<AvrLibm>;

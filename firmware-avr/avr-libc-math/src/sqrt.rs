@@ -11,10 +11,10 @@
 //! same path. Every other argument — ±0, negative numbers, infinities, NaNs — runs avr-libc's
 //! own opening sequence (`__fp_splitA`, then `__fp_mpack` or `__fp_nan`, as its `sqrt` does),
 //! so those results stay avr-libc's to the bit. Hand-written because every leg and body solve
-//! calls `sqrt` and this version is measured faster than avr-libc's (see `BENCHMARKS.md`),
-//! which stays the reference. The emulator test `avr_sqrt` compares the bits with avr-libc's
-//! `sqrt` (its `sqrt.o` linked under another name into the benchmark firmware) and with the
-//! IEEE square root.
+//! calls `sqrt` and this version is measured faster than avr-libc's (see
+//! `docs/benchmark-journal.md`), which stays the reference. The emulator test `avr_sqrt`
+//! compares the bits with avr-libc's `sqrt` (its `sqrt.o` linked under another name into the
+//! benchmark firmware) and with the IEEE square root.
 //!
 //! # The recurrence
 //!
