@@ -99,8 +99,8 @@ fn run_kernel_batch(kernel: KernelFn, count: usize) {
 pub type PoseRecord = [u32; 13];
 
 /// Pose records of one batch: as many as fit in [`KERNEL_BATCH`], whose memory they share.
-pub const POSE_BATCH_LEN: usize = core::mem::size_of::<[[u32; 2]; KERNEL_BATCH_LEN]>()
-    / core::mem::size_of::<PoseRecord>();
+pub const POSE_BATCH_LEN: usize =
+    core::mem::size_of::<[[u32; 2]; KERNEL_BATCH_LEN]>() / core::mem::size_of::<PoseRecord>();
 
 /// Solves the first `count` records of the pose batch (in [`KERNEL_BATCH`]'s memory) with
 /// `solve`, in place.

@@ -141,7 +141,10 @@ static KERNELS: [bench::KernelFn; 8] = [
     |a, _| {
         let a = f32::from_bits(a);
         // SAFETY: a C function of one `double` (32-bit on the AVR), no preconditions.
-        (AvrLibm::sqrt(a).to_bits(), unsafe { avr_libc_sqrt(a) }.to_bits())
+        (
+            AvrLibm::sqrt(a).to_bits(),
+            unsafe { avr_libc_sqrt(a) }.to_bits(),
+        )
     },
 ];
 
