@@ -89,7 +89,8 @@ wire_enum! {
         /// [`NackReason::InvalidArgument`].
         10 => SetPoseConfig(PoseConfig),
         /// Start a motion that the device runs by itself, frame by frame (since 2.1). Its
-        /// parameters are checked and the motion preflighted first. → [`DeviceToHost::MotionAck`],
+        /// parameters are checked (first against their ranges, [`crate::range`]) and the motion
+        /// preflighted first. → [`DeviceToHost::MotionAck`],
         /// or a nack naming the parameter ([`NackReason::InvalidParameter`]), the failing sample
         /// ([`NackReason::Preflight`], [`NackReason::ServoRange`]), [`NackReason::MotionRunning`]
         /// or [`NackReason::OutputsDisabled`] (nothing moves, a running motion keeps running).
@@ -102,8 +103,9 @@ wire_enum! {
         13 => GetMotion,
         /// The running walk's velocity command, body frame; it must be refreshed within the
         /// walk's `velocity_timeout_ms` (since 2.1). → [`DeviceToHost::MotionAck`], or
-        /// [`NackReason::NotWalking`] or [`NackReason::InvalidParameter`] naming the component
-        /// beyond the gait's reach.
+        /// [`NackReason::InvalidParameter`] naming a component outside its range
+        /// ([`crate::range`]), [`NackReason::NotWalking`], or [`NackReason::InvalidParameter`]
+        /// naming the component beyond the gait's reach.
         14 => SetVelocity {
             /// Forward speed, m/s.
             forward_m_s: f32,
@@ -112,7 +114,8 @@ wire_enum! {
             /// Yaw rate, rad/s, counter-clockwise positive (REP 103).
             yaw_rate_rad_s: f32,
         },
-        /// The joint-speed limit of every output, rad/s (finite, > 0; since 1.1).
+        /// The joint-speed limit of every output, rad/s, within
+        /// [`crate::range::JOINT_SPEED_LIMIT_RAD_S`] (since 1.1).
         /// → [`DeviceToHost::Ack`] or [`NackReason::InvalidParameter`].
         15 => SetJointSpeedLimit {
             /// The limit, rad/s.

@@ -22,12 +22,48 @@
 //! A NaN or infinite value is [`NackReason::NonFinite`] (for the stance height
 //! [`NackReason::InvalidArgument`], as in protocol 1.x); a finite value outside its range is
 //! [`NackReason::OutOfRange`] naming the field. Calibrations have their own check
-//! ([`crate::servo::Calibration::validate`]); the other fields (sequence numbers, flags, enum
-//! indices, `timeout_ms`) admit every value their type can hold. The motion requests' parameters
-//! are checked by the device's motion engine, which knows how they bound each other.
+//! ([`crate::servo::Calibration::validate`]); the other fields of the requests above (sequence
+//! numbers, flags, enum indices, `timeout_ms`) admit every value their type can hold.
+//!
+//! ## Motion fields
+//!
+//! Every number of [`Request::StartMotion`], [`Request::SetVelocity`] and
+//! [`Request::SetJointSpeedLimit`] has a [`ParamRange`] too, checked here before any maths and
+//! refused as [`NackReason::InvalidParameter`] naming the [`MotionParam`] and its
+//! [`ParamProblem`]:
+//!
+//! | field | admissible | why |
+//! |---|---|---|
+//! | sway `amplitude_rad` | [`SWAY_AMPLITUDE_RAD`]: `[−π/2, π/2]` rad | a quarter turn of the body with the feet on the ground is beyond any leg (the start check refuses far less) |
+//! | `period_s`, `step_period_s`, `cycle_s` | [`PERIOD_S`]: `[0.1, 60]` s | five 50 Hz servo frames per period at least; slower than a minute is no motion to watch |
+//! | `duration_s` (when given) | [`DURATION_S`]: `[0.02, 3600]` s | one servo frame at least; an hour at most, where f32 motion time still resolves 0.24 ms (longer: no duration, then `StopMotion`) |
+//! | `yaw_rate_rad_s` (yaw turn, velocity) | [`YAW_RATE_RAD_S`]: `[−π, π]` rad/s | half a turn per second, beyond what a servo-driven quadruped turns |
+//! | `forward_m_s`, `lateral_m_s` | [`SPEED_M_S`]: `[−10, 10]` m/s | 36 km/h, many times what a servo-driven quadruped walks; the gait's stride disc bounds the speed by the robot after this check |
+//! | `lift_height_m`, `stride_m`, `step_height_m` | `[0,` [`reach_limit_m`]`]` | no foot moves farther than the reach |
+//! | walk `body_height_m` | `[`[`MIN_STANCE_HEIGHT_M`]`, reach_limit_m]` | as the stance height |
+//! | `duty_factor` | [`DUTY_FACTOR`]: `[0.05, 0.95]` | stance and swing each at least a twentieth of the loop |
+//! | `velocity_timeout_ms` | `[1, 65535]` ms | 0 would stop a walk at once |
+//! | `joint_speed_limit_rad_s` | [`JOINT_SPEED_LIMIT_RAD_S`]: `[0.1, π/0.02]` rad/s | a servo's whole travel (π rad) in half a minute at the least; beyond its whole travel in one 20 ms servo frame a limit limits nothing |
+//!
+//! What a value outside gets ([`ParamRange::check`]): NaN or ±∞ is [`ParamProblem::NonFinite`];
+//! zero or a negative value (−0 too) of a field that must be positive (periods, durations, the
+//! body height, the joint-speed limit, the timeout) is [`ParamProblem::NotPositive`], a
+//! negative length [`ParamProblem::Negative`] (−0 is 0); every other finite value outside
+//! (a subnormal below a positive minimum, ±1e30, the next float beyond a bound, a duty factor
+//! of 0 or 1) is [`ParamProblem::OutOfRange`]. The fields are checked in declaration order; the first one
+//! refused is named. The device's motion engine then checks what depends on the robot and on
+//! the other fields (reach, the step height below the body, the velocity within the gait's
+//! stride disc) and preflights the motion; this check only keeps out values that are no motion
+//! at all, so that host and device refuse them alike, before any maths.
+//!
+//! [`ParamRange::check`] compares the bits, not the floats: exactly the float order on every
+//! target, subnormals included, and integer compares rather than a soft-float call per bound
+//! on the ATmega2560.
 
-use crate::msg::{Field, NackReason, PoseConfig, Request};
-use core::f32::consts::PI;
+use crate::msg::{
+    Field, MotionCommand, MotionParam, NackReason, ParamProblem, PoseConfig, Request,
+};
+use core::f32::consts::{FRAC_PI_2, PI};
 use kin_core::{Joint, LegId, Pose, Robot};
 
 /// The lowest admissible stance height, m: below it the hips sit on the feet' level, a
@@ -73,6 +109,18 @@ impl Ranges {
     pub const fn reach_limit_m(&self) -> f32 {
         self.feet_m[2]
     }
+
+    /// The range of a motion's lengths (a lift, a stride, a step height), m:
+    /// `[0,` [`reach_limit_m`]`]`.
+    pub const fn length_m(&self) -> ParamRange {
+        ParamRange::non_negative(self.reach_limit_m())
+    }
+
+    /// The range of a walk's body height, m: that of the stance height,
+    /// `[`[`MIN_STANCE_HEIGHT_M`]`,` [`reach_limit_m`]`]`.
+    pub const fn body_height_m(&self) -> ParamRange {
+        ParamRange::positive(MIN_STANCE_HEIGHT_M, self.reach_limit_m())
+    }
 }
 
 /// The first of `values` whose magnitude exceeds its bound (`bounds` repeated: value `i` has
@@ -110,8 +158,8 @@ fn magnitude_beyond(v: f32, bound: f32) -> bool {
 ///
 /// # Errors
 /// [`NackReason::NonFinite`], [`NackReason::OutOfRange`] naming the first field out of range
-/// (in declaration order), or [`NackReason::InvalidArgument`] for a stance height that is not
-/// positive.
+/// (in declaration order), [`NackReason::InvalidArgument`] for a stance height that is not
+/// positive, or [`NackReason::InvalidParameter`] naming the first motion field refused.
 pub fn check_request(request: &Request, robot: &Robot) -> Result<(), NackReason> {
     check_request_in(request, &Ranges::of(robot))
 }
@@ -126,21 +174,32 @@ pub fn check_request_in(request: &Request, ranges: &Ranges) -> Result<(), NackRe
         Request::SetFeet { feet_in_body_m } => feet_in(feet_in_body_m, ranges),
         Request::SetJoints { angles_rad } => check_joints(angles_rad),
         Request::SetPoseConfig(p) => pose_config_in(p, ranges),
+        Request::StartMotion(m) => motion_in(m, ranges),
+        Request::SetVelocity {
+            forward_m_s,
+            lateral_m_s,
+            yaw_rate_rad_s,
+        } => first_invalid(&[
+            (MotionParam::ForwardMS, SPEED_M_S, *forward_m_s),
+            (MotionParam::LateralMS, SPEED_M_S, *lateral_m_s),
+            (MotionParam::YawRateRadS, YAW_RATE_RAD_S, *yaw_rate_rad_s),
+        ]),
+        Request::SetJointSpeedLimit {
+            joint_speed_limit_rad_s,
+        } => first_invalid(&[(
+            MotionParam::JointSpeedLimitRadS,
+            JOINT_SPEED_LIMIT_RAD_S,
+            *joint_speed_limit_rad_s,
+        )]),
         Request::Hello { .. }
         | Request::GetState
         | Request::SetOutputs { .. }
         | Request::SetLinkTimeout(_)
         | Request::SetCalibration { .. }
         | Request::GetCalibration { .. }
-        | Request::SaveCalibration => Ok(()),
-        // A motion's parameters depend on each other and on the robot's reach: the device's
-        // motion engine checks them before the motion starts and names the parameter it
-        // refuses (`NackReason::InvalidParameter`, `NackReason::Preflight`).
-        Request::StartMotion(_)
+        | Request::SaveCalibration
         | Request::StopMotion
-        | Request::GetMotion
-        | Request::SetVelocity { .. }
-        | Request::SetJointSpeedLimit { .. } => Ok(()),
+        | Request::GetMotion => Ok(()),
     }
 }
 
@@ -230,6 +289,268 @@ fn pose_config_in(p: &PoseConfig, ranges: &Ranges) -> Result<(), NackReason> {
         Err(NackReason::OutOfRange {
             field: Field::StanceHeight,
         })
+    }
+}
+
+/// What a finite value below a [`ParamRange`]'s minimum is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Below {
+    /// [`ParamProblem::OutOfRange`], whatever its sign (signed fields, the duty factor).
+    OutOfRange,
+    /// [`ParamProblem::NotPositive`] when zero or negative, else [`ParamProblem::OutOfRange`]
+    /// (periods, durations, the body height, the joint-speed limit).
+    NotPositive,
+    /// [`ParamProblem::Negative`]: the minimum is 0 and −0 is 0 (lengths).
+    Negative,
+}
+
+/// The admissible values `[min, max]` of a numeric motion field, in the field's unit (see the
+/// module docs for each field's), and what a value outside them is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParamRange {
+    /// The smallest admissible value.
+    pub min: f32,
+    /// The largest admissible value.
+    pub max: f32,
+    /// What a value below `min` is.
+    pub below: Below,
+}
+
+impl ParamRange {
+    /// `[−max, max]`; a value outside is [`ParamProblem::OutOfRange`].
+    pub const fn symmetric(max: f32) -> ParamRange {
+        ParamRange {
+            min: -max,
+            max,
+            below: Below::OutOfRange,
+        }
+    }
+
+    /// `[min, max]` with `min > 0`; zero or a negative value is [`ParamProblem::NotPositive`].
+    pub const fn positive(min: f32, max: f32) -> ParamRange {
+        ParamRange {
+            min,
+            max,
+            below: Below::NotPositive,
+        }
+    }
+
+    /// `[0, max]`; a negative value is [`ParamProblem::Negative`].
+    pub const fn non_negative(max: f32) -> ParamRange {
+        ParamRange {
+            min: 0.0,
+            max,
+            below: Below::Negative,
+        }
+    }
+
+    /// `[min, max]`; a value outside is [`ParamProblem::OutOfRange`].
+    pub const fn interval(min: f32, max: f32) -> ParamRange {
+        ParamRange {
+            min,
+            max,
+            below: Below::OutOfRange,
+        }
+    }
+
+    /// Checks `v` (see the module docs): the comparisons on the bits, the same on every
+    /// target.
+    ///
+    /// # Errors
+    /// [`ParamProblem::NonFinite`] for NaN or ±∞; then as [`ParamRange::below`] says for a
+    /// value below `min`, [`ParamProblem::OutOfRange`] above `max`.
+    pub const fn check(&self, v: f32) -> Result<(), ParamProblem> {
+        if !finite(v) {
+            return Err(ParamProblem::NonFinite);
+        }
+        let k = order_key(v);
+        if k > order_key(self.max) {
+            return Err(ParamProblem::OutOfRange);
+        }
+        if k >= order_key(self.min) {
+            return Ok(());
+        }
+        Err(match self.below {
+            Below::OutOfRange => ParamProblem::OutOfRange,
+            Below::NotPositive if k <= 0 => ParamProblem::NotPositive,
+            Below::NotPositive => ParamProblem::OutOfRange,
+            Below::Negative => ParamProblem::Negative,
+        })
+    }
+}
+
+/// `v` is neither NaN nor ±∞: its exponent bits are not all ones.
+const fn finite(v: f32) -> bool {
+    v.to_bits() & 0x7f80_0000 != 0x7f80_0000
+}
+
+/// An integer that orders finite floats as `<` does, with −0 = +0: the magnitude's bits,
+/// negated for a negative value.
+const fn order_key(v: f32) -> i32 {
+    let magnitude = (v.to_bits() & 0x7fff_ffff) as i32;
+    if v.is_sign_negative() {
+        -magnitude
+    } else {
+        magnitude
+    }
+}
+
+/// A sway's amplitude `A`, rad: `[−π/2, π/2]`. The body turned a quarter turn with its feet
+/// on the ground is beyond the reach of any leg (the device's start check then refuses far
+/// less); the sign only sets the direction of the first half-period.
+pub const SWAY_AMPLITUDE_RAD: ParamRange = ParamRange::symmetric(FRAC_PI_2);
+
+/// A period, s — a sway's `period_s`, a yaw turn's `step_period_s`, a foot path's or a walk's
+/// `cycle_s`: `[0.1, 60]`. The device samples motions at 50 Hz: a period of 0.1 s is five
+/// servo frames, about the fewest in which its samples still trace the motion (its start
+/// check samples four points of a period); a period of more than a minute is a motion too
+/// slow to watch (hold a pose instead).
+pub const PERIOD_S: ParamRange = ParamRange::positive(0.1, 60.0);
+
+/// A motion's duration, s, when one is given (none: until `StopMotion`): `[0.02, 3600]`. One
+/// 20 ms servo frame at least (the device rounds it up to whole periods); an hour at most,
+/// where f32 motion time still resolves 0.24 ms.
+pub const DURATION_S: ParamRange = ParamRange::positive(0.02, 3600.0);
+
+/// A yaw rate (a yaw turn's, a velocity command's), rad/s, counter-clockwise positive:
+/// `[−π, π]`, half a turn per second, beyond what a servo-driven quadruped turns.
+pub const YAW_RATE_RAD_S: ParamRange = ParamRange::symmetric(PI);
+
+/// A velocity command's forward or lateral speed, m/s: `[−10, 10]` (36 km/h, many times what
+/// a servo-driven quadruped walks). What a robot's gait can take is narrower and the device's
+/// walker checks it after this check (the footholds within its stride disc).
+pub const SPEED_M_S: ParamRange = ParamRange::symmetric(10.0);
+
+/// A foot path's duty factor (the stance fraction of its loop): `[0.05, 0.95]`, stance and
+/// swing each at least a twentieth of the loop (the gait's own bound is the open `(0, 1)`).
+pub const DUTY_FACTOR: ParamRange = ParamRange::interval(0.05, 0.95);
+
+/// One 50 Hz servo frame, s: the step of the device's joint-speed limiter.
+const SERVO_FRAME_S: f32 = 0.02;
+
+/// The joint-speed limit of every output, rad/s: `[0.1, π / 0.02]`.
+///
+/// The minimum moves a servo in useful time: its whole travel (π rad) in 31 s, a stand-up
+/// (about 1.5 rad at the knee) in 15 s, 2 mrad per 20 ms frame — far above the resolution of
+/// an f32 angle (2.4e-7 rad near π), so that every frame moves the outputs. A limit of 1e-45
+/// rad/s would be "finite and > 0" and yet move no output ever: it rounds to a step of 0. The
+/// maximum is a servo's whole travel in one 20 ms frame (157 rad/s): a higher limit limits
+/// nothing, and none is needed (the fastest hobby servos turn 20–30 rad/s unloaded).
+pub const JOINT_SPEED_LIMIT_RAD_S: ParamRange = ParamRange::positive(0.1, PI / SERVO_FRAME_S);
+
+/// The admissible range of `param` for a robot of `ranges` (see the module docs); `None` for
+/// the parameters that are no single number (the path, the velocity as a whole, the stance)
+/// and for the walk's `velocity_timeout_ms`, an integer (`[1, 65535]` ms).
+pub fn param_range(param: MotionParam, ranges: &Ranges) -> Option<ParamRange> {
+    use MotionParam as P;
+    Some(match param {
+        P::AmplitudeRad => SWAY_AMPLITUDE_RAD,
+        P::PeriodS | P::StepPeriodS | P::CycleS => PERIOD_S,
+        P::DurationS => DURATION_S,
+        P::YawRateRadS => YAW_RATE_RAD_S,
+        P::LiftHeightM | P::StrideM | P::StepHeightM => ranges.length_m(),
+        P::DutyFactor => DUTY_FACTOR,
+        P::BodyHeightM => ranges.body_height_m(),
+        P::ForwardMS | P::LateralMS => SPEED_M_S,
+        P::JointSpeedLimitRadS => JOINT_SPEED_LIMIT_RAD_S,
+        _ => return None,
+    })
+}
+
+/// The first of `fields` (parameter, range, value) whose value its range refuses. One loop
+/// for every motion request: on the ATmega2560 each unrolled check is its own code.
+#[inline(never)]
+fn first_invalid(fields: &[(MotionParam, ParamRange, f32)]) -> Result<(), NackReason> {
+    for &(param, range, v) in fields {
+        if let Err(problem) = range.check(v) {
+            return Err(NackReason::InvalidParameter { param, problem });
+        }
+    }
+    Ok(())
+}
+
+/// A motion's duration, when given.
+fn duration(duration_s: Option<f32>) -> Result<(), NackReason> {
+    match duration_s {
+        Some(d) => first_invalid(&[(MotionParam::DurationS, DURATION_S, d)]),
+        None => Ok(()),
+    }
+}
+
+/// A motion command's numbers (see the module docs), in declaration order.
+///
+/// # Errors
+/// As [`check_request`].
+pub fn check_motion(m: &MotionCommand, robot: &Robot) -> Result<(), NackReason> {
+    motion_in(m, &Ranges::of(robot))
+}
+
+fn motion_in(m: &MotionCommand, ranges: &Ranges) -> Result<(), NackReason> {
+    use MotionParam as P;
+    let length = ranges.length_m();
+    match *m {
+        MotionCommand::StandUp | MotionCommand::Sit | MotionCommand::Rest => Ok(()),
+        MotionCommand::Sway {
+            amplitude_rad,
+            period_s,
+            duration_s,
+            ..
+        } => {
+            first_invalid(&[
+                (P::AmplitudeRad, SWAY_AMPLITUDE_RAD, amplitude_rad),
+                (P::PeriodS, PERIOD_S, period_s),
+            ])?;
+            duration(duration_s)
+        }
+        MotionCommand::YawTurn {
+            yaw_rate_rad_s,
+            step_period_s,
+            lift_height_m,
+            duration_s,
+        } => {
+            first_invalid(&[
+                (P::YawRateRadS, YAW_RATE_RAD_S, yaw_rate_rad_s),
+                (P::StepPeriodS, PERIOD_S, step_period_s),
+                (P::LiftHeightM, length, lift_height_m),
+            ])?;
+            duration(duration_s)
+        }
+        MotionCommand::FootPath {
+            stride_m,
+            step_height_m,
+            duty_factor,
+            cycle_s,
+            duration_s,
+            ..
+        } => {
+            first_invalid(&[
+                (P::StrideM, length, stride_m),
+                (P::StepHeightM, length, step_height_m),
+                (P::DutyFactor, DUTY_FACTOR, duty_factor),
+                (P::CycleS, PERIOD_S, cycle_s),
+            ])?;
+            duration(duration_s)
+        }
+        MotionCommand::Walk {
+            body_height_m,
+            step_height_m,
+            cycle_s,
+            velocity_timeout_ms,
+            ..
+        } => {
+            first_invalid(&[
+                (P::BodyHeightM, ranges.body_height_m(), body_height_m),
+                (P::StepHeightM, length, step_height_m),
+                (P::CycleS, PERIOD_S, cycle_s),
+            ])?;
+            if velocity_timeout_ms == 0 {
+                return Err(NackReason::InvalidParameter {
+                    param: P::VelocityTimeoutMs,
+                    problem: ParamProblem::NotPositive,
+                });
+            }
+            Ok(())
+        }
     }
 }
 
