@@ -40,7 +40,8 @@ pub struct Config {
     pub firmware: FirmwareVersion,
     /// Storage address of calibration bank A; [`crate::store::STORAGE_LEN`] bytes are used.
     pub storage_base: u16,
-    /// Joint-speed limit of every output at power-on, rad/s (finite, > 0; see
+    /// Joint-speed limit of every output at power-on, rad/s (within the range that
+    /// `SetJointSpeedLimit` admits, [`quad_protocol::range::JOINT_SPEED_LIMIT_RAD_S`]; see
     /// [`crate::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S`]).
     pub joint_speed_limit_rad_s: f32,
 }
@@ -57,7 +58,8 @@ pub enum ConfigError {
     PresetMismatch,
     /// The storage banks do not fit below address 65536.
     StorageBase,
-    /// The joint-speed limit is not a finite speed > 0.
+    /// The joint-speed limit is outside the range `SetJointSpeedLimit` admits
+    /// ([`quad_protocol::range::JOINT_SPEED_LIMIT_RAD_S`]).
     JointSpeedLimit,
 }
 
@@ -68,9 +70,9 @@ impl fmt::Display for ConfigError {
             ConfigError::StanceHeight => f.write_str("stance height must be a finite length > 0"),
             ConfigError::PresetMismatch => f.write_str("preset and robot geometry differ"),
             ConfigError::StorageBase => f.write_str("calibration storage exceeds 64 KiB"),
-            ConfigError::JointSpeedLimit => {
-                f.write_str("joint speed limit must be a finite speed > 0, in rad/s")
-            }
+            ConfigError::JointSpeedLimit => f.write_str(
+                "joint speed limit must be within SetJointSpeedLimit's range, [0.1, 157.08] rad/s",
+            ),
         }
     }
 }
@@ -152,7 +154,12 @@ impl Config {
         if self.storage_base as u32 + crate::store::STORAGE_LEN as u32 > 0x1_0000 {
             return Err(ConfigError::StorageBase);
         }
-        if crate::engine::Limiter::new(self.joint_speed_limit_rad_s).is_err() {
+        // The range the wire admits (`SetJointSpeedLimit`), then the limiter's own check.
+        if quad_protocol::range::JOINT_SPEED_LIMIT_RAD_S
+            .check(self.joint_speed_limit_rad_s)
+            .is_err()
+            || crate::engine::Limiter::new(self.joint_speed_limit_rad_s).is_err()
+        {
             return Err(ConfigError::JointSpeedLimit);
         }
         Ok(())
@@ -324,6 +331,21 @@ mod tests {
         c = Config::fernando2025();
         c.joint_speed_limit_rad_s = 0.0;
         assert_eq!(ValidConfig::new(c), Err(ConfigError::JointSpeedLimit));
+    }
+
+    /// The limit at power-on is held to the range `SetJointSpeedLimit` admits: a subnormal one
+    /// ("finite and > 0") would move no output ever.
+    #[test]
+    fn the_boot_joint_speed_limit_is_within_the_wire_range() {
+        let mut c = Config::shahriar2023();
+        for bad in [1e-45, 0.099, 158.0, f32::INFINITY] {
+            c.joint_speed_limit_rad_s = bad;
+            assert_eq!(c.validate(), Err(ConfigError::JointSpeedLimit), "{bad}");
+        }
+        for good in [0.1, 3.0, 100.0] {
+            c.joint_speed_limit_rad_s = good;
+            assert_eq!(c.validate(), Ok(()), "{good}");
+        }
     }
 
     #[test]

@@ -61,7 +61,9 @@ struct Held {
 /// - Every pulse written lies within its servo's calibrated `[min_us, max_us]`; a calibration
 ///   change that would put the held angle outside the new travel is refused.
 /// - Every request is range-checked first ([`quad_protocol::check_request`], the host's own
-///   check): a finite value outside its field's range is [`NackReason::OutOfRange`].
+///   check): a finite value outside its field's range is [`NackReason::OutOfRange`]; a motion
+///   field (`StartMotion`, `SetVelocity`, `SetJointSpeedLimit`) outside its range is
+///   [`NackReason::InvalidParameter`] naming it, before the motion engine does any maths.
 /// - Configuration requests are answered with [`DeviceToHost::Configured`], echoing the setting
 ///   as applied.
 /// - Link loss: when no valid frame arrived for `timeout_ms` (≠ 0), the failsafe holds the

@@ -52,8 +52,10 @@
 //! limiter still bounds every step), as does stopping the outputs.
 //!
 //! ## Start check
-//! A motion's parameters are validated by kin-core's constructors (finite, positive, in range;
-//! each refusal names its parameter), without their own reach checks (the start check covers
+//! A request from the wire has passed the protocol's range check already
+//! ([`quad_protocol::range`]: every number within its field's range, the same check the host
+//! runs before sending). A motion's parameters are then validated by kin-core's constructors
+//! (finite, positive, in range; each refusal names its parameter), without their own reach checks (the start check covers
 //! them) and without validating the robot again (the device validated it at boot). It runs the motion through the same per-frame code the running motion uses — the
 //! motion's frame at a sample time, its body IK (which refuses unreachable feet and joint
 //! limits), the servo travel — at a bounded set of samples, plus kin-core's singularity
