@@ -109,3 +109,31 @@ fn bad_values_are_refused_naming_the_option() {
         assert!(r.stderr.contains(words), "{args:?}: {}", r.stderr);
     }
 }
+
+#[test]
+fn values_outside_their_range_are_refused_before_sending_naming_the_option_and_its_range() {
+    for (args, words) in [
+        (
+            vec!["run", "sway-roll", "--amplitude-rad", "1e30"],
+            "--amplitude-rad is outside its admissible range [-1.5707964, 1.5707964] rad",
+        ),
+        (
+            vec!["run", "sway-pitch", "--period-s", "1e-45"],
+            "--period-s is outside its admissible range [0.1, 60] s",
+        ),
+        (
+            vec!["run", "trot", "--forward-m-s", "inf"],
+            "--forward-m-s is not a finite number (admissible: [-10, 10] m/s)",
+        ),
+        (
+            vec!["run", "foot-path", "--duty-factor", "0.99"],
+            "--duty-factor is outside its admissible range [0.05, 0.95]",
+        ),
+    ] {
+        let r = run(&args);
+        assert_eq!(r.code, 2, "{args:?}: {}", r.stdout);
+        assert!(r.stdout.is_empty(), "{args:?}: no summary");
+        assert!(r.stderr.contains("not sent"), "{args:?}: {}", r.stderr);
+        assert!(r.stderr.contains(words), "{args:?}: {}", r.stderr);
+    }
+}

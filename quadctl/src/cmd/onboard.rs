@@ -88,9 +88,11 @@ Parameters (units in the names; every one optional, the defaults are the device'
              strides finish, the feet park on the stance).
 Durations are rounded up to whole periods by the device.
 
-Bad values (NaN, zero or negative periods and durations, amplitudes or heights beyond reach,
-velocities beyond what the gait reaches) are refused by the device before anything moves; the
-refusal names the option. Exit status: 0 done; 2 refused, stopped early or the link failed.";
+Bad values are refused before anything moves, the option named: a value outside its range
+(docs/protocol.md, motion field ranges: NaN, zero or negative periods and durations, an
+amplitude beyond 90 degrees, ...) by the host before sending, with the device's own reason and
+the range; amplitudes or heights beyond reach and velocities beyond what the gait reaches by
+the device. Exit status: 0 done; 2 refused, stopped early or the link failed.";
 
 /// `quadctl run --help`'s examples (run from the repository root).
 pub const RUN_EXAMPLES: &str = "\

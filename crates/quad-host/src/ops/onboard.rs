@@ -3,12 +3,16 @@
 //! refusals in words. The operations behind `quadctl stand`, `sit`, `rest`, `run` and `drive`.
 //!
 //! A motion's parameters and their defaults are the device's own (`quad_device::engine`'s
-//! requests, sent as `quad_protocol::MotionCommand`): the host adds nothing but the words of a
-//! refusal. Refused requests change nothing on the device.
+//! requests, sent as `quad_protocol::MotionCommand`). Before sending a motion request the host
+//! runs the range check the device runs first ([`quad_protocol::range`]): a number outside its
+//! field's range is refused here with the device's own reason, [`Error::NotSent`], and nothing
+//! is sent; what depends on the robot's reach and travel stays the device's to check. Refused
+//! requests change nothing on the device.
 
 use crate::client::{self, Client, ClientConfig, Outcome, Verdict};
 use crate::link::{self, Link, Target};
 use quad_device::engine;
+use quad_protocol::range::{self, ParamRange, Ranges};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     DeviceInfo, DeviceToHost, Flags, MotionCommand, MotionKind, MotionParam, MotionStage,
@@ -51,6 +55,21 @@ pub enum Error {
         /// requests): named when the device's start check finds a foot it cannot place.
         shaped_by: &'static [MotionParam],
     },
+    /// A number of the request is outside its field's range (`quad_protocol::range`): not
+    /// sent; the device refuses it with the same reason.
+    #[error(
+        "{request} not sent: {}{}; the device refuses it alike",
+        words(.reason),
+        admissible(.reason, .range)
+    )]
+    NotSent {
+        /// The request.
+        request: &'static str,
+        /// The reason the device gives to the same request.
+        reason: NackReason,
+        /// The refused field and its range, when it is one number's.
+        range: Option<(MotionParam, ParamRange)>,
+    },
     /// The motion stopped early on the device.
     #[error("the motion stopped early on the device: {}", words(.0))]
     Fault(NackReason),
@@ -67,6 +86,55 @@ pub enum Error {
         /// What is wrong.
         problem: &'static str,
     },
+}
+
+impl Error {
+    /// The reason a refused request got, from the device ([`Error::Refused`]) or from the
+    /// host's range check before sending ([`Error::NotSent`]).
+    pub fn refusal(&self) -> Option<&NackReason> {
+        match self {
+            Error::Refused { reason, .. } | Error::NotSent { reason, .. } => Some(reason),
+            _ => None,
+        }
+    }
+}
+
+/// The unit of a motion parameter, as its name ends.
+fn unit(param: MotionParam) -> &'static str {
+    match param {
+        MotionParam::AmplitudeRad => "rad",
+        MotionParam::PeriodS
+        | MotionParam::DurationS
+        | MotionParam::StepPeriodS
+        | MotionParam::CycleS => "s",
+        MotionParam::YawRateRadS | MotionParam::JointSpeedLimitRadS => "rad/s",
+        MotionParam::LiftHeightM
+        | MotionParam::StrideM
+        | MotionParam::StepHeightM
+        | MotionParam::BodyHeightM => "m",
+        MotionParam::ForwardMS | MotionParam::LateralMS => "m/s",
+        _ => "",
+    }
+}
+
+/// A field's range after the words of its refusal: " [min, max] unit" after "outside its
+/// admissible range", else " (admissible: [min, max] unit)"; empty without a range.
+fn admissible(reason: &NackReason, range: &Option<(MotionParam, ParamRange)>) -> String {
+    let Some((param, r)) = range else {
+        return String::new();
+    };
+    let unit = match unit(*param) {
+        "" => String::new(),
+        u => format!(" {u}"),
+    };
+    let interval = format!("[{}, {}]{unit}", r.min, r.max);
+    match reason {
+        NackReason::InvalidParameter {
+            problem: ParamProblem::OutOfRange,
+            ..
+        } => format!(" {interval}"),
+        _ => format!(" (admissible: {interval})"),
+    }
 }
 
 /// The command-line option of a motion parameter.
@@ -200,6 +268,9 @@ pub struct Session<L> {
     client: Client<L>,
     info: DeviceInfo,
     calibration: [Calibration; 12],
+    /// The request ranges of the device's robot (`None` for a geometry that is no preset: the
+    /// host does not know it, the device alone checks).
+    ranges: Option<Ranges>,
 }
 
 impl<L: Link> Session<L> {
@@ -221,6 +292,28 @@ impl<L: Link> Session<L> {
             client,
             info,
             calibration,
+            ranges: info.robot.robot().map(|r| Ranges::of(&r)),
+        })
+    }
+
+    /// The range check the device runs first ([`quad_protocol::range::check_request`]), on
+    /// the host before sending.
+    ///
+    /// # Errors
+    /// [`Error::NotSent`] with the reason the device gives.
+    pub fn check(&self, request: &Request) -> Result<(), Error> {
+        let Some(ranges) = &self.ranges else {
+            return Ok(());
+        };
+        range::check_request_in(request, ranges).map_err(|reason| Error::NotSent {
+            request: client::request_name(request),
+            reason,
+            range: match reason {
+                NackReason::InvalidParameter { param, .. } => {
+                    range::param_range(param, ranges).map(|r| (param, r))
+                }
+                _ => None,
+            },
         })
     }
 
@@ -244,11 +337,14 @@ impl<L: Link> Session<L> {
         self.client.link().now()
     }
 
-    /// A motion request (`StartMotion`, `StopMotion`, `GetMotion`, `SetVelocity`).
+    /// A motion request (`StartMotion`, `StopMotion`, `GetMotion`, `SetVelocity`), sent once
+    /// the host's range check ([`Session::check`]) passes it.
     ///
     /// # Errors
-    /// [`Error::Refused`] with the device's reason, or the link's errors.
+    /// [`Error::NotSent`] (nothing sent), [`Error::Refused`] with the device's reason, or the
+    /// link's errors.
     pub fn motion(&mut self, request: Request) -> Result<MotionAnswer, Error> {
+        self.check(&request)?;
         let name = client::request_name(&request);
         let retries = self.client.config().retries;
         let exchange = self
@@ -400,13 +496,23 @@ pub struct VelocityStep {
     pub duration_s: f32,
 }
 
+/// The velocity command of `step`.
+fn velocity_request(step: &VelocityStep) -> Request {
+    Request::SetVelocity {
+        forward_m_s: step.forward_m_s,
+        lateral_m_s: step.lateral_m_s,
+        yaw_rate_rad_s: step.yaw_rate_rad_s,
+    }
+}
+
 /// Runs `request` to its end: stands up first when the outputs are off (unless the request
 /// is a posture; a sit or rest with the outputs off has nothing to do and returns at once),
 /// starts it, sends the `walk` velocity steps at [`POLL_PERIOD`] (for a walk,
 /// then stops it), and waits until the device is idle. `each` sees every answer.
 ///
 /// # Errors
-/// See [`Error`]; a refusal leaves the device as it was (apart from a stand-up first).
+/// See [`Error`]; a refusal leaves the device as it was (apart from a stand-up first; a
+/// request or velocity outside the protocol's ranges is refused before it).
 pub fn run<L: Link>(
     session: &mut Session<L>,
     request: &engine::Request,
@@ -414,6 +520,12 @@ pub fn run<L: Link>(
     limit: Duration,
     mut each: impl FnMut(&MotionAnswer),
 ) -> Result<Summary, Error> {
+    // The range check of the motion and of its velocity commands before anything moves (a
+    // stand-up first included).
+    session.check(&Request::StartMotion(MotionCommand::from(request)))?;
+    for step in walk {
+        session.check(&velocity_request(step))?;
+    }
     let posture = matches!(
         request,
         engine::Request::StandUp | engine::Request::Sit | engine::Request::Rest
@@ -442,11 +554,7 @@ pub fn run<L: Link>(
         for step in walk {
             let until = session.now() + Duration::from_secs_f32(step.duration_s);
             loop {
-                let sent = session.motion(Request::SetVelocity {
-                    forward_m_s: step.forward_m_s,
-                    lateral_m_s: step.lateral_m_s,
-                    yaw_rate_rad_s: step.yaw_rate_rad_s,
-                });
+                let sent = session.motion(velocity_request(step));
                 let answer = match sent {
                     Ok(a) => a,
                     Err(e) => {
@@ -490,6 +598,15 @@ pub fn ramping(status: &MotionStatus) -> bool {
     matches!(status.stage, MotionStage::Approach | MotionStage::Leave)
 }
 
+/// A refusal (the device's, or the host's range check's) as the teleop's answer; any other
+/// error as it is.
+fn refused(e: Error) -> Result<crate::ops::drive::Answer<MotionAnswer>, Error> {
+    match e.refusal() {
+        Some(reason) => Ok(crate::ops::drive::Answer::Refused(words(reason))),
+        None => Err(e),
+    }
+}
+
 /// The teleop's device end ([`crate::ops::drive::Walker`]) on a [`Session`]: a trot or walk
 /// at a body height, velocity commands, stop and sit.
 pub struct SessionWalker<'a, L> {
@@ -514,8 +631,7 @@ impl<L: Link> crate::ops::drive::Walker for SessionWalker<'_, L> {
         let request = engine::Request::Walk(engine::WalkRequest::new(self.pattern, body_height_m));
         match self.session.start(&request) {
             Ok(a) => Ok(Answer::Accepted(a)),
-            Err(Error::Refused { reason, .. }) => Ok(Answer::Refused(words(&reason))),
-            Err(e) => Err(e),
+            Err(e) => refused(e),
         }
     }
 
@@ -530,8 +646,7 @@ impl<L: Link> crate::ops::drive::Walker for SessionWalker<'_, L> {
             yaw_rate_rad_s: c.yaw_rate_rad_s,
         }) {
             Ok(a) => Ok(Answer::Accepted(a)),
-            Err(Error::Refused { reason, .. }) => Ok(Answer::Refused(words(&reason))),
-            Err(e) => Err(e),
+            Err(e) => refused(e),
         }
     }
 
