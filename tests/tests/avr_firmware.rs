@@ -269,7 +269,9 @@ fn tables_read_with_lpm_lie_in_the_lowest_64_kb() {
             .flash_objects();
         for table in ["ATAN_CELLS", "SIN_COS_CELLS"] {
             assert!(
-                objects.iter().any(|o| o.name.contains(table) && o.size_bytes > 0),
+                objects
+                    .iter()
+                    .any(|o| o.name.contains(table) && o.size_bytes > 0),
                 "{bin}: no {table} among the flash objects {objects:?}"
             );
         }
