@@ -70,6 +70,8 @@ struct Held {
 ///   pulses or stops the outputs ([`LinkLossAction`]) and sets [`Flags::FAILSAFE_ACTIVE`],
 ///   latched until an answer that carries a readback has reported it. Stopped outputs stay
 ///   stopped until the host enables them again.
+/// - A request received twice in a row as the same frame (a retry) is answered twice with the
+///   same answer and acts once ([`Device::receive`]).
 /// - Unreadable frames are answered with a nack without a sequence number (`BadCrc`,
 ///   `BadFrame`, `Oversize`), at most one per [`FRAMING_NACK_INTERVAL_MS`], and change nothing
 ///   but the frame counters.
@@ -109,6 +111,9 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     last_valid_ms: u32,
     /// When the last nack of an unreadable frame was sent (`None`: never).
     last_framing_nack_ms: Option<u32>,
+    /// The last request answered over the link and its answer, replayed for an exact repeat
+    /// (a retry whose answer was lost): see [`Device::receive`].
+    last_answered: Option<Answered>,
     engine: Engine<M>,
     /// The angles on the outputs while they are enabled.
     out_rad: [f32; 12],
@@ -191,6 +196,7 @@ where
             calibration_default: true,
             last_valid_ms: now,
             last_framing_nack_ms: None,
+            last_answered: None,
             engine: Engine::new(*valid.limiter()),
             out_rad: [0.0; 12],
             next_frame: now,
@@ -237,10 +243,47 @@ where
     /// ([`encode_frame_in_pieces`]): its first bytes as soon as they are final, so that a
     /// transmitter starts while the rest is encoded; one frame's pieces all come before the
     /// next frame's.
+    ///
+    /// Every request is safe to retry: an exact repeat of the last request answered here (the
+    /// same `seq` and the same frame CRC, so the same bytes) is answered with the same answer
+    /// again and does not act again — a `StartMotion` resent because its `MotionAck` was lost
+    /// gets that `MotionAck`, not `MotionRunning`. A repeated `seq` with other bytes is a new
+    /// request. ([`Device::handle`], which sees no frame, always acts.)
     pub fn receive(&mut self, mut bytes: &[u8], mut tx: impl FnMut(&[u8])) {
         while let Some(remaining) = self.receive_one(bytes, &mut tx) {
             bytes = remaining;
         }
+    }
+
+    /// Answers the request `msg` of a frame whose CRC is `crc`: an exact repeat of the last
+    /// request answered (the same `seq` and the same frame CRC: a retry whose answer was lost)
+    /// gets the same answer again, without the request acting again; any other request is
+    /// handled ([`Device::handle`]) and remembered, unless it was refused `Busy` (the host
+    /// then resends it to have it carried out). A repeat feeds the link timer as any frame
+    /// does.
+    fn answer_once(&mut self, msg: &HostToDevice, crc: Option<u16>) -> DeviceToHost {
+        if let (Some(last), Some(crc)) = (&self.last_answered, crc) {
+            if last.seq == msg.seq && last.crc == crc {
+                self.last_valid_ms = self.clock.now_ms();
+                self.failsafe_armed = true;
+                return last.answer;
+            }
+        }
+        let answer = self.handle_ref(msg);
+        // `Busy` asks for the same request again once the device is free: not remembered.
+        let busy = matches!(
+            answer,
+            DeviceToHost::Nack {
+                reason: NackReason::Busy,
+                ..
+            }
+        );
+        self.last_answered = crc.filter(|_| !busy).map(|crc| Answered {
+            seq: msg.seq,
+            crc,
+            answer,
+        });
+        answer
     }
 
     /// Consumes `bytes` up to the end of the first frame in them, handles it and sends its
@@ -252,7 +295,8 @@ where
         let (reason, remaining) = match &feed_request(&mut self.acc, bytes) {
             Feed::NeedMore => return None,
             Feed::Frame { msg, remaining } => {
-                let answer = self.handle_ref(msg);
+                let crc = self.acc.frame_crc();
+                let answer = self.answer_once(msg, crc);
                 self.encode(&answer, tx);
                 return Some(remaining);
             }
@@ -942,6 +986,14 @@ pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8], tx: &mut dyn FnMut(&
 #[inline(never)]
 fn check_range(request: &Request, ranges: &Ranges) -> Result<(), NackReason> {
     check_request_in(request, ranges)
+}
+
+/// A request answered over the link: its sequence number, its frame's CRC, the answer.
+#[derive(Debug, Clone, Copy)]
+struct Answered {
+    seq: u16,
+    crc: u16,
+    answer: DeviceToHost,
 }
 
 const fn nack(seq: Option<u16>, reason: NackReason) -> DeviceToHost {
