@@ -1,7 +1,7 @@
-//! Links avr-libc's own `sqrt` into the benchmark firmware (`bench`) under the name
-//! `avr_libc_sqrt`: the firmware defines `sqrt` itself (`avr_libc_math::sqrt`), so `libm.a`'s
-//! `sqrt.o` is never linked as it stands; the emulator test `avr_sqrt` compares the two bit for
-//! bit. The member is taken from the `libm.a` that avr-gcc links and renamed with
+//! Links avr-libc's own `sqrt` into the benchmark and test harness firmwares (`bench`,
+//! `harness`) under the name `avr_libc_sqrt`: the firmware defines `sqrt` itself
+//! (`avr_libc_math::sqrt`), so `libm.a`'s `sqrt.o` is never linked as it stands; the emulator
+//! tests `avr_sqrt` and `avr_kernel_edges` compare the two bit for bit. The member is taken from the `libm.a` that avr-gcc links and renamed with
 //! `avr-objcopy`; the other binaries are left alone. Links every binary with the linker's
 //! relaxation (`--relax`).
 
@@ -60,7 +60,10 @@ fn main() {
             &renamed.to_string_lossy(),
         ],
     );
-    println!("cargo:rustc-link-arg-bin=bench={}", renamed.display());
-    // Its helpers (`__fp_splitA`, `__fp_norm2`, …) from `libm.a`, after it on the command line.
-    println!("cargo:rustc-link-arg-bin=bench=-lm");
+    for bin in ["bench", "harness"] {
+        println!("cargo:rustc-link-arg-bin={bin}={}", renamed.display());
+        // Its helpers (`__fp_splitA`, `__fp_norm2`, …) from `libm.a`, after it on the command
+        // line.
+        println!("cargo:rustc-link-arg-bin={bin}=-lm");
+    }
 }

@@ -15,8 +15,6 @@
 //! | body pose at the stance | `B`, backend u8, roll pitch yaw x y z f32 | `b`, status u8, 12 × f32 |
 //! | memory | `S` | `s`, static SRAM u16, max stack u16 |
 //! | one primitive | `F`, op u8, a b f32 | `f`, status u8, result f32 |
-//! | a kernel over the batch in SRAM | `K`, kernel u8, count u16 | `k`, status u8 |
-//! | IK over the pose batch in SRAM | `P`, backend u8, count u8 | `p`, status u8 |
 //! | start an onboard motion (untimed) | `M`, motion u8 | `m`, status u8 |
 //! | one servo frame of it | `N` | `n`, status u8, stage u8 |
 //!
@@ -26,12 +24,6 @@
 //! firmware's configuration) and its approach ramp is run before the timed frames. A timed
 //! frame is what `Device::poll` does at a servo frame boundary: the engine's tick (the motion
 //! and its body IK), the limiter step of the twelve outputs and their calibrated pulses.
-//!
-//! `K` is the kernels' test harness: the host writes up to [`KERNEL_BATCH_LEN`] argument pairs
-//! straight into [`KERNEL_BATCH`] (in simavr's memory, not over the UART), the firmware
-//! replaces each pair by the two results of kernel `kernel` of its table ([`KernelFn`]) and
-//! answers; the host reads the results from memory. Status 2 for an unknown kernel or a count
-//! beyond the batch.
 //!
 //! Status 0 = solved, 1 = unreachable, 2 = unknown backend. Boot sends `R` once ready.
 //! Robot: [`kin_core::Robot::shahriar2023`] with its knee bend and limits; body poses about
@@ -44,9 +36,7 @@ use crate::usart::Usart0;
 use core::marker::PhantomData;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::Axis;
-use kin_core::{
-    body, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, RotationOrder, Vec3,
-};
+use kin_core::{body, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
 use quad_device::engine::{
     self, Engine, Limiter, PulseMaps, Request, Setup, Stage, WalkRequest, FRAME_MS,
 };
@@ -64,88 +54,6 @@ pub const ROBOT: Robot = Robot::shahriar2023();
 /// One float primitive under test, `op(a, b)` (unary ones ignore `b`).
 pub type PrimFn = fn(f32, f32) -> f32;
 
-/// One kernel of the test harness (`K`): the two results of its arguments `(a, b)`, as bits
-/// (a kernel of one result, or of one argument, ignores the rest).
-pub type KernelFn = fn(u32, u32) -> (u32, u32);
-
-/// Argument pairs of one harness batch ([`KERNEL_BATCH`]).
-pub const KERNEL_BATCH_LEN: usize = 128;
-
-/// The harness batch: argument pairs written by the host, replaced by the results. Exported
-/// under its own name, so that the host finds it in the ELF's symbols.
-#[no_mangle]
-pub static mut KERNEL_BATCH: [[u32; 2]; KERNEL_BATCH_LEN] = [[0; 2]; KERNEL_BATCH_LEN];
-
-/// Runs `kernel` over the first `count` pairs of [`KERNEL_BATCH`], in place.
-fn run_kernel_batch(kernel: KernelFn, count: usize) {
-    let batch = core::ptr::addr_of_mut!(KERNEL_BATCH).cast::<[u32; 2]>();
-    for i in 0..count.min(KERNEL_BATCH_LEN) {
-        // SAFETY: `i` is within the batch; volatile, because the host writes the pairs behind
-        // the program's back; the firmware's only other code runs no harness batch.
-        unsafe {
-            let slot = batch.add(i);
-            let [a, b] = core::ptr::read_volatile(slot);
-            let (r0, r1) = kernel(a, b);
-            core::ptr::write_volatile(slot, [r0, r1]);
-        }
-    }
-}
-
-/// One record of a pose batch (`P`): word 0 the bytes `[target, order, policy, status]`, then
-/// twelve floats. `target` 0–3 is a leg (its foot in the hip frame in floats 0–2, its three
-/// angles out), 255 the body (roll pitch yaw x y z and the stance height in floats 0–6, the
-/// twelve angles out); `order` indexes [`kin_core::RotationOrder::ALL`], `policy` is 0 reject
-/// or 1 clamp; `status` out: bit 0 refused, bits 4–7 the legs clamped.
-pub type PoseRecord = [u32; 13];
-
-/// Pose records of one batch: as many as fit in [`KERNEL_BATCH`], whose memory they share.
-pub const POSE_BATCH_LEN: usize =
-    core::mem::size_of::<[[u32; 2]; KERNEL_BATCH_LEN]>() / core::mem::size_of::<PoseRecord>();
-
-/// Solves the first `count` records of the pose batch (in [`KERNEL_BATCH`]'s memory) with
-/// `solve`, in place.
-fn run_pose_batch(solve: &dyn Solve, count: usize) {
-    let batch = core::ptr::addr_of_mut!(KERNEL_BATCH).cast::<PoseRecord>();
-    for i in 0..count.min(POSE_BATCH_LEN) {
-        // SAFETY: record `i` lies within the batch's memory (`POSE_BATCH_LEN`); volatile, as
-        // in `run_kernel_batch`.
-        unsafe {
-            let slot = batch.add(i);
-            let mut record = core::ptr::read_volatile(slot);
-            let [target, order, policy, _] = record[0].to_le_bytes();
-            let f = |k: usize| f32::from_bits(record[1 + k]);
-            let order = RotationOrder::ALL[usize::from(order) % 6];
-            let policy = if policy == 1 {
-                ReachPolicy::Clamp
-            } else {
-                ReachPolicy::Reject
-            };
-            let (status, angles): (u8, [f32; 12]) = if target == 255 {
-                let pose = Pose::from_array([f(0), f(1), f(2), f(3), f(4), f(5)]);
-                match solve.body_with(&pose, order, f(6), policy) {
-                    Ok((angles, clamped)) => (clamped << 4, angles),
-                    Err(_) => (1, [0.0; 12]),
-                }
-            } else {
-                let leg = LegId::from_index(usize::from(target) & 3).unwrap_or(LegId::FL);
-                match solve.leg_with(leg, Vec3::new(f(0), f(1), f(2)), policy) {
-                    Ok((a, clamped)) => {
-                        let mut angles = [0.0; 12];
-                        angles[..3].copy_from_slice(&a);
-                        (u8::from(clamped) << 4, angles)
-                    }
-                    Err(_) => (1, [0.0; 12]),
-                }
-            };
-            record[0] = u32::from_le_bytes([target, 0, 0, status]);
-            for (w, a) in record[1..].iter_mut().zip(angles) {
-                *w = a.to_bits();
-            }
-            core::ptr::write_volatile(slot, record);
-        }
-    }
-}
-
 /// The IK of one math backend under test.
 pub trait Solve {
     /// One leg IK under [`ReachPolicy::Reject`]: the abduction, hip and knee angles.
@@ -153,22 +61,6 @@ pub trait Solve {
     /// One body pose at the stance of [`STANCE_HEIGHT_M`] under [`ReachPolicy::Reject`]: the
     /// twelve angles.
     fn body(&self, pose: &Pose) -> Result<[f32; 12], IkError>;
-    /// One leg IK under `policy`: the angles and whether the target was clamped.
-    fn leg_with(
-        &self,
-        leg_id: LegId,
-        foot_in_hip: Vec3,
-        policy: ReachPolicy,
-    ) -> Result<([f32; 3], bool), IkError>;
-    /// One body pose about the body centre in `order`, at the stance of `stance_height_m`,
-    /// under `policy`: the angles and the legs clamped (bit `i` for leg `i`).
-    fn body_with(
-        &self,
-        pose: &Pose,
-        order: RotationOrder,
-        stance_height_m: f32,
-        policy: ReachPolicy,
-    ) -> Result<([f32; 12], u8), IkError>;
 }
 
 /// A math backend under test: the id the host selects it by, and its IK.
@@ -216,41 +108,6 @@ impl<M: Math> Solve for Prepared<M> {
         )?;
         Ok(solution.angles_rad)
     }
-
-    fn leg_with(
-        &self,
-        leg_id: LegId,
-        foot_in_hip: Vec3,
-        policy: ReachPolicy,
-    ) -> Result<([f32; 3], bool), IkError> {
-        self.solver
-            .leg()
-            .inverse(leg_id, foot_in_hip, policy)
-            .map(|s| (s.angles.to_array(), s.clamped.is_some()))
-    }
-
-    fn body_with(
-        &self,
-        pose: &Pose,
-        order: RotationOrder,
-        stance_height_m: f32,
-        policy: ReachPolicy,
-    ) -> Result<([f32; 12], u8), IkError> {
-        let mut solution = body::BodySolution::default();
-        self.solver.inverse_at_stance_into(
-            pose,
-            &BodyConfig::about_centre(order),
-            stance_height_m,
-            policy,
-            &mut solution,
-        )?;
-        let clamped = solution
-            .clamped
-            .iter()
-            .enumerate()
-            .fold(0u8, |m, (i, c)| m | (u8::from(c.is_some()) << i));
-        Ok((solution.angles_rad, clamped))
-    }
 }
 
 /// kin-core's IK on backend `M` with the solver built from the robot inside every timed call
@@ -280,25 +137,6 @@ impl<M: Math> Solve for PerCall<M> {
     #[inline(never)]
     fn body(&self, pose: &Pose) -> Result<[f32; 12], IkError> {
         Prepared::<M>::new(core::hint::black_box(&self.robot)).body(pose)
-    }
-
-    fn leg_with(
-        &self,
-        leg_id: LegId,
-        foot_in_hip: Vec3,
-        policy: ReachPolicy,
-    ) -> Result<([f32; 3], bool), IkError> {
-        Prepared::<M>::new(&self.robot).leg_with(leg_id, foot_in_hip, policy)
-    }
-
-    fn body_with(
-        &self,
-        pose: &Pose,
-        order: RotationOrder,
-        stance_height_m: f32,
-        policy: ReachPolicy,
-    ) -> Result<([f32; 12], u8), IkError> {
-        Prepared::<M>::new(&self.robot).body_with(pose, order, stance_height_m, policy)
     }
 }
 
@@ -475,7 +313,6 @@ pub fn serve(
     porta: &pac::PORTA,
     backends: &[Backend<'_>],
     prims: &[PrimFn],
-    kernels: &[KernelFn],
     motion: &mut dyn MotionBench,
 ) -> ! {
     // SAFETY: any DDRA value is valid; PA0 becomes an output, low.
@@ -541,34 +378,6 @@ pub fn serve(
                     }
                     None => send_status(usart, STATUS_UNKNOWN_BACKEND, 1),
                 }
-            }
-            b'K' => {
-                let kernel = read_byte(usart) as usize;
-                let count = u16::from_le_bytes([read_byte(usart), read_byte(usart)]) as usize;
-                let status = match kernels.get(kernel) {
-                    Some(&f) if count <= KERNEL_BATCH_LEN => {
-                        marker(porta, true);
-                        run_kernel_batch(core::hint::black_box(f), count);
-                        marker(porta, false);
-                        STATUS_OK
-                    }
-                    _ => STATUS_UNKNOWN_BACKEND,
-                };
-                usart.write(b'k');
-                usart.write(status);
-            }
-            b'P' => {
-                let backend = read_byte(usart);
-                let count = read_byte(usart) as usize;
-                let status = match backends.iter().find(|b| b.id == backend) {
-                    Some(b) if count <= POSE_BATCH_LEN => {
-                        run_pose_batch(b.solve, count);
-                        STATUS_OK
-                    }
-                    _ => STATUS_UNKNOWN_BACKEND,
-                };
-                usart.write(b'p');
-                usart.write(status);
             }
             b'M' => {
                 let m = read_byte(usart);

@@ -35,6 +35,7 @@ pub mod app;
 pub mod bench;
 pub mod clock;
 pub mod eeprom;
+pub mod harness;
 pub mod mem;
 pub mod servo;
 pub mod stack;

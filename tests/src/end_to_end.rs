@@ -1,7 +1,7 @@
 //! The firmware's IK end to end: random body poses and foot targets over the whole workspace of
 //! the preset the firmware carries (seed 000's robot), every rotation order and both reach
 //! policies, solved by the firmware's solver (`body::Solver` on `AvrFast`, as the device
-//! builds it) in simavr through the benchmark firmware's pose batch (`P`), and compared with
+//! builds it) in simavr through the test harness firmware's pose batch (`P`), and compared with
 //!
 //! - the host's `SoftFloat` path (kin-core with the same kernels on the host): the same verdict
 //!   (solved, refused, the legs clamped) and the share of bit-identical angles;
@@ -21,9 +21,6 @@ use seeded_rng::SplitMix64;
 
 /// The bound of the angle error against f64: 0.01°, rad.
 pub const TOLERANCE_RAD: f64 = 0.01 * std::f64::consts::PI / 180.0;
-
-/// The benchmark firmware's backend id of the firmware's math (`AvrFast`).
-const FIRMWARE_BACKEND: u8 = 3;
 
 /// What is solved.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -119,7 +116,7 @@ pub fn host_answer(solver: &body::Solver<SoftFloat>, case: &Case) -> Answer {
 pub fn firmware_answers(harness: &mut Harness, cases: &[Case]) -> Vec<Answer> {
     let records: Vec<[u32; 13]> = cases.iter().map(record).collect();
     harness
-        .run_poses(FIRMWARE_BACKEND, &records)
+        .run_poses(&records)
         .into_iter()
         .zip(cases)
         .map(|(r, case)| {

@@ -1,8 +1,9 @@
 //! The AVR kernels checked against their twins, bit for bit, in simavr: the harness that streams
-//! argument pairs through a kernel of the benchmark firmware from memory, and the twins.
+//! argument pairs through a kernel of the test harness firmware (`harness.elf`,
+//! `firmware_avr::harness`) from memory, and the twins.
 //!
 //! The harness ([`Harness`]) writes up to 128 pairs straight into the firmware's
-//! `KERNEL_BATCH` in simavr's memory, sends one 4-byte `K` request (see `firmware_avr::bench`),
+//! `KERNEL_BATCH` in simavr's memory, sends one 4-byte `K` request,
 //! and reads the results back from memory: the UART carries no arguments, so the emulator's
 //! time goes to the kernel. The kernels and their twins ([`Kernel`]):
 //!
@@ -19,17 +20,17 @@ use kin_core::math::{poly, SoftFloat};
 use quad_host::emu::{build, elf, Mega2560};
 use std::time::{Duration, Instant};
 
-/// Argument pairs of one batch: `firmware_avr::bench::KERNEL_BATCH_LEN`.
+/// Argument pairs of one batch: `firmware_avr::harness::KERNEL_BATCH_LEN`.
 pub const BATCH_LEN: usize = 128;
 
-/// Records of one pose batch: `firmware_avr::bench::POSE_BATCH_LEN` (52-byte records in the
+/// Records of one pose batch: `firmware_avr::harness::POSE_BATCH_LEN` (52-byte records in the
 /// same 1,024 bytes).
 pub const POSE_BATCH_LEN: usize = BATCH_LEN * 8 / 52;
 
 /// Cycles allowed for one batch (128 evaluations of the slowest kernel, with a wide margin).
 const BATCH_TIMEOUT_CYCLES: u64 = 50_000_000;
 
-/// A kernel of the harness, by its id in the benchmark firmware's table (`KERNELS`).
+/// A kernel of the harness, by its id in the harness firmware's table (`KERNELS`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Kernel {
     /// The firmware's arctangent, `AvrLibm::atan2_fixed` (asm); arguments `(y, x)`.
@@ -150,7 +151,7 @@ impl std::fmt::Display for Finding {
     }
 }
 
-/// The benchmark firmware booted for the kernels' harness.
+/// The test harness firmware (`harness.elf`), booted.
 pub struct Harness {
     emu: Mega2560,
     batch_addr: u16,
@@ -161,21 +162,21 @@ pub struct Harness {
 }
 
 impl Harness {
-    /// Builds (once per process) and boots `bench.elf`.
+    /// Builds (once per process) and boots `harness.elf`.
     ///
     /// # Panics
     /// When the firmware cannot be built or booted, or lacks the batch.
     pub fn boot() -> Harness {
-        let path = build::firmware_elf(build::BENCH).unwrap_or_else(|e| panic!("{e}"));
+        let path = build::firmware_elf(build::HARNESS).unwrap_or_else(|e| panic!("{e}"));
         let batch_addr = elf::Elf::read(&path)
             .unwrap_or_else(|e| panic!("{e}"))
             .data_symbol("KERNEL_BATCH")
-            .expect("bench.elf exports KERNEL_BATCH");
+            .expect("harness.elf exports KERNEL_BATCH");
         let mut emu = Mega2560::new(&path).unwrap_or_else(|e| panic!("{e}"));
         let ready = emu
             .read_exact(1, 1_000_000)
-            .expect("benchmark firmware sends 'R' at boot");
-        assert_eq!(ready, b"R", "benchmark firmware boot byte");
+            .expect("the harness firmware sends 'R' at boot");
+        assert_eq!(ready, b"R", "harness firmware boot byte");
         Harness {
             emu,
             batch_addr,
@@ -218,12 +219,12 @@ impl Harness {
         out
     }
 
-    /// The records of the pose batch (`firmware_avr::bench::PoseRecord`) solved by the
-    /// firmware's backend `backend`, in order.
+    /// The records of the pose batch (`firmware_avr::harness::PoseRecord`) solved by the
+    /// firmware's IK, in order.
     ///
     /// # Panics
     /// When the firmware does not answer a batch.
-    pub fn run_poses(&mut self, backend: u8, records: &[[u32; 13]]) -> Vec<[u32; 13]> {
+    pub fn run_poses(&mut self, records: &[[u32; 13]]) -> Vec<[u32; 13]> {
         let started = Instant::now();
         let mut out = Vec::with_capacity(records.len());
         for chunk in records.chunks(POSE_BATCH_LEN) {
@@ -233,7 +234,7 @@ impl Harness {
                 .flat_map(|w| w.to_le_bytes())
                 .collect();
             self.emu.write_data(self.batch_addr, &bytes);
-            self.emu.uart_write(&[b'P', backend, chunk.len() as u8]);
+            self.emu.uart_write(&[b'P', chunk.len() as u8]);
             let answer = self
                 .emu
                 .read_exact(2, BATCH_TIMEOUT_CYCLES)

@@ -101,78 +101,9 @@ static PRIMS: [bench::PrimFn; 25] = [
     |a, _| unsafe { avr_libc_sqrt(a) },
 ];
 
-/// The kernels of the test harness (`K`, see `bench`), by id: 0 `AvrLibm::atan2_fixed` (the
-/// firmware's arctangent, asm) and 1 `poly::atan2_fixed` (the portable kernel on the AVR);
-/// 2 `AvrLibm::sin_cos_fixed` (the firmware's sine and cosine, asm part) and 3
-/// `poly::sin_cos_fixed` (portable); the firmware's float primitives beside avr-libc's own
-/// path in one record, `(firmware, avr-libc)`: 4 add, 5 sub, 6 mul, 7 `sqrt`.
-static KERNELS: [bench::KernelFn; 8] = [
-    |a, b| {
-        let r = AvrLibm::atan2_fixed(f32::from_bits(a), f32::from_bits(b));
-        (r.to_bits(), 0)
-    },
-    |a, b| {
-        let r = poly::atan2_fixed::<AvrFast>(f32::from_bits(a), f32::from_bits(b));
-        (r.to_bits(), 0)
-    },
-    |a, _| {
-        let (s, c) = AvrLibm::sin_cos_fixed(f32::from_bits(a));
-        (s.to_bits(), c.to_bits())
-    },
-    |a, _| {
-        let (s, c) = poly::sin_cos_fixed::<AvrFast>(f32::from_bits(a));
-        (s.to_bits(), c.to_bits())
-    },
-    |a, b| {
-        let (a, b) = (f32::from_bits(a), f32::from_bits(b));
-        // SAFETY: the shim follows the C calling convention.
-        (f32::to_bits(a + b), unsafe { libc_addsf3(a, b) }.to_bits())
-    },
-    |a, b| {
-        let (a, b) = (f32::from_bits(a), f32::from_bits(b));
-        // SAFETY: as above.
-        (f32::to_bits(a - b), unsafe { libc_subsf3(a, b) }.to_bits())
-    },
-    |a, b| {
-        let (a, b) = (f32::from_bits(a), f32::from_bits(b));
-        // SAFETY: as above.
-        (f32::to_bits(a * b), unsafe { libc_mulsf3(a, b) }.to_bits())
-    },
-    |a, _| {
-        let a = f32::from_bits(a);
-        // SAFETY: a C function of one `double` (32-bit on the AVR), no preconditions.
-        (
-            AvrLibm::sqrt(a).to_bits(),
-            unsafe { avr_libc_sqrt(a) }.to_bits(),
-        )
-    },
-];
-
-// avr-libc's `__addsf3`, `__subsf3` and `__mulsf3` as `libm.a` has them (its `addsf3.o` and
-// `mulsf3.o`, which the firmware's own definitions replace): the reference of the test
-// `avr_float`.
-core::arch::global_asm!(
-    ".section .text.libc_float_shims,\"ax\",@progbits",
-    "libc_subsf3:",
-    "subi r21, 0x80",
-    "libc_addsf3:",
-    "clr r26",
-    "clr r27",
-    "call __addsf3x",
-    "jmp __fp_round",
-    "libc_mulsf3:",
-    "call __mulsf3x",
-    "jmp __fp_round",
-);
-
-extern "C" {
-    fn libc_addsf3(a: f32, b: f32) -> f32;
-    fn libc_subsf3(a: f32, b: f32) -> f32;
-    fn libc_mulsf3(a: f32, b: f32) -> f32;
-    // avr-libc's own `sqrt` (`libm.a`'s `sqrt.o`, which the firmware's definition
-    // replaces), linked under this name by the build script: the reference of `avr_sqrt`.
-    fn avr_libc_sqrt(x: f32) -> f32;
-}
+// avr-libc's own float primitives and `sqrt` (`libc_addsf3`, …, `avr_libc_sqrt`): the
+// references of the tests `avr_float` and `avr_sqrt`.
+firmware_avr::avr_libc_references!();
 
 #[avr_device::entry]
 fn main() -> ! {
@@ -207,14 +138,7 @@ fn main() -> ! {
             solve: &PerCall::<AvrFast>::new(bench::ROBOT),
         },
     ];
-    bench::serve(
-        &mut usart,
-        &dp.PORTA,
-        &backends,
-        &PRIMS,
-        &KERNELS,
-        &mut motion,
-    )
+    bench::serve(&mut usart, &dp.PORTA, &backends, &PRIMS, &mut motion)
 }
 
 #[avr_device::interrupt(atmega2560)]

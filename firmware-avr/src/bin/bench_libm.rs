@@ -37,8 +37,6 @@ fn main() -> ! {
         &dp.PORTA,
         &backends,
         &PRIMS,
-        // The kernels' harness tests the firmware's build only.
-        &[],
         &mut bench::NoMotion,
     )
 }

@@ -18,6 +18,9 @@ pub const FIRMWARE_1MBAUD: &str = "firmware-1mbaud";
 pub const BENCH: &str = "bench";
 /// The cycle benchmark of the straightforward build (Rust libm, soft-float).
 pub const BENCH_LIBM: &str = "bench-libm";
+/// The test harness: the firmware's kernels and IK over batches in SRAM
+/// (`firmware_avr::harness`).
+pub const HARNESS: &str = "harness";
 
 /// Test only, defective on purpose: the 1 Mbaud firmware whose receive path keeps interrupts
 /// off too long (`firmware-avr/src/bin/firmware_1mbaud_cli_hold.rs`); the emulator tests show
@@ -141,7 +144,8 @@ fn build_once() -> &'static Result<(), Error> {
 }
 
 /// Builds the firmware workspace (once per process) and returns the path of the release ELF
-/// of binary `bin` ([`FIRMWARE`], [`FIRMWARE_1MBAUD`], [`BENCH`] or [`BENCH_LIBM`]).
+/// of binary `bin` ([`FIRMWARE`], [`FIRMWARE_1MBAUD`], [`BENCH`], [`BENCH_LIBM`] or
+/// [`HARNESS`]).
 ///
 /// # Errors
 /// The build's output when it fails, or [`Error::Missing`] when the ELF was not produced.
