@@ -255,22 +255,23 @@ where
         }
     }
 
-    /// Answers the request `msg` of a frame whose CRC is `crc`: an exact repeat of the last
-    /// request answered (the same `seq` and the same frame CRC: a retry whose answer was lost)
-    /// gets the same answer again, without the request acting again; any other request is
-    /// handled ([`Device::handle`]) and remembered, unless it was refused `Busy` (the host
-    /// then resends it to have it carried out). A repeat feeds the link timer as any frame
-    /// does.
-    fn answer_once(&mut self, msg: &HostToDevice, crc: Option<u16>) -> DeviceToHost {
-        if let (Some(last), Some(crc)) = (&self.last_answered, crc) {
-            if last.seq == msg.seq && last.crc == crc {
-                self.last_valid_ms = self.clock.now_ms();
-                self.failsafe_armed = true;
-                return last.answer;
-            }
+    /// The answer to replay when the request `seq` of a frame whose CRC is `crc` is an exact
+    /// repeat of the last request answered (a retry whose answer was lost), `None` for a new
+    /// request. A repeat feeds the link timer as any frame does.
+    fn repeated(&mut self, seq: u16, crc: Option<u16>) -> Option<DeviceToHost> {
+        let last = self.last_answered.as_ref()?;
+        if last.seq != seq || Some(last.crc) != crc {
+            return None;
         }
-        let answer = self.handle_ref(msg);
-        // `Busy` asks for the same request again once the device is free: not remembered.
+        self.last_valid_ms = self.clock.now_ms();
+        self.failsafe_armed = true;
+        Some(last.answer)
+    }
+
+    /// Remembers `answer` to the request `seq` of a frame whose CRC is `crc`, for
+    /// [`Device::repeated`]; unless it is a `Busy` nack, which asks for the same request again
+    /// once the device is free.
+    fn remember(&mut self, seq: u16, crc: Option<u16>, answer: &DeviceToHost) {
         let busy = matches!(
             answer,
             DeviceToHost::Nack {
@@ -279,11 +280,10 @@ where
             }
         );
         self.last_answered = crc.filter(|_| !busy).map(|crc| Answered {
-            seq: msg.seq,
+            seq,
             crc,
-            answer,
+            answer: *answer,
         });
-        answer
     }
 
     /// Consumes `bytes` up to the end of the first frame in them, handles it and sends its
@@ -295,9 +295,15 @@ where
         let (reason, remaining) = match &feed_request(&mut self.acc, bytes) {
             Feed::NeedMore => return None,
             Feed::Frame { msg, remaining } => {
-                let crc = self.acc.frame_crc();
-                let answer = self.answer_once(msg, crc);
+                let (seq, crc) = (msg.seq, self.acc.frame_crc());
+                if let Some(answer) = self.repeated(seq, crc) {
+                    self.encode(&answer, tx);
+                    return Some(remaining);
+                }
+                let answer = self.handle_ref(msg);
                 self.encode(&answer, tx);
+                // Remembered once the answer's first bytes are on their way.
+                self.remember(seq, crc, &answer);
                 return Some(remaining);
             }
             Feed::BadCrc { remaining } => (NackReason::BadCrc, *remaining),
