@@ -3,7 +3,8 @@
 //! a share of `--evaluations` values of its classes (every value of a class that fits, the
 //! values nearest the edges first), seeded by `--seed`. Each kernel's run appends one JSON line
 //! to the ledger (`--ledger`, default `target/kernel-campaign/ledger.jsonl`); the last lines
-//! printed are the ledger's totals per kernel as a Markdown table (the benchmark page's).
+//! printed are the ledger's totals per kernel as Markdown (a table, and the evaluations by
+//! class), also written into `BENCHMARKS.md` between its `kernel-campaign` markers.
 //!
 //! Usage: `kernel-campaign [--kernel NAME]... [--evaluations N] [--poses N] [--seed S]
 //! [--ledger PATH]` (kernels: the firmware's six by default: atan2_fixed, sin_cos_fixed, add,
@@ -192,40 +193,111 @@ fn append(ledger: &PathBuf, entry: &Entry) {
     writeln!(file, "{}", serde_json::to_string(entry).expect("JSON")).expect("ledger write");
 }
 
-/// The ledger's totals per kernel, as a Markdown table.
+/// One kernel's totals over the ledger's runs.
+struct Total {
+    kernel: String,
+    runs: u64,
+    evaluations: u64,
+    mismatches: u64,
+    seconds: f64,
+    rates: Vec<u64>,
+    /// `(class, evaluations, mismatches)`, summed over the runs.
+    classes: Vec<(String, u64, u64)>,
+}
+
+/// The ledger's totals per kernel as Markdown (a table, then each kernel's evaluations by
+/// class), printed, and written into `BENCHMARKS.md` between its campaign markers when the
+/// page has them.
 fn print_totals(ledger: &PathBuf) {
     let text = std::fs::read_to_string(ledger).unwrap_or_default();
-    let mut totals: Vec<(String, u64, u64, u64, f64, Vec<u64>)> = Vec::new();
+    let mut totals: Vec<Total> = Vec::new();
     for line in text.lines() {
         let Ok(e) = serde_json::from_str::<Entry>(line) else {
             continue;
         };
-        match totals.iter_mut().find(|t| t.0 == e.kernel) {
-            Some(t) => {
-                t.1 += e.evaluations;
-                t.2 += e.mismatches;
-                t.3 += 1;
-                t.4 += e.seconds;
-                t.5.push(e.evaluations_per_s as u64);
+        let i = match totals.iter().position(|t| t.kernel == e.kernel) {
+            Some(i) => i,
+            None => {
+                totals.push(Total {
+                    kernel: e.kernel.clone(),
+                    runs: 0,
+                    evaluations: 0,
+                    mismatches: 0,
+                    seconds: 0.0,
+                    rates: Vec::new(),
+                    classes: Vec::new(),
+                });
+                totals.len() - 1
             }
-            None => totals.push((
-                e.kernel,
-                e.evaluations,
-                e.mismatches,
-                1,
-                e.seconds,
-                vec![e.evaluations_per_s as u64],
-            )),
+        };
+        let t = &mut totals[i];
+        t.runs += 1;
+        t.evaluations += e.evaluations;
+        t.mismatches += e.mismatches;
+        t.seconds += e.seconds;
+        t.rates.push(e.evaluations_per_s as u64);
+        for (class, n, bad) in e.classes {
+            match t.classes.iter_mut().find(|c| c.0 == class) {
+                Some(c) => {
+                    c.1 += n;
+                    c.2 += bad;
+                }
+                None => t.classes.push((class, n, bad)),
+            }
         }
     }
-    println!("| kernel | runs | evaluations | mismatches | hours | evaluations/s (median run) |");
-    println!("|---|---|---|---|---|---|");
-    for (kernel, n, bad, runs, seconds, mut rates) in totals {
-        rates.sort_unstable();
-        println!(
-            "| {kernel} | {runs} | {n} | {bad} | {:.2} | {} |",
-            seconds / 3600.0,
-            rates[rates.len() / 2]
+    let mut md = String::from(
+        "| kernel | runs | evaluations | mismatches | hours | evaluations/s (median run) |\n|---|---|---|---|---|---|\n",
+    );
+    for t in &mut totals {
+        t.rates.sort_unstable();
+        md += &format!(
+            "| {} | {} | {} | {} | {:.2} | {} |\n",
+            t.kernel,
+            t.runs,
+            t.evaluations,
+            t.mismatches,
+            t.seconds / 3600.0,
+            t.rates[t.rates.len() / 2]
         );
+    }
+    for t in &totals {
+        md += &format!(
+            "\n<details><summary>{}: evaluations by class</summary>\n\n| class | evaluations | mismatches |\n|---|---|---|\n",
+            t.kernel
+        );
+        for (class, n, bad) in &t.classes {
+            md += &format!("| {class} | {n} | {bad} |\n");
+        }
+        md += "\n</details>\n";
+    }
+    print!("{md}");
+    write_benchmarks(&md);
+}
+
+/// The markers of the campaign's section in `BENCHMARKS.md`.
+const BEGIN: &str = "<!-- kernel-campaign:begin -->";
+const END: &str = "<!-- kernel-campaign:end -->";
+
+/// Replaces the text between the campaign markers of `BENCHMARKS.md` (in the current
+/// directory) by `md`; nothing when the page or its markers are missing.
+fn write_benchmarks(md: &str) {
+    let path = std::path::Path::new("BENCHMARKS.md");
+    let Ok(page) = std::fs::read_to_string(path) else {
+        return;
+    };
+    let (Some(b), Some(e)) = (page.find(BEGIN), page.find(END)) else {
+        return;
+    };
+    if e < b {
+        return;
+    }
+    let new = format!("{}{BEGIN}\n{md}{}", &page[..b], &page[e..]);
+    match std::fs::write(path, new) {
+        Ok(()) => eprintln!(
+            "kernel-campaign: the totals written into {}",
+            path.display()
+        ),
+        Err(err) => eprintln!("kernel-campaign: cannot write {}: {err}", path.display()),
     }
 }
