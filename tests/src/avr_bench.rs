@@ -222,7 +222,7 @@ pub fn reference_body(robot: &Robot, pose: &Pose, start: &[f32; 12]) -> [f64; 12
 }
 
 /// Largest |a − b| over the angles, rad (angles wrapped to (−π, π]).
-fn max_abs_diff(a: &[f32], b: &[f64]) -> f64 {
+pub fn max_abs_diff(a: &[f32], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
         .map(|(&x, &y)| {

@@ -12,7 +12,7 @@
 //! The CI runs a seeded share (`tests/avr_end_to_end.rs`); `cargo xtask kernel-campaign
 //! --poses N` runs the long one.
 
-use crate::avr_bench::reference_leg_checked;
+use crate::avr_bench::{max_abs_diff, reference_leg_checked};
 use crate::kernels::Harness;
 use kin_core::math::SoftFloat;
 use kin_core::{body, BodyConfig, LegId, Pose, ReachPolicy, Robot, RotationOrder, Vec3};
@@ -217,17 +217,6 @@ pub fn reference(robot: &Robot, case: &Case, start: &[f32]) -> Option<Vec<f64>> 
     }
 }
 
-/// The largest |a − b| over angles, rad (wrapped to the nearest turn).
-pub fn max_error(a: &[f32], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&x, &y)| {
-            let d = (f64::from(x) - y).rem_euclid(std::f64::consts::TAU);
-            d.min(std::f64::consts::TAU - d)
-        })
-        .fold(0.0, f64::max)
-}
-
 /// Figures of an end-to-end run.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct Figures {
@@ -327,7 +316,7 @@ pub fn run(
             match reference(&robot, case, &angles) {
                 Some(q) => {
                     fig.referenced += 1;
-                    let e = max_error(&angles, &q);
+                    let e = max_abs_diff(&angles, &q);
                     fig.max_error_rad = fig.max_error_rad.max(e);
                     if e > TOLERANCE_RAD {
                         fig.outliers += 1;

@@ -4,6 +4,9 @@
 //! - [`budget`]: the firmware's flash and SRAM against its budget (`cargo xtask ci budget`).
 //! - [`pins`]: a servo pin's step between two pulses against the joint-speed limiter.
 //! - [`symbols`]: which routines a firmware ELF links (`avr-nm`).
+//! - [`wire`]: raw frames to the emulated firmware and the answers that come back.
+//! - [`kernels`], [`kernel_edges`]: the AVR kernels against their twins at their edges.
+//! - [`end_to_end`]: the firmware's IK against the host's and f64.
 //!
 //! Building the firmware and running it in simavr is `quad_host::emu` (one implementation
 //! for these tests and `quadctl`).
@@ -15,3 +18,4 @@ pub mod kernel_edges;
 pub mod kernels;
 pub mod pins;
 pub mod symbols;
+pub mod wire;

@@ -9,6 +9,7 @@
 
 use integration_tests::avr_bench::{self, STACK_PAINT, STANCE_HEIGHT_M};
 use integration_tests::symbols;
+use integration_tests::wire::frame;
 use kin_core::body::{self, Pose};
 use kin_core::{BodyConfig, ReachPolicy, RotationOrder};
 use quad_host::client::{
@@ -18,9 +19,8 @@ use quad_host::emu::{build, elf, Pulse, CYCLES_PER_TICK, PERIOD_CYCLES, SERVO_PI
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_host::link::{Faults, Link};
 use quad_protocol::{
-    encode_frame, Accumulator, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction,
-    LinkTimeout, NackReason, Request, RobotPreset, MAX_DECODED_LEN, MAX_FRAME_LEN,
-    PROTOCOL_VERSION,
+    DeviceToHost, Flags, LinkLossAction, LinkTimeout, NackReason, Request, RobotPreset,
+    MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 use seeded_rng::SplitMix64 as Rng;
 use std::path::PathBuf;
@@ -407,33 +407,7 @@ fn unreachable_target_is_nacked_and_the_pins_keep_their_pulses_at(baud: u32) {
 
 /// Sends raw bytes and collects the answers that arrive within `wait`.
 fn raw_exchange(link: &mut EmulatorLink, bytes: &[u8], wait: Duration) -> Vec<DeviceToHost> {
-    link.send(bytes).expect("send");
-    let end = link.now() + wait;
-    let mut acc = Accumulator::<MAX_DECODED_LEN>::new();
-    let mut answers = Vec::new();
-    let mut buf = [0u8; 256];
-    while link.now() < end {
-        let n = link.recv(&mut buf, end - link.now()).expect("recv");
-        let mut rest = &buf[..n];
-        loop {
-            match acc.feed::<DeviceToHost>(rest) {
-                Feed::NeedMore => break,
-                Feed::Frame { msg, remaining } => {
-                    answers.push(msg);
-                    rest = remaining;
-                }
-                other => panic!("the device sent an unreadable frame: {other:?}"),
-            }
-        }
-    }
-    answers
-}
-
-fn frame(seq: u16, request: Request) -> Vec<u8> {
-    let mut buf = [0u8; MAX_FRAME_LEN];
-    encode_frame(&HostToDevice { seq, request }, &mut buf)
-        .expect("encodes")
-        .to_vec()
+    integration_tests::wire::answers(link, bytes, wait, None)
 }
 
 #[test]

@@ -4,16 +4,15 @@
 //! runs gets its `MotionAck` again, not `MotionRunning`). A repeated `seq` with other bytes is
 //! a new request. Simulated time; the firmware is built once per test process.
 
+use integration_tests::wire::{self, frame};
 use kin_core::motion::gait::{GaitParams, Pattern};
 use kin_core::motion::laws::Axis;
 use kin_core::{Pose, ReachPolicy, RotationOrder};
 use quad_host::emu::build;
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
-use quad_host::link::Link;
 use quad_protocol::{
-    encode_frame, Accumulator, DeviceToHost, Feed, HostToDevice, LinkLossAction, LinkTimeout,
-    MotionCommand, NackReason, PoseConfig, Request, ServoId, MAX_DECODED_LEN, MAX_FRAME_LEN,
-    PROTOCOL_VERSION,
+    DeviceToHost, LinkLossAction, LinkTimeout, MotionCommand, NackReason, PoseConfig, Request,
+    ServoId, PROTOCOL_VERSION,
 };
 use std::time::Duration;
 
@@ -23,40 +22,10 @@ const TIMEOUT: Duration = Duration::from_secs(3);
 /// How long the line is watched after the answer, for a second one.
 const AFTER: Duration = Duration::from_millis(40);
 
-fn frame(seq: u16, request: Request) -> Vec<u8> {
-    let mut buf = [0u8; MAX_FRAME_LEN];
-    encode_frame(&HostToDevice { seq, request }, &mut buf)
-        .expect("encodes")
-        .to_vec()
-}
-
 /// Sends `bytes` and returns the one answer that arrives within [`TIMEOUT`] (checking for
 /// [`AFTER`] more that no second one follows).
 fn exchange(link: &mut EmulatorLink, bytes: &[u8]) -> DeviceToHost {
-    link.send(bytes).expect("send");
-    let mut end = link.now() + TIMEOUT;
-    let mut answered = false;
-    let mut acc = Accumulator::<MAX_DECODED_LEN>::new();
-    let mut answers = Vec::new();
-    let mut buf = [0u8; 256];
-    while link.now() < end {
-        let n = link.recv(&mut buf, end - link.now()).expect("recv");
-        let mut rest = &buf[..n];
-        loop {
-            match acc.feed::<DeviceToHost>(rest) {
-                Feed::NeedMore => break,
-                Feed::Frame { msg, remaining } => {
-                    answers.push(msg);
-                    rest = remaining;
-                    if !answered {
-                        answered = true;
-                        end = link.now() + AFTER;
-                    }
-                }
-                other => panic!("the device sent an unreadable frame: {other:?}"),
-            }
-        }
-    }
+    let answers = wire::answers(link, bytes, TIMEOUT, Some(AFTER));
     assert_eq!(answers.len(), 1, "one answer to one request: {answers:?}");
     answers[0]
 }
