@@ -137,7 +137,7 @@ pub fn targets() -> Targets {
 
 /// f64 forward kinematics of one leg (kin-core's canonical chain):
 /// `Rx(a)·([0, s·d_lat, −d_ax] + Ry(h)·[0,0,−L1] + Ry(h+k)·[0,0,−L2])`.
-fn fk64(robot: &Robot, leg: LegId, q: Vector3<f64>) -> Vector3<f64> {
+pub fn fk64(robot: &Robot, leg: LegId, q: Vector3<f64>) -> Vector3<f64> {
     let g = &robot.leg;
     let (l1, l2) = (g.femur_m as f64, g.tibia_m as f64);
     let (a, h, k) = (q.x, q.y, q.z);

@@ -12,7 +12,7 @@
 //! The CI runs a seeded share (`tests/avr_end_to_end.rs`); `cargo xtask kernel-campaign
 //! --poses N` runs the long one.
 
-use crate::avr_bench::{max_abs_diff, reference_leg_checked};
+use crate::avr_bench::{fk64, max_abs_diff, reference_leg_checked};
 use crate::kernels::Harness;
 use kin_core::math::SoftFloat;
 use kin_core::{body, BodyConfig, LegId, Pose, ReachPolicy, Robot, RotationOrder, Vec3};
@@ -170,14 +170,14 @@ fn elementary(axis: u8, angle: f64) -> Matrix3<f64> {
     }
 }
 
-/// The f64 angles of a solved, unclamped `case` from the firmware's `start`: `None` when the
-/// reference does not converge (a target at a singularity).
-pub fn reference(robot: &Robot, case: &Case, start: &[f32]) -> Option<Vec<f64>> {
+/// The f64 targets of `case`: per leg solved, its foot in its hip frame (one leg, or the four
+/// of a body pose in order FL, FR, RL, RR), computed in f64 from the case's f32 values.
+pub fn targets(robot: &Robot, case: &Case) -> Vec<(LegId, Vector3<f64>)> {
     match case.target {
-        Target::Leg(leg, foot) => {
-            let f = Vector3::new(f64::from(foot.x), f64::from(foot.y), f64::from(foot.z));
-            reference_leg_checked(robot, leg, f, [start[0], start[1], start[2]]).map(|q| q.to_vec())
-        }
+        Target::Leg(leg, foot) => vec![(
+            leg,
+            Vector3::new(f64::from(foot.x), f64::from(foot.y), f64::from(foot.z)),
+        )],
         Target::Body(pose, stance) => {
             let angles = [
                 f64::from(pose.roll_rad),
@@ -192,29 +192,61 @@ pub fn reference(robot: &Robot, case: &Case, start: &[f32]) -> Option<Vec<f64>> 
                 f64::from(pose.y_m),
                 f64::from(pose.z_m),
             );
-            let mut out = Vec::with_capacity(12);
-            for leg in LegId::ALL {
-                let hip = robot.hip_in_body(leg);
-                let hip = Vector3::new(f64::from(hip.x), f64::from(hip.y), f64::from(hip.z));
-                let foot_world = hip
-                    + Vector3::new(
-                        0.0,
-                        f64::from(leg.side()) * f64::from(robot.leg.d_lat_m),
-                        -f64::from(stance),
-                    );
-                let local = rot.transpose() * (foot_world - t) - hip;
-                let i = leg.index();
-                let q = reference_leg_checked(
-                    robot,
-                    leg,
-                    local,
-                    [start[3 * i], start[3 * i + 1], start[3 * i + 2]],
-                )?;
-                out.extend(q);
-            }
-            Some(out)
+            LegId::ALL
+                .iter()
+                .map(|&leg| {
+                    let hip = robot.hip_in_body(leg);
+                    let hip = Vector3::new(f64::from(hip.x), f64::from(hip.y), f64::from(hip.z));
+                    let foot_world = hip
+                        + Vector3::new(
+                            0.0,
+                            f64::from(leg.side()) * f64::from(robot.leg.d_lat_m),
+                            -f64::from(stance),
+                        );
+                    (leg, rot.transpose() * (foot_world - t) - hip)
+                })
+                .collect()
         }
     }
+}
+
+/// The f64 angles of a solved, unclamped `case` from the firmware's `start`: `None` when the
+/// reference does not converge (a target at a singularity).
+pub fn reference(robot: &Robot, case: &Case, start: &[f32]) -> Option<Vec<f64>> {
+    let mut out = Vec::with_capacity(start.len());
+    for (i, (leg, foot)) in targets(robot, case).into_iter().enumerate() {
+        let q = reference_leg_checked(
+            robot,
+            leg,
+            foot,
+            [start[3 * i], start[3 * i + 1], start[3 * i + 2]],
+        )?;
+        out.extend(q);
+    }
+    Some(out)
+}
+
+/// The largest distance, m, between the feet that `angles` put (f64 forward kinematics) and
+/// the f64 targets of `case`; with it, the smallest depth of a foot below its abduction offset
+/// (`√(y² + z² − d_lat²)` in the hip frame), m: the IK's abduction angle is ill-conditioned as
+/// that depth goes to 0 (an angle error of about the foot's rounding divided by it).
+pub fn foot_error(robot: &Robot, case: &Case, angles: &[f32]) -> (f64, f64) {
+    let d_lat = f64::from(robot.leg.d_lat_m);
+    targets(robot, case).into_iter().enumerate().fold(
+        (0.0, f64::INFINITY),
+        |(err, depth), (i, (leg, foot))| {
+            let q = Vector3::new(
+                f64::from(angles[3 * i]),
+                f64::from(angles[3 * i + 1]),
+                f64::from(angles[3 * i + 2]),
+            );
+            let e = (fk64(robot, leg, q) - foot).norm();
+            let w = (foot.y * foot.y + foot.z * foot.z - d_lat * d_lat)
+                .max(0.0)
+                .sqrt();
+            (err.max(e), depth.min(w))
+        },
+    )
 }
 
 /// Figures of an end-to-end run.
@@ -242,6 +274,9 @@ pub struct Figures {
     pub max_error_rad: f64,
     /// Errors above [`TOLERANCE_RAD`].
     pub outliers: u64,
+    /// Largest distance between the feet the firmware's angles put (f64 forward kinematics)
+    /// and the f64 targets, over the referenced cases, m.
+    pub max_foot_error_m: f64,
     /// The first differences and outliers, described.
     pub first_findings: Vec<String>,
 }
@@ -318,10 +353,14 @@ pub fn run(
                     fig.referenced += 1;
                     let e = max_abs_diff(&angles, &q);
                     fig.max_error_rad = fig.max_error_rad.max(e);
+                    let (foot_err, depth) = foot_error(&robot, case, &angles);
+                    fig.max_foot_error_m = fig.max_foot_error_m.max(foot_err);
                     if e > TOLERANCE_RAD {
                         fig.outliers += 1;
                         fig.note(format!(
-                            "error {e:e} rad {case:?}: firmware {angles:?}, f64 {q:?}"
+                            "error {e:e} rad (feet within {foot_err:e} m of their targets, the \
+                             shallowest {depth:e} m below its abduction offset) {case:?}: \
+                             firmware {angles:?}, f64 {q:?}"
                         ));
                     }
                 }
