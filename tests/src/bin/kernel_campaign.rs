@@ -7,7 +7,7 @@
 //! class), also written into `BENCHMARKS.md` between its `kernel-campaign` markers.
 //!
 //! Usage: `kernel-campaign [--kernel NAME]... [--evaluations N] [--poses N] [--seed S]
-//! [--ledger PATH]` (kernels: the firmware's six by default: atan2_fixed, sin_cos_fixed, add,
+//! [--ledger PATH] [--totals]` (`--totals`: run nothing, only print and write the totals) (kernels: the firmware's six by default: atan2_fixed, sin_cos_fixed, add,
 //! sub, mul, sqrt; with `--poses` and no `--kernel`, none). `--poses N` also runs `N` random
 //! body poses and foot targets through the firmware's IK end to end
 //! (`integration_tests::end_to_end`), its figures as a ledger line of kernel `end-to-end`.
@@ -45,7 +45,7 @@ struct Entry {
 }
 
 fn usage(e: &str) -> ExitCode {
-    eprintln!("kernel-campaign: {e}\nusage: kernel-campaign [--kernel NAME]... [--evaluations N] [--seed S] [--ledger PATH]");
+    eprintln!("kernel-campaign: {e}\nusage: kernel-campaign [--kernel NAME]... [--evaluations N] [--poses N] [--seed S] [--ledger PATH] [--totals]");
     ExitCode::from(2)
 }
 
@@ -54,6 +54,7 @@ fn main() -> ExitCode {
     let mut evaluations: u64 = 100_000_000;
     let mut seed: u64 = 1;
     let mut poses: u64 = 0;
+    let mut totals_only = false;
     let mut ledger = PathBuf::from("target/kernel-campaign/ledger.jsonl");
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -82,11 +83,19 @@ fn main() -> ExitCode {
                     .map_err(|e| format!("--seed {v}: {e}"))
             }),
             "--ledger" => value("--ledger").map(|v| ledger = v.into()),
+            "--totals" => {
+                totals_only = true;
+                Ok(())
+            }
             other => Err(format!("unknown argument {other}")),
         };
         if let Err(e) = parsed {
             return usage(&e);
         }
+    }
+    if totals_only {
+        print_totals(&ledger);
+        return ExitCode::SUCCESS;
     }
     if kernels.is_empty() && poses == 0 {
         kernels = FIRMWARE_KERNELS.to_vec();
