@@ -1008,3 +1008,43 @@ fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
         }
     }
 }
+
+/// A retry (the same frame again, its answer lost) gets the same answer and does not act
+/// again: the save writes the storage once, the motion starts once; a repeated `seq` with
+/// other bytes, or the first frame again after another request, is a new request.
+#[test]
+fn an_exact_repeat_is_answered_again_without_acting() {
+    let mut dev = device(Config::shahriar2023());
+    hello(&mut dev);
+    ack(ask(&mut dev, 1, Request::SetOutputs { enabled: true }));
+    let save = frame(2, Request::SaveCalibration);
+    let first = feed(&mut dev, &save);
+    let written = dev.storage().written;
+    assert!(written > 0, "the save wrote");
+    let again = feed(&mut dev, &save);
+    assert_eq!(again, first);
+    assert_eq!(dev.storage().written, written, "the retry wrote again");
+    let sway = |amplitude_rad| {
+        Request::StartMotion(quad_protocol::MotionCommand::Sway {
+            axis: kin_core::motion::laws::Axis::Roll,
+            amplitude_rad,
+            period_s: 2.0,
+            duration_s: None,
+        })
+    };
+    let start = frame(3, sway(0.05));
+    let started = feed(&mut dev, &start);
+    assert!(
+        matches!(started[..], [DeviceToHost::MotionAck { .. }]),
+        "{started:?}"
+    );
+    assert_eq!(feed(&mut dev, &start), started);
+    assert_eq!(
+        nack_reason(ask(&mut dev, 3, sway(0.06))),
+        NackReason::MotionRunning
+    );
+    assert_eq!(
+        nack_reason(feed(&mut dev, &start)[0]),
+        NackReason::MotionRunning
+    );
+}
