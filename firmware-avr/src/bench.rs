@@ -45,7 +45,7 @@ use quad_device::{default_calibration, Config};
 /// Stance height of the body-pose benchmark: seed 000 Table 4 body height, m.
 pub const STANCE_HEIGHT_M: f32 = 0.277;
 
-/// The marker pin: PA0 (D22).
+/// The marker pin: PA0 (D22), written as `pa0` (the PAC's field); this is its bit.
 pub const MARKER: u8 = 0;
 
 /// The robot of the benchmark.
@@ -161,14 +161,7 @@ fn read_f32(usart: &mut Usart0) -> f32 {
 }
 
 fn marker(porta: &pac::PORTA, high: bool) {
-    // SAFETY: any PORTA value is valid; only PA0 changes.
-    porta.porta().modify(|r, w| unsafe {
-        w.bits(if high {
-            r.bits() | 1 << MARKER
-        } else {
-            r.bits() & !(1 << MARKER)
-        })
-    });
+    porta.porta().modify(|_, w| w.pa0().bit(high));
 }
 
 /// Onboard motion frames under test (requests `M` and `N`).
@@ -315,11 +308,9 @@ pub fn serve(
     prims: &[PrimFn],
     motion: &mut dyn MotionBench,
 ) -> ! {
-    // SAFETY: any DDRA value is valid; PA0 becomes an output, low.
+    // PA0 becomes an output, low.
     marker(porta, false);
-    porta
-        .ddra()
-        .modify(|r, w| unsafe { w.bits(r.bits() | 1 << MARKER) });
+    porta.ddra().modify(|_, w| w.pa0().set_bit());
     usart.write(b'R');
     loop {
         match read_byte(usart) {

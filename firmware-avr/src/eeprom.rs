@@ -24,9 +24,6 @@ pub const SIZE: u16 = 4096;
 /// Longest wait for one byte to be written, ms (the datasheet's 3.3 ms with a wide margin).
 pub const WRITE_TIMEOUT_MS: u32 = 10;
 
-/// EECR bits.
-const EEPE: u8 = 1 << 1;
-
 /// Set by the `EE_READY` handler when the byte being written is done.
 static WRITE_DONE: Mutex<Cell<bool>> = Mutex::new(Cell::new(true));
 
@@ -78,7 +75,7 @@ impl Eeprom {
     }
 
     fn busy(&self) -> bool {
-        self.ee.eecr().read().bits() & EEPE != 0
+        self.ee.eecr().read().eepe().bit_is_set()
     }
 
     fn read_byte(&mut self, addr: u16) -> u8 {

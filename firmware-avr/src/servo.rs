@@ -73,32 +73,105 @@ const START_GUARD_TICKS: u16 = 2_000;
 /// Ticks after the longest pulse before the compare units may be switched.
 const QUIET_MARGIN_TICKS: u16 = 16;
 
-/// GTCCR bits: timer synchronisation mode, prescaler reset of Timer0/1/3/4/5.
-const GTCCR_TSM: u8 = 1 << 7;
-const GTCCR_PSRSYNC: u8 = 1 << 0;
+/// WGMn1:0 of mode 14 (fast PWM, TOP = ICRn: WGMn3:0 = `1110`), the bits in TCCRnA; datasheet
+/// §17.11, Table 17-2.
+const WGM_LOW_MODE14: u8 = 0b10;
+/// WGMn3:2 of mode 14, the bits in TCCRnB.
+const WGM_HIGH_MODE14: u8 = 0b11;
 
-/// TCCRnA: WGMn1 (mode 14 = WGM 1110, low two bits `10`).
-const TCCRA_MODE14: u8 = 0b0000_0010;
-/// TCCRnB: WGMn3 | WGMn2 | CSn1 (prescaler 8).
-const TCCRB_MODE14_PRESCALE8: u8 = 0b0001_1010;
-/// COMnx = `10` (clear on compare match, set at BOTTOM) for unit A, B, C.
-const COM_CLEAR: [u8; 3] = [0b1000_0000, 0b0010_0000, 0b0000_1000];
+/// Which of a timer's three compare units (A, B, C) drive their pins: clear on compare match,
+/// set at BOTTOM (COMnx = `10`, datasheet §17.11, Table 17-4). A unit that does not leaves its
+/// pin to its PORT bit, held low. The pins: Timer1 PB5-7, Timer3 PE3-5, Timer4 PH3-5, Timer5
+/// PL3-5 (Arduino Mega D11-13, D5/D2/D3, D6-8, D46-44).
+type Connected = [bool; 3];
 
-/// Pin bit of each compare output (A, B, C) of each timer: PB5-7, PE3-5, PH3-5, PL3-5.
-const PIN_BIT: [[u8; 3]; 4] = [
-    [1 << 5, 1 << 6, 1 << 7],
-    [1 << 3, 1 << 4, 1 << 5],
-    [1 << 3, 1 << 4, 1 << 5],
-    [1 << 3, 1 << 4, 1 << 5],
-];
+/// Writes TCCRnA of one timer — mode 14's low WGM bits and each compare unit connected or not
+/// — then drives the pins of the units that are not connected low (when there are any).
+macro_rules! connect {
+    ($tc:expr, $tccra:ident, $wgm:ident, [$com_a:ident, $com_b:ident, $com_c:ident],
+     $port:expr, $portx:ident, [$pin_a:ident, $pin_b:ident, $pin_c:ident], $on:expr) => {{
+        let on: Connected = $on;
+        $tc.$tccra().write(|w| {
+            w.$wgm().set(WGM_LOW_MODE14);
+            if on[0] {
+                w.$com_a().match_clear();
+            } else {
+                w.$com_a().disconnected();
+            }
+            if on[1] {
+                w.$com_b().match_clear();
+            } else {
+                w.$com_b().disconnected();
+            }
+            if on[2] {
+                w.$com_c().match_clear()
+            } else {
+                w.$com_c().disconnected()
+            }
+        });
+        if !(on[0] & on[1] & on[2]) {
+            $port.$portx().modify(|r, w| {
+                w.$pin_a()
+                    .bit(r.$pin_a().bit() & on[0])
+                    .$pin_b()
+                    .bit(r.$pin_b().bit() & on[1])
+                    .$pin_c()
+                    .bit(r.$pin_c().bit() & on[2])
+            });
+        }
+    }};
+}
 
-/// All three pin bits of each timer.
-const PIN_MASK: [u8; 4] = [
-    PIN_BIT[0][0] | PIN_BIT[0][1] | PIN_BIT[0][2],
-    PIN_BIT[1][0] | PIN_BIT[1][1] | PIN_BIT[1][2],
-    PIN_BIT[2][0] | PIN_BIT[2][1] | PIN_BIT[2][2],
-    PIN_BIT[3][0] | PIN_BIT[3][1] | PIN_BIT[3][2],
-];
+/// Timer `t`'s connections (0..4: Timer1, 3, 4, 5), see [`connect!`].
+#[inline(always)]
+fn apply_connections(dp: &pac::Peripherals, t: usize, on: Connected) {
+    // Clearing the PORT bits after disconnecting is a no-op on the chip (the compare unit never
+    // writes PORTx) and keeps simulators that model the output through PORTx right. The port is
+    // written only when a channel is disconnected: such a simulator also drives every
+    // connected pin of the port from PORTx on any write.
+    match t {
+        0 => connect!(
+            dp.TC1,
+            tccr1a,
+            wgm1,
+            [com1a, com1b, com1c],
+            dp.PORTB,
+            portb,
+            [pb5, pb6, pb7],
+            on
+        ),
+        1 => connect!(
+            dp.TC3,
+            tccr3a,
+            wgm3,
+            [com3a, com3b, com3c],
+            dp.PORTE,
+            porte,
+            [pe3, pe4, pe5],
+            on
+        ),
+        2 => connect!(
+            dp.TC4,
+            tccr4a,
+            wgm4,
+            [com4a, com4b, com4c],
+            dp.PORTH,
+            porth,
+            [ph3, ph4, ph5],
+            on
+        ),
+        _ => connect!(
+            dp.TC5,
+            tccr5a,
+            wgm5,
+            [com5a, com5b, com5c],
+            dp.PORTL,
+            portl,
+            [pl3, pl4, pl5],
+            on
+        ),
+    }
+}
 
 /// Why a pulse width was refused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -247,7 +320,7 @@ fn apply_staged() {
         .max(longest_new)
         .saturating_add(QUIET_MARGIN_TICKS);
     let before = PERIOD_TICKS - WRITE_GUARD_TICKS;
-    let connections: [(u8, u8); 4] = core::array::from_fn(|t| connection(t, enabled, &ticks));
+    let connections: [Connected; 4] = core::array::from_fn(|t| connection(t, enabled, &ticks));
     // SAFETY: after `Servos::new` the timers' compare and control registers and the servo
     // bits of the ports are written only here, under `BUSY` (or by the panic handler, which
     // never returns).
@@ -295,14 +368,14 @@ fn tcnt(dp: &pac::Peripherals, t: usize) -> u16 {
 
 /// Timer `T`'s writes — its three compare registers (channels with a non-zero width: fast
 /// PWM keeps the pin high for OCR + 1 ticks, OCR = TOP high throughout) and its connections
-/// `(TCCRnA, port bits to drive low)` — in one interrupts-off stretch that begins by checking
+/// ([`apply_connections`]) — in one interrupts-off stretch that begins by checking
 /// that its count lies in `(after, before)` (or `at_once`, without that check); false (nothing
 /// written) when it does not.
 #[inline(always)]
 fn write_in_window<const T: usize>(
     dp: &pac::Peripherals,
     ticks: &[u16; CHANNELS],
-    connection: (u8, u8),
+    connection: Connected,
     after: u16,
     before: u16,
     at_once: bool,
@@ -350,63 +423,10 @@ fn write_ocr(dp: &pac::Peripherals, channel: usize, ocr: u16) {
     };
 }
 
-/// TCCRnA of timer `t` (0..4) with the compare units of the channels that should drive their
-/// pins (outputs `enabled` and a non-zero width), and the port bits of the others.
-fn connection(t: usize, enabled: bool, ticks: &[u16; CHANNELS]) -> (u8, u8) {
-    let mut v = TCCRA_MODE14;
-    let mut low = 0u8;
-    for (unit, com) in COM_CLEAR.iter().enumerate() {
-        if enabled && ticks[3 * t + unit] != 0 {
-            v |= com;
-        } else {
-            low |= PIN_BIT[t][unit];
-        }
-    }
-    (v, low)
-}
-
-/// Writes TCCRnA of timer `t` and drives the port bits `low` low.
-#[inline(always)]
-fn apply_connections(dp: &pac::Peripherals, t: usize, (v, low): (u8, u8)) {
-    // SAFETY: mode-14 bits plus COM bits: a valid TCCRnA value; any PORTx value is valid.
-    // Clearing the PORT bits after disconnecting is a no-op on the chip (the compare unit never
-    // writes PORTx) and keeps simulators that model the output through PORTx right. The port is
-    // written only when a channel is disconnected: such a simulator also drives every
-    // connected pin of the port from PORTx on any write.
-    match t {
-        0 => {
-            dp.TC1.tccr1a().write(|w| unsafe { w.bits(v) });
-            if low != 0 {
-                dp.PORTB
-                    .portb()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-        }
-        1 => {
-            dp.TC3.tccr3a().write(|w| unsafe { w.bits(v) });
-            if low != 0 {
-                dp.PORTE
-                    .porte()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-        }
-        2 => {
-            dp.TC4.tccr4a().write(|w| unsafe { w.bits(v) });
-            if low != 0 {
-                dp.PORTH
-                    .porth()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-        }
-        _ => {
-            dp.TC5.tccr5a().write(|w| unsafe { w.bits(v) });
-            if low != 0 {
-                dp.PORTL
-                    .portl()
-                    .modify(|r, w| unsafe { w.bits(r.bits() & !low) });
-            }
-        }
-    }
+/// The compare units of timer `t` (0..4) that should drive their pins: outputs `enabled` and a
+/// non-zero width.
+fn connection(t: usize, enabled: bool, ticks: &[u16; CHANNELS]) -> Connected {
+    core::array::from_fn(|unit| enabled && ticks[3 * t + unit] != 0)
 }
 
 /// The four 16-bit timers as servo outputs. After [`Servos::new`] it holds the outputs' target
@@ -443,53 +463,90 @@ impl Servos {
         porth: pac::PORTH,
         portl: pac::PORTL,
     ) -> Servos {
-        // Pins low first, then outputs: no glitch.
-        // SAFETY (all `bits` writes below): every bit pattern is valid in PORTx/DDRx and in the
-        // timer control registers; the values are the documented mode-14 settings.
-        portb
-            .portb()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[0]) });
-        porte
-            .porte()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[1]) });
-        porth
-            .porth()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[2]) });
-        portl
-            .portl()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[3]) });
-        portb
-            .ddrb()
-            .modify(|r, w| unsafe { w.bits(r.bits() | PIN_MASK[0]) });
-        porte
-            .ddre()
-            .modify(|r, w| unsafe { w.bits(r.bits() | PIN_MASK[1]) });
-        porth
-            .ddrh()
-            .modify(|r, w| unsafe { w.bits(r.bits() | PIN_MASK[2]) });
-        portl
-            .ddrl()
-            .modify(|r, w| unsafe { w.bits(r.bits() | PIN_MASK[3]) });
+        // Pins low first, then outputs: no glitch (datasheet §13.2.3, switching between input
+        // and output).
+        macro_rules! pins_low_out {
+            ($port:expr, $portx:ident, $ddrx:ident, [$a:ident, $b:ident, $c:ident]) => {{
+                $port
+                    .$portx()
+                    .modify(|_, w| w.$a().clear_bit().$b().clear_bit().$c().clear_bit());
+                $port
+                    .$ddrx()
+                    .modify(|_, w| w.$a().set_bit().$b().set_bit().$c().set_bit());
+            }};
+        }
+        pins_low_out!(portb, portb, ddrb, [pb5, pb6, pb7]);
+        pins_low_out!(porte, porte, ddre, [pe3, pe4, pe5]);
+        pins_low_out!(porth, porth, ddrh, [ph3, ph4, ph5]);
+        pins_low_out!(portl, portl, ddrl, [pl3, pl4, pl5]);
 
+        // Each timer stopped, set to mode 14 with its compare units disconnected, TOP = one
+        // period, count 0, then clocked at f_cpu / 8 (datasheet §17.11: TCCRnA, TCCRnB, ICRn,
+        // TCNTn; Table 17-6, the clock select).
         macro_rules! init {
-            ($tc:expr, $tccra:ident, $tccrb:ident, $icr:ident, $tcnt:ident) => {{
-                $tc.$tccrb().write(|w| unsafe { w.bits(0) });
-                $tc.$tccra().write(|w| unsafe { w.bits(TCCRA_MODE14) });
+            ($tc:expr, $tccra:ident, $tccrb:ident, $icr:ident, $tcnt:ident, $wgm:ident, $cs:ident,
+             [$a:ident, $b:ident, $c:ident]) => {{
+                $tc.$tccrb().write(|w| w.$cs().no_clock());
+                $tc.$tccra().write(|w| {
+                    w.$wgm()
+                        .set(WGM_LOW_MODE14)
+                        .$a()
+                        .disconnected()
+                        .$b()
+                        .disconnected()
+                        .$c()
+                        .disconnected()
+                });
                 $tc.$icr().write(|w| w.set(PERIOD_TICKS - 1));
                 $tc.$tcnt().write(|w| w.set(0));
                 $tc.$tccrb()
-                    .write(|w| unsafe { w.bits(TCCRB_MODE14_PRESCALE8) });
+                    .write(|w| w.$wgm().set(WGM_HIGH_MODE14).$cs().prescale_8());
             }};
         }
-        // Halt the shared prescaler while the timers are set up, then release it: all four
-        // count from 0 on the same prescaler edge.
-        tc0.gtccr()
-            .write(|w| unsafe { w.bits(GTCCR_TSM | GTCCR_PSRSYNC) });
-        init!(tc1, tccr1a, tccr1b, icr1, tcnt1);
-        init!(tc3, tccr3a, tccr3b, icr3, tcnt3);
-        init!(tc4, tccr4a, tccr4b, icr4, tcnt4);
-        init!(tc5, tccr5a, tccr5b, icr5, tcnt5);
-        tc0.gtccr().write(|w| unsafe { w.bits(0) });
+        // The shared prescaler halted while the timers are set up, then released: all four
+        // count from 0 on the same prescaler edge (datasheet §18.4.1, GTCCR: TSM, PSRSYNC).
+        tc0.gtccr().write(|w| w.tsm().set_bit().psrsync().set_bit());
+        init!(
+            tc1,
+            tccr1a,
+            tccr1b,
+            icr1,
+            tcnt1,
+            wgm1,
+            cs1,
+            [com1a, com1b, com1c]
+        );
+        init!(
+            tc3,
+            tccr3a,
+            tccr3b,
+            icr3,
+            tcnt3,
+            wgm3,
+            cs3,
+            [com3a, com3b, com3c]
+        );
+        init!(
+            tc4,
+            tccr4a,
+            tccr4b,
+            icr4,
+            tcnt4,
+            wgm4,
+            cs4,
+            [com4a, com4b, com4c]
+        );
+        init!(
+            tc5,
+            tccr5a,
+            tccr5b,
+            icr5,
+            tcnt5,
+            wgm5,
+            cs5,
+            [com5a, com5b, com5c]
+        );
+        tc0.gtccr().write(|w| w.tsm().clear_bit());
 
         Servos {
             _tc1: tc1,
@@ -581,23 +638,9 @@ impl Servos {
 /// Disconnects every compare unit (pins fall back to their PORT value, low). For the panic
 /// handler, which cannot own the timers.
 pub fn force_all_low(dp: &pac::Peripherals) {
-    // SAFETY: mode-14 bits without COM bits: a valid TCCRnA value; any PORTx value is valid.
-    dp.TC1.tccr1a().write(|w| unsafe { w.bits(TCCRA_MODE14) });
-    dp.TC3.tccr3a().write(|w| unsafe { w.bits(TCCRA_MODE14) });
-    dp.TC4.tccr4a().write(|w| unsafe { w.bits(TCCRA_MODE14) });
-    dp.TC5.tccr5a().write(|w| unsafe { w.bits(TCCRA_MODE14) });
-    dp.PORTB
-        .portb()
-        .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[0]) });
-    dp.PORTE
-        .porte()
-        .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[1]) });
-    dp.PORTH
-        .porth()
-        .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[2]) });
-    dp.PORTL
-        .portl()
-        .modify(|r, w| unsafe { w.bits(r.bits() & !PIN_MASK[3]) });
+    for t in 0..4 {
+        apply_connections(dp, t, [false; 3]);
+    }
 }
 
 impl quad_device::ServoOutputs for Servos {

@@ -36,15 +36,19 @@ pub const TX_CAPACITY: usize = RING_CAPACITY;
 const _: () = assert!(RING_CAPACITY.is_power_of_two() && RING_CAPACITY <= 128);
 const _: () = assert!(quad_device::device::TX_LEN <= TX_CAPACITY);
 
-/// UCSR0B: RXCIE0 | UDRIE0 | RXEN0 | TXEN0.
-const UCSR0B_RXCIE: u8 = 1 << 7;
-const UCSR0B_UDRIE: u8 = 1 << 5;
-const UCSR0B_RXEN: u8 = 1 << 4;
-const UCSR0B_TXEN: u8 = 1 << 3;
-/// Receiver, transmitter and receive interrupt on; the transmit interrupt off (nothing to send).
-const UCSR0B_IDLE: u8 = UCSR0B_RXCIE | UCSR0B_RXEN | UCSR0B_TXEN;
-/// As [`UCSR0B_IDLE`] with the data-register-empty interrupt on (bytes waiting).
-const UCSR0B_SENDING: u8 = UCSR0B_IDLE | UCSR0B_UDRIE;
+/// UCSR0B with the receiver, the transmitter and the receive interrupt on, and the
+/// data-register-empty interrupt on when `sending` (bytes waiting); datasheet §22.10.3.
+#[inline(always)]
+fn ucsr0b(w: &mut pac::usart0::ucsr0b::W, sending: bool) -> &mut pac::usart0::ucsr0b::W {
+    w.rxcie0()
+        .set_bit()
+        .rxen0()
+        .set_bit()
+        .txen0()
+        .set_bit()
+        .udrie0()
+        .bit(sending)
+}
 
 /// Supported line rates. With U2X at 16 MHz, 1,000,000 baud is exact and 115,200 baud is
 /// 2.1 % fast (UBRR 16), within the receivers' tolerance.
@@ -274,8 +278,7 @@ impl Usart0 {
         usart
             .ucsr0c()
             .write(|w| w.ucsz0().chr8().usbs0().stop1().upm0().disabled());
-        // SAFETY: a valid UCSR0B value (receiver, transmitter, receive interrupt).
-        usart.ucsr0b().write(|w| unsafe { w.bits(UCSR0B_IDLE) });
+        usart.ucsr0b().write(|w| ucsr0b(w, false));
         Usart0 { usart, sent: false }
     }
 
@@ -330,11 +333,9 @@ impl Usart0 {
 
     fn start_transmitter(&mut self) {
         self.sent = true;
-        // SAFETY: a valid UCSR0B value. One store: the interrupt handler, which writes the
-        // same register when the ring runs empty, cannot come between a read and a write.
-        self.usart
-            .ucsr0b()
-            .write(|w| unsafe { w.bits(UCSR0B_SENDING) });
+        // One store, not a read-modify-write: the interrupt handler, which writes the same
+        // register when the ring runs empty, cannot come between a read and a write.
+        self.usart.ucsr0b().write(|w| ucsr0b(w, true));
     }
 
     /// Bytes queued by [`Usart0::send`] and not yet handed to the transmitter.
@@ -416,8 +417,7 @@ pub fn on_udre_interrupt() {
             usart.udr0().write(|w| w.set(byte));
         }
         None => {
-            // SAFETY: a valid UCSR0B value.
-            usart.ucsr0b().write(|w| unsafe { w.bits(UCSR0B_IDLE) });
+            usart.ucsr0b().write(|w| ucsr0b(w, false));
         }
     }
 }

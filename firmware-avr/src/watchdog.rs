@@ -38,8 +38,19 @@ impl ResetCause {
 /// Reads and clears MCUSR (WDRF must be cleared, or the watchdog cannot be reconfigured).
 pub fn take_reset_cause(cpu: &pac::CPU) -> ResetCause {
     let mcusr = cpu.mcusr().read().bits();
-    // SAFETY: writing 0 clears the reset flags; any value is valid.
-    cpu.mcusr().write(|w| unsafe { w.bits(0) });
+    // Datasheet §12.5.1: each flag is cleared by writing zero to it.
+    cpu.mcusr().write(|w| {
+        w.porf()
+            .clear_bit()
+            .extrf()
+            .clear_bit()
+            .borf()
+            .clear_bit()
+            .wdrf()
+            .clear_bit()
+            .jtrf()
+            .clear_bit()
+    });
     ResetCause { mcusr }
 }
 

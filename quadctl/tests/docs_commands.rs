@@ -46,6 +46,10 @@ enum Check {
     /// the firmware in simavr, minutes; `twin_cli` runs it. Run with `--help` appended: the
     /// arguments must be accepted.
     SimArgs,
+    /// `cd firmware-avr && cargo build --release [--bin NAME]`: the firmware build, which is the
+    /// `firmware` step of `cargo xtask ci`: a `--bin` must name a binary of
+    /// firmware-avr/Cargo.toml.
+    FirmwareBuild,
     /// `quadctl serve`: serves until Ctrl-C. Run with `--check` (and `--listen 127.0.0.1:0`
     /// unless the line sets an address): the device must open, the address bind and the page
     /// be complete, then it stops; on a board's port, as [`Check::BoardPort`].
@@ -66,6 +70,7 @@ const RULES: &[(&str, Check)] = &[
         Check::CargoTarget,
     ),
     ("cargo bench -p ", Check::CargoTarget),
+    ("cd firmware-avr && cargo build --release", Check::FirmwareBuild),
     ("cargo run --release -p quadctl -- sim ", Check::SimArgs),
     ("cargo run --release -p quadctl -- serve ", Check::Serve),
     ("cargo run --release -p quadctl -- ", Check::Run),
@@ -287,6 +292,18 @@ fn check_command(command: &str, check: Check, dir: &Path) {
                     "{command}: no example {example}"
                 ),
                 None => assert!(dir.join("benches").is_dir(), "{command}: no benches"),
+            }
+        }
+        Check::FirmwareBuild => {
+            let manifest = std::fs::read_to_string(repo_root().join("firmware-avr/Cargo.toml"))
+                .expect("firmware-avr/Cargo.toml");
+            let words: Vec<&str> = command.split_whitespace().collect();
+            if let Some(i) = words.iter().position(|w| *w == "--bin") {
+                let bin = words.get(i + 1).expect("--bin NAME");
+                assert!(
+                    manifest.contains(&format!("name = \"{bin}\"")),
+                    "{command}: firmware-avr/Cargo.toml has no binary {bin}"
+                );
             }
         }
     }
