@@ -70,7 +70,10 @@ const RULES: &[(&str, Check)] = &[
         Check::CargoTarget,
     ),
     ("cargo bench -p ", Check::CargoTarget),
-    ("cd firmware-avr && cargo build --release", Check::FirmwareBuild),
+    (
+        "cd firmware-avr && cargo build --release",
+        Check::FirmwareBuild,
+    ),
     ("cargo run --release -p quadctl -- sim ", Check::SimArgs),
     ("cargo run --release -p quadctl -- serve ", Check::Serve),
     ("cargo run --release -p quadctl -- ", Check::Run),

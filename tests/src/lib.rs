@@ -11,6 +11,7 @@
 //! Building the firmware and running it in simavr is `quad_host::emu` (one implementation
 //! for these tests and `quadctl`).
 
+pub mod answer_times;
 pub mod avr_bench;
 pub mod budget;
 pub mod end_to_end;

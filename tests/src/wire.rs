@@ -54,3 +54,30 @@ pub fn answers(
     }
     answers
 }
+
+/// Sends `bytes` on an idle line and returns the first answer with the time from the request's
+/// first byte on the line to the answer's last byte; `None` when none comes within `patience`.
+///
+/// # Panics
+/// When the link fails or the device sends an unreadable frame.
+pub fn timed_answer(
+    link: &mut EmulatorLink,
+    bytes: &[u8],
+    patience: Duration,
+) -> Option<(DeviceToHost, Duration)> {
+    let start = link.now();
+    link.send(bytes).expect("send");
+    let end = start + patience;
+    let mut acc = Accumulator::<MAX_DECODED_LEN>::new();
+    let mut buf = [0u8; 256];
+    while link.now() < end {
+        // The emulated link returns at the end of a frame, when the clock is at its last byte.
+        let n = link.recv(&mut buf, end - link.now()).expect("recv");
+        match acc.feed::<DeviceToHost>(&buf[..n]) {
+            Feed::NeedMore => {}
+            Feed::Frame { msg, .. } => return Some((msg, link.now() - start)),
+            other => panic!("the device sent an unreadable frame: {other:?}"),
+        }
+    }
+    None
+}

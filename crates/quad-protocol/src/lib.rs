@@ -34,6 +34,7 @@ pub mod frame;
 pub mod msg;
 pub mod range;
 pub mod servo;
+pub mod timing;
 pub mod wire;
 
 pub use frame::{

@@ -38,3 +38,39 @@ fn protocol_doc_states_the_constants_of_the_code() {
         assert!(flat.contains(&m), "docs/protocol.md lacks {m}");
     }
 }
+
+/// The answer-time table of `docs/protocol.md` ("Answer times") as `quad_protocol::timing`
+/// prints it.
+fn answer_time_rows() -> String {
+    use quad_protocol::timing::{Kind, BAUDS};
+    let ms = |us: u32| format!("{:.1}", f64::from(us) / 1000.0);
+    Kind::ALL
+        .iter()
+        .map(|k| {
+            let [slow, fast] = k.worst_us();
+            format!(
+                "| {} | {} | {} | {} | {} |\n",
+                k.name(),
+                ms(slow),
+                k.timeout(BAUDS[0]).as_millis(),
+                ms(fast),
+                k.timeout(BAUDS[1]).as_millis()
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn protocol_doc_answer_times_are_the_table_of_the_code() {
+    let begin = "<!-- answer-times:begin -->\n";
+    let end = "<!-- answer-times:end -->";
+    let start = DOC.find(begin).expect("the answer-times markers") + begin.len();
+    let stop = DOC[start..].find(end).expect("the end marker") + start;
+    let section = &DOC[start..stop];
+    let rows: String = section.lines().skip(2).map(|l| format!("{l}\n")).collect();
+    let expected = answer_time_rows();
+    assert_eq!(
+        rows, expected,
+        "docs/protocol.md's answer-time table differs from quad_protocol::timing; its rows:\n{expected}"
+    );
+}

@@ -1,0 +1,216 @@
+//! How long the device takes to answer each kind of request, and how long a host should wait.
+//!
+//! An answer time runs from the request's first byte on the line to the answer's last byte: it
+//! holds both frames' time on the wire and the device's work in between (a body pose's IK, a
+//! motion's preflight, an EEPROM write). [`Kind::worst_us`] is the longest the ATmega2560
+//! firmware takes at each supported line rate, measured on the emulated chip over cases that
+//! include each kind's slowest (the test `avr_answer_times`, which fails when a measurement
+//! exceeds its bound or falls far below it, so that the table stays tight). A host waits
+//! [`Kind::timeout`] before it resends: the worst time with half again as margin, plus
+//! [`HOST_LATENCY`] for the host's side of the line.
+//!
+//! `docs/protocol.md` ("Answer times") prints this table; a test checks that the two agree.
+
+use crate::msg::{MotionCommand, Request};
+use core::time::Duration;
+
+/// The line rates the firmware is built for, bit/s: [`Kind::worst_us`]'s columns.
+pub const BAUDS: [u32; 2] = [115_200, 1_000_000];
+
+/// Added to every suggested timeout for the host's side of the line: a USB serial adapter
+/// delivers bytes in USB frames (1 ms on the Mega's own USB bridge, up to 16 ms on adapters
+/// whose latency timer is at its default), and a host scheduler can add a few ms more.
+pub const HOST_LATENCY: Duration = Duration::from_millis(20);
+
+/// A row of the answer-time table: a request kind, with `StartMotion` split by motion (their
+/// preflights differ by an order of magnitude).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[allow(missing_docs)] // The names are the requests' (and the motions').
+pub enum Kind {
+    Hello,
+    GetState,
+    SetBodyPose,
+    SetFeet,
+    SetJoints,
+    SetOutputs,
+    SetLinkTimeout,
+    SetCalibration,
+    GetCalibration,
+    SaveCalibration,
+    SetPoseConfig,
+    StartStandUp,
+    StartSit,
+    StartRest,
+    StartSway,
+    StartYawTurn,
+    StartFootPath,
+    StartWalk,
+    StopMotion,
+    GetMotion,
+    SetVelocity,
+    SetJointSpeedLimit,
+}
+
+impl Kind {
+    /// Every row, in the order of the table.
+    pub const ALL: [Kind; 22] = [
+        Kind::Hello,
+        Kind::GetState,
+        Kind::SetBodyPose,
+        Kind::SetFeet,
+        Kind::SetJoints,
+        Kind::SetOutputs,
+        Kind::SetLinkTimeout,
+        Kind::SetCalibration,
+        Kind::GetCalibration,
+        Kind::SaveCalibration,
+        Kind::SetPoseConfig,
+        Kind::StartStandUp,
+        Kind::StartSit,
+        Kind::StartRest,
+        Kind::StartSway,
+        Kind::StartYawTurn,
+        Kind::StartFootPath,
+        Kind::StartWalk,
+        Kind::StopMotion,
+        Kind::GetMotion,
+        Kind::SetVelocity,
+        Kind::SetJointSpeedLimit,
+    ];
+
+    /// The row of `request`.
+    pub const fn of(request: &Request) -> Kind {
+        match request {
+            Request::Hello { .. } => Kind::Hello,
+            Request::GetState => Kind::GetState,
+            Request::SetBodyPose(_) => Kind::SetBodyPose,
+            Request::SetFeet { .. } => Kind::SetFeet,
+            Request::SetJoints { .. } => Kind::SetJoints,
+            Request::SetOutputs { .. } => Kind::SetOutputs,
+            Request::SetLinkTimeout(_) => Kind::SetLinkTimeout,
+            Request::SetCalibration { .. } => Kind::SetCalibration,
+            Request::GetCalibration { .. } => Kind::GetCalibration,
+            Request::SaveCalibration => Kind::SaveCalibration,
+            Request::SetPoseConfig(_) => Kind::SetPoseConfig,
+            Request::StartMotion(m) => match m {
+                MotionCommand::StandUp => Kind::StartStandUp,
+                MotionCommand::Sit => Kind::StartSit,
+                MotionCommand::Rest => Kind::StartRest,
+                MotionCommand::Sway { .. } => Kind::StartSway,
+                MotionCommand::YawTurn { .. } => Kind::StartYawTurn,
+                MotionCommand::FootPath { .. } => Kind::StartFootPath,
+                MotionCommand::Walk { .. } => Kind::StartWalk,
+            },
+            Request::StopMotion => Kind::StopMotion,
+            Request::GetMotion => Kind::GetMotion,
+            Request::SetVelocity { .. } => Kind::SetVelocity,
+            Request::SetJointSpeedLimit { .. } => Kind::SetJointSpeedLimit,
+        }
+    }
+
+    /// The row's name as `docs/protocol.md` prints it.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Kind::Hello => "Hello",
+            Kind::GetState => "GetState",
+            Kind::SetBodyPose => "SetBodyPose",
+            Kind::SetFeet => "SetFeet",
+            Kind::SetJoints => "SetJoints",
+            Kind::SetOutputs => "SetOutputs",
+            Kind::SetLinkTimeout => "SetLinkTimeout",
+            Kind::SetCalibration => "SetCalibration",
+            Kind::GetCalibration => "GetCalibration",
+            Kind::SaveCalibration => "SaveCalibration",
+            Kind::SetPoseConfig => "SetPoseConfig",
+            Kind::StartStandUp => "StartMotion StandUp",
+            Kind::StartSit => "StartMotion Sit",
+            Kind::StartRest => "StartMotion Rest",
+            Kind::StartSway => "StartMotion Sway",
+            Kind::StartYawTurn => "StartMotion YawTurn",
+            Kind::StartFootPath => "StartMotion FootPath",
+            Kind::StartWalk => "StartMotion Walk",
+            Kind::StopMotion => "StopMotion",
+            Kind::GetMotion => "GetMotion",
+            Kind::SetVelocity => "SetVelocity",
+            Kind::SetJointSpeedLimit => "SetJointSpeedLimit",
+        }
+    }
+
+    /// The longest answer time of this kind at each of [`BAUDS`], µs: the firmware's measured
+    /// worst, rounded up to the next 0.1 ms.
+    pub const fn worst_us(self) -> [u32; 2] {
+        match self {
+            Kind::Hello => [7_600, 5_700],
+            Kind::GetState => [7_600, 1_400],
+            Kind::SetBodyPose => [13_500, 4_800],
+            Kind::SetFeet => [16_000, 4_900],
+            Kind::SetJoints => [13_900, 2_900],
+            Kind::SetOutputs => [9_500, 2_200],
+            Kind::SetLinkTimeout => [8_100, 1_500],
+            Kind::SetCalibration => [12_800, 2_700],
+            Kind::GetCalibration => [3_400, 800],
+            Kind::SaveCalibration => [659_800, 652_900],
+            Kind::SetPoseConfig => [8_900, 1_600],
+            Kind::StartStandUp => [13_600, 5_600],
+            Kind::StartSit => [11_300, 2_800],
+            Kind::StartRest => [11_200, 2_800],
+            Kind::StartSway => [40_200, 31_200],
+            Kind::StartYawTurn => [44_200, 34_600],
+            Kind::StartFootPath => [45_700, 35_600],
+            Kind::StartWalk => [67_400, 57_800],
+            Kind::StopMotion => [11_500, 2_000],
+            Kind::GetMotion => [16_600, 4_800],
+            Kind::SetVelocity => [23_200, 17_000],
+            Kind::SetJointSpeedLimit => [9_200, 1_700],
+        }
+    }
+
+    /// How long a host waits for this kind's answer at `baud` before it resends: the worst
+    /// time at the nearest of [`BAUDS`] at or below `baud` (the slower line for a rate between
+    /// them, 115,200's for a slower one, scaled up), times 1.5, plus [`HOST_LATENCY`], rounded
+    /// up to whole milliseconds.
+    pub fn timeout(self, baud: u32) -> Duration {
+        let [slow_us, fast_us] = self.worst_us();
+        let worst_us = if baud >= BAUDS[1] {
+            u64::from(fast_us)
+        } else if baud >= BAUDS[0] {
+            u64::from(slow_us)
+        } else {
+            // Slower than the slowest row: the whole answer time scaled by the rate, an
+            // overestimate (the device's own work does not slow down).
+            u64::from(slow_us) * u64::from(BAUDS[0]) / u64::from(baud.max(1))
+        };
+        let us = worst_us * 3 / 2 + HOST_LATENCY.as_micros() as u64;
+        Duration::from_millis(us.div_ceil(1000))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_row_names_itself_once_and_maps_back() {
+        for (i, k) in Kind::ALL.iter().enumerate() {
+            assert!(Kind::ALL[..i].iter().all(|o| o.name() != k.name()));
+        }
+        assert_eq!(Kind::of(&Request::GetMotion), Kind::GetMotion);
+        assert_eq!(
+            Kind::of(&Request::StartMotion(MotionCommand::Sit)),
+            Kind::StartSit
+        );
+    }
+
+    #[test]
+    fn the_timeout_covers_the_worst_with_margin_at_every_rate() {
+        for k in Kind::ALL {
+            let [slow, fast] = k.worst_us();
+            for (baud, worst) in [(115_200, slow), (1_000_000, fast), (2_000_000, fast)] {
+                let t = k.timeout(baud);
+                assert!(t >= Duration::from_micros(u64::from(worst) * 3 / 2) + HOST_LATENCY);
+                assert!(t < Duration::from_micros(u64::from(worst) * 3 / 2) + HOST_LATENCY * 2);
+            }
+            assert!(k.timeout(57_600) >= k.timeout(115_200));
+        }
+    }
+}
