@@ -1,0 +1,259 @@
+//! What docs/protocol.md ("Device behaviour") says the device does, on the firmware in simavr:
+//! the version a `HelloAck` reports, what may start while the outputs are off, the rest pose,
+//! and the joint-speed limiter (per joint for a direct setpoint, one synchronised ramp for a
+//! motion's start), seen on the pins. Simulated time.
+
+use integration_tests::wire::{self, frame};
+use quad_host::emu::build;
+use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
+use quad_protocol::{DeviceToHost, LegSet, MotionCommand, NackReason, Request, PROTOCOL_VERSION};
+use std::time::Duration;
+
+const PATIENCE: Duration = Duration::from_millis(500);
+
+fn boot() -> EmulatorLink {
+    let elf = build::firmware_elf(build::FIRMWARE).unwrap_or_else(|e| panic!("{e}"));
+    EmulatorLink::boot(&elf, EmulatorConfig::new(115_200)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Sends `request` with sequence number `seq` and returns its one answer.
+fn ask(link: &mut EmulatorLink, seq: u16, request: Request) -> DeviceToHost {
+    let answers = wire::answers(link, &frame(seq, request), PATIENCE, Some(Duration::ZERO));
+    assert_eq!(answers.len(), 1, "{request:?}: {answers:?}");
+    answers[0]
+}
+
+fn hello(link: &mut EmulatorLink) -> quad_protocol::DeviceInfo {
+    match ask(
+        link,
+        0,
+        Request::Hello {
+            version: PROTOCOL_VERSION,
+        },
+    ) {
+        DeviceToHost::HelloAck { info, .. } => info,
+        other => panic!("Hello: {other:?}"),
+    }
+}
+
+/// Polls `GetMotion` (sequence numbers from `seq` on) until no motion runs.
+fn wait_idle(link: &mut EmulatorLink, seq: &mut u16) {
+    for _ in 0..400 {
+        link.idle(Duration::from_millis(50)).expect("runs");
+        *seq += 1;
+        match ask(link, *seq, Request::GetMotion) {
+            DeviceToHost::MotionAck { status, .. } if status.kind.is_none() => return,
+            DeviceToHost::MotionAck { .. } => {}
+            other => panic!("GetMotion: {other:?}"),
+        }
+    }
+    panic!("the motion did not end");
+}
+
+#[test]
+fn hello_ack_reports_the_device_version_whatever_the_host_minor() {
+    let mut link = boot();
+    for (seq, host) in [(1, 0x0200u16), (2, 0x0201), (3, 0x02ff)] {
+        match ask(&mut link, seq, Request::Hello { version: host }) {
+            DeviceToHost::HelloAck { info, .. } => assert_eq!(info.version, PROTOCOL_VERSION),
+            other => panic!("Hello {host:#06x}: {other:?}"),
+        }
+    }
+    assert_eq!(
+        ask(&mut link, 4, Request::Hello { version: 0x0100 }),
+        DeviceToHost::Nack {
+            seq: Some(4),
+            reason: NackReason::UnknownVersion {
+                supported: PROTOCOL_VERSION
+            }
+        }
+    );
+}
+
+#[test]
+fn with_the_outputs_off_only_stand_up_starts_and_setpoints_are_held_with_no_pulse() {
+    let mut link = boot();
+    hello(&mut link);
+    let refused = [
+        MotionCommand::Sit,
+        MotionCommand::Rest,
+        MotionCommand::Sway {
+            axis: kin_core::motion::laws::Axis::Roll,
+            amplitude_rad: 0.1,
+            period_s: 2.0,
+            duration_s: None,
+        },
+        MotionCommand::YawTurn {
+            yaw_rate_rad_s: 0.2,
+            step_period_s: 1.0,
+            lift_height_m: 0.03,
+            duration_s: None,
+        },
+        MotionCommand::FootPath {
+            path: kin_core::motion::path::PathKind::Ellipse,
+            legs: LegSet::All,
+            stride_m: 0.05,
+            step_height_m: 0.03,
+            duty_factor: 0.5,
+            cycle_s: 2.0,
+            duration_s: None,
+        },
+        MotionCommand::Walk {
+            gait: kin_core::motion::gait::Pattern::Trot,
+            body_height_m: 0.277,
+            step_height_m: 0.04,
+            cycle_s: 0.6,
+            velocity_timeout_ms: 500,
+        },
+    ];
+    let mut seq = 10;
+    for m in refused {
+        seq += 1;
+        assert_eq!(
+            ask(&mut link, seq, Request::StartMotion(m)),
+            DeviceToHost::Nack {
+                seq: Some(seq),
+                reason: NackReason::OutputsDisabled
+            },
+            "{m:?} with the outputs off"
+        );
+    }
+    seq += 1;
+    match ask(
+        &mut link,
+        seq,
+        Request::SetBodyPose(kin_core::Pose::default()),
+    ) {
+        DeviceToHost::Ack { readback, .. } => {
+            assert!(readback.angles_rad.iter().any(|a| *a != 0.0));
+            assert_eq!(readback.pulses_half_us, [0; 12]);
+            assert!(!readback
+                .flags
+                .contains(quad_protocol::Flags::OUTPUTS_ENABLED));
+        }
+        other => panic!("SetBodyPose with the outputs off: {other:?}"),
+    }
+    seq += 1;
+    match ask(&mut link, seq, Request::StartMotion(MotionCommand::StandUp)) {
+        DeviceToHost::MotionAck { readback, .. } => {
+            assert!(readback
+                .flags
+                .contains(quad_protocol::Flags::OUTPUTS_ENABLED));
+        }
+        other => panic!("StandUp with the outputs off: {other:?}"),
+    }
+}
+
+#[test]
+fn sit_ends_at_the_documented_rest_pose() {
+    let mut link = boot();
+    let info = hello(&mut link);
+    let robot = info.robot.robot().expect("a preset robot");
+    let rest = quad_device::engine::rest_angles(&robot).expect("a rest pose");
+    // The documented rule: abduction 0, the knee 0.2 rad short of the folded end of its range,
+    // the hip at minus half the knee.
+    let knee = robot.limits.min_rad[2] + 0.2;
+    for leg in rest.chunks_exact(3) {
+        assert_eq!(leg, [0.0, -0.5 * knee, knee]);
+    }
+    let mut seq = 1;
+    for m in [MotionCommand::StandUp, MotionCommand::Sit] {
+        seq += 1;
+        assert!(matches!(
+            ask(&mut link, seq, Request::StartMotion(m)),
+            DeviceToHost::MotionAck { .. }
+        ));
+        wait_idle(&mut link, &mut seq);
+    }
+    seq += 1;
+    match ask(&mut link, seq, Request::GetState) {
+        DeviceToHost::Ack { readback, .. } => assert_eq!(readback.angles_rad, rest),
+        other => panic!("GetState: {other:?}"),
+    }
+}
+
+/// The pulse width of every channel, period by period, for `periods` periods.
+fn pulse_periods(link: &mut EmulatorLink, periods: usize) -> Vec<[u64; 12]> {
+    (0..periods)
+        .map(|_| {
+            let p = link.next_pulses().expect("runs");
+            core::array::from_fn(|c| p[c].map_or(0, |p| p.high_cycles))
+        })
+        .collect()
+}
+
+/// The first period from which channel `c` no longer changes (by more than the emulator's
+/// edge resolution), or `None` if it moved less than ten times that in all (too little to
+/// tell when it arrived).
+fn arrival(periods: &[[u64; 12]], c: usize) -> Option<usize> {
+    const SLACK_CYCLES: u64 = 40;
+    let last = periods.last().expect("periods")[c];
+    let settled = |p: &[u64; 12]| p[c].abs_diff(last) <= SLACK_CYCLES;
+    if periods[0][c].abs_diff(last) < 10 * SLACK_CYCLES {
+        return None;
+    }
+    let i = periods.iter().rposition(|p| !settled(p)).expect("moved");
+    Some(i + 1)
+}
+
+#[test]
+fn a_direct_setpoint_moves_each_joint_at_the_limit_and_a_motion_starts_with_one_ramp() {
+    let mut link = boot();
+    hello(&mut link);
+    let mut seq = 1;
+    let stance = |abd: f32| {
+        let leg = [abd, 0.7, -1.4];
+        core::array::from_fn::<f32, 12, _>(|i| leg[i % 3])
+    };
+    for request in [
+        Request::SetOutputs { enabled: true },
+        Request::SetJoints {
+            angles_rad: stance(0.0),
+        },
+    ] {
+        seq += 1;
+        assert!(!matches!(
+            ask(&mut link, seq, request),
+            DeviceToHost::Nack { .. }
+        ));
+    }
+    link.idle(Duration::from_secs(2)).expect("runs");
+    // Direct: the abductions 0.3 rad away (5 limiter steps at 3 rad/s), FL's hip 0.06 (one).
+    let mut target = stance(0.3);
+    target[1] += 0.06;
+    let mut periods = pulse_periods(&mut link, 1);
+    seq += 1;
+    assert!(matches!(
+        ask(&mut link, seq, Request::SetJoints { angles_rad: target }),
+        DeviceToHost::Ack { .. }
+    ));
+    periods.extend(pulse_periods(&mut link, 12));
+    let abduction = arrival(&periods, 0).expect("FL abduction moves");
+    let hip = arrival(&periods, 1).expect("FL hip moves");
+    assert!(
+        abduction >= hip + 3,
+        "per joint: the hip's small step arrives first (abduction {abduction}, hip {hip})"
+    );
+    // A motion's start: StandUp ramps from here to the stance, every moving joint together.
+    let mut periods = pulse_periods(&mut link, 1);
+    seq += 1;
+    assert!(matches!(
+        ask(&mut link, seq, Request::StartMotion(MotionCommand::StandUp)),
+        DeviceToHost::MotionAck { .. }
+    ));
+    periods.extend(pulse_periods(&mut link, 40));
+    let arrivals: Vec<usize> = (0..12).filter_map(|c| arrival(&periods, c)).collect();
+    assert!(
+        arrivals.len() >= 8,
+        "the ramp moves the joints: {arrivals:?}"
+    );
+    let (first, last) = (
+        arrivals.iter().min().unwrap(),
+        arrivals.iter().max().unwrap(),
+    );
+    assert!(
+        last - first <= 1,
+        "synchronised: every joint arrives in the same period: {arrivals:?}"
+    );
+    wait_idle(&mut link, &mut seq);
+}
