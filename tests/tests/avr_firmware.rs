@@ -565,10 +565,9 @@ fn soak_of_1000_poses_with_line_corruption_has_no_wrong_pulse_and_no_reset() {
         .parse()
         .expect("faults");
     let config = EmulatorConfig {
-        baud: 1_000_000,
         faults,
         seed: 7,
-        eeprom: None,
+        ..EmulatorConfig::new(1_000_000)
     };
     let link = EmulatorLink::boot(&firmware(build::FIRMWARE_1MBAUD), config)
         .unwrap_or_else(|e| panic!("{e}"));

@@ -85,6 +85,8 @@ const RX_FIFO_SLOTS: u16 = 64;
 /// The global interrupt flag's bit in SREG (simavr's `sreg[S_I]`).
 const SREG_I_BIT: usize = 7;
 const UCSR0B: u16 = 0xC1;
+/// UCSR0B's receiver-enable bit.
+const UCSR0B_RXEN0: u8 = 1 << 4;
 const UBRR0L: u16 = 0xC4;
 const UBRR0H: u16 = 0xC5;
 /// Watchdog control and MCU status registers.
@@ -201,11 +203,13 @@ impl Pulse {
 pub struct InterruptsOff {
     /// The longest, cycles.
     pub longest_cycles: u64,
-    /// The longest during which bytes were arriving or waiting unread in the receiver, cycles.
+    /// The longest part of a stretch during which the receiver was on and bytes were arriving
+    /// or waiting unread in it, cycles: what can cost bytes (from reset until the firmware
+    /// turns the receiver on, the chip hears nothing).
     pub longest_receiving_cycles: u64,
-    /// Where that one began ([`Mega2560::cycle`]).
+    /// Where that part began ([`Mega2560::cycle`]).
     pub longest_receiving_at_cycle: u64,
-    /// The program counter (byte address) at which it began.
+    /// The program counter (byte address) at which its stretch began.
     pub longest_receiving_pc: u32,
 }
 
@@ -303,8 +307,8 @@ pub struct Mega2560 {
     /// simavr's FIFO read index when the last overrun happened, while its DOR0 is owed.
     dor_owed: Option<u16>,
     /// The interrupts-off stretch in progress: its first cycle, the program counter there and
-    /// whether bytes were arriving during it.
-    cli_since: Option<(u64, u32, bool)>,
+    /// the cycle from which bytes were arriving during it (if they were).
+    cli_since: Option<(u64, u32, Option<u64>)>,
     interrupts_off: InterruptsOff,
     /// simavr's cycle counter after the last step.
     last_raw: u64,
@@ -656,9 +660,12 @@ impl Mega2560 {
         unsafe { *(*avr).data.add(usize::from(UCSR0A)) |= UCSR0A_DOR0 };
     }
 
-    /// True while bytes are on their way to the receiver or wait unread in it.
+    /// True while USART0's receiver is on (RXEN0) and bytes are on their way to it or wait
+    /// unread in it. With the receiver off (from reset until the firmware sets the USART up)
+    /// the chip hears nothing, so no byte can be lost to a stretch with interrupts off.
     fn receiving(&self) -> bool {
-        !self.input.is_empty() || self.cycle() < self.rx_line_free || self.rx_fifo().0 > 0
+        self.data(UCSR0B) & UCSR0B_RXEN0 != 0
+            && (!self.input.is_empty() || self.cycle() < self.rx_line_free || self.rx_fifo().0 > 0)
     }
 
     /// Follows SREG.I after a step that started at cycle `before` at program counter `pc`.
@@ -667,19 +674,27 @@ impl Mega2560 {
         // reads it.
         let off = self.avr().sreg[SREG_I_BIT] == 0;
         let receiving = self.receiving();
+        let now = self.cycle();
         match (&mut self.cli_since, off) {
-            (None, true) => self.cli_since = Some((before, pc, receiving)),
-            (Some((_, _, seen)), true) => *seen |= receiving,
-            (Some((start, at_pc, seen)), false) => {
-                let (start, at_pc, seen) = (*start, *at_pc, *seen);
+            (None, true) => self.cli_since = Some((before, pc, receiving.then_some(before))),
+            (Some((_, _, since)), true) => {
+                if receiving && since.is_none() {
+                    *since = Some(before);
+                }
+            }
+            (Some((start, at_pc, since)), false) => {
+                let (start, at_pc, since) = (*start, *at_pc, *since);
                 self.cli_since = None;
-                let len = self.cycle() - start;
                 let s = &mut self.interrupts_off;
-                s.longest_cycles = s.longest_cycles.max(len);
-                if seen && len > s.longest_receiving_cycles {
-                    s.longest_receiving_cycles = len;
-                    s.longest_receiving_at_cycle = start;
-                    s.longest_receiving_pc = at_pc;
+                s.longest_cycles = s.longest_cycles.max(now - start);
+                // Only the part with the receiver listening and bytes coming can lose them.
+                if let Some(since) = since {
+                    let len = now - since;
+                    if len > s.longest_receiving_cycles {
+                        s.longest_receiving_cycles = len;
+                        s.longest_receiving_at_cycle = since;
+                        s.longest_receiving_pc = at_pc;
+                    }
                 }
             }
             (None, false) => {}
@@ -722,7 +737,7 @@ impl Mega2560 {
     /// USART0's line rate as the firmware configured it (UBRR0, U2X0), bit/s; `None` while
     /// the receiver is off.
     pub fn uart_baud(&self) -> Option<f64> {
-        if self.data(UCSR0B) & (1 << 4) == 0 {
+        if self.data(UCSR0B) & UCSR0B_RXEN0 == 0 {
             return None;
         }
         let ubrr = u32::from(self.data(UBRR0L)) | u32::from(self.data(UBRR0H) & 0x0F) << 8;

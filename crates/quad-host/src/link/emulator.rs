@@ -17,6 +17,15 @@
 //!   writes of 3.4 ms per byte, its 1 kHz clock and link-loss failsafe) is emulated instruction
 //!   by instruction.
 //!
+//! ## Interrupts off
+//! A stretch with interrupts off (SREG.I clear, interrupt handlers included) while the receiver
+//! is on and bytes arrive must end within [`receive_cover_cycles`] — two byte times, the cover of
+//! the chip's two-byte receive buffer — or a real chip could lose a byte that the emulator's
+//! timing happened to spare. The link fails with [`Error::InterruptsOff`] (naming the stretch's
+//! length and its program counter) at the first that does not, unless
+//! [`EmulatorConfig::check_interrupts_off`] is off (a test of a firmware that breaks the rule on
+//! purpose).
+//!
 //! ## Faults
 //! [`Faults`] apply to both directions, drawn from one seeded generator: per frame a stall, a
 //! cut and a duplication, per byte a drop (its line time passes) and a bit flip — as in
@@ -76,6 +85,9 @@ pub struct EmulatorConfig {
     pub seed: u64,
     /// EEPROM contents at power-on (`None`: erased, all 0xFF).
     pub eeprom: Option<Vec<u8>>,
+    /// Fail on an interrupts-off stretch beyond [`receive_cover_cycles`] while bytes arrive
+    /// (see the module docs); on by default.
+    pub check_interrupts_off: bool,
 }
 
 impl EmulatorConfig {
@@ -86,8 +98,16 @@ impl EmulatorConfig {
             faults: Faults::NONE,
             seed: 1,
             eeprom: None,
+            check_interrupts_off: true,
         }
     }
+}
+
+/// The longest interrupts-off stretch while bytes arrive that loses none, cycles, for a line of
+/// `byte_cycles` cycles per byte: two byte times (the chip's two-byte receive buffer fills while
+/// the third byte is still in the shift register).
+pub const fn receive_cover_cycles(byte_cycles: u64) -> u64 {
+    2 * byte_cycles
 }
 
 /// Why the emulator could not start or run.
@@ -112,6 +132,22 @@ pub enum Error {
         BOOT_LIMIT.as_secs_f64()
     )]
     NoBoot,
+    /// Interrupts stayed off longer than the receive buffer covers while bytes arrived.
+    #[error(
+        "interrupts were off for {cycles} cycles while bytes arrived (from program counter \
+         {pc:#x}, cycle {at_cycle}): more than the {limit} cycles the two-byte receive buffer \
+         covers at this line rate; a real chip could lose bytes"
+    )]
+    InterruptsOff {
+        /// The stretch's length while bytes arrived, cycles.
+        cycles: u64,
+        /// Where the stretch began (byte address).
+        pc: u32,
+        /// The cycle from which bytes arrived during it.
+        at_cycle: u64,
+        /// [`receive_cover_cycles`] at the firmware's line rate.
+        limit: u64,
+    },
     /// The firmware's line rate differs from the host's.
     #[error("the firmware listens at {firmware:.0} baud, the host sends at {host} baud")]
     Baud {
@@ -526,6 +562,18 @@ impl EmulatorLink {
             self.mcu.uart_write(&[b]);
         }
         self.mcu.step().map_err(Self::emu_error)?;
+        if self.config.check_interrupts_off {
+            let off = self.mcu.interrupts_off();
+            let limit = receive_cover_cycles(self.byte_cycles);
+            if off.longest_receiving_cycles > limit {
+                return Err(super::Error::Emulator(Error::InterruptsOff {
+                    cycles: off.longest_receiving_cycles,
+                    pc: off.longest_receiving_pc,
+                    at_cycle: off.longest_receiving_at_cycle,
+                    limit,
+                }));
+            }
+        }
         let resets = self.mcu.resets();
         if resets.count != self.resets_seen {
             self.resets_seen = resets.count;
