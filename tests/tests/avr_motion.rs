@@ -303,3 +303,117 @@ fn onboard_trot_with_a_changing_velocity_keeps_every_frame_and_the_speed_bound()
     assert!(trot_frames as f32 >= 0.9 * trot_s * 50.0 * 0.75);
     assert!(rig.max_step_rad > 0.5 * f64::from(DEFAULT_JOINT_SPEED_LIMIT_RAD_S) * 0.02);
 }
+
+/// Cut points of [`a_link_cut_anywhere_in_a_trot_stride_ends_it_at_the_stance`] spread over one
+/// gait cycle.
+const LINK_CUTS: u32 = 20;
+
+/// The link-loss failsafe's timeout in that test, ms.
+const LINK_TIMEOUT_MS: u16 = 200;
+
+#[test]
+fn a_link_cut_anywhere_in_a_trot_stride_ends_it_at_the_stance() {
+    let mut rig = Rig::boot();
+    let h = rig.stance_height_m();
+    match rig.ask(Request::SetLinkTimeout(quad_protocol::LinkTimeout {
+        timeout_ms: LINK_TIMEOUT_MS,
+        action: quad_protocol::LinkLossAction::Hold,
+    })) {
+        DeviceToHost::Configured { .. } => {}
+        other => panic!("SetLinkTimeout: {other:?}"),
+    }
+    rig.start(MotionCommand::StandUp);
+    rig.until_idle(10.0);
+    let stance = match rig.ask(Request::GetState) {
+        DeviceToHost::Ack { readback, .. } => readback.angles_rad,
+        other => panic!("GetState: {other:?}"),
+    };
+    let cycle_s = GaitParams::DEFAULT_CYCLE_S;
+    for cut in 0..LINK_CUTS {
+        rig.start(MotionCommand::Walk {
+            gait: Pattern::Trot,
+            body_height_m: h,
+            step_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * h,
+            cycle_s,
+            velocity_timeout_ms: 500,
+        });
+        // Steered at 20 Hz for one cycle plus this cut's share of the next, then silence.
+        let start = rig.link.now();
+        let cut_at = Duration::from_secs_f32(cycle_s * (1.0 + cut as f32 / LINK_CUTS as f32));
+        while rig.link.now() - start < cut_at {
+            let answer = rig.ask(Request::SetVelocity {
+                forward_m_s: 0.04,
+                lateral_m_s: 0.0,
+                yaw_rate_rad_s: 0.05,
+            });
+            assert!(
+                matches!(answer, DeviceToHost::MotionAck { .. }),
+                "{answer:?}"
+            );
+            rig.frame();
+            rig.frame();
+        }
+        // The link is gone: every frame watched (the limiter's bound asserted) until the
+        // failsafe has acted and well beyond.
+        let silent = rig.link.now();
+        while rig.link.now() - silent < Duration::from_millis(u64::from(LINK_TIMEOUT_MS) + 300) {
+            rig.frame();
+        }
+        // Back: the motion ends (its stride finished, a ramp to the stance), reported.
+        match rig.ask(Request::GetState) {
+            DeviceToHost::Ack { readback, .. } => assert!(
+                readback
+                    .flags
+                    .contains(quad_protocol::Flags::FAILSAFE_ACTIVE),
+                "cut {cut}: the failsafe's action is reported on reconnect"
+            ),
+            other => panic!("GetState: {other:?}"),
+        }
+        let max = 200;
+        let mut n = 0;
+        loop {
+            match rig.ask(Request::GetMotion) {
+                DeviceToHost::MotionAck { status, .. } if status.kind.is_none() => break,
+                DeviceToHost::MotionAck { .. } => {}
+                other => panic!("GetMotion: {other:?}"),
+            }
+            for _ in 0..5 {
+                rig.frame();
+            }
+            n += 1;
+            assert!(n < max, "cut {cut}: the trot did not end");
+        }
+        // Every foot down: the target at the stance, and the pins there.
+        let pulses_half_us = match rig.ask(Request::GetState) {
+            DeviceToHost::Ack { readback, .. } => {
+                assert_eq!(
+                    readback.angles_rad, stance,
+                    "cut {cut}: the trot ended away from the stance"
+                );
+                readback.pulses_half_us
+            }
+            other => panic!("GetState: {other:?}"),
+        };
+        for _ in 0..5 {
+            rig.frame();
+        }
+        let pins = rig.link.next_pulses().expect("runs");
+        // A period watched outside `frame`: the next frame starts a new run.
+        rig.last = None;
+        for (c, pin) in pins.iter().enumerate() {
+            let width_us = pin.expect("the outputs are on").high_us();
+            let readback_us = f64::from(pulses_half_us[c]) / 2.0;
+            assert!(
+                (width_us - readback_us).abs() <= 1.0,
+                "cut {cut}: {:?} pulses {width_us} µs, the stance's {readback_us} µs",
+                ServoId::ALL[c]
+            );
+        }
+    }
+    println!(
+        "link cut at {LINK_CUTS} points of a trot stride: every trot ended at the stance, \
+         {} frames watched, largest joint step {:.4} rad (bound {:.4}), {} late",
+        rig.frames, rig.max_step_rad, rig.max_allowed_rad, rig.late
+    );
+    assert_eq!(rig.late, 0);
+}
