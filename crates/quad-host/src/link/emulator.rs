@@ -170,6 +170,44 @@ pub struct PulseStats {
     pub first_error: Option<String>,
 }
 
+/// The pulses of each channel, one period after another: the largest change of width between
+/// two consecutive periods (the pair, so that a caller can bound it through the channel's
+/// calibration, the pulses' edges known only to a simavr step) and the periods a channel
+/// missed (a pulse more than a period and a half after its last).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PulseSteps {
+    /// Consecutive pulses compared.
+    pub compared: u64,
+    /// Pulses that came more than a period and a half after the channel's last.
+    pub gaps: u64,
+    /// Per channel, the two consecutive pulses with the largest change of width.
+    pub largest: [Option<(Pulse, Pulse)>; 12],
+    /// Per channel, the narrowest and the widest pulse.
+    pub extremes: [Option<(Pulse, Pulse)>; 12],
+}
+
+impl PulseSteps {
+    fn on_pulse(&mut self, last: &Pulse, now: &Pulse) {
+        let e = self.extremes[now.channel].get_or_insert((*now, *now));
+        if now.high_cycles < e.0.high_cycles {
+            e.0 = *now;
+        }
+        if now.high_cycles > e.1.high_cycles {
+            e.1 = *now;
+        }
+        if now.rise_cycle - last.rise_cycle > PERIOD_CYCLES * 3 / 2 {
+            self.gaps += 1;
+            return;
+        }
+        self.compared += 1;
+        let d = now.high_cycles.abs_diff(last.high_cycles);
+        let slot = &mut self.largest[now.channel];
+        if slot.is_none_or(|(a, b)| b.high_cycles.abs_diff(a.high_cycles) < d) {
+            *slot = Some((*last, *now));
+        }
+    }
+}
+
 /// The longest a staged state may wait before the pins show it: a period, the window's last
 /// millisecond in which no apply begins, and the millisecond tick that applies it.
 pub const APPLY_LATENCY: std::time::Duration = std::time::Duration::from_millis(23);
@@ -388,6 +426,7 @@ pub struct EmulatorLink {
     pulses: PulseCheck,
     /// The last complete pulse of each channel.
     last_pulses: [Option<Pulse>; 12],
+    steps: PulseSteps,
     stats: LineStats,
 }
 
@@ -448,6 +487,7 @@ impl EmulatorLink {
             resets_seen: 0,
             pulses: PulseCheck::new(),
             last_pulses: [None; 12],
+            steps: PulseSteps::default(),
             stats: LineStats::default(),
         };
         link.collect();
@@ -498,6 +538,17 @@ impl EmulatorLink {
     pub fn pulse_stats(&mut self) -> PulseStats {
         self.pulses.resolve(true);
         self.pulses.stats.clone()
+    }
+
+    /// The steps between consecutive pulses of each channel since boot (or the last
+    /// [`EmulatorLink::reset_pulse_steps`]).
+    pub fn pulse_steps(&self) -> PulseSteps {
+        self.steps
+    }
+
+    /// Forgets the steps seen so far.
+    pub fn reset_pulse_steps(&mut self) {
+        self.steps = PulseSteps::default();
     }
 
     /// The last complete pulse seen on each channel.
@@ -586,6 +637,9 @@ impl EmulatorLink {
         while let Some(p) = self.mcu.pop_pulse() {
             if let Some(t) = tap.as_deref_mut() {
                 t.push(p);
+            }
+            if let Some(last) = self.last_pulses[p.channel] {
+                self.steps.on_pulse(&last, &p);
             }
             self.last_pulses[p.channel] = Some(p);
             self.pulses.on_pulse(p);
