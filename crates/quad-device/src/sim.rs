@@ -2,13 +2,13 @@
 //! set of device fakes that the host's simulated link, the twin and the tests all use, in the
 //! manner of `embedded-hal-mock`.
 //!
-//! - [`Servos`]: twelve outputs that keep the last pulses written and count the writes;
-//!   [`Servos::logging`] also keeps every write and every enable, and [`Servos::latched`] makes
+//! - [`Outputs`]: twelve outputs that keep the last pulses written and count the writes;
+//!   [`Outputs::logging`] also keeps every write and every enable, and [`Outputs::latched`] makes
 //!   a write wait for the next PWM period of a [`PwmPeriods`] counter, as the firmware's timers
 //!   do.
 //! - [`VirtualClock`]: a clock its owner sets or advances (nanosecond resolution, read by the
 //!   device in wrapping milliseconds); clones share one time.
-//! - [`Eeprom`]: bytes in RAM, erased to `0xFF`, with a power-cut budget on writes and a fault
+//! - [`RamEeprom`]: bytes in RAM, erased to `0xFF`, with a power-cut budget on writes and a fault
 //!   budget on reads.
 //!
 //! What one user needs on top stays with it as a thin wrapper (the host's EEPROM image file,
@@ -21,14 +21,14 @@ use alloc::vec::Vec;
 use core::cell::Cell;
 use core::fmt;
 
-/// Size of the ATmega2560's EEPROM, bytes: the size of [`Eeprom::erased`].
+/// Size of the ATmega2560's EEPROM, bytes: the size of [`RamEeprom::erased`].
 pub const EEPROM_LEN: usize = 4096;
 
 /// Nanoseconds per millisecond.
 const NS_PER_MS: u64 = 1_000_000;
 
 /// The PWM periods begun so far (wrapping), shared between the test or simulator that lets
-/// them pass and the [`Servos::latched`] outputs that latch their writes to them. Clones share
+/// them pass and the [`Outputs::latched`] outputs that latch their writes to them. Clones share
 /// one counter.
 #[derive(Debug, Clone, Default)]
 pub struct PwmPeriods(Rc<Cell<u32>>);
@@ -50,14 +50,14 @@ impl PwmPeriods {
     }
 }
 
-/// Every write and every enable, in order (for [`Servos::logging`]).
+/// Every write and every enable, in order (for [`Outputs::logging`]).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 struct Log {
     writes: Vec<[u16; 12]>,
     enables: Vec<bool>,
 }
 
-/// The latch of [`Servos::latched`]: the periods, and the period of the last write.
+/// The latch of [`Outputs::latched`]: the periods, and the period of the last write.
 #[derive(Debug, Clone, Default)]
 struct Latch {
     periods: PwmPeriods,
@@ -66,12 +66,12 @@ struct Latch {
 
 /// Twelve simulated servo outputs: what is on the pins.
 ///
-/// [`Servos::default`] keeps the state and a count only, in constant memory (a simulator that
-/// runs for hours); [`Servos::logging`] also logs every call, for tests that check the sequence.
+/// [`Outputs::default`] keeps the state and a count only, in constant memory (a simulator that
+/// runs for hours); [`Outputs::logging`] also logs every call, for tests that check the sequence.
 /// Without a latch, the outputs count no PWM periods and the device times its frames by its
 /// clock ([`ServoOutputs::periods_begun`] is `None`).
 #[derive(Debug, Clone, Default)]
-pub struct Servos {
+pub struct Outputs {
     /// True while the outputs are driven.
     pub enabled: bool,
     /// The last pulses written, half-µs (zeros before the first write).
@@ -82,21 +82,21 @@ pub struct Servos {
     latch: Option<Latch>,
 }
 
-impl Servos {
-    /// Outputs that also log every `set_pulses` and `set_enabled` call ([`Servos::writes`],
-    /// [`Servos::enables`]).
-    pub fn logging() -> Servos {
-        Servos {
+impl Outputs {
+    /// Outputs that also log every `set_pulses` and `set_enabled` call ([`Outputs::writes`],
+    /// [`Outputs::enables`]).
+    pub fn logging() -> Outputs {
+        Outputs {
             log: Some(Log::default()),
-            ..Servos::default()
+            ..Outputs::default()
         }
     }
 
     /// These outputs with their writes latched to `periods`, as the firmware's: a write stays
     /// pending for the rest of the period it was made in.
     #[must_use]
-    pub fn latched(self, periods: PwmPeriods) -> Servos {
-        Servos {
+    pub fn latched(self, periods: PwmPeriods) -> Outputs {
+        Outputs {
             latch: Some(Latch {
                 periods,
                 written_in: None,
@@ -108,7 +108,7 @@ impl Servos {
     /// Every `set_pulses` call, in order.
     ///
     /// # Panics
-    /// When the outputs were not made with [`Servos::logging`] (they keep no log).
+    /// When the outputs were not made with [`Outputs::logging`] (they keep no log).
     pub fn writes(&self) -> &[[u16; 12]] {
         &self.log().writes
     }
@@ -116,7 +116,7 @@ impl Servos {
     /// Every `set_enabled` call, in order.
     ///
     /// # Panics
-    /// When the outputs were not made with [`Servos::logging`] (they keep no log).
+    /// When the outputs were not made with [`Outputs::logging`] (they keep no log).
     pub fn enables(&self) -> &[bool] {
         &self.log().enables
     }
@@ -124,11 +124,11 @@ impl Servos {
     fn log(&self) -> &Log {
         self.log
             .as_ref()
-            .expect("these outputs keep no log: make them with Servos::logging()")
+            .expect("these outputs keep no log: make them with Outputs::logging()")
     }
 }
 
-impl ServoOutputs for Servos {
+impl ServoOutputs for Outputs {
     fn set_pulses(&mut self, pulses_half_us: &[u16; 12]) {
         self.pulses_half_us = *pulses_half_us;
         self.write_count += 1;
@@ -224,7 +224,7 @@ impl core::error::Error for EepromError {}
 /// bytes (a write stops at the byte that finds the budget used up and fails, its earlier bytes
 /// written); with `read_budget = Some(n)` the next `n` reads succeed and every later one fails.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Eeprom {
+pub struct RamEeprom {
     /// The bytes.
     pub bytes: Vec<u8>,
     /// Bytes that may still be written before the power fails (`None`: no power cut).
@@ -235,15 +235,15 @@ pub struct Eeprom {
     pub written: usize,
 }
 
-impl Eeprom {
+impl RamEeprom {
     /// An erased EEPROM of [`EEPROM_LEN`] bytes.
-    pub fn erased() -> Eeprom {
-        Eeprom::with_bytes(vec![0xFF; EEPROM_LEN])
+    pub fn erased() -> RamEeprom {
+        RamEeprom::with_bytes(vec![0xFF; EEPROM_LEN])
     }
 
     /// An EEPROM holding `bytes` (its size is theirs), with no faults.
-    pub fn with_bytes(bytes: Vec<u8>) -> Eeprom {
-        Eeprom {
+    pub fn with_bytes(bytes: Vec<u8>) -> RamEeprom {
+        RamEeprom {
             bytes,
             write_budget: None,
             read_budget: None,
@@ -252,13 +252,13 @@ impl Eeprom {
     }
 }
 
-impl Default for Eeprom {
+impl Default for RamEeprom {
     fn default() -> Self {
-        Eeprom::erased()
+        RamEeprom::erased()
     }
 }
 
-impl Storage for Eeprom {
+impl Storage for RamEeprom {
     type Error = EepromError;
 
     fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), EepromError> {
@@ -296,7 +296,7 @@ mod tests {
 
     #[test]
     fn a_power_cut_writes_the_bytes_before_it() {
-        let mut e = Eeprom::erased();
+        let mut e = RamEeprom::erased();
         e.write_budget = Some(2);
         assert_eq!(e.write(10, &[1, 2, 3]), Err(EepromError::PowerCut));
         assert_eq!(&e.bytes[10..13], &[1, 2, 0xFF]);
@@ -306,7 +306,7 @@ mod tests {
 
     #[test]
     fn reads_fail_once_their_budget_is_used() {
-        let mut e = Eeprom::erased();
+        let mut e = RamEeprom::erased();
         e.read_budget = Some(1);
         let mut b = [0u8; 2];
         assert_eq!(e.read(0, &mut b), Ok(()));
@@ -328,7 +328,7 @@ mod tests {
     #[test]
     fn a_latched_write_is_pending_until_the_next_period() {
         let periods = PwmPeriods::starting_at(7);
-        let mut s = Servos::logging().latched(periods.clone());
+        let mut s = Outputs::logging().latched(periods.clone());
         assert_eq!(s.periods_begun(), Some(7));
         assert!(!s.write_pending());
         s.set_pulses(&[3000; 12]);
@@ -336,6 +336,6 @@ mod tests {
         periods.begin();
         assert!(!s.write_pending());
         assert_eq!(s.writes(), &[[3000; 12]]);
-        assert_eq!(Servos::default().periods_begun(), None);
+        assert_eq!(Outputs::default().periods_begun(), None);
     }
 }

@@ -230,7 +230,7 @@ impl Store {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::Eeprom;
+    use crate::sim::RamEeprom;
 
     #[test]
     fn record_round_trip_and_rejects() {
@@ -252,7 +252,7 @@ mod tests {
 
     #[test]
     fn saves_alternate_banks_and_generations_grow() {
-        let mut mem = Eeprom::erased();
+        let mut mem = RamEeprom::erased();
         let mut store = Store::new(0);
         let mut table = [Calibration::STANDARD; 12];
         assert!(!store.load(&mut mem, &mut table));
@@ -271,7 +271,7 @@ mod tests {
 
     #[test]
     fn a_bank_that_fails_on_the_loading_pass_is_not_loaded() {
-        let mut mem = Eeprom::erased();
+        let mut mem = RamEeprom::erased();
         let mut table = [Calibration::STANDARD; 12];
         table[0].center_us = 1400;
         Store::new(0).save(&mut mem, &table).unwrap();

@@ -406,9 +406,9 @@ fn failsafe_case(action: LinkLossAction) -> (Dev, VirtualClock) {
     clock.set_ms(1_000);
     let mut dev = Device::new(
         Config::fernando2025(),
-        Servos::logging(),
+        Outputs::logging(),
         clock.clone(),
-        Eeprom::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
@@ -561,9 +561,9 @@ fn a_refused_calibration_leaves_the_held_pulses_as_they_were() {
     let clock = VirtualClock::default();
     let mut dev = Device::new(
         Config::fernando2025(),
-        Servos::logging(),
+        Outputs::logging(),
         clock.clone(),
-        Eeprom::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
@@ -629,7 +629,7 @@ fn saved_calibration_survives_a_power_cycle() {
         .contains(Flags::CALIBRATION_UNSAVED | Flags::CALIBRATION_DEFAULT));
     let table = *dev.calibration();
     let (_, clock, storage) = dev.into_parts();
-    let mut dev2 = Device::new(Config::fernando2025(), Servos::logging(), clock, storage).unwrap();
+    let mut dev2 = Device::new(Config::fernando2025(), Outputs::logging(), clock, storage).unwrap();
     assert_eq!(dev2.calibration(), &table);
     let rb = ack(ask(&mut dev2, 3, Request::GetState));
     assert!(!rb.flags.contains(Flags::CALIBRATION_DEFAULT));
@@ -637,11 +637,11 @@ fn saved_calibration_survives_a_power_cycle() {
 
 #[test]
 fn a_failing_storage_is_nacked_and_keeps_the_ram_table() {
-    let mut mem = Eeprom::erased();
+    let mut mem = RamEeprom::erased();
     mem.write_budget = Some(3);
     let mut dev = Device::new(
         Config::fernando2025(),
-        Servos::logging(),
+        Outputs::logging(),
         VirtualClock::default(),
         mem,
     )
@@ -660,11 +660,11 @@ fn a_failing_storage_is_nacked_and_keeps_the_ram_table() {
 #[test]
 fn readback_angles_are_finite_and_zero_when_nothing_is_held() {
     // A calibration whose travel excludes the stance: nothing is held at power-on.
-    let mut mem = Eeprom::erased();
+    let mut mem = RamEeprom::erased();
     {
         let mut dev = Device::new(
             Config::fernando2025(),
-            Servos::logging(),
+            Outputs::logging(),
             VirtualClock::default(),
             &mut mem,
         )
@@ -715,7 +715,7 @@ fn readback_angles_are_finite_and_zero_when_nothing_is_held() {
     }
     let mut dev = Device::new(
         Config::fernando2025(),
-        Servos::logging(),
+        Outputs::logging(),
         VirtualClock::default(),
         mem,
     )
@@ -905,9 +905,9 @@ fn nacks_of_unreadable_frames_are_rate_limited() {
     let clock = VirtualClock::default();
     let mut dev = Device::new(
         Config::fernando2025(),
-        Servos::logging(),
+        Outputs::logging(),
         clock.clone(),
-        Eeprom::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
@@ -949,9 +949,9 @@ fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
     let config = Config::fernando2025();
     let mut dev = Device::new(
         config,
-        Servos::logging().latched(periods.clone()),
+        Outputs::logging().latched(periods.clone()),
         VirtualClock::default(),
-        Eeprom::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);

@@ -34,7 +34,13 @@ impl Rig {
     fn new(config: Config) -> Rig {
         let clock = VirtualClock::default();
         clock.set_ms(1_000);
-        let dev = Device::new(config, Servos::logging(), clock.clone(), Eeprom::erased()).unwrap();
+        let dev = Device::new(
+            config,
+            Outputs::logging(),
+            clock.clone(),
+            RamEeprom::erased(),
+        )
+        .unwrap();
         Rig {
             dev,
             clock,

@@ -19,9 +19,9 @@ fn rig() -> (Dev, VirtualClock) {
     clock.set_ms(1_000);
     let mut dev = Device::new(
         Config::fernando2025(),
-        Servos::logging(),
+        Outputs::logging(),
         clock.clone(),
-        Eeprom::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);

@@ -6,7 +6,7 @@
 #![cfg(unix)]
 
 use kin_core::body::Pose;
-use quad_device::sim::{Eeprom, Servos, VirtualClock};
+use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
 use quad_device::{Config, Device};
 use quad_host::client::{
     AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
@@ -27,9 +27,9 @@ fn serve(mut master: TTYPort, stop: Arc<AtomicBool>) {
     let clock = VirtualClock::default();
     let mut device: Device<_, _, _> = Device::new(
         Config::fernando2025(),
-        Servos::default(),
+        Outputs::default(),
         &clock,
-        Eeprom::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     let wall = || clock.set_ns(start.elapsed().as_nanos() as u64);

@@ -2,7 +2,7 @@
 //! in-memory fakes (`quad_device::sim`): an erased EEPROM, a clock the loop advances by one
 //! servo frame at a time, outputs that keep the last pulses.
 
-use quad_device::sim::{Eeprom, Servos, VirtualClock};
+use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
 use quad_device::{Config, ConfigError, Device};
 use quad_protocol::servo::Error as ServoError;
 use quad_protocol::{DeviceToHost, HostToDevice, NackReason, Request, ServoId, PROTOCOL_VERSION};
@@ -45,7 +45,7 @@ impl std::error::Error for DeviceError {}
 /// The device controller in this process, powered on, its outputs enabled: requests at message
 /// level, its clock advanced one frame at a time by the loop.
 pub struct InProcess {
-    device: Device<Servos, VirtualClock, Eeprom>,
+    device: Device<Outputs, VirtualClock, RamEeprom>,
     clock: VirtualClock,
     seq: u16,
 }
@@ -58,8 +58,13 @@ impl InProcess {
     /// [`DeviceError`].
     pub fn start(config: Config) -> Result<InProcess, DeviceError> {
         let clock = VirtualClock::default();
-        let device = Device::new(config, Servos::default(), clock.clone(), Eeprom::erased())
-            .map_err(DeviceError::Config)?;
+        let device = Device::new(
+            config,
+            Outputs::default(),
+            clock.clone(),
+            RamEeprom::erased(),
+        )
+        .map_err(DeviceError::Config)?;
         let mut d = InProcess {
             device,
             clock,
@@ -98,7 +103,7 @@ impl InProcess {
     }
 
     /// The outputs now.
-    pub fn outputs(&self) -> &Servos {
+    pub fn outputs(&self) -> &Outputs {
         self.device.outputs()
     }
 

@@ -3,21 +3,21 @@
 
 #![allow(dead_code)]
 
-pub use quad_device::sim::{Eeprom, Servos, VirtualClock};
+pub use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
 use quad_device::{Clock, Config, Device, ServoOutputs, Storage};
 use quad_protocol::{
     encode_frame, Accumulator, DeviceToHost, Feed, HostToDevice, Request, MAX_DECODED_LEN,
     MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 
-pub type Dev = Device<Servos, VirtualClock, Eeprom>;
+pub type Dev = Device<Outputs, VirtualClock, RamEeprom>;
 
 pub fn device(config: Config) -> Dev {
     Device::new(
         config,
-        Servos::logging(),
+        Outputs::logging(),
         VirtualClock::default(),
-        Eeprom::erased(),
+        RamEeprom::erased(),
     )
     .unwrap()
 }

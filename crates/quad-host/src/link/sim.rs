@@ -32,7 +32,7 @@
 
 use super::{byte_time, Error, Faults, LineStats, Link};
 use kin_core::DefaultMath;
-use quad_device::sim::{Eeprom, EepromError, Servos, VirtualClock, EEPROM_LEN};
+use quad_device::sim::{EepromError, Outputs, RamEeprom, VirtualClock, EEPROM_LEN};
 use quad_device::{Config, ConfigError, Device, Storage};
 use std::collections::VecDeque;
 use std::fmt;
@@ -49,7 +49,7 @@ use seeded_rng::SplitMix64;
 #[non_exhaustive]
 pub enum ImageError {
     /// The in-memory EEPROM refused the access (out of range).
-    Eeprom(EepromError),
+    RamEeprom(EepromError),
     /// The image file could not be written.
     File(std::io::Error),
 }
@@ -57,7 +57,7 @@ pub enum ImageError {
 impl fmt::Display for ImageError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            ImageError::Eeprom(e) => write!(f, "{e}"),
+            ImageError::RamEeprom(e) => write!(f, "{e}"),
             ImageError::File(e) => write!(f, "EEPROM image file: {e}"),
         }
     }
@@ -65,12 +65,12 @@ impl fmt::Display for ImageError {
 
 impl std::error::Error for ImageError {}
 
-/// The simulated device's EEPROM: the shared in-memory [`Eeprom`], erased or loaded from an
+/// The simulated device's EEPROM: the shared in-memory [`RamEeprom`], erased or loaded from an
 /// image file that every write updates, so that a calibration saved in one run is there in the
 /// next.
 #[derive(Debug, Clone)]
 pub struct EepromImage {
-    eeprom: Eeprom,
+    eeprom: RamEeprom,
     file: Option<PathBuf>,
 }
 
@@ -78,7 +78,7 @@ impl EepromImage {
     /// An erased EEPROM, in memory only.
     pub fn erased() -> EepromImage {
         EepromImage {
-            eeprom: Eeprom::erased(),
+            eeprom: RamEeprom::erased(),
             file: None,
         }
     }
@@ -96,13 +96,13 @@ impl EepromImage {
         };
         bytes.resize(EEPROM_LEN, 0xFF);
         Ok(EepromImage {
-            eeprom: Eeprom::with_bytes(bytes),
+            eeprom: RamEeprom::with_bytes(bytes),
             file: Some(path),
         })
     }
 
     /// The EEPROM's bytes.
-    pub fn eeprom(&self) -> &Eeprom {
+    pub fn eeprom(&self) -> &RamEeprom {
         &self.eeprom
     }
 }
@@ -111,11 +111,13 @@ impl Storage for EepromImage {
     type Error = ImageError;
 
     fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), ImageError> {
-        self.eeprom.read(addr, buf).map_err(ImageError::Eeprom)
+        self.eeprom.read(addr, buf).map_err(ImageError::RamEeprom)
     }
 
     fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), ImageError> {
-        self.eeprom.write(addr, data).map_err(ImageError::Eeprom)?;
+        self.eeprom
+            .write(addr, data)
+            .map_err(ImageError::RamEeprom)?;
         if let Some(path) = &self.file {
             std::fs::write(path, &self.eeprom.bytes).map_err(ImageError::File)?;
         }
@@ -125,7 +127,7 @@ impl Storage for EepromImage {
 
 /// The device as simulated: host math backend, the shared in-memory outputs and clock, the
 /// EEPROM image.
-type Simulated = Device<Servos, VirtualClock, EepromImage, DefaultMath>;
+type Simulated = Device<Outputs, VirtualClock, EepromImage, DefaultMath>;
 
 /// Line and device parameters of a [`SimLink`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -219,7 +221,7 @@ impl SimLink {
         storage: EepromImage,
     ) -> Result<SimLink, ConfigError> {
         let clock = VirtualClock::default();
-        let device = Device::new(device_config, Servos::default(), clock.clone(), storage)?;
+        let device = Device::new(device_config, Outputs::default(), clock.clone(), storage)?;
         Ok(SimLink {
             config,
             device_config,
@@ -237,7 +239,7 @@ impl SimLink {
     }
 
     /// The simulated device, for inspection.
-    pub fn device(&self) -> &Device<Servos, VirtualClock, EepromImage, DefaultMath> {
+    pub fn device(&self) -> &Device<Outputs, VirtualClock, EepromImage, DefaultMath> {
         &self.device
     }
 
@@ -249,13 +251,13 @@ impl SimLink {
     pub fn reset_device(&mut self) -> Result<(), ConfigError> {
         let placeholder = Device::new(
             self.device_config,
-            Servos::default(),
+            Outputs::default(),
             VirtualClock::default(),
             EepromImage::erased(),
         )?;
         let old = std::mem::replace(&mut self.device, placeholder);
         let (_, clock, storage) = old.into_parts();
-        self.device = Device::new(self.device_config, Servos::default(), clock, storage)?;
+        self.device = Device::new(self.device_config, Outputs::default(), clock, storage)?;
         self.fifo.clear();
         Ok(())
     }
