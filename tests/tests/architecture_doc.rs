@@ -335,10 +335,7 @@ fn code_paths(span: &str) -> Vec<Vec<String>> {
         let glued = rest[..start].ends_with(|c: char| c.is_ascii_digit());
         rest = &rest[start..];
         let mut path = Vec::new();
-        loop {
-            let Some(name) = leading_ident(rest) else {
-                break;
-            };
+        while let Some(name) = leading_ident(rest) {
             path.push(name.to_owned());
             rest = &rest[name.len()..];
             match rest.strip_prefix("::") {
