@@ -23,6 +23,8 @@
 //! - [`config`]: the robot preset, pose interpretation and failsafe at power-on, and the default
 //!   servo calibration.
 //! - [`store`]: the calibration table in storage, two banks with a generation counter and a CRC.
+//! - `sim` (feature `sim`, needs `alloc`): in-memory servo outputs, clock and EEPROM, the one set
+//!   of fakes the host's simulated link, the twin and the tests use.
 //!
 //! ## Firmware sketch
 //!
@@ -52,10 +54,15 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "sim")]
+extern crate alloc;
+
 pub mod config;
 pub mod device;
 pub mod engine;
 pub mod hal;
+#[cfg(feature = "sim")]
+pub mod sim;
 pub mod store;
 
 pub use config::{default_calibration, Config, ConfigError, ValidConfig};

@@ -230,25 +230,7 @@ impl Store {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct Mem([u8; STORAGE_LEN as usize]);
-
-    impl Storage for Mem {
-        type Error = ();
-        fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), ()> {
-            let a = addr as usize;
-            buf.copy_from_slice(self.0.get(a..a + buf.len()).ok_or(())?);
-            Ok(())
-        }
-        fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), ()> {
-            let a = addr as usize;
-            self.0
-                .get_mut(a..a + data.len())
-                .ok_or(())?
-                .copy_from_slice(data);
-            Ok(())
-        }
-    }
+    use crate::sim::RamEeprom;
 
     #[test]
     fn record_round_trip_and_rejects() {
@@ -270,7 +252,7 @@ mod tests {
 
     #[test]
     fn saves_alternate_banks_and_generations_grow() {
-        let mut mem = Mem([0xFF; STORAGE_LEN as usize]);
+        let mut mem = RamEeprom::erased();
         let mut store = Store::new(0);
         let mut table = [Calibration::STANDARD; 12];
         assert!(!store.load(&mut mem, &mut table));
@@ -287,40 +269,21 @@ mod tests {
         }
     }
 
-    /// Storage whose reads fail once `reads_left` is used up.
-    struct Flaky {
-        mem: Mem,
-        reads_left: usize,
-    }
-
-    impl Storage for Flaky {
-        type Error = ();
-        fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), ()> {
-            self.reads_left = self.reads_left.checked_sub(1).ok_or(())?;
-            self.mem.read(addr, buf)
-        }
-        fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), ()> {
-            self.mem.write(addr, data)
-        }
-    }
-
     #[test]
     fn a_bank_that_fails_on_the_loading_pass_is_not_loaded() {
-        let mut mem = Mem([0xFF; STORAGE_LEN as usize]);
+        let mut mem = RamEeprom::erased();
         let mut table = [Calibration::STANDARD; 12];
         table[0].center_us = 1400;
         Store::new(0).save(&mut mem, &table).unwrap();
         // A pass over a valid bank reads the header, twelve records and the CRC; over the
         // erased bank B only the header. Then the loading pass fails after three records.
-        let mut flaky = Flaky {
-            mem,
-            reads_left: 14 + 1 + 4,
-        };
+        let mut flaky = mem;
+        flaky.read_budget = Some(14 + 1 + 4);
         let mut store = Store::new(0);
         let mut back = [Calibration::STANDARD; 12];
         assert!(!store.load(&mut flaky, &mut back));
         assert_eq!(store.active(), None);
-        flaky.reads_left = usize::MAX;
+        flaky.read_budget = None;
         assert!(store.load(&mut flaky, &mut back));
         assert_eq!(back, table);
     }

@@ -31,7 +31,7 @@ fn ready() -> Dev {
 /// without a sequence number (as many as `expected`), and the good frame is answered.
 fn check_bad(bad: &[u8], expected: &[NackReason]) {
     let mut dev = ready();
-    let writes = dev.outputs().writes.clone();
+    let writes = dev.outputs().writes().to_vec();
     let before = dev.readback();
     let answers = feed(&mut dev, bad);
     let after = feed(&mut dev, &frame(42, Request::GetState));
@@ -57,7 +57,7 @@ fn check_bad(bad: &[u8], expected: &[NackReason]) {
         }
         other => panic!("good frame got {other:?}"),
     }
-    assert_eq!(dev.outputs().writes, writes, "nothing moved");
+    assert_eq!(dev.outputs().writes(), writes, "nothing moved");
     assert!(dev.outputs().enabled);
 }
 
@@ -83,7 +83,7 @@ fn a_truncated_frame_is_nacked_and_the_next_one_works() {
     for cut in 2..f.len() - 1 {
         // A cut frame is either broken COBS or too short (BadFrame), or has a wrong CRC.
         let mut dev = ready();
-        let writes = dev.outputs().writes.clone();
+        let writes = dev.outputs().writes().to_vec();
         let mut wire = f[..cut].to_vec();
         wire.extend(frame(8, Request::GetState));
         let answers = feed(&mut dev, &wire);
@@ -100,7 +100,7 @@ fn a_truncated_frame_is_nacked_and_the_next_one_works() {
             answers[0]
         );
         assert!(matches!(answers[1], DeviceToHost::Ack { seq: 8, .. }));
-        assert_eq!(dev.outputs().writes, writes);
+        assert_eq!(dev.outputs().writes(), writes);
     }
 }
 
@@ -124,7 +124,7 @@ fn a_wrong_crc_is_nacked_for_every_bit() {
                 continue; // a new delimiter: two frames, covered by the fuzz tests
             }
             let mut dev = ready();
-            let writes = dev.outputs().writes.clone();
+            let writes = dev.outputs().writes().to_vec();
             let answers = feed(&mut dev, &bad);
             assert_eq!(answers.len(), 1);
             assert!(
@@ -138,7 +138,7 @@ fn a_wrong_crc_is_nacked_for_every_bit() {
                 "byte {i} bit {bit}: {:?}",
                 answers[0]
             );
-            assert_eq!(dev.outputs().writes, writes);
+            assert_eq!(dev.outputs().writes(), writes);
         }
     }
 }
@@ -291,7 +291,7 @@ fn run_stream(stream: &[u8]) -> usize {
                 }
             }
         }
-        let writes = &dev.outputs().writes;
+        let writes = &dev.outputs().writes();
         for w in &writes[checked..] {
             for (i, &p) in w.iter().enumerate() {
                 let c = dev.calibration()[i];
@@ -303,7 +303,7 @@ fn run_stream(stream: &[u8]) -> usize {
         }
         checked = writes.len();
         t += 1;
-        dev.clock().set(t);
+        dev.clock().set_ms(t);
         dev.poll();
     }
     let answers = feed(&mut dev, &frame(0xBEEF, Request::GetState));

@@ -6,6 +6,7 @@ use common::*;
 use kin_core::body::{self, Pose};
 use kin_core::{BodyConfig, Joint, LegId, ReachPolicy, Vec3};
 use quad_device::config::DEFAULT_CENTER_US;
+use quad_device::sim::PwmPeriods;
 use quad_device::{Config, Device};
 use quad_protocol::servo::{self, Calibration};
 use quad_protocol::{
@@ -57,19 +58,19 @@ const POSE: Pose = Pose {
 #[test]
 fn outputs_start_disabled_and_nothing_is_written_until_enabled() {
     let mut dev = device(Config::fernando2025());
-    assert_eq!(dev.outputs().enables, [false]);
-    assert!(dev.outputs().writes.is_empty());
+    assert_eq!(dev.outputs().enables(), [false]);
+    assert!(dev.outputs().writes().is_empty());
     hello(&mut dev);
     let rb = ack(ask(&mut dev, 1, Request::SetBodyPose(POSE)));
     assert!(!rb.flags.contains(Flags::OUTPUTS_ENABLED));
     assert_eq!(rb.pulses_half_us, [0; 12], "stopped outputs read back as 0");
-    assert!(dev.outputs().writes.is_empty(), "no write while stopped");
+    assert!(dev.outputs().writes().is_empty(), "no write while stopped");
     let rb = ack(ask(&mut dev, 2, Request::SetOutputs { enabled: true }));
     assert!(rb.flags.contains(Flags::OUTPUTS_ENABLED));
-    assert_eq!(dev.outputs().enables, [false, true]);
+    assert_eq!(dev.outputs().enables(), [false, true]);
     // Enabling starts from the target held while stopped.
-    assert_eq!(dev.outputs().writes.len(), 1);
-    assert_eq!(dev.outputs().writes[0], rb.pulses_half_us);
+    assert_eq!(dev.outputs().writes().len(), 1);
+    assert_eq!(dev.outputs().writes()[0], rb.pulses_half_us);
     assert_eq!(rb.angles_rad, expected_angles(dev.config(), &POSE));
 }
 
@@ -107,7 +108,7 @@ fn requests_before_hello_are_refused_except_reads() {
         ask(&mut dev, 6, Request::GetCalibration { servo: ServoId::ALL[4] }),
         DeviceToHost::Calibration { servo, .. } if servo == ServoId::ALL[4]
     ));
-    assert!(dev.outputs().writes.is_empty() && !dev.outputs_enabled());
+    assert!(dev.outputs().writes().is_empty() && !dev.outputs_enabled());
 }
 
 #[test]
@@ -149,7 +150,7 @@ fn body_pose_readback_is_kin_core_and_the_calibration_mapping() {
                 dev.calibration()[i].pulse_half_us(w)
             );
         }
-        assert_eq!(dev.outputs().writes.last(), Some(&rb.pulses_half_us));
+        assert_eq!(dev.outputs().writes().last(), Some(&rb.pulses_half_us));
         assert!(!rb.flags.contains(Flags::CLAMPED));
         assert_writes_in_travel(&dev);
     }
@@ -189,7 +190,7 @@ fn set_joints_bypasses_the_ik_but_not_the_limits() {
     let mut dev = device(config);
     hello(&mut dev);
     ack(ask(&mut dev, 1, Request::SetOutputs { enabled: true }));
-    let before = *dev.outputs().writes.last().unwrap();
+    let before = *dev.outputs().writes().last().unwrap();
     let mut q = expected_angles(&config, &Pose::default());
     q[4] += 0.1;
     let rb = ack(ask(&mut dev, 2, Request::SetJoints { angles_rad: q }));
@@ -213,7 +214,7 @@ fn set_joints_bypasses_the_ik_but_not_the_limits() {
     let rb2 = ack(ask(&mut dev, 5, Request::GetState));
     assert_eq!(rb2.angles_rad, q, "refused requests moved nothing");
     assert_ne!(before, rb.pulses_half_us);
-    assert_eq!(dev.outputs().writes.len(), 2);
+    assert_eq!(dev.outputs().writes().len(), 2);
 }
 
 #[test]
@@ -223,7 +224,7 @@ fn invalid_or_unreachable_requests_move_nothing() {
     hello(&mut dev);
     ack(ask(&mut dev, 1, Request::SetOutputs { enabled: true }));
     let good = ack(ask(&mut dev, 2, Request::SetBodyPose(POSE)));
-    let writes = dev.outputs().writes.len();
+    let writes = dev.outputs().writes().len();
     let cases = [
         (
             Pose {
@@ -284,7 +285,7 @@ fn invalid_or_unreachable_requests_move_nothing() {
             calibration: narrow,
         },
     ));
-    let writes_after_cal = dev.outputs().writes.len();
+    let writes_after_cal = dev.outputs().writes().len();
     assert_eq!(
         writes_after_cal,
         writes + 1,
@@ -304,7 +305,7 @@ fn invalid_or_unreachable_requests_move_nothing() {
         ),
         "{reason:?}"
     );
-    assert_eq!(dev.outputs().writes.len(), writes_after_cal);
+    assert_eq!(dev.outputs().writes().len(), writes_after_cal);
     let rb = ack(ask(&mut dev, 22, Request::GetState));
     assert_eq!(rb.angles_rad, good.angles_rad);
     assert_writes_in_travel(&dev);
@@ -395,19 +396,19 @@ fn the_latest_valid_setpoint_wins() {
     let last = expected_angles(&config, &poses[3]);
     let rb = ack(ask(&mut dev, 30, Request::GetState));
     assert_eq!(rb.angles_rad, last);
-    assert_eq!(dev.outputs().writes.last(), Some(&rb.pulses_half_us));
+    assert_eq!(dev.outputs().writes().last(), Some(&rb.pulses_half_us));
     // One write per accepted pose (plus the enable), none for the refused one.
-    assert_eq!(dev.outputs().writes.len(), 1 + 4);
+    assert_eq!(dev.outputs().writes().len(), 1 + 4);
 }
 
-fn failsafe_case(action: LinkLossAction) -> (Dev, TestClock) {
-    let clock = TestClock::default();
-    clock.set(1_000);
+fn failsafe_case(action: LinkLossAction) -> (Dev, VirtualClock) {
+    let clock = VirtualClock::default();
+    clock.set_ms(1_000);
     let mut dev = Device::new(
         Config::fernando2025(),
-        Outputs::default(),
+        Outputs::logging(),
         clock.clone(),
-        Mem::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
@@ -427,10 +428,10 @@ fn failsafe_case(action: LinkLossAction) -> (Dev, TestClock) {
 #[test]
 fn link_loss_disables_the_outputs_when_configured() {
     let (mut dev, clock) = failsafe_case(LinkLossAction::Disable);
-    clock.set(1_199);
+    clock.set_ms(1_199);
     dev.poll();
     assert!(dev.outputs_enabled(), "not before the timeout");
-    clock.set(1_200);
+    clock.set_ms(1_200);
     dev.poll();
     assert!(!dev.outputs_enabled() && !dev.outputs().enabled);
     let rb = ack(ask(&mut dev, 4, Request::GetState));
@@ -448,11 +449,11 @@ fn link_loss_disables_the_outputs_when_configured() {
 #[test]
 fn link_loss_holds_the_pose_when_configured() {
     let (mut dev, clock) = failsafe_case(LinkLossAction::Hold);
-    let writes = dev.outputs().writes.clone();
-    clock.set(5_000);
+    let writes = dev.outputs().writes().to_vec();
+    clock.set_ms(5_000);
     dev.poll();
     assert!(dev.outputs_enabled() && dev.outputs().enabled);
-    assert_eq!(dev.outputs().writes, writes, "holding writes nothing new");
+    assert_eq!(dev.outputs().writes(), writes, "holding writes nothing new");
     let rb = ack(ask(&mut dev, 4, Request::GetState));
     assert!(rb
         .flags
@@ -464,7 +465,7 @@ fn link_loss_holds_the_pose_when_configured() {
 fn frames_keep_the_link_alive_and_timeout_zero_never_fires() {
     let (mut dev, clock) = failsafe_case(LinkLossAction::Disable);
     for t in (1_000..3_000).step_by(150) {
-        clock.set(t);
+        clock.set_ms(t);
         ack(ask(&mut dev, 7, Request::GetState));
         dev.poll();
         assert!(dev.outputs_enabled(), "at {t} ms");
@@ -477,7 +478,7 @@ fn frames_keep_the_link_alive_and_timeout_zero_never_fires() {
             action: LinkLossAction::Disable,
         }),
     ));
-    clock.set(u32::MAX);
+    clock.set_ms(u32::MAX);
     dev.poll();
     assert!(dev.outputs_enabled());
 }
@@ -545,7 +546,7 @@ fn calibration_changes_are_checked_against_the_held_angle() {
     ));
     assert_eq!(rb.pulses_half_us[s.index()], 3040);
     assert!(rb.flags.contains(Flags::CALIBRATION_UNSAVED));
-    assert_eq!(dev.outputs().writes.last(), Some(&rb.pulses_half_us));
+    assert_eq!(dev.outputs().writes().last(), Some(&rb.pulses_half_us));
     match ask(&mut dev, 5, Request::GetCalibration { servo: s }) {
         DeviceToHost::Calibration { calibration, .. } => assert_eq!(calibration, trimmed),
         other => panic!("{other:?}"),
@@ -557,17 +558,17 @@ fn calibration_changes_are_checked_against_the_held_angle() {
 fn a_refused_calibration_leaves_the_held_pulses_as_they_were() {
     // The outputs on their way to a new knee target: a travel that admits the target but not
     // where the output is now is refused, and the readback's pulses stay the old mapping's.
-    let clock = TestClock::default();
+    let clock = VirtualClock::default();
     let mut dev = Device::new(
         Config::fernando2025(),
-        Outputs::default(),
+        Outputs::logging(),
         clock.clone(),
-        Mem::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
     ack(ask(&mut dev, 1, Request::SetOutputs { enabled: true }));
-    clock.set(25); // Past the enabling frame: new targets go through the limiter.
+    clock.set_ms(25); // Past the enabling frame: new targets go through the limiter.
     dev.poll();
     let s = ServoId {
         leg: LegId::RR,
@@ -628,7 +629,7 @@ fn saved_calibration_survives_a_power_cycle() {
         .contains(Flags::CALIBRATION_UNSAVED | Flags::CALIBRATION_DEFAULT));
     let table = *dev.calibration();
     let (_, clock, storage) = dev.into_parts();
-    let mut dev2 = Device::new(Config::fernando2025(), Outputs::default(), clock, storage).unwrap();
+    let mut dev2 = Device::new(Config::fernando2025(), Outputs::logging(), clock, storage).unwrap();
     assert_eq!(dev2.calibration(), &table);
     let rb = ack(ask(&mut dev2, 3, Request::GetState));
     assert!(!rb.flags.contains(Flags::CALIBRATION_DEFAULT));
@@ -636,12 +637,12 @@ fn saved_calibration_survives_a_power_cycle() {
 
 #[test]
 fn a_failing_storage_is_nacked_and_keeps_the_ram_table() {
-    let mut mem = Mem::erased();
-    mem.budget = Some(3);
+    let mut mem = RamEeprom::erased();
+    mem.write_budget = Some(3);
     let mut dev = Device::new(
         Config::fernando2025(),
-        Outputs::default(),
-        TestClock::default(),
+        Outputs::logging(),
+        VirtualClock::default(),
         mem,
     )
     .unwrap();
@@ -659,12 +660,12 @@ fn a_failing_storage_is_nacked_and_keeps_the_ram_table() {
 #[test]
 fn readback_angles_are_finite_and_zero_when_nothing_is_held() {
     // A calibration whose travel excludes the stance: nothing is held at power-on.
-    let mut mem = Mem::erased();
+    let mut mem = RamEeprom::erased();
     {
         let mut dev = Device::new(
             Config::fernando2025(),
-            Outputs::default(),
-            TestClock::default(),
+            Outputs::logging(),
+            VirtualClock::default(),
             &mut mem,
         )
         .unwrap();
@@ -714,8 +715,8 @@ fn readback_angles_are_finite_and_zero_when_nothing_is_held() {
     }
     let mut dev = Device::new(
         Config::fernando2025(),
-        Outputs::default(),
-        TestClock::default(),
+        Outputs::logging(),
+        VirtualClock::default(),
         mem,
     )
     .unwrap();
@@ -726,7 +727,7 @@ fn readback_angles_are_finite_and_zero_when_nothing_is_held() {
         nack_reason(ask(&mut dev, 2, Request::SetOutputs { enabled: true })),
         NackReason::InvalidArgument
     );
-    assert!(dev.outputs().writes.is_empty() && !dev.outputs().enabled);
+    assert!(dev.outputs().writes().is_empty() && !dev.outputs().enabled);
 }
 
 #[test]
@@ -786,7 +787,7 @@ fn finite_values_out_of_range_are_named_and_move_nothing() {
     hello(&mut dev);
     ack(ask(&mut dev, 1, Request::SetOutputs { enabled: true }));
     let before = ack(ask(&mut dev, 2, Request::SetBodyPose(POSE)));
-    let writes = dev.outputs().writes.len();
+    let writes = dev.outputs().writes().len();
     let cases = [
         (
             Request::SetBodyPose(Pose {
@@ -851,14 +852,14 @@ fn finite_values_out_of_range_are_named_and_move_nothing() {
     }
     let after = ack(ask(&mut dev, 20, Request::GetState));
     assert_eq!(after.angles_rad, before.angles_rad);
-    assert_eq!(dev.outputs().writes.len(), writes);
+    assert_eq!(dev.outputs().writes().len(), writes);
     assert_eq!(dev.config().pose_config, Config::fernando2025().pose_config);
 }
 
 #[test]
 fn the_failsafe_flag_is_latched_until_an_answer_reports_it() {
     let (mut dev, clock) = failsafe_case(LinkLossAction::Hold);
-    clock.set(5_000);
+    clock.set_ms(5_000);
     dev.poll();
     // Answers without a readback do not clear it.
     assert!(matches!(
@@ -901,12 +902,12 @@ fn the_failsafe_flag_is_latched_until_an_answer_reports_it() {
 
 #[test]
 fn nacks_of_unreadable_frames_are_rate_limited() {
-    let clock = TestClock::default();
+    let clock = VirtualClock::default();
     let mut dev = Device::new(
         Config::fernando2025(),
-        Outputs::default(),
+        Outputs::logging(),
         clock.clone(),
-        Mem::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
@@ -931,33 +932,10 @@ fn nacks_of_unreadable_frames_are_rate_limited() {
     };
     assert_eq!(readback.frames_bad, 50);
     // Within the interval: counted only; after it, answered again.
-    clock.set(quad_device::device::FRAMING_NACK_INTERVAL_MS - 1);
+    clock.set_ms(quad_device::device::FRAMING_NACK_INTERVAL_MS - 1);
     assert!(feed(&mut dev, &garbage).is_empty());
-    clock.set(quad_device::device::FRAMING_NACK_INTERVAL_MS);
+    clock.set_ms(quad_device::device::FRAMING_NACK_INTERVAL_MS);
     assert_eq!(feed(&mut dev, &garbage).len(), 1);
-}
-
-/// Outputs whose writes the PWM periods latch, as the firmware's: a write stays pending for the
-/// rest of the period it was made in.
-#[derive(Default)]
-struct Latched {
-    period: std::rc::Rc<std::cell::Cell<u32>>,
-    written_in: Option<u32>,
-    writes: Vec<[u16; 12]>,
-}
-
-impl quad_device::ServoOutputs for Latched {
-    fn set_pulses(&mut self, pulses_half_us: &[u16; 12]) {
-        self.writes.push(*pulses_half_us);
-        self.written_in = Some(self.period.get());
-    }
-    fn set_enabled(&mut self, _enabled: bool) {}
-    fn periods_begun(&self) -> Option<u32> {
-        Some(self.period.get())
-    }
-    fn write_pending(&self) -> bool {
-        self.written_in == Some(self.period.get())
-    }
 }
 
 /// A host that sends a new, distant target early in every PWM period (each request's write is
@@ -967,16 +945,13 @@ impl quad_device::ServoOutputs for Latched {
 /// never ran while a write was pending, and every target was written at once.)
 #[test]
 fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
-    let period = std::rc::Rc::new(std::cell::Cell::new(100u32));
+    let periods = PwmPeriods::starting_at(100);
     let config = Config::fernando2025();
     let mut dev = Device::new(
         config,
-        Latched {
-            period: period.clone(),
-            ..Latched::default()
-        },
-        TestClock::default(),
-        Mem::erased(),
+        Outputs::logging().latched(periods.clone()),
+        VirtualClock::default(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
@@ -992,11 +967,11 @@ fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
         .fold(0.0f32, f32::max);
     let bound_half_us = 2.0 * gain * config.joint_speed_limit_rad_s * 0.02 + 1.0;
     for k in 1..40 {
-        period.set(period.get() + 1);
+        periods.begin();
         ack(ask(&mut dev, 2 + k as u16, Request::SetBodyPose(pose(k))));
         dev.poll();
     }
-    let writes = &dev.outputs().writes;
+    let writes = &dev.outputs().writes();
     assert!(writes.len() > 10, "{} writes", writes.len());
     for (w, pair) in writes.windows(2).enumerate() {
         for (ch, (&a, &b)) in pair[0].iter().zip(&pair[1]).enumerate() {

@@ -24,7 +24,7 @@ const MAX_FRAMES: u32 = 20_000;
 
 struct Rig {
     dev: Dev,
-    clock: TestClock,
+    clock: VirtualClock,
     /// Largest output change in one frame seen, rad.
     max_step_rad: f32,
     frames: u32,
@@ -32,9 +32,15 @@ struct Rig {
 
 impl Rig {
     fn new(config: Config) -> Rig {
-        let clock = TestClock::default();
-        clock.set(1_000);
-        let dev = Device::new(config, Outputs::default(), clock.clone(), Mem::erased()).unwrap();
+        let clock = VirtualClock::default();
+        clock.set_ms(1_000);
+        let dev = Device::new(
+            config,
+            Outputs::logging(),
+            clock.clone(),
+            RamEeprom::erased(),
+        )
+        .unwrap();
         Rig {
             dev,
             clock,
@@ -50,7 +56,7 @@ impl Rig {
     /// One frame: the clock 20 ms on, one poll; checks the step of every output.
     fn frame(&mut self) {
         let before = self.dev.output_angles().copied();
-        self.clock.set(self.clock.0.get() + FRAME_MS);
+        self.clock.advance_ms(FRAME_MS);
         self.dev.poll();
         self.frames += 1;
         if let (Some(a), Some(b)) = (before, self.dev.output_angles()) {
@@ -138,7 +144,7 @@ fn stand_up_enables_at_the_rest_pose_and_ramps_to_the_stance_and_back() {
         let rest = rest_angles(&config.robot).unwrap();
         assert!(rig.dev.outputs_enabled());
         assert_eq!(rig.outputs(), rest, "enabled at the rest pose");
-        let first = rig.dev.outputs().writes[0];
+        let first = rig.dev.outputs().writes()[0];
         for (i, p) in first.iter().enumerate() {
             assert_eq!(Ok(*p), rig.dev.calibration()[i].pulse_half_us(rest[i]));
         }
@@ -174,13 +180,13 @@ fn a_direct_setpoint_is_approached_frame_by_frame_after_the_enabling_frame() {
         z_m: -0.1,
         ..Pose::default()
     };
-    let writes = rig.dev.outputs().writes.len();
+    let writes = rig.dev.outputs().writes().len();
     let answer = ask(&mut rig.dev, 2, Wire::SetBodyPose(pose));
     let quad_protocol::DeviceToHost::Ack { readback, .. } = answer else {
         panic!("{answer:?}")
     };
     assert_eq!(
-        rig.dev.outputs().writes.len(),
+        rig.dev.outputs().writes().len(),
         writes,
         "nothing written at once"
     );
@@ -199,7 +205,7 @@ fn a_direct_setpoint_is_approached_frame_by_frame_after_the_enabling_frame() {
     // A late loop (five frames) still moves each output by one step only.
     ask(&mut rig.dev, 3, Wire::SetBodyPose(Pose::default()));
     let before = rig.outputs();
-    rig.clock.set(rig.clock.0.get() + 5 * FRAME_MS);
+    rig.clock.advance_ms(5 * FRAME_MS);
     rig.dev.poll();
     let after = rig.outputs();
     let step = before
@@ -417,7 +423,7 @@ fn bad_parameters_are_refused_by_name_and_move_nothing() {
             .start_motion(&Request::seed001_sway(Axis::Roll, None)),
         Err(Error::OutputsOff)
     );
-    assert!(rig.dev.outputs().writes.is_empty());
+    assert!(rig.dev.outputs().writes().is_empty());
     rig.stand();
     let sway = |a: f32, t: f32, d: Option<f32>| Request::Sway {
         axis: Axis::Roll,
@@ -465,7 +471,7 @@ fn bad_parameters_are_refused_by_name_and_move_nothing() {
         (walk(|w| w.body_height_m = f32::NAN), "stance_height_m"),
         (walk(|w| w.velocity_timeout_ms = 0), "velocity_timeout_ms"),
     ];
-    let writes = rig.dev.outputs().writes.len();
+    let writes = rig.dev.outputs().writes().len();
     let held = rig.dev.readback();
     for (request, name) in cases {
         let e = rig.dev.start_motion(&request).unwrap_err();
@@ -475,7 +481,7 @@ fn bad_parameters_are_refused_by_name_and_move_nothing() {
             rig.frame();
         }
         assert_eq!(
-            rig.dev.outputs().writes.len(),
+            rig.dev.outputs().writes().len(),
             writes,
             "{request:?} moved a servo"
         );
@@ -491,7 +497,7 @@ fn bad_parameters_are_refused_by_name_and_move_nothing() {
             other => panic!("{request:?}: {other:?}"),
         }
         assert_eq!(rig.dev.motion_status().kind, None);
-        assert_eq!(rig.dev.outputs().writes.len(), writes);
+        assert_eq!(rig.dev.outputs().writes().len(), writes);
         assert_eq!(rig.dev.readback(), held);
     }
     // A walk refuses velocities beyond its reach, by component; the walk keeps running.

@@ -14,23 +14,23 @@ use quad_protocol::{
     NackReason, ParamProblem, Request,
 };
 
-fn rig() -> (Dev, TestClock) {
-    let clock = TestClock::default();
-    clock.set(1_000);
+fn rig() -> (Dev, VirtualClock) {
+    let clock = VirtualClock::default();
+    clock.set_ms(1_000);
     let mut dev = Device::new(
         Config::fernando2025(),
-        Outputs::default(),
+        Outputs::logging(),
         clock.clone(),
-        Mem::erased(),
+        RamEeprom::erased(),
     )
     .unwrap();
     hello(&mut dev);
     (dev, clock)
 }
 
-fn frames(dev: &mut Dev, clock: &TestClock, n: u32) {
+fn frames(dev: &mut Dev, clock: &VirtualClock, n: u32) {
     for _ in 0..n {
-        clock.set(clock.0.get() + FRAME_MS);
+        clock.advance_ms(FRAME_MS);
         dev.poll();
     }
 }

@@ -11,11 +11,11 @@ use quad_protocol::{DeviceToHost, Flags, NackReason, Request, ServoId};
 
 type Table = [Calibration; 12];
 
-fn boot(mem: Mem) -> Dev {
+fn boot(mem: RamEeprom) -> Dev {
     Device::new(
         Config::fernando2025(),
-        Outputs::default(),
-        TestClock::default(),
+        Outputs::logging(),
+        VirtualClock::default(),
         mem,
     )
     .unwrap()
@@ -31,7 +31,7 @@ fn table(tag: u16) -> Table {
 }
 
 /// Boots on `mem`, sets `t` and saves; returns the answer to the save and the storage.
-fn save(mem: Mem, t: &Table) -> (DeviceToHost, Mem) {
+fn save(mem: RamEeprom, t: &Table) -> (DeviceToHost, RamEeprom) {
     let mut dev = boot(mem);
     hello(&mut dev);
     // Nothing held that the new table could exclude: centre moves only, within travel.
@@ -60,10 +60,10 @@ fn save(mem: Mem, t: &Table) -> (DeviceToHost, Mem) {
     (answer, mem)
 }
 
-fn saved(mem: Mem, t: &Table) -> Mem {
+fn saved(mem: RamEeprom, t: &Table) -> RamEeprom {
     let (answer, mut mem) = save(mem, t);
     assert!(matches!(answer, DeviceToHost::Ack { .. }));
-    mem.budget = None;
+    mem.write_budget = None;
     mem
 }
 
@@ -72,7 +72,7 @@ fn a_save_cut_at_every_byte_keeps_the_previous_calibration() {
     let defaults = table(0);
     for prior in 0..3u16 {
         // prior = 0: nothing stored; 1: bank A active; 2: bank B active.
-        let mut base = Mem::erased();
+        let mut base = RamEeprom::erased();
         for k in 1..=prior {
             base = saved(base, &table(10 * k));
         }
@@ -91,9 +91,9 @@ fn a_save_cut_at_every_byte_keeps_the_previous_calibration() {
         assert_eq!(total, 191, "bytes written by one save");
         for cut in 0..=total {
             let mut mem = base.clone();
-            mem.budget = Some(cut);
+            mem.write_budget = Some(cut);
             let (answer, mut mem) = save(mem, &new);
-            mem.budget = None;
+            mem.write_budget = None;
             let dev = boot(mem);
             if cut < total {
                 assert!(
@@ -132,7 +132,7 @@ fn a_save_cut_at_every_byte_keeps_the_previous_calibration() {
 fn a_damaged_bank_falls_back_to_the_other() {
     let first = table(5);
     let second = table(6);
-    let mem = saved(saved(Mem::erased(), &first), &second);
+    let mem = saved(saved(RamEeprom::erased(), &first), &second);
     // `second` went to bank B (generation 2).
     let mut store = Store::new(0);
     let mut t = table(0);
@@ -160,7 +160,7 @@ fn a_damaged_bank_falls_back_to_the_other() {
 #[test]
 fn erased_and_zeroed_storage_give_the_defaults() {
     for fill in [0xFF, 0x00] {
-        let mut mem = Mem::erased();
+        let mut mem = RamEeprom::erased();
         mem.bytes = vec![fill; STORAGE_LEN as usize];
         let dev = boot(mem);
         assert_eq!(dev.calibration(), &table(0));

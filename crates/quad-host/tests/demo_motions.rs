@@ -4,7 +4,7 @@
 use kin_core::Robot;
 use quad_device::Config;
 use quad_host::client::{AngleCheck, Client, ClientConfig};
-use quad_host::link::sim::{SimConfig, SimLink, SimStorage};
+use quad_host::link::sim::{EepromImage, SimConfig, SimLink};
 use quad_host::ops::demo_motions;
 use quad_host::ops::onboard::Session;
 use quad_protocol::RobotPreset;
@@ -15,7 +15,7 @@ fn the_tour_runs_and_every_check_passes_on_the_simulated_device() {
     let link = SimLink::new(
         SimConfig::default(),
         Config::shahriar2023(),
-        SimStorage::erased(),
+        EepromImage::erased(),
     )
     .unwrap();
     let client = Client::new(link, ClientConfig::sim(Duration::ZERO));

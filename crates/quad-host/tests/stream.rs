@@ -243,7 +243,7 @@ fn a_sim_link_with_no_device_answer_times_out_in_virtual_time() {
     let mut link = SimLink::new(
         SimConfig::default(),
         quad_device::Config::fernando2025(),
-        quad_host::link::sim::SimStorage::erased(),
+        quad_host::link::sim::EepromImage::erased(),
     )
     .unwrap();
     let t0 = std::time::Instant::now();
@@ -336,7 +336,7 @@ fn tampered(acks: u32, nacks: u32) -> quad_host::client::PoseStream<Tamper> {
     let inner = SimLink::new(
         SimConfig::default(),
         config,
-        quad_host::link::sim::SimStorage::erased(),
+        quad_host::link::sim::EepromImage::erased(),
     )
     .unwrap();
     let link = Tamper {

@@ -6,12 +6,12 @@
 #![cfg(unix)]
 
 use kin_core::body::Pose;
-use quad_device::{Clock, Config, Device};
+use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
+use quad_device::{Config, Device};
 use quad_host::client::{
     AngleCheck, Client, ClientConfig, PoseResult, PoseStream, StreamSetup, AVR_ANGLE_TOLERANCE_RAD,
 };
 use quad_host::link::serial::SerialLink;
-use quad_host::link::sim::{SimOutputs, SimStorage};
 use quad_host::link::Link;
 use quad_protocol::{NackReason, RobotPreset};
 use serialport::{SerialPort, TTYPort};
@@ -20,28 +20,24 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-struct WallClock(Instant);
-
-impl Clock for WallClock {
-    fn now_ms(&self) -> u32 {
-        self.0.elapsed().as_millis() as u32
-    }
-}
-
-/// Runs the device on `master` until `stop`.
+/// Runs the device on `master` until `stop`, its clock following the wall clock.
 fn serve(mut master: TTYPort, stop: Arc<AtomicBool>) {
     master.set_timeout(Duration::from_millis(5)).unwrap();
+    let start = Instant::now();
+    let clock = VirtualClock::default();
     let mut device: Device<_, _, _> = Device::new(
         Config::fernando2025(),
-        SimOutputs::default(),
-        WallClock(Instant::now()),
-        SimStorage::erased(),
+        Outputs::default(),
+        &clock,
+        RamEeprom::erased(),
     )
     .unwrap();
+    let wall = || clock.set_ns(start.elapsed().as_nanos() as u64);
     let mut buf = [0u8; 256];
     while !stop.load(Ordering::Relaxed) {
         match master.read(&mut buf) {
             Ok(n) => {
+                wall();
                 let mut out = Vec::new();
                 device.receive(&buf[..n], |f| out.extend_from_slice(f));
                 master.write_all(&out).unwrap();
@@ -49,6 +45,7 @@ fn serve(mut master: TTYPort, stop: Arc<AtomicBool>) {
             Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
             Err(e) => panic!("pty master: {e}"),
         }
+        wall();
         device.poll();
     }
 }

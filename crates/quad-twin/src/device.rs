@@ -1,74 +1,11 @@
-//! The device controller (`quad-device`) on the host, as the twin drives it: RAM storage, a
-//! clock the loop advances by one servo frame at a time, outputs that keep the last pulses.
+//! The device controller (`quad-device`) in this process, as the twin drives it, on the shared
+//! in-memory fakes (`quad_device::sim`): an erased EEPROM, a clock the loop advances by one
+//! servo frame at a time, outputs that keep the last pulses.
 
-use quad_device::store::STORAGE_LEN;
-use quad_device::{Clock, Config, ConfigError, Device, ServoOutputs, Storage};
+use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
+use quad_device::{Config, ConfigError, Device};
 use quad_protocol::servo::Error as ServoError;
 use quad_protocol::{DeviceToHost, HostToDevice, NackReason, Request, ServoId, PROTOCOL_VERSION};
-use std::cell::Cell;
-use std::rc::Rc;
-
-/// The servo outputs as the twin reads them.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
-pub struct Outputs {
-    /// True while the device drives the outputs.
-    pub enabled: bool,
-    /// The last pulses written, half-µs (zeros before the first write).
-    pub pulses_half_us: [u16; 12],
-}
-
-impl ServoOutputs for Outputs {
-    fn set_pulses(&mut self, pulses_half_us: &[u16; 12]) {
-        self.pulses_half_us = *pulses_half_us;
-    }
-    fn set_enabled(&mut self, enabled: bool) {
-        self.enabled = enabled;
-    }
-}
-
-/// The device's millisecond clock, advanced by the loop.
-#[derive(Debug, Clone, Default)]
-pub struct FrameClock(Rc<Cell<u32>>);
-
-impl FrameClock {
-    /// Advances the clock by `ms`.
-    pub fn advance(&self, ms: u32) {
-        self.0.set(self.0.get().wrapping_add(ms));
-    }
-}
-
-impl Clock for FrameClock {
-    fn now_ms(&self) -> u32 {
-        self.0.get()
-    }
-}
-
-/// Erased RAM "EEPROM" (the device then boots on its default calibration).
-#[derive(Debug, Clone)]
-pub struct Ram(Vec<u8>);
-
-impl Default for Ram {
-    fn default() -> Self {
-        Ram(vec![0xFF; usize::from(STORAGE_LEN)])
-    }
-}
-
-impl Storage for Ram {
-    type Error = ();
-    fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), ()> {
-        let a = usize::from(addr);
-        buf.copy_from_slice(self.0.get(a..a + buf.len()).ok_or(())?);
-        Ok(())
-    }
-    fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), ()> {
-        let a = usize::from(addr);
-        self.0
-            .get_mut(a..a + data.len())
-            .ok_or(())?
-            .copy_from_slice(data);
-        Ok(())
-    }
-}
 
 /// Why the device refused a step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -105,24 +42,30 @@ impl core::fmt::Display for DeviceError {
 
 impl std::error::Error for DeviceError {}
 
-/// A powered-on device with its outputs enabled.
-pub struct SimDevice {
-    device: Device<Outputs, FrameClock, Ram>,
-    clock: FrameClock,
+/// The device controller in this process, powered on, its outputs enabled: requests at message
+/// level, its clock advanced one frame at a time by the loop.
+pub struct InProcess {
+    device: Device<Outputs, VirtualClock, RamEeprom>,
+    clock: VirtualClock,
     seq: u16,
 }
 
-impl SimDevice {
+impl InProcess {
     /// Powers the device of `config` on, says hello and enables its outputs (on the nominal
     /// stance it holds at power-on).
     ///
     /// # Errors
     /// [`DeviceError`].
-    pub fn start(config: Config) -> Result<SimDevice, DeviceError> {
-        let clock = FrameClock::default();
-        let device = Device::new(config, Outputs::default(), clock.clone(), Ram::default())
-            .map_err(DeviceError::Config)?;
-        let mut d = SimDevice {
+    pub fn start(config: Config) -> Result<InProcess, DeviceError> {
+        let clock = VirtualClock::default();
+        let device = Device::new(
+            config,
+            Outputs::default(),
+            clock.clone(),
+            RamEeprom::erased(),
+        )
+        .map_err(DeviceError::Config)?;
+        let mut d = InProcess {
             device,
             clock,
             seq: 0,
@@ -155,13 +98,13 @@ impl SimDevice {
 
     /// Advances the device clock by one frame and runs its main-loop poll.
     pub fn tick(&mut self, frame_ms: u32) {
-        self.clock.advance(frame_ms);
+        self.clock.advance_ms(frame_ms);
         self.device.poll();
     }
 
     /// The outputs now.
-    pub fn outputs(&self) -> Outputs {
-        *self.device.outputs()
+    pub fn outputs(&self) -> &Outputs {
+        self.device.outputs()
     }
 
     /// The outputs' pulses mapped back to joint angles through the device's own calibration

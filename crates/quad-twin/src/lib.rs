@@ -8,7 +8,8 @@
 //! later). At the end the twin computes the run's metrics ([`Summary`]) and, when asked, its
 //! plots and pictures.
 //!
-//! - [`device`]: the controller on the host (RAM storage, a frame clock, recording outputs).
+//! - [`device`]: the controller in this process ([`device::InProcess`], on the shared in-memory
+//!   fakes of `quad_device::sim`).
 //! - [`motions`]: the motions of the twin's catalogue, from kin-core's motion laws.
 //! - [`source`]: [`source::FrameSource`], where frames come from ([`source::HostDriven`]: a
 //!   host sending `SetFeet` every frame to the in-process device;
@@ -419,7 +420,7 @@ pub fn run_plan(
     let plan = *plan;
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {
-            let device = device::SimDevice::start(*config)
+            let device = device::InProcess::start(*config)
                 .map_err(|error| Error::Device { frame: 0, error })?;
             if options.onboard {
                 Box::new(source::Onboard::new(plan, device).ok_or(Error::NotOnboard {
@@ -519,7 +520,7 @@ pub fn run_source(
     let mut feedback = None;
     for k in 0..source.frame_count() {
         let frame = source.next(k, feedback.as_ref())?;
-        match twin.exchange(&link::ToTwin::frame(k, &frame))? {
+        match twin.exchange(&frame.to_twin(k))? {
             link::FromTwin::State(state) => feedback = Some(state),
             _ => return Err(Error::Protocol("expected `state`")),
         }

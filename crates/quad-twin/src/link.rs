@@ -13,7 +13,6 @@
 //!
 //! A twin that fails answers `{"type":"error", "message":…}` and exits non-zero.
 
-use crate::source::DeviceFrame;
 use serde::{Deserialize, Serialize};
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
@@ -62,21 +61,6 @@ pub enum ToTwin<'a> {
     },
     /// The run is over: compute the metrics, write the files, answer the summary.
     End,
-}
-
-impl<'a> ToTwin<'a> {
-    /// The message of a device frame.
-    pub fn frame(k: u32, f: &DeviceFrame) -> ToTwin<'a> {
-        ToTwin::Frame {
-            k,
-            t_s: f.t_s,
-            enabled: f.enabled,
-            pulses_half_us: f.pulses_half_us,
-            angles_rad: f.angles_rad,
-            commanded_pose: f.commanded_pose.to_array(),
-            stance: f.stance,
-        }
-    }
 }
 
 /// The body state after a frame: what an IMU on the body and contact switches would read.

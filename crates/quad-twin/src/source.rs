@@ -1,8 +1,8 @@
 //! Where the frames come from: a host sending every frame's feet ([`HostDriven`]), or the
 //! device running the motion itself ([`Onboard`]).
 
-use crate::device::{DeviceError, SimDevice};
-use crate::link::BodyState;
+use crate::device::{DeviceError, InProcess};
+use crate::link::{BodyState, ToTwin};
 use crate::motions::Plan;
 use kin_core::motion::gait::Velocity;
 use kin_core::Pose;
@@ -30,6 +30,21 @@ pub struct DeviceFrame {
     pub stance: [bool; 4],
 }
 
+impl DeviceFrame {
+    /// The message that hands this frame, frame `k` of the run, to the twin.
+    pub fn to_twin(&self, k: u32) -> ToTwin<'static> {
+        ToTwin::Frame {
+            k,
+            t_s: self.t_s,
+            enabled: self.enabled,
+            pulses_half_us: self.pulses_half_us,
+            angles_rad: self.angles_rad,
+            commanded_pose: self.commanded_pose.to_array(),
+            stance: self.stance,
+        }
+    }
+}
+
 /// A producer of servo frames, given the twin's answer to the previous one (the body state an
 /// IMU would measure; unused while the loop is open).
 pub trait FrameSource {
@@ -47,12 +62,12 @@ pub trait FrameSource {
 /// `SetFeet` request, then the device's outputs read.
 pub struct HostDriven {
     plan: Plan,
-    device: SimDevice,
+    device: InProcess,
 }
 
 impl HostDriven {
     /// Drives `device` (started, outputs enabled) through `plan`.
-    pub fn new(plan: Plan, device: SimDevice) -> HostDriven {
+    pub fn new(plan: Plan, device: InProcess) -> HostDriven {
         HostDriven { plan, device }
     }
 }
@@ -85,7 +100,7 @@ impl FrameSource for HostDriven {
 /// commanded pose and the feet on the ground are the plan's, for the metrics.
 pub struct Onboard {
     plan: Plan,
-    device: SimDevice,
+    device: InProcess,
     command: MotionCommand,
     velocity: Option<Velocity>,
 }
@@ -93,7 +108,7 @@ pub struct Onboard {
 impl Onboard {
     /// Runs `plan` on `device` (started, outputs enabled); `None` when the plan has no onboard
     /// form ([`Plan::onboard`]).
-    pub fn new(plan: Plan, device: SimDevice) -> Option<Onboard> {
+    pub fn new(plan: Plan, device: InProcess) -> Option<Onboard> {
         let (command, velocity) = plan.onboard()?;
         Some(Onboard {
             plan,
@@ -146,7 +161,7 @@ impl FrameSource for Onboard {
 /// Frame `k` of an in-process run: `request` (if any) sent, one frame of the device's clock,
 /// its outputs read; the commanded pose and the feet on the ground are `target`'s.
 fn step(
-    device: &mut SimDevice,
+    device: &mut InProcess,
     k: u32,
     request: Option<Request>,
     target: &crate::motions::Target,

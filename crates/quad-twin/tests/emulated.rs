@@ -12,7 +12,7 @@
 //! `k` or `k + 1`; any other difference fails it.
 
 use quad_device::Config;
-use quad_twin::device::SimDevice;
+use quad_twin::device::InProcess;
 use quad_twin::emulated::Emulated;
 use quad_twin::source::{FrameSource, HostDriven};
 use quad_twin::{MotionKind, Plan};
@@ -30,7 +30,7 @@ fn the_firmwares_pulses_equal_the_device_controllers() {
         ..Config::shahriar2023()
     };
     let plan = Plan::new(MotionKind::Trot, &config).unwrap();
-    let mut device = HostDriven::new(plan, SimDevice::start(config).unwrap());
+    let mut device = HostDriven::new(plan, InProcess::start(config).unwrap());
     let mut firmware = Emulated::boot(plan, &config, None, false).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(firmware.frame_count(), device.frame_count());
     let expected: Vec<[u16; 12]> = (0..=FRAMES)

@@ -161,7 +161,7 @@ fn each_frame_is_answered_with_the_body_state_an_imu_would_read() {
         })
         .unwrap();
     assert!(matches!(ready, FromTwin::Ready { timestep_s } if timestep_s <= 1.0 / 500.0));
-    let mut device = quad_twin::device::SimDevice::start(*config).unwrap();
+    let mut device = quad_twin::device::InProcess::start(*config).unwrap();
     let mut source_state = None;
     for k in 0..10 {
         let angles = device.output_angles_rad().unwrap();

@@ -180,12 +180,12 @@ pub fn open(target: &Target) -> Result<Box<dyn Link>, Error> {
             let device = Config::for_preset(*preset).ok_or(Error::NoSimulatedRobot)?;
             let storage = match storage {
                 Some(path) => {
-                    sim::SimStorage::with_file(path.clone()).map_err(|source| Error::Storage {
+                    sim::EepromImage::with_file(path.clone()).map_err(|source| Error::Storage {
                         path: path.clone(),
                         source,
                     })?
                 }
-                None => sim::SimStorage::erased(),
+                None => sim::EepromImage::erased(),
             };
             Ok(Box::new(sim::SimLink::new(*config, device, storage)?))
         }

@@ -32,89 +32,53 @@
 
 use super::{byte_time, Error, Faults, LineStats, Link};
 use kin_core::DefaultMath;
-use quad_device::{Clock, Config, ConfigError, Device, ServoOutputs, Storage};
-use std::cell::Cell;
+use quad_device::sim::{EepromError, Outputs, RamEeprom, VirtualClock, EEPROM_LEN};
+use quad_device::{Config, ConfigError, Device, Storage};
 use std::collections::VecDeque;
 use std::fmt;
 use std::path::PathBuf;
-use std::rc::Rc;
 use std::time::Duration;
-
-/// Size of the simulated EEPROM, bytes (the ATmega2560's 4 KiB).
-pub const EEPROM_LEN: usize = 4096;
 
 /// Default receive FIFO of the simulated device, bytes.
 pub const DEFAULT_RX_FIFO_LEN: usize = 64;
 
 use seeded_rng::SplitMix64;
 
-/// The simulated servo outputs: what is on the twelve pins.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct SimOutputs {
-    /// True while the outputs are driven.
-    pub enabled: bool,
-    /// The last pulses written, half-µs.
-    pub pulses_half_us: [u16; 12],
-    /// Number of `set_pulses` calls.
-    pub writes: u64,
-}
-
-impl ServoOutputs for SimOutputs {
-    fn set_pulses(&mut self, pulses_half_us: &[u16; 12]) {
-        self.pulses_half_us = *pulses_half_us;
-        self.writes += 1;
-    }
-    fn set_enabled(&mut self, enabled: bool) {
-        self.enabled = enabled;
-    }
-}
-
-/// The device's millisecond clock, read from the link's virtual clock.
-#[derive(Debug, Clone, Default)]
-pub struct SimClock(Rc<Cell<u64>>);
-
-impl Clock for SimClock {
-    fn now_ms(&self) -> u32 {
-        // Wrapping, as on the device.
-        (self.0.get() / 1_000_000) as u32
-    }
-}
-
-/// Why the simulated storage failed.
+/// Why the simulated EEPROM failed.
 #[derive(Debug)]
 #[non_exhaustive]
-pub enum SimStorageError {
-    /// Access beyond [`EEPROM_LEN`].
-    OutOfRange,
-    /// The backing file could not be written.
+pub enum ImageError {
+    /// The in-memory EEPROM refused the access (out of range).
+    RamEeprom(EepromError),
+    /// The image file could not be written.
     File(std::io::Error),
 }
 
-impl fmt::Display for SimStorageError {
+impl fmt::Display for ImageError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SimStorageError::OutOfRange => f.write_str("EEPROM address out of range"),
-            SimStorageError::File(e) => write!(f, "EEPROM image file: {e}"),
+            ImageError::RamEeprom(e) => write!(f, "{e}"),
+            ImageError::File(e) => write!(f, "EEPROM image file: {e}"),
         }
     }
 }
 
-impl std::error::Error for SimStorageError {}
+impl std::error::Error for ImageError {}
 
-/// The simulated EEPROM: erased (0xFF) or loaded from an image file, which every write
-/// updates, so that a calibration saved in one run is there in the next.
+/// The simulated device's EEPROM: the shared in-memory [`RamEeprom`], erased or loaded from an
+/// image file that every write updates, so that a calibration saved in one run is there in the
+/// next.
 #[derive(Debug, Clone)]
-pub struct SimStorage {
-    /// The bytes.
-    pub bytes: Vec<u8>,
+pub struct EepromImage {
+    eeprom: RamEeprom,
     file: Option<PathBuf>,
 }
 
-impl SimStorage {
+impl EepromImage {
     /// An erased EEPROM, in memory only.
-    pub fn erased() -> SimStorage {
-        SimStorage {
-            bytes: vec![0xFF; EEPROM_LEN],
+    pub fn erased() -> EepromImage {
+        EepromImage {
+            eeprom: RamEeprom::erased(),
             file: None,
         }
     }
@@ -124,48 +88,46 @@ impl SimStorage {
     ///
     /// # Errors
     /// When the file exists but cannot be read.
-    pub fn with_file(path: PathBuf) -> std::io::Result<SimStorage> {
+    pub fn with_file(path: PathBuf) -> std::io::Result<EepromImage> {
         let mut bytes = match std::fs::read(&path) {
             Ok(b) => b,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
             Err(e) => return Err(e),
         };
         bytes.resize(EEPROM_LEN, 0xFF);
-        Ok(SimStorage {
-            bytes,
+        Ok(EepromImage {
+            eeprom: RamEeprom::with_bytes(bytes),
             file: Some(path),
         })
     }
+
+    /// The EEPROM's bytes.
+    pub fn eeprom(&self) -> &RamEeprom {
+        &self.eeprom
+    }
 }
 
-impl Storage for SimStorage {
-    type Error = SimStorageError;
+impl Storage for EepromImage {
+    type Error = ImageError;
 
-    fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), SimStorageError> {
-        let a = usize::from(addr);
-        let src = self
-            .bytes
-            .get(a..a + buf.len())
-            .ok_or(SimStorageError::OutOfRange)?;
-        buf.copy_from_slice(src);
-        Ok(())
+    fn read(&mut self, addr: u16, buf: &mut [u8]) -> Result<(), ImageError> {
+        self.eeprom.read(addr, buf).map_err(ImageError::RamEeprom)
     }
 
-    fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), SimStorageError> {
-        let a = usize::from(addr);
-        self.bytes
-            .get_mut(a..a + data.len())
-            .ok_or(SimStorageError::OutOfRange)?
-            .copy_from_slice(data);
+    fn write(&mut self, addr: u16, data: &[u8]) -> Result<(), ImageError> {
+        self.eeprom
+            .write(addr, data)
+            .map_err(ImageError::RamEeprom)?;
         if let Some(path) = &self.file {
-            std::fs::write(path, &self.bytes).map_err(SimStorageError::File)?;
+            std::fs::write(path, &self.eeprom.bytes).map_err(ImageError::File)?;
         }
         Ok(())
     }
 }
 
-/// The device as simulated: host math backend, simulated outputs, clock and EEPROM.
-pub type SimDevice = Device<SimOutputs, SimClock, SimStorage, DefaultMath>;
+/// The device as simulated: host math backend, the shared in-memory outputs and clock, the
+/// EEPROM image.
+type Simulated = Device<Outputs, VirtualClock, EepromImage, DefaultMath>;
 
 /// Line and device parameters of a [`SimLink`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -242,8 +204,8 @@ pub struct SimLink {
     dev_free_ns: u64,
     /// Times at which the bytes in the device's receive FIFO are taken, oldest first.
     fifo: VecDeque<u64>,
-    clock: Rc<Cell<u64>>,
-    device: SimDevice,
+    clock: VirtualClock,
+    device: Simulated,
     stats: LineStats,
 }
 
@@ -256,11 +218,10 @@ impl SimLink {
     pub fn new(
         config: SimConfig,
         device_config: Config,
-        storage: SimStorage,
+        storage: EepromImage,
     ) -> Result<SimLink, ConfigError> {
-        let clock = SimClock::default();
-        let shared = clock.0.clone();
-        let device = Device::new(device_config, SimOutputs::default(), clock, storage)?;
+        let clock = VirtualClock::default();
+        let device = Device::new(device_config, Outputs::default(), clock.clone(), storage)?;
         Ok(SimLink {
             config,
             device_config,
@@ -271,14 +232,14 @@ impl SimLink {
             d2h: Line::default(),
             dev_free_ns: 0,
             fifo: VecDeque::new(),
-            clock: shared,
+            clock,
             device,
             stats: LineStats::default(),
         })
     }
 
     /// The simulated device, for inspection.
-    pub fn device(&self) -> &SimDevice {
+    pub fn device(&self) -> &Device<Outputs, VirtualClock, EepromImage, DefaultMath> {
         &self.device
     }
 
@@ -290,13 +251,13 @@ impl SimLink {
     pub fn reset_device(&mut self) -> Result<(), ConfigError> {
         let placeholder = Device::new(
             self.device_config,
-            SimOutputs::default(),
-            SimClock::default(),
-            SimStorage::erased(),
+            Outputs::default(),
+            VirtualClock::default(),
+            EepromImage::erased(),
         )?;
         let old = std::mem::replace(&mut self.device, placeholder);
         let (_, clock, storage) = old.into_parts();
-        self.device = Device::new(self.device_config, SimOutputs::default(), clock, storage)?;
+        self.device = Device::new(self.device_config, Outputs::default(), clock, storage)?;
         self.fifo.clear();
         Ok(())
     }
@@ -358,9 +319,9 @@ impl SimLink {
     /// time pass as the firmware's loop does, however long the host waits at once.
     fn poll_at(&mut self, t_ns: u64) {
         const MS_NS: u64 = 1_000_000;
-        let mut t = (self.clock.get() / MS_NS + 1) * MS_NS;
+        let mut t = (self.clock.now_ns() / MS_NS + 1) * MS_NS;
         while t < t_ns {
-            self.clock.set(t);
+            self.clock.set_ns(t);
             self.device.poll();
             t += MS_NS;
         }
@@ -369,8 +330,8 @@ impl SimLink {
     }
 
     fn set_device_time(&mut self, t_ns: u64) {
-        if t_ns > self.clock.get() {
-            self.clock.set(t_ns);
+        if t_ns > self.clock.now_ns() {
+            self.clock.set_ns(t_ns);
         }
     }
 
@@ -467,7 +428,7 @@ mod tests {
             compute: Duration::from_micros(500),
             ..SimConfig::default()
         };
-        let mut link = SimLink::new(cfg, Config::fernando2025(), SimStorage::erased()).unwrap();
+        let mut link = SimLink::new(cfg, Config::fernando2025(), EepromImage::erased()).unwrap();
         let req = frame(
             1,
             Request::Hello {
@@ -494,7 +455,8 @@ mod tests {
                 seed,
                 ..SimConfig::default()
             };
-            let mut link = SimLink::new(cfg, Config::fernando2025(), SimStorage::erased()).unwrap();
+            let mut link =
+                SimLink::new(cfg, Config::fernando2025(), EepromImage::erased()).unwrap();
             let mut got = Vec::new();
             for seq in 0..50 {
                 link.send(&frame(seq, Request::GetState)).unwrap();

@@ -6,7 +6,7 @@
 use kin_core::body::Pose;
 use quad_device::Config;
 use quad_host::client::{AngleCheck, Client, ClientConfig, Expected, PoseStream, StreamSetup};
-use quad_host::link::sim::{SimConfig, SimLink, SimStorage};
+use quad_host::link::sim::{EepromImage, SimConfig, SimLink};
 use quad_protocol::RobotPreset;
 use seeded_rng::SplitMix64 as Rng;
 
@@ -23,7 +23,7 @@ pub fn connect(cfg: SimConfig, robot: Robo) -> PoseStream<SimLink> {
         Robo::Fernando => (Config::fernando2025(), RobotPreset::Fernando2025),
         Robo::Shahriar => (Config::shahriar2023(), RobotPreset::Shahriar2023),
     };
-    let link = SimLink::new(cfg, config, SimStorage::erased()).unwrap();
+    let link = SimLink::new(cfg, config, EepromImage::erased()).unwrap();
     let client = Client::new(link, ClientConfig::sim(cfg.compute));
     PoseStream::connect(
         client,

@@ -41,14 +41,27 @@
 //!   half-written value: a runt pulse of a few cycles).
 //! - simavr applies a compare register at once, not at the next period as the chip does (the
 //!   firmware writes them between pulses, where both agree).
+//!
+//! Files: this one the simulator itself (set-up, stepping, resets, memory, the EEPROM);
+//! `uart.rs` USART0 as strict as the chip and the interrupts-off stretches; `pins.rs` the pins
+//! and the servo pulses on them, with the compare-register commit.
 
-use super::{CYCLES_PER_US, F_CPU_HZ, SERVO_PINS};
+mod pins;
+mod uart;
+
+pub use pins::Pulse;
+pub use uart::InterruptsOff;
+
+use super::CYCLES_PER_US;
+use super::F_CPU_HZ;
+use pins::{on_ocr_low_write, OcrWrite, OCR_LOW};
 use simavr_ffi as ffi;
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::path::{Path, PathBuf};
 use std::ptr::NonNull;
 use std::sync::{Arc, Mutex};
+use uart::{on_uart_output, on_uart_xoff, on_uart_xon};
 
 extern "C" {
     fn free(ptr: *mut c_void);
@@ -60,63 +73,31 @@ const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
 }
 
 const IOCTL_UART_GET_FLAGS: u32 = ioctl(b'u', b'a', b'g', b'0');
+
 const IOCTL_UART_SET_FLAGS: u32 = ioctl(b'u', b'a', b's', b'0');
+
 const IOCTL_UART_GET_IRQ: u32 = ioctl(b'u', b'a', b'r', b'0');
+
 const IOCTL_EEPROM_GET: u32 = ioctl(b'e', b'e', b'g', b'p');
+
 const IOCTL_EEPROM_SET: u32 = ioctl(b'e', b'e', b's', b'p');
 
 /// Bytes of EEPROM.
 pub const EEPROM_LEN: usize = 4096;
 
-/// Data-space addresses of USART0's registers.
 /// `out A, Rr` with the register bits masked out (`1011 1AAr rrrr AAAA`).
 const OUT_IO_MASK: u16 = 0xFE0F;
+
 /// `out 0x3e, Rr`: a write of SPH.
 const OUT_SPH: u16 = 0xBE0E;
+
 /// `out 0x3d, Rr`: a write of SPL.
 const OUT_SPL: u16 = 0xBE0D;
 
-const UCSR0A: u16 = 0xC0;
-const UDR0: u16 = 0xC6;
-/// UCSR0A's data-overrun flag.
-const UCSR0A_DOR0: u8 = 1 << 3;
-/// Slots of simavr's USART receive FIFO (`DECLARE_FIFO(uint16_t, uart_fifo, 64)`).
-const RX_FIFO_SLOTS: u16 = 64;
-/// The global interrupt flag's bit in SREG (simavr's `sreg[S_I]`).
-const SREG_I_BIT: usize = 7;
-const UCSR0B: u16 = 0xC1;
-/// UCSR0B's receiver-enable bit.
-const UCSR0B_RXEN0: u8 = 1 << 4;
-const UBRR0L: u16 = 0xC4;
-const UBRR0H: u16 = 0xC5;
 /// Watchdog control and MCU status registers.
 const WDTCSR: u16 = 0x60;
+
 const MCUSR: u16 = 0x54;
-
-/// Data addresses of the low bytes of the twelve servo compare registers (OCR1A/B/C,
-/// OCR3A/B/C, OCR4A/B/C, OCR5A/B/C), in channel order.
-const OCR_LOW: [u16; 12] = [
-    0x88, 0x8A, 0x8C, 0x98, 0x9A, 0x9C, 0xA8, 0xAA, 0xAC, 0x128, 0x12A, 0x12C,
-];
-
-/// Data addresses of (DDRx, PORTx) of the ports A–L.
-fn port_regs(port: char) -> Option<(u16, u16)> {
-    let base = match port.to_ascii_uppercase() {
-        'A' => 0x20,
-        'B' => 0x23,
-        'C' => 0x26,
-        'D' => 0x29,
-        'E' => 0x2C,
-        'F' => 0x2F,
-        'G' => 0x32,
-        'H' => 0x100,
-        'J' => 0x103,
-        'K' => 0x106,
-        'L' => 0x109,
-        _ => return None,
-    };
-    Some((base + 1, base + 2))
-}
 
 /// simavr's state is per simulator, but creating simulators and its logger are not
 /// thread-safe: creation is serialised.
@@ -164,55 +145,6 @@ pub enum EmuError {
     },
 }
 
-/// One high pulse seen on a servo pin.
-///
-/// The pins are read after every simavr step (one instruction, or an interrupt entry and its
-/// first instruction): an edge is seen at the end of the step in which it happened, up to that
-/// step's length late. [`Pulse::width_could_be`] takes this into account.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Pulse {
-    /// Channel (index into [`SERVO_PINS`]).
-    pub channel: usize,
-    /// Cycle at which the rising edge was seen.
-    pub rise_cycle: u64,
-    /// Cycles between seeing the rising and the falling edge.
-    pub high_cycles: u64,
-    /// Length of the step in which the rising edge was seen, cycles.
-    pub rise_step_cycles: u64,
-    /// Length of the step in which the falling edge was seen, cycles.
-    pub fall_step_cycles: u64,
-}
-
-impl Pulse {
-    /// High time as seen, µs.
-    pub fn high_us(&self) -> f64 {
-        self.high_cycles as f64 / CYCLES_PER_US as f64
-    }
-
-    /// True when the real width (within the steps' uncertainty) can be within `tolerance` of
-    /// `want` cycles.
-    pub fn width_could_be(&self, want: u64, tolerance: u64) -> bool {
-        let lo = self.high_cycles.saturating_sub(self.fall_step_cycles);
-        let hi = self.high_cycles + self.rise_step_cycles;
-        want + tolerance >= lo && want <= hi + tolerance
-    }
-}
-
-/// The longest stretches with interrupts off (SREG.I clear, interrupt handlers included).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct InterruptsOff {
-    /// The longest, cycles.
-    pub longest_cycles: u64,
-    /// The longest part of a stretch during which the receiver was on and bytes were arriving
-    /// or waiting unread in it, cycles: what can cost bytes (from reset until the firmware
-    /// turns the receiver on, the chip hears nothing).
-    pub longest_receiving_cycles: u64,
-    /// Where that part began ([`Mega2560::cycle`]).
-    pub longest_receiving_at_cycle: u64,
-    /// The program counter (byte address) at which its stretch began.
-    pub longest_receiving_pc: u32,
-}
-
 /// Resets seen since the simulator was created.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Resets {
@@ -235,62 +167,6 @@ struct Hooks {
     xon: bool,
     /// The wrapped write handlers of the servo compare registers' low bytes, in channel order.
     ocr: [OcrWrite; 12],
-}
-
-/// simavr's write handler of one OCR low byte, and the value the register had after the
-/// previous low-byte write.
-struct OcrWrite {
-    handler: ffi::avr_io_write_t,
-    param: *mut c_void,
-    committed: u16,
-}
-
-/// The write handler installed on a servo OCR low byte: simavr's own, then — when that one
-/// saw no change because only the high byte changed — simavr's again with the low byte
-/// perturbed before the call, so that it reconfigures the timer with the committed value.
-unsafe extern "C" fn on_ocr_low_write(
-    avr: *mut ffi::avr_t,
-    addr: ffi::avr_io_addr_t,
-    v: u8,
-    param: *mut c_void,
-) {
-    // SAFETY: `param` points into the `Hooks` allocation (see `on_uart_output`); `avr` is the
-    // running simulator and `addr`, `addr + 1` are the register's bytes in its data space.
-    unsafe {
-        let w = &mut *param.cast::<OcrWrite>();
-        let data = (*avr).data;
-        let lo = usize::from(addr);
-        let before = u16::from_le_bytes([*data.add(lo), *data.add(lo + 1)]);
-        if let Some(handler) = w.handler {
-            handler(avr, addr, v, w.param);
-            let after = u16::from_le_bytes([*data.add(lo), *data.add(lo + 1)]);
-            if after == before && after != w.committed {
-                *data.add(lo) ^= 1;
-                handler(avr, addr, v, w.param);
-            }
-            w.committed = after;
-        }
-    }
-}
-
-unsafe extern "C" fn on_uart_output(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
-    // SAFETY: `param` is the `Hooks` allocation registered in `Mega2560::new`, alive until the
-    // simulator is dropped; simavr calls hooks only from within `avr_run`/`avr_raise_irq`,
-    // during which no Rust reference to it exists.
-    let hooks = unsafe { &mut *param.cast::<Hooks>() };
-    // SAFETY: the avr_t outlives its hooks.
-    let raw = unsafe { (*hooks.avr).cycle };
-    hooks.out.push_back((hooks.base + raw, value as u8));
-}
-
-unsafe extern "C" fn on_uart_xon(_: *mut ffi::avr_irq_t, _: u32, param: *mut c_void) {
-    // SAFETY: as in `on_uart_output`.
-    unsafe { (*param.cast::<Hooks>()).xon = true };
-}
-
-unsafe extern "C" fn on_uart_xoff(_: *mut ffi::avr_irq_t, _: u32, param: *mut c_void) {
-    // SAFETY: as in `on_uart_output`.
-    unsafe { (*param.cast::<Hooks>()).xon = false };
 }
 
 /// An ATmega2560 at 16 MHz running one ELF in simavr.
@@ -548,207 +424,6 @@ impl Mega2560 {
         self.run_cycles(us * CYCLES_PER_US)
     }
 
-    /// Hands bytes to USART0's receiver: they go on the line back to back at the firmware's
-    /// line rate, starting now (or when the bytes before them are through), and reach the
-    /// receiver as the chip's would (see the module docs: a byte the firmware is too slow for
-    /// is lost).
-    pub fn uart_write(&mut self, bytes: &[u8]) {
-        self.input.extend(bytes);
-        self.feed_uart();
-    }
-
-    /// Bytes handed to [`Mega2560::uart_write`] that have not started on the line yet.
-    pub fn uart_input_pending(&self) -> usize {
-        self.input.len()
-    }
-
-    /// Bytes the receive buffer lost since power-on because the firmware did not read them in
-    /// time (data overruns, see the module docs).
-    pub fn rx_overruns(&self) -> u64 {
-        self.rx_overruns
-    }
-
-    /// The longest interrupts-off stretches seen since power-on (or the last
-    /// [`Mega2560::reset_interrupts_off`]).
-    pub fn interrupts_off(&self) -> InterruptsOff {
-        self.interrupts_off
-    }
-
-    /// Forgets the interrupts-off stretches seen so far (e.g. those of the boot code).
-    pub fn reset_interrupts_off(&mut self) {
-        self.interrupts_off = InterruptsOff::default();
-        self.cli_since = None;
-    }
-
-    /// simavr's USART0 (the parameter of its UDR0 read handler).
-    fn uart0(&self) -> *mut ffi::avr_uart_t {
-        // SAFETY: the I/O table is part of the live simulator; UDR0 has a read handler
-        // registered by simavr's USART0 module, whose parameter is its `avr_uart_t`.
-        unsafe {
-            (*self.avr.as_ptr()).io[usize::from(UDR0) - 0x20]
-                .r
-                .param
-                .cast()
-        }
-    }
-
-    /// simavr's receive FIFO: bytes in it (received or arriving, not yet read by the firmware)
-    /// and its read index.
-    fn rx_fifo(&self) -> (u16, u16) {
-        let uart = self.uart0();
-        if uart.is_null() {
-            return (0, 0);
-        }
-        // SAFETY: a live `avr_uart_t`; nothing runs inside simavr now.
-        let fifo = unsafe { &(*uart).input };
-        let len = fifo.write.wrapping_sub(fifo.read) & (RX_FIFO_SLOTS - 1);
-        (len, fifo.read)
-    }
-
-    /// One byte time on the line as simavr's receiver counts it, cycles (0 before the firmware
-    /// configured USART0).
-    fn rx_byte_cycles(&self) -> u64 {
-        let uart = self.uart0();
-        if uart.is_null() {
-            return 0;
-        }
-        // SAFETY: as in `rx_fifo`.
-        unsafe { (*uart).cycles_per_byte }
-    }
-
-    /// Puts the bytes whose line slot has come into simavr's receiver, applying the chip's
-    /// overrun (see the module docs).
-    fn feed_uart(&mut self) {
-        let now = self.cycle();
-        let byte_cycles = self.rx_byte_cycles().max(1);
-        while !self.input.is_empty() && self.rx_line_free <= now {
-            let (unread, read_index) = self.rx_fifo();
-            if unread >= 3 {
-                // Two bytes in the buffer, one complete in the shift register, and a new start
-                // bit: the shift register's byte — the newest in the FIFO — is lost.
-                let uart = self.uart0();
-                // SAFETY: as in `rx_fifo`; the newest entry is dropped by moving the write
-                // index back one slot.
-                unsafe {
-                    let fifo = &mut (*uart).input;
-                    fifo.write = fifo.write.wrapping_sub(1) & (RX_FIFO_SLOTS - 1);
-                }
-                self.rx_overruns += 1;
-                self.dor_owed = Some(read_index);
-            }
-            let Some(b) = self.input.pop_front() else {
-                break;
-            };
-            // SAFETY: a valid IRQ of this simulator.
-            unsafe { ffi::avr_raise_irq(self.uart_in.as_ptr(), u32::from(b)) };
-            self.rx_line_free = self.rx_line_free.max(now) + byte_cycles;
-        }
-        self.owe_dor();
-    }
-
-    /// Keeps DOR0 set after an overrun until the firmware reads UDR0 (see the module docs).
-    fn owe_dor(&mut self) {
-        let Some(read_at_overrun) = self.dor_owed else {
-            return;
-        };
-        if self.rx_fifo().1 != read_at_overrun {
-            self.dor_owed = None;
-            return;
-        }
-        let avr = self.avr.as_ptr();
-        // SAFETY: UCSR0A is within the data space; nothing runs inside simavr now.
-        unsafe { *(*avr).data.add(usize::from(UCSR0A)) |= UCSR0A_DOR0 };
-    }
-
-    /// True while USART0's receiver is on (RXEN0) and bytes are on their way to it or wait
-    /// unread in it. With the receiver off (from reset until the firmware sets the USART up)
-    /// the chip hears nothing, so no byte can be lost to a stretch with interrupts off.
-    fn receiving(&self) -> bool {
-        self.data(UCSR0B) & UCSR0B_RXEN0 != 0
-            && (!self.input.is_empty() || self.cycle() < self.rx_line_free || self.rx_fifo().0 > 0)
-    }
-
-    /// Follows SREG.I after a step that started at cycle `before` at program counter `pc`.
-    fn track_interrupts_off(&mut self, before: u64, pc: u32) {
-        // simavr keeps the flags in `sreg[]` and updates SREG's data byte only when the program
-        // reads it.
-        let off = self.avr().sreg[SREG_I_BIT] == 0;
-        let receiving = self.receiving();
-        let now = self.cycle();
-        match (&mut self.cli_since, off) {
-            (None, true) => self.cli_since = Some((before, pc, receiving.then_some(before))),
-            (Some((_, _, since)), true) => {
-                if receiving && since.is_none() {
-                    *since = Some(before);
-                }
-            }
-            (Some((start, at_pc, since)), false) => {
-                let (start, at_pc, since) = (*start, *at_pc, *since);
-                self.cli_since = None;
-                let s = &mut self.interrupts_off;
-                s.longest_cycles = s.longest_cycles.max(now - start);
-                // Only the part with the receiver listening and bytes coming can lose them.
-                if let Some(since) = since {
-                    let len = now - since;
-                    if len > s.longest_receiving_cycles {
-                        s.longest_receiving_cycles = len;
-                        s.longest_receiving_at_cycle = since;
-                        s.longest_receiving_pc = at_pc;
-                    }
-                }
-            }
-            (None, false) => {}
-        }
-    }
-
-    /// Bytes USART0 has sent and nobody has taken, with the cycle each was written to UDR0.
-    pub fn uart_take(&mut self) -> Vec<(u64, u8)> {
-        self.output.drain(..).collect()
-    }
-
-    /// The oldest byte USART0 has sent and nobody has taken.
-    pub fn uart_pop(&mut self) -> Option<(u64, u8)> {
-        self.output.pop_front()
-    }
-
-    /// Number of sent bytes not yet taken.
-    pub fn uart_available(&self) -> usize {
-        self.output.len()
-    }
-
-    /// Runs until USART0 has sent `n` more bytes (returned without their cycles), or
-    /// `timeout_cycles` elapsed (then `Err` with what came).
-    ///
-    /// # Errors
-    /// A timeout (the bytes so far) — a stopped CPU panics, as it is a firmware bug.
-    pub fn read_exact(&mut self, n: usize, timeout_cycles: u64) -> Result<Vec<u8>, Vec<u8>> {
-        let end = self.cycle() + timeout_cycles;
-        while self.output.len() < n {
-            if self.cycle() >= end {
-                return Err(self.uart_take().into_iter().map(|(_, b)| b).collect());
-            }
-            if let Err(e) = self.step() {
-                panic!("{e}");
-            }
-        }
-        Ok(self.output.drain(..n).map(|(_, b)| b).collect())
-    }
-
-    /// USART0's line rate as the firmware configured it (UBRR0, U2X0), bit/s; `None` while
-    /// the receiver is off.
-    pub fn uart_baud(&self) -> Option<f64> {
-        if self.data(UCSR0B) & UCSR0B_RXEN0 == 0 {
-            return None;
-        }
-        let ubrr = u32::from(self.data(UBRR0L)) | u32::from(self.data(UBRR0H) & 0x0F) << 8;
-        let per_bit = if self.data(UCSR0A) & (1 << 1) != 0 {
-            8
-        } else {
-            16
-        } * (ubrr + 1);
-        Some(f64::from(F_CPU_HZ) / f64::from(per_bit))
-    }
-
     /// One byte of the data space (registers, I/O, SRAM); 0 beyond RAMEND.
     pub fn data(&self, addr: u16) -> u8 {
         let avr = self.avr();
@@ -843,98 +518,6 @@ impl Mega2560 {
             p += 1;
         }
         end + 1 - p
-    }
-
-    /// The level driven on pin `bit` of `port` ('A'..='L'): its PORT bit when DDR makes it an
-    /// output, low otherwise. Unknown ports read low.
-    pub fn pin(&self, port: char, bit: u8) -> bool {
-        port_regs(port).is_some_and(|(ddr, p)| {
-            let m = 1u8 << (bit & 7);
-            self.data(ddr) & m != 0 && self.data(p) & m != 0
-        })
-    }
-
-    /// True when pin `bit` of `port` is configured as an output.
-    pub fn is_output(&self, port: char, bit: u8) -> bool {
-        port_regs(port).is_some_and(|(ddr, _)| self.data(ddr) & (1 << (bit & 7)) != 0)
-    }
-
-    /// Levels of the twelve servo pins, bit `i` = channel `i`.
-    pub fn servo_levels(&self) -> u16 {
-        let level = |(ddr, port): (u16, u16)| self.data(ddr) & self.data(port);
-        let (b, e, h, l) = (
-            level((0x24, 0x25)),
-            level((0x2D, 0x2E)),
-            level((0x101, 0x102)),
-            level((0x10A, 0x10B)),
-        );
-        let mut out = 0u16;
-        for (i, &(port, bit)) in SERVO_PINS.iter().enumerate() {
-            let v = match port {
-                'B' => b,
-                'E' => e,
-                'H' => h,
-                _ => l,
-            };
-            if v & (1 << bit) != 0 {
-                out |= 1 << i;
-            }
-        }
-        out
-    }
-
-    /// Starts (or stops) recording the servo pulses ([`Mega2560::take_pulses`]). Edges are
-    /// tracked after every instruction either way.
-    pub fn capture_pulses(&mut self, on: bool) {
-        self.capture = on;
-        if !on {
-            self.pulses.clear();
-        }
-    }
-
-    /// The servo pulses completed since the last call (capture on), in order of their
-    /// falling edges.
-    pub fn take_pulses(&mut self) -> Vec<Pulse> {
-        self.pulses.drain(..).collect()
-    }
-
-    /// The oldest servo pulse completed and not yet taken (capture on).
-    pub fn pop_pulse(&mut self) -> Option<Pulse> {
-        self.pulses.pop_front()
-    }
-
-    /// True while a pulse is in progress on `channel`.
-    pub fn pulse_in_progress(&self, channel: usize) -> bool {
-        self.rise.get(channel).is_some_and(Option::is_some)
-    }
-
-    fn track_servos(&mut self, step: u64) {
-        let now = self.servo_levels();
-        let changed = now ^ self.levels;
-        if changed == 0 {
-            return;
-        }
-        let cycle = self.cycle();
-        for ch in 0..12 {
-            let bit = 1u16 << ch;
-            if changed & bit == 0 {
-                continue;
-            }
-            if now & bit != 0 {
-                self.rise[ch] = Some((cycle, step));
-            } else if let Some((r, rise_step)) = self.rise[ch].take() {
-                if self.capture {
-                    self.pulses.push_back(Pulse {
-                        channel: ch,
-                        rise_cycle: r,
-                        high_cycles: cycle - r,
-                        rise_step_cycles: rise_step,
-                        fall_step_cycles: step,
-                    });
-                }
-            }
-        }
-        self.levels = now;
     }
 
     /// The EEPROM's bytes.

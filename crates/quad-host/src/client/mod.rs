@@ -1,0 +1,215 @@
+//! The host end of the device link: handshake, requests retried under one sequence number, and
+//! the body-pose stream with its end-to-end readback check.
+//!
+//! ## Requests
+//! [`Client::exchange`] sends one request and waits for the answer carrying its sequence number,
+//! at most [`ClientConfig::retries`] more times with the **same** sequence number when
+//! - no answer came within the timeout (request or answer lost, or a stall),
+//! - a nack without a sequence number came (the device could not read a frame: bad CRC, bad
+//!   COBS, oversize) *after* the request could have reached the device — an earlier one is about
+//!   older garbage and is ignored,
+//! - the answer failed the caller's check (the readback check below): a frame corrupted on the
+//!   line can pass a 16-bit CRC (about 1 in 65,536 damaged frames), and a retry tells a
+//!   corrupted request or answer from a real disagreement, which persists.
+//!
+//! Answers with another sequence number (late or duplicated answers to earlier attempts) are
+//! dropped. The device acts on every copy of a request it reads; a body pose is idempotent, so
+//! a duplicate only costs line time, and the latest pose wins.
+//!
+//! The answer timeout of an attempt is the wire time of the request and of the longest answer at
+//! the link's baud rate plus [`ClientConfig::turnaround`] (device computation and, on a real
+//! port, USB latency).
+//!
+//! ## Readback check ([`PoseStream`])
+//! For every body pose the host runs kin-core itself (`body::Solver::inverse_at_stance` on `DefaultMath`,
+//! the device's robot, stance height, rotation order and reject policy) and maps the angles
+//! through the device's calibration (read at connection):
+//! - a pose the host solves must be acked, with the twelve angles equal to the host's
+//!   ([`AngleCheck::Exact`]: the same bits, when both sides run the same math, as the simulated
+//!   device does; [`AngleCheck::Within`]: within a bound, e.g. [`AVR_ANGLE_TOLERANCE_RAD`] for
+//!   the ATmega2560's avr-libc math) and the twelve pulses equal to the host's calibration
+//!   mapping **of the device's angles** (`quad_protocol::servo`, bit-exact on every IEEE-754
+//!   f32 implementation), or 0 while the outputs are off;
+//! - a pose the host rejects (unreachable, joint limit, non-finite, beyond a servo's travel)
+//!   must be nacked with the same reason, leg and kind.
+
+//!
+//! ## Files
+//! - `exchange.rs`: [`Client`], one request and its answer under one sequence number, retried;
+//!   the session requests built on it (handshake, acknowledged requests, calibration reads).
+//! - `stream.rs`: [`PoseStream`], body poses, feet or joints streamed and judged.
+//! - `checks.rs`: what the host expects of an answer ([`expected`], [`judge`],
+//!   [`check_readback`]) and how angles are compared ([`AngleCheck`]).
+
+mod checks;
+mod exchange;
+mod stream;
+
+pub use checks::{
+    check_readback, expected, judge, AngleCheck, Expected, Mismatch, AVR_ANGLE_TOLERANCE_RAD,
+};
+pub use exchange::{Client, Counters, Exchange, Outcome, Verdict};
+pub use stream::{PoseResult, PoseStream, Setpoint, StreamSetup, StreamStats};
+
+use crate::link;
+use quad_protocol::{DeviceToHost, NackReason, Request, RobotPreset, PROTOCOL_VERSION};
+use std::time::Duration;
+
+/// Default number of retries of a streamed request (a body pose).
+pub const DEFAULT_RETRIES: u32 = 10;
+
+/// Retries of a session request (handshake, configuration, calibration): these must get
+/// through even on a poor line, and repeating them is harmless.
+pub const SESSION_RETRIES: u32 = 100;
+
+/// Timing and retry policy of a [`Client`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClientConfig {
+    /// Resends of a streamed request after its first attempt ([`Client::exchange`]).
+    pub retries: u32,
+    /// Resends of a session request ([`Client::request`] and what builds on it).
+    pub session_retries: u32,
+    /// Added to the wire time of request + answer to make an attempt's timeout.
+    pub turnaround: Duration,
+    /// Extra time allowed for `SaveCalibration` (an EEPROM write of ~200 bytes at 3.4 ms each).
+    pub save_time: Duration,
+    /// How long the handshake keeps trying (a Mega resets when its port opens).
+    pub hello_patience: Duration,
+}
+
+impl ClientConfig {
+    /// For the simulated UART: the modelled device time plus 1 ms.
+    pub fn sim(compute: Duration) -> ClientConfig {
+        ClientConfig {
+            retries: DEFAULT_RETRIES,
+            session_retries: SESSION_RETRIES,
+            turnaround: compute + Duration::from_millis(1),
+            save_time: Duration::from_secs(1),
+            hello_patience: Duration::from_millis(100),
+        }
+    }
+
+    /// For the firmware in simavr ([`crate::link::emulator`]), in simulated time: 20 ms of
+    /// turnaround (one servo period; a body-pose solve takes about 7 ms), 1 s of handshake
+    /// patience.
+    pub fn emulator() -> ClientConfig {
+        ClientConfig {
+            retries: DEFAULT_RETRIES,
+            session_retries: SESSION_RETRIES,
+            turnaround: Duration::from_millis(20),
+            save_time: Duration::from_secs(1),
+            hello_patience: Duration::from_secs(1),
+        }
+    }
+
+    /// For a real port: 50 ms of turnaround (USB latency and the device's IK), 4 s of
+    /// handshake patience.
+    pub fn serial() -> ClientConfig {
+        ClientConfig {
+            retries: DEFAULT_RETRIES,
+            session_retries: SESSION_RETRIES,
+            turnaround: Duration::from_millis(50),
+            save_time: Duration::from_secs(1),
+            hello_patience: Duration::from_secs(4),
+        }
+    }
+
+    /// The configuration that suits `target`, with `retries` resends per streamed request.
+    pub fn for_target(target: &link::Target, retries: u32) -> ClientConfig {
+        let config = match target {
+            link::Target::Sim { config, .. } => ClientConfig::sim(config.compute),
+            link::Target::Emulator { .. } => ClientConfig::emulator(),
+            link::Target::Serial { .. } => ClientConfig::serial(),
+        };
+        ClientConfig { retries, ..config }
+    }
+}
+
+/// Why a session request failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The link failed.
+    #[error(transparent)]
+    Link(#[from] link::Error),
+    /// No answer after every attempt.
+    #[error("no answer to {request} after every retry")]
+    NoAnswer {
+        /// The request's name.
+        request: &'static str,
+    },
+    /// The device refused.
+    #[error("the device refused {request}: {reason}")]
+    Refused {
+        /// The request's name.
+        request: &'static str,
+        /// Why.
+        reason: NackReason,
+    },
+    /// An answer of the wrong kind.
+    #[error("unexpected answer to {request}: {}", answer_name(answer))]
+    Unexpected {
+        /// The request's name.
+        request: &'static str,
+        /// The answer.
+        answer: Box<DeviceToHost>,
+    },
+    /// The device speaks another major protocol version.
+    #[error(
+        "the device speaks protocol {}.{}, this host {}.{}",
+        device >> 8,
+        device & 0xFF,
+        PROTOCOL_VERSION >> 8,
+        PROTOCOL_VERSION & 0xFF
+    )]
+    Version {
+        /// The device's version.
+        device: u16,
+    },
+    /// The device runs another robot than the host was asked for.
+    #[error(
+        "the device runs robot {}, the host was given {}",
+        crate::names::robot_preset_name(*device),
+        crate::names::robot_preset_name(*host)
+    )]
+    Robot {
+        /// The device's robot.
+        device: RobotPreset,
+        /// The host's.
+        host: RobotPreset,
+    },
+}
+
+/// Short name of an answer, for messages.
+pub fn answer_name(a: &DeviceToHost) -> &'static str {
+    match a {
+        DeviceToHost::Nack { .. } => "Nack",
+        DeviceToHost::HelloAck { .. } => "HelloAck",
+        DeviceToHost::Ack { .. } => "Ack",
+        DeviceToHost::Calibration { .. } => "Calibration",
+        DeviceToHost::Configured { .. } => "Configured",
+        DeviceToHost::MotionAck { .. } => "MotionAck",
+    }
+}
+
+/// Short name of a request, for messages.
+pub fn request_name(r: &Request) -> &'static str {
+    match r {
+        Request::Hello { .. } => "Hello",
+        Request::GetState => "GetState",
+        Request::SetBodyPose(_) => "SetBodyPose",
+        Request::SetFeet { .. } => "SetFeet",
+        Request::SetJoints { .. } => "SetJoints",
+        Request::SetOutputs { .. } => "SetOutputs",
+        Request::SetLinkTimeout(_) => "SetLinkTimeout",
+        Request::SetCalibration { .. } => "SetCalibration",
+        Request::GetCalibration { .. } => "GetCalibration",
+        Request::SaveCalibration => "SaveCalibration",
+        Request::SetPoseConfig(_) => "SetPoseConfig",
+        Request::StartMotion(_) => "StartMotion",
+        Request::StopMotion => "StopMotion",
+        Request::GetMotion => "GetMotion",
+        Request::SetVelocity { .. } => "SetVelocity",
+        Request::SetJointSpeedLimit { .. } => "SetJointSpeedLimit",
+    }
+}
