@@ -23,3 +23,13 @@ def test_workspace_map(root, tmp_path: pathlib.Path):
         capture_output=True,
     )
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_readme_python_example_runs_as_written(root):
+    text = (root / "README.md").read_text()
+    blocks = text.split("```python\n")[1:]
+    assert blocks, "README.md has a python block"
+    for block in blocks:
+        code = block.split("```")[0]
+        assert len(code.strip().splitlines()) == 5
+        subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
