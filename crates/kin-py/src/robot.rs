@@ -13,6 +13,19 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use quad_host::robot_file;
 
+/// `(values (N, 3), codes (N,))`.
+type Rows3<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i8>>);
+/// `(values (N, a, b), codes (N,))`.
+type Rows3d<'py> = (Bound<'py, PyArray3<f32>>, Bound<'py, PyArray1<i8>>);
+/// `(values (N,), codes (N,))`.
+type Rows1<'py> = (Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<i8>>);
+/// `(angles (N, 4, 3), codes (N,), legs (N,))`.
+type BodyRows<'py> = (
+    Bound<'py, PyArray3<f32>>,
+    Bound<'py, PyArray1<i8>>,
+    Bound<'py, PyArray1<i8>>,
+);
+
 /// Reach code of a row that was solved exactly.
 pub const OK: i8 = 0;
 /// Reach code: the foot is farther than femur + tibia.
@@ -241,7 +254,7 @@ impl Robot {
         }
         let feet = self.robot.stance_feet(stance_height_m);
         let flat: Vec<f32> = feet.iter().flat_map(|f| f.to_array()).collect();
-        Ok(PyArray1::from_vec(py, flat).reshape([4, 3])?)
+        PyArray1::from_vec(py, flat).reshape([4, 3])
     }
 
     /// Leg IK of many foot targets of one leg: ``foot_in_hip_m`` (N, 3), the feet in the hip
@@ -256,7 +269,7 @@ impl Robot {
         leg: &Bound<'py, PyAny>,
         foot_in_hip_m: &Bound<'py, PyAny>,
         policy: &str,
-    ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i8>>)> {
+    ) -> PyResult<Rows3<'py>> {
         let leg = leg_arg(leg)?;
         let policy = policy_arg(policy)?;
         let rows = arrays::read(foot_in_hip_m, &[3], "foot_in_hip_m")?;
@@ -314,7 +327,7 @@ impl Robot {
         py: Python<'py>,
         leg: &Bound<'py, PyAny>,
         angles_rad: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i8>>)> {
+    ) -> PyResult<Rows3<'py>> {
         let leg = leg_arg(leg)?;
         let rows = arrays::read(angles_rad, &[3], "angles_rad")?;
         let g = self.robot.leg;
@@ -345,7 +358,7 @@ impl Robot {
         py: Python<'py>,
         leg: &Bound<'py, PyAny>,
         angles_rad: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyArray1<i8>>)> {
+    ) -> PyResult<Rows3d<'py>> {
         let leg = leg_arg(leg)?;
         let rows = arrays::read(angles_rad, &[3], "angles_rad")?;
         let g = self.robot.leg;
@@ -383,7 +396,7 @@ impl Robot {
         py: Python<'py>,
         leg: &Bound<'py, PyAny>,
         angles_rad: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<i8>>)> {
+    ) -> PyResult<Rows1<'py>> {
         let leg = leg_arg(leg)?;
         let rows = arrays::read(angles_rad, &[3], "angles_rad")?;
         let solver = self.leg_solver();
@@ -421,11 +434,7 @@ impl Robot {
         stance_height_m: Option<f32>,
         rotation_order: Option<&str>,
         policy: &str,
-    ) -> PyResult<(
-        Bound<'py, PyArray3<f32>>,
-        Bound<'py, PyArray1<i8>>,
-        Bound<'py, PyArray1<i8>>,
-    )> {
+    ) -> PyResult<BodyRows<'py>> {
         let policy = policy_arg(policy)?;
         let config = BodyConfig::about_centre(order_arg(rotation_order)?);
         let poses = arrays::read(pose, &[6], "pose")?;
@@ -475,7 +484,7 @@ impl Robot {
         pose: &Bound<'py, PyAny>,
         angles_rad: &Bound<'py, PyAny>,
         rotation_order: Option<&str>,
-    ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyArray1<i8>>)> {
+    ) -> PyResult<Rows3d<'py>> {
         let config = BodyConfig::about_centre(order_arg(rotation_order)?);
         let poses = arrays::read(pose, &[6], "pose")?;
         let angles = arrays::read(angles_rad, &[4, 3], "angles_rad")?;
@@ -605,7 +614,7 @@ fn finish2(
     n: usize,
     w: usize,
     codes: Vec<i8>,
-) -> PyResult<(Bound<'_, PyArray2<f32>>, Bound<'_, PyArray1<i8>>)> {
+) -> PyResult<Rows3<'_>> {
     let arr = PyArray1::from_vec(py, out).reshape([n, w])?;
     Ok((arr, PyArray1::from_vec(py, codes)))
 }
