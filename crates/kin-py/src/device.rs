@@ -1,6 +1,7 @@
 //! `quadkin.Device`: the device client (quad-host's [`Client`] over one of its links: the
 //! simulated controller, the firmware in simavr, or a serial port).
 
+use crate::bridge::BridgeLink;
 use crate::errors;
 use crate::robot::leg_arg;
 use kin_core::motion::gait::Pattern;
@@ -13,7 +14,7 @@ use pyo3::types::PyDict;
 use quad_host::client::{Client, ClientConfig, DEFAULT_RETRIES};
 use quad_host::link::serial::SerialLink;
 use quad_host::link::sim::{SimConfig, SimLink, SimStorage};
-use quad_host::link::{self, Link, Target};
+use quad_host::link::{self, Link};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     DeviceInfo, DeviceToHost, Flags, LegSet, MotionCommand, MotionStatus, Readback, Request,
@@ -38,8 +39,13 @@ pub struct Device {
 }
 
 impl Device {
-    fn open(target: Target, link: Box<dyn Link>, port: String, retries: u32) -> PyResult<Device> {
-        let mut client = Client::new(link, ClientConfig::for_target(&target, retries));
+    fn open(
+        config: ClientConfig,
+        link: Box<dyn Link>,
+        port: String,
+        retries: u32,
+    ) -> PyResult<Device> {
+        let mut client = Client::new(link, ClientConfig { retries, ..config });
         let info = client.hello().map_err(|e| errors::device(e, &port))?;
         Ok(Device { client, port, info })
     }
@@ -136,12 +142,46 @@ impl Device {
         };
         let sim = SimLink::new(config, device_config, store)
             .map_err(|e| errors::link(&link::Error::Device(e), &port))?;
-        let target = Target::Sim {
-            preset,
-            config,
-            storage,
-        };
-        Device::open(target, Box::new(sim), port, retries)
+        Device::open(
+            ClientConfig::sim(config.compute),
+            Box::new(sim),
+            port,
+            retries,
+        )
+    }
+
+    /// The real firmware in simavr (``quadctl --emulator``), run by the ``quad-link-bridge``
+    /// program (``cargo build --release -p quad-link-bridge``; simavr cannot be linked into
+    /// this module): ``bridge`` its path (default: ``$QUADKIN_LINK_BRIDGE``, else
+    /// ``quad-link-bridge`` on ``PATH``); ``elf`` the firmware ELF (default: built from
+    /// ``firmware-avr/`` for the line rate); ``storage`` an EEPROM image file (read at
+    /// power-on, written when the device is closed). Times are simulated.
+    #[staticmethod]
+    #[pyo3(signature = (elf = None, baud = 115_200, storage = None, retries = DEFAULT_RETRIES, bridge = None))]
+    fn emulator(
+        elf: Option<PathBuf>,
+        baud: u32,
+        storage: Option<PathBuf>,
+        retries: u32,
+        bridge: Option<PathBuf>,
+    ) -> PyResult<Device> {
+        let program = bridge
+            .or_else(|| std::env::var_os("QUADKIN_LINK_BRIDGE").map(PathBuf::from))
+            .unwrap_or_else(|| PathBuf::from("quad-link-bridge"));
+        let mut args = vec![
+            "--emulator".to_owned(),
+            "--baud".to_owned(),
+            baud.to_string(),
+        ];
+        for (flag, path) in [("--elf", &elf), ("--storage", &storage)] {
+            if let Some(p) = path {
+                args.push(flag.to_owned());
+                args.push(p.to_string_lossy().into_owned());
+            }
+        }
+        let port = "emulator".to_owned();
+        let link = BridgeLink::spawn(&program, &args).map_err(|e| errors::link(&e, &port))?;
+        Device::open(ClientConfig::emulator(), Box::new(link), port, retries)
     }
 
     /// A real device on serial port ``port`` (e.g. ``/dev/ttyACM0``).
@@ -149,11 +189,12 @@ impl Device {
     #[pyo3(signature = (port, baud = 115_200, retries = DEFAULT_RETRIES))]
     fn serial(port: &str, baud: u32, retries: u32) -> PyResult<Device> {
         let link = SerialLink::open(port, baud).map_err(|e| errors::link(&e, port))?;
-        let target = Target::Serial {
-            path: port.to_owned(),
-            baud,
-        };
-        Device::open(target, Box::new(link), port.to_owned(), retries)
+        Device::open(
+            ClientConfig::serial(),
+            Box::new(link),
+            port.to_owned(),
+            retries,
+        )
     }
 
     /// The link's name: ``"sim"``, ``"emulator"`` or the port.

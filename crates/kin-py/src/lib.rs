@@ -6,13 +6,15 @@
 //! - [`motion::sample_motion`]: the motion laws and gaits sampled to arrays, as `quadctl
 //!   motion`;
 //! - [`device::Device`]: the device client over the simulated controller, the firmware in
-//!   simavr or a serial port, with typed exceptions ([`errors`]).
+//!   simavr (through the `quad-link-bridge` process, [`bridge`]) or a serial port, with typed
+//!   exceptions ([`errors`]).
 //!
 //! Batch calls run kin-core's scalar solves row by row ([`arrays::for_rows`]) with the GIL
 //! released, over rayon's threads for large batches. No Rust panic is meant to reach Python;
 //! PyO3 would turn one into `pyo3_runtime.PanicException`.
 
 pub mod arrays;
+pub mod bridge;
 pub mod device;
 pub mod errors;
 pub mod motion;

@@ -25,3 +25,25 @@ def quadctl() -> pathlib.Path:
     exe = ROOT / "target" / "debug" / "quadctl"
     assert exe.is_file(), exe
     return exe
+
+
+@pytest.fixture(scope="session")
+def link_bridge() -> pathlib.Path:
+    """The workspace's debug `quad-link-bridge`, which runs the firmware in simavr for
+    `quadkin.Device.emulator` (the test step of `cargo xtask ci` has built it)."""
+    env = {k: v for k, v in os.environ.items() if k != "RUSTUP_TOOLCHAIN"}
+    subprocess.run(
+        ["cargo", "build", "--quiet", "-p", "quad-link-bridge"], cwd=ROOT, check=True, env=env
+    )
+    exe = ROOT / "target" / "debug" / "quad-link-bridge"
+    assert exe.is_file(), exe
+    return exe
+
+
+@pytest.fixture(scope="session")
+def firmware_elf() -> pathlib.Path:
+    """The firmware ELF built by the CI's `firmware` step (`cd firmware-avr && cargo build
+    --release`); missing is a failure, not a skip."""
+    elf = ROOT / "firmware-avr" / "target" / "avr-none" / "release" / "firmware.elf"
+    assert elf.is_file(), f"{elf}: build the firmware first (cd firmware-avr && cargo build --release)"
+    return elf

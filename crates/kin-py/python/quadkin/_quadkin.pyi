@@ -190,6 +190,15 @@ class Device:
         retries: int = 10,
     ) -> Device: ...
     @staticmethod
+    def emulator(
+        elf: Optional[Union[str, PathLike[str]]] = None,
+        baud: int = 115200,
+        storage: Optional[Union[str, PathLike[str]]] = None,
+        retries: int = 10,
+        bridge: Optional[Union[str, PathLike[str]]] = None,
+    ) -> Device:
+        """The firmware in simavr, run by the quad-link-bridge program."""
+    @staticmethod
     def serial(port: str, baud: int = 115200, retries: int = 10) -> Device: ...
     @property
     def port(self) -> str: ...
