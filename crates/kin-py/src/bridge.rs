@@ -1,6 +1,7 @@
 //! A device link served by the `quad-link-bridge` process (crates/quad-link-bridge) over its
-//! stdin/stdout: how `Device.emulator` ([`crate::device::Device`]) reaches the firmware in simavr, which
-//! cannot be linked into this shared library (simavr's static libelf uses initial-exec TLS).
+//! stdin/stdout: how `Device.emulator` ([`crate::device::Device`]) reaches the firmware in
+//! simavr, which cannot be linked into this shared library (simavr's static libelf uses
+//! initial-exec TLS).
 
 use quad_host::link::{Error, Link};
 use std::io::{self, BufReader, BufWriter, Read, Write};
