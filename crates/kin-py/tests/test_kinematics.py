@@ -247,3 +247,18 @@ def test_robot_files_toml_and_urdf(tmp_path, root, quadctl):
     assert from_urdf.tibia_m == pytest.approx(ref.tibia_m, abs=1e-6)
     with pytest.raises(ValueError):
         quadkin.Robot.from_toml("[leg]\nfemur_m = -1\n")
+
+
+def test_odd_arrays_answer_or_raise_typed_errors():
+    robot = quadkin.Robot("shahriar2023")
+    feet = random_feet(64, seed=7)
+    want, _ = robot.leg_ik("FL", feet[::-1].copy())
+    got, _ = robot.leg_ik("FL", feet[::-1])  # negative strides
+    assert np.array_equal(got, want)
+    for bad in (None, np.float64(1.0), np.zeros((2, 3), dtype=np.float16), [[1, 2], [3]]):
+        with pytest.raises((TypeError, ValueError)):
+            robot.leg_ik("FL", bad)
+    with pytest.raises(ValueError, match=r"\(N, 4, 3\)"):
+        robot.body_fk(np.zeros((2, 6)), np.zeros((2, 12)))
+    with pytest.raises(ValueError, match="same N"):
+        robot.body_fk(np.zeros((2, 6)), np.zeros((3, 4, 3)))
