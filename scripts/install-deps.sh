@@ -19,7 +19,8 @@
 #     `-Z build-std=core`), clippy + rustfmt on `stable` (rust-toolchain.toml), and the
 #     `wasm32-unknown-unknown` target on `stable` (kin-core in the browser, crates/kin-wasm).
 #
-# Does nothing (and needs no network) when everything is already present. Installing needs
+# Does nothing (and needs no network) when everything is already present, but for the quadkin
+# wheel, rebuilt and reinstalled every run (cargo recompiles only what changed). Installing needs
 # root; without it, a missing piece is an error naming the command to run.
 set -euo pipefail
 
