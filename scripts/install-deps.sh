@@ -10,11 +10,17 @@
 #   - the browser panel (`quadctl serve`): Debian's chromium and chromium-driver (the browser
 #     tests drive the headless browser through chromedriver), Node.js and npm, then `npm ci`
 #     in web/ (three.js, pinned by web/package-lock.json; rerun only when that file changes).
+#   - the Python package `quadkin` (crates/kin-py): a virtual environment `.venv-py` at the
+#     repository root with the pinned packages of crates/kin-py/requirements.txt (maturin,
+#     numpy, pytest, matplotlib; recreated only when that file changes), then the package's
+#     wheel built by maturin (release, target dir target/python; cargo rebuilds only what
+#     changed) and installed into it.
 #   - rustup: the `nightly` toolchain with `rust-src` (no_std build for avr-none with
 #     `-Z build-std=core`), clippy + rustfmt on `stable` (rust-toolchain.toml), and the
 #     `wasm32-unknown-unknown` target on `stable` (kin-core in the browser, crates/kin-wasm).
 #
-# Does nothing (and needs no network) when everything is already present. Installing needs
+# Does nothing (and needs no network) when everything is already present, but for the quadkin
+# wheel, rebuilt and reinstalled every run (cargo recompiles only what changed). Installing needs
 # root; without it, a missing piece is an error naming the command to run.
 set -euo pipefail
 
@@ -132,3 +138,29 @@ else
     "$VENV/bin/pip" install --quiet --disable-pip-version-check -r "$REQUIREMENTS" </dev/null
     echo "$want" >"$STAMP"
 fi
+
+# --- Python package: quadkin into .venv-py ---------------------------------------------------
+PYVENV="$ROOT/.venv-py"
+PYREQ="$ROOT/crates/kin-py/requirements.txt"
+PYSTAMP="$PYVENV/.requirements.sha256"
+want=$(sha256sum "$PYREQ" | cut -d' ' -f1)
+have=$(cat "$PYSTAMP" 2>/dev/null || true)
+if [ -x "$PYVENV/bin/python" ] && [ "$want" = "$have" ]; then
+    echo "install-deps: Python environment .venv-py present"
+else
+    echo "install-deps: creating .venv-py from crates/kin-py/requirements.txt"
+    rm -rf "$PYVENV"
+    python3 -m venv "$PYVENV"
+    "$PYVENV/bin/pip" install --quiet --disable-pip-version-check -r "$PYREQ" </dev/null
+    echo "$want" >"$PYSTAMP"
+fi
+echo "install-deps: building the quadkin wheel (maturin) into .venv-py"
+rm -rf "$ROOT/target/python/wheels"
+(
+    unset RUSTUP_TOOLCHAIN CARGO_ENCODED_RUSTFLAGS
+    cd "$ROOT/crates/kin-py"
+    "$PYVENV/bin/maturin" build --quiet --release --interpreter "$PYVENV/bin/python" \
+        --target-dir "$ROOT/target/python" --out "$ROOT/target/python/wheels" </dev/null
+)
+"$PYVENV/bin/pip" install --quiet --disable-pip-version-check --no-deps --force-reinstall \
+    "$ROOT"/target/python/wheels/quadkin-*.whl </dev/null

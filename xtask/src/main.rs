@@ -11,6 +11,7 @@
 //! | `firmware`     | `cargo build --release` in `firmware-avr/` (when that directory exists) |
 //! | `budget`       | the firmware's flash ≤ 128 KB and SRAM (static + worst stack in simavr) ≤ 6 KB: figures and margins; tables read with `lpm` in the lowest 64 KB (`integration_tests::budget`) |
 //! | `test`         | `cargo test --workspace`                                              |
+//! | `python`       | pytest of the Python package `quadkin` (crates/kin-py/tests, examples/python) in `.venv-py`, where the `deps` step installed it |
 //! | `doc`          | `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`     |
 //!
 //! `cargo xtask ci --list` prints the steps; `cargo xtask ci STEP...` runs only those.
@@ -218,6 +219,20 @@ fn ci_steps(root: &Path) -> Vec<Step> {
         "test",
         &["cargo", "test", "--workspace", "--no-fail-fast"],
     ));
+    // The Python package: its wheel was built and installed into .venv-py by the deps step;
+    // the tests compare with `quadctl` (built by the test step) and run the examples.
+    steps.push(Step::new(
+        "python",
+        &[
+            ".venv-py/bin/python",
+            "-m",
+            "pytest",
+            "-q",
+            "-p",
+            "no:cacheprovider",
+            "crates/kin-py/tests",
+        ],
+    ));
     steps.push(
         Step::new("doc", &["cargo", "doc", "--workspace", "--no-deps"])
             .with_env("RUSTDOCFLAGS", "-D warnings"),
@@ -390,7 +405,15 @@ mod tests {
     fn step_names_are_unique_and_cover_the_required_checks() {
         let steps = ci_steps(&workspace_root());
         let mut n = names(&steps);
-        for required in ["deps", "fmt", "clippy", "avr-kin-core", "test", "doc"] {
+        for required in [
+            "deps",
+            "fmt",
+            "clippy",
+            "avr-kin-core",
+            "test",
+            "python",
+            "doc",
+        ] {
             assert!(n.contains(&required), "missing step {required}");
         }
         n.sort_unstable();
@@ -410,6 +433,10 @@ mod tests {
         assert_eq!(n[0], "deps");
         let pos = |name| n.iter().position(|s| *s == name).unwrap();
         assert!(pos("firmware") < pos("test"));
+        assert!(
+            pos("test") < pos("python"),
+            "the Python tests use the test step's quadctl"
+        );
         assert_eq!(
             pos("budget"),
             pos("firmware") + 1,
