@@ -170,6 +170,12 @@ impl Kind {
     /// them, 115,200's for a slower one, scaled up), times 1.5, plus [`HOST_LATENCY`], rounded
     /// up to whole milliseconds.
     pub fn timeout(self, baud: u32) -> Duration {
+        self.timeout_with(baud, HOST_LATENCY)
+    }
+
+    /// [`Kind::timeout`] with `host_latency` in place of [`HOST_LATENCY`] (a line without a USB
+    /// bridge, e.g. the emulated chip's).
+    pub fn timeout_with(self, baud: u32, host_latency: Duration) -> Duration {
         let [slow_us, fast_us] = self.worst_us();
         let worst_us = if baud >= BAUDS[1] {
             u64::from(fast_us)
@@ -180,7 +186,7 @@ impl Kind {
             // overestimate (the device's own work does not slow down).
             u64::from(slow_us) * u64::from(BAUDS[0]) / u64::from(baud.max(1))
         };
-        let us = worst_us * 3 / 2 + HOST_LATENCY.as_micros() as u64;
+        let us = worst_us * 3 / 2 + host_latency.as_micros() as u64;
         Duration::from_millis(us.div_ceil(1000))
     }
 }

@@ -1,9 +1,10 @@
 //! [`Client`]: one request and its answer under one sequence number, retried (see the module
 //! docs of [`crate::client`]), and the session requests built on it.
 
-use super::{request_name, ClientConfig, Error};
+use super::{request_name, AnswerWait, ClientConfig, Error};
 use crate::link::{self, byte_time, Link};
 use quad_protocol::servo::Calibration;
+use quad_protocol::timing;
 use quad_protocol::{
     encode_frame, frame, Accumulator, DeviceInfo, DeviceToHost, Feed, HostToDevice, NackReason,
     Readback, Request, ServoId, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, MAX_FRAME_LEN,
@@ -110,15 +111,22 @@ impl<L: Link> Client<L> {
         &self.config
     }
 
-    /// Timeout of one attempt of a request whose frame has `wire_len` bytes.
+    /// Timeout of one attempt of a request whose frame has `wire_len` bytes
+    /// ([`ClientConfig::answer_wait`]).
     pub fn attempt_timeout(&self, wire_len: usize, request: &Request) -> Duration {
-        let answer_len = frame::encoded_len_max(DEVICE_TO_HOST_MAX_LEN);
-        let mut t =
-            byte_time(self.link.baud()) * (wire_len + answer_len) as u32 + self.config.turnaround;
-        if matches!(request, Request::SaveCalibration) {
-            t += self.config.save_time;
+        match self.config.answer_wait {
+            AnswerWait::Measured { host_latency } => {
+                timing::Kind::of(request).timeout_with(self.link.baud(), host_latency)
+            }
+            AnswerWait::Modelled { compute, save } => {
+                let answer_len = frame::encoded_len_max(DEVICE_TO_HOST_MAX_LEN);
+                let mut t = byte_time(self.link.baud()) * (wire_len + answer_len) as u32 + compute;
+                if matches!(request, Request::SaveCalibration) {
+                    t += save;
+                }
+                t
+            }
         }
-        t
     }
 
     /// Sends `request` and waits for its answer, retrying under the same sequence number (see

@@ -13,12 +13,13 @@
 //!   corrupted request or answer from a real disagreement, which persists.
 //!
 //! Answers with another sequence number (late or duplicated answers to earlier attempts) are
-//! dropped. The device acts on every copy of a request it reads; a body pose is idempotent, so
-//! a duplicate only costs line time, and the latest pose wins.
+//! dropped. The device answers an exact repeat of the request it answered last with the same
+//! answer, without acting again (docs/protocol.md, link rules), so a resend is always safe.
 //!
-//! The answer timeout of an attempt is the wire time of the request and of the longest answer at
-//! the link's baud rate plus [`ClientConfig::turnaround`] (device computation and, on a real
-//! port, USB latency).
+//! The answer timeout of an attempt ([`AnswerWait`]) is, for the ATmega2560 (a real port or
+//! the emulated chip), the firmware's measured answer time of that kind of request at the
+//! link's line rate with a margin ([`quad_protocol::timing`]); for the simulated device, the
+//! wire time of the request and of the longest answer plus its modelled computation.
 //!
 //! ## Readback check ([`PoseStream`])
 //! For every body pose the host runs kin-core itself (`body::Solver::inverse_at_stance` on `DefaultMath`,
@@ -69,12 +70,31 @@ pub struct ClientConfig {
     pub retries: u32,
     /// Resends of a session request ([`Client::request`] and what builds on it).
     pub session_retries: u32,
-    /// Added to the wire time of request + answer to make an attempt's timeout.
-    pub turnaround: Duration,
-    /// Extra time allowed for `SaveCalibration` (an EEPROM write of ~200 bytes at 3.4 ms each).
-    pub save_time: Duration,
+    /// How long an attempt waits for its answer.
+    pub answer_wait: AnswerWait,
     /// How long the handshake keeps trying (a Mega resets when its port opens).
     pub hello_patience: Duration,
+}
+
+/// How long an attempt of a request waits for its answer before it is resent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnswerWait {
+    /// The ATmega2560 firmware's answer time of the request's kind at the link's line rate,
+    /// measured ([`quad_protocol::timing`], docs/protocol.md "Answer times"), with half again
+    /// as margin and `host_latency` for the host's side of the line.
+    Measured {
+        /// A real port's USB frames and scheduling ([`quad_protocol::timing::HOST_LATENCY`]);
+        /// next to nothing for the emulated chip.
+        host_latency: Duration,
+    },
+    /// The wire time of the request and of the longest answer, plus `compute`, plus `save`
+    /// for `SaveCalibration`: for the simulated device, whose time is modelled.
+    Modelled {
+        /// The device's time per request.
+        compute: Duration,
+        /// The extra time of an EEPROM save.
+        save: Duration,
+    },
 }
 
 impl ClientConfig {
@@ -83,8 +103,10 @@ impl ClientConfig {
         ClientConfig {
             retries: DEFAULT_RETRIES,
             session_retries: SESSION_RETRIES,
-            turnaround: compute + Duration::from_millis(1),
-            save_time: Duration::from_secs(1),
+            answer_wait: AnswerWait::Modelled {
+                compute: compute + Duration::from_millis(1),
+                save: Duration::from_secs(1),
+            },
             hello_patience: Duration::from_millis(100),
         }
     }
@@ -96,8 +118,9 @@ impl ClientConfig {
         ClientConfig {
             retries: DEFAULT_RETRIES,
             session_retries: SESSION_RETRIES,
-            turnaround: Duration::from_millis(20),
-            save_time: Duration::from_secs(1),
+            answer_wait: AnswerWait::Measured {
+                host_latency: Duration::from_millis(2),
+            },
             hello_patience: Duration::from_secs(1),
         }
     }
@@ -108,8 +131,9 @@ impl ClientConfig {
         ClientConfig {
             retries: DEFAULT_RETRIES,
             session_retries: SESSION_RETRIES,
-            turnaround: Duration::from_millis(50),
-            save_time: Duration::from_secs(1),
+            answer_wait: AnswerWait::Measured {
+                host_latency: quad_protocol::timing::HOST_LATENCY,
+            },
             hello_patience: Duration::from_secs(4),
         }
     }
