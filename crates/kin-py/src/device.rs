@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use quad_host::client::{Client, ClientConfig, DEFAULT_RETRIES};
 use quad_host::link::serial::SerialLink;
-use quad_host::link::sim::{SimConfig, SimLink, SimStorage};
+use quad_host::link::sim::{SimConfig, SimLink, EepromImage};
 use quad_host::link::{self, Link};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
@@ -129,7 +129,7 @@ impl Device {
         let device_config = quad_device::Config::for_preset(preset)
             .ok_or_else(|| errors::link(&link::Error::NoSimulatedRobot, &port))?;
         let store = match &storage {
-            Some(path) => SimStorage::with_file(path.clone()).map_err(|source| {
+            Some(path) => EepromImage::with_file(path.clone()).map_err(|source| {
                 errors::link(
                     &link::Error::Storage {
                         path: path.clone(),
@@ -138,7 +138,7 @@ impl Device {
                     &port,
                 )
             })?,
-            None => SimStorage::erased(),
+            None => EepromImage::erased(),
         };
         let sim = SimLink::new(config, device_config, store)
             .map_err(|e| errors::link(&link::Error::Device(e), &port))?;
