@@ -15,8 +15,9 @@ use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
     check_request_in, encode_frame_in_pieces, is_compatible, Accumulator, DeviceInfo, DeviceToHost,
-    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges,
-    Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, MotionCommand, NackReason, PoseConfig,
+    Ranges, Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN,
+    PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -430,12 +431,12 @@ where
     }
 
     /// Starts a motion of the engine (see [`engine`]): validated and start-checked first, refused
-    /// with nothing changed. [`engine::Request::StandUp`] with the outputs off holds the rest
+    /// with nothing changed. [`MotionCommand::StandUp`] with the outputs off holds the rest
     /// pose and enables the outputs at it.
     ///
     /// # Errors
     /// [`engine::Error`].
-    pub fn start_motion(&mut self, request: &engine::Request) -> Result<(), engine::Error> {
+    pub fn start_motion(&mut self, request: &MotionCommand) -> Result<(), engine::Error> {
         let setup = Setup {
             robot: &self.config.robot,
             solver: &self.solver,
@@ -590,7 +591,7 @@ where
                 .set_joint_speed_limit(joint_speed_limit_rad_s)
                 .map_err(NackReason::from),
             Request::StartMotion(m) => {
-                let r = self.start_motion(&engine::Request::from(m));
+                let r = self.start_motion(&m);
                 return self.motion_answer(seq, r);
             }
             Request::StopMotion => {
