@@ -227,7 +227,7 @@ impl ValidConfig {
 
 /// The calibration a controller holds from [`crate::Device::stopped`] until
 /// [`crate::Device::boot`]: all zeros, an empty travel (0 µs) that no angle maps into. Zeros so
-/// that it costs a memset, not a 180-byte table copied into SRAM at reset.
+/// that it costs a memset, not a table copied into SRAM at reset.
 pub(crate) const UNBOOTED_CALIBRATION: Table = [Calibration {
     zero_rad: 0.0,
     reversed: false,

@@ -126,11 +126,12 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
 }
 
 // The request handlers are `#[inline(never)]` on purpose: inlined into one function (as LTO
-// does on the ATmega2560), their locals make a stack frame of several hundred bytes, beyond the
-// AVR's 63-byte frame-pointer displacement. Every access then costs about 8 instructions, which
-// doubled the firmware's flash, and the LLVM AVR backend miscompiled one such access (it saved
-// SREG in r0 while r0 still held a `mul` result: a wrong calibration index). Small frames avoid
-// both; `firmware-avr`'s emulator tests scan the ELF for that pattern.
+// does on the ATmega2560), their locals make one large stack frame, beyond the reach of the
+// AVR's frame-pointer displacement: every access then costs a pointer adjustment (the flash
+// grew by half), and the LLVM AVR backend miscompiled one such access (it saved SREG in r0
+// while r0 still held a `mul` result: a wrong calibration index). Small frames avoid both;
+// `firmware-avr`'s emulator tests scan the ELF for that pattern. The figures are in
+// docs/benchmark-journal.md.
 impl<O, C, S, M> Device<O, C, S, M>
 where
     O: ServoOutputs,
@@ -513,7 +514,7 @@ where
     }
 
     /// [`Device::handle`] on a borrowed request: [`Device::receive`] hands it the request
-    /// where the decoder left it (a copy of up to 50 bytes fewer per request on the AVR).
+    /// where the decoder left it (no copy of the request on the way).
     #[inline(never)]
     fn handle_ref(&mut self, msg: &HostToDevice) -> DeviceToHost {
         self.last_valid_ms = self.clock.now_ms();
@@ -988,8 +989,8 @@ pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8], tx: &mut dyn FnMut(&
     encode_frame_in_pieces(answer, out, tx).unwrap_or(0)
 }
 
-/// [`check_request_in`], out of line: inlined into [`Device::answer`], its copies of the request's
-/// values took the dispatcher's stack frame beyond the AVR's 63-byte displacement.
+/// [`check_request_in`], out of line: inlined into [`Device::answer`], its copies of the
+/// request's values took the dispatcher's stack frame beyond the frame-pointer displacement.
 #[inline(never)]
 fn check_range(request: &Request, ranges: &Ranges) -> Result<(), NackReason> {
     check_request_in(request, ranges)
