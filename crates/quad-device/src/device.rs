@@ -210,6 +210,7 @@ where
     /// loads the calibration from storage (the defaults of [`default_calibration`](crate::default_calibration) when none is
     /// valid) and holds
     /// the nominal stance (zero body pose) when it maps within that calibration.
+    // Out of line: the boot's stance IK in its own stack frame, not the dispatcher's.
     #[inline(never)]
     pub fn boot(&mut self) {
         self.calibration_default = !self.load_calibration();
@@ -361,6 +362,7 @@ where
     /// One servo frame, when a frame boundary has passed: the engine's new target, then one
     /// limiter step of the outputs toward the held target. The boundaries are the outputs' PWM
     /// periods when they count them ([`ServoOutputs::periods_begun`]), else the clock's 20 ms.
+    // Out of line: the per-frame path (engine tick, limiter step) in its own small frames.
     #[inline(never)]
     fn frame_tick(&mut self) {
         if !self.outputs_enabled {
@@ -527,6 +529,7 @@ where
         answer
     }
 
+    // Out of line: the dispatcher's frame holds only the request, each handler its own locals.
     #[inline(never)]
     fn answer(&mut self, msg: &HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
@@ -659,6 +662,7 @@ where
 
     /// The state an `Ack` reports: held angles (zeros when nothing is held), the pulses on the
     /// outputs (zeros while stopped), flags and frame counters.
+    // Out of line: one readback builder for every answer that carries one.
     #[inline(never)]
     pub fn readback(&self) -> Readback {
         let flags = Flags::EMPTY
@@ -751,6 +755,7 @@ where
     }
 
     /// `SetFeet`: the feet in the body frame at the zero pose.
+    // Out of line: the body solve's locals stay out of the dispatcher's stack frame.
     #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
@@ -796,6 +801,7 @@ where
     }
 
     /// Maps all twelve angles through the calibration; commits and drives only when all map.
+    // Out of line: one mapping of twelve angles for every setpoint source.
     #[inline(never)]
     fn apply(
         &mut self,
@@ -883,6 +889,7 @@ where
         true
     }
 
+    // Out of line: one instance for the requests and the failsafe that stop the outputs.
     #[inline(never)]
     fn stop_outputs(&mut self) {
         self.outputs.set_enabled(false);
@@ -918,6 +925,7 @@ where
         Ok(())
     }
 
+    // Out of line: a request handler (see the note above `impl Device`).
     #[inline(never)]
     fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), NackReason> {
         let map = c.pulse_map().map_err(NackReason::BadCalibration)?;
@@ -956,6 +964,7 @@ where
         Ok(())
     }
 
+    // Out of line: a request handler (see the note above `impl Device`).
     #[inline(never)]
     fn save_calibration(&mut self) -> Result<(), NackReason> {
         self.store
