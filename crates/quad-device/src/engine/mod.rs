@@ -2,7 +2,7 @@
 //! at a time, every setpoint through one joint-speed limiter.
 //!
 //! The engine calls kin-core's motion code — the robot-free laws [`laws::SwayLaw`],
-//! [`laws::YawTurnLaw`], [`laws::LegPathsLaw`] over the [`PathKind`] paths (the robot is the
+//! [`laws::YawTurnLaw`], [`laws::LegPathsLaw`] over the [`PathKind`](kin_core::motion::path::PathKind) paths (the robot is the
 //! device's, in its body solver), and the [`Walker`] stepper — and kin-core's body IK; it holds
 //! no law of its own. It is `no_std`, allocation-free and generic over the
 //! kin-core [`Math`] backend, so the firmware and the host's simulated link run the same code.
@@ -60,7 +60,7 @@
 //! motion's frame at a sample time, its body IK (which refuses unreachable feet and joint
 //! limits), the servo travel — at a bounded set of samples, plus kin-core's singularity
 //! measure on each leg ([`kin_core::leg::Solver::inverse_condition`] against
-//! [`SINGULARITY_THRESHOLD`]). A refusal ([`Error`]) changes nothing.
+//! [`SINGULARITY_THRESHOLD`](kin_core::jacobian::SINGULARITY_THRESHOLD)). A refusal ([`Error`]) changes nothing.
 //! - The sways, the yaw turn and the foot paths are periodic in their joint angles, so one
 //!   period covers the whole motion: [`START_CHECK_SAMPLES`] evenly spaced instants, a
 //!   multiple of 4, so that the sways' extremes (T/4, 3T/4) and the yaw turn's apexes and
