@@ -253,7 +253,6 @@ pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> 
 
 /// [`default_calibration`] written in place (no table-sized temporary on the stack), with the
 /// body solver of the robot (a device's own, built once).
-#[inline(never)]
 pub(crate) fn write_default_calibration<M: Math>(
     solver: &body::Solver<M>,
     pose_config: &PoseConfig,

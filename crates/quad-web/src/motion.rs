@@ -180,3 +180,45 @@ impl From<&MotionStatus> for MotionState {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use kin_core::motion::gait::Pattern;
+    use kin_core::motion::laws::Axis;
+    use kin_core::LegId;
+    use quad_protocol::{LegSet, MotionCommand};
+
+    #[test]
+    fn every_motion_reads_back_from_its_snake_case_json() {
+        let motions = [
+            MotionCommand::StandUp,
+            MotionCommand::Sit,
+            MotionCommand::Rest,
+            MotionCommand::seed001_sway(Axis::Pitch, Some(20.0)),
+            MotionCommand::seed001_yaw_turn(None),
+            MotionCommand::seed000_rectangle(LegSet::One(LegId::RL), Some(3.0)),
+            MotionCommand::seed000_rectangle(LegSet::All, None),
+            MotionCommand::walk(Pattern::Walk, 0.3),
+        ];
+        for m in motions {
+            let text = serde_json::to_string(&m).unwrap();
+            assert_eq!(
+                serde_json::from_str::<MotionCommand>(&text).unwrap(),
+                m,
+                "{text}"
+            );
+        }
+        assert_eq!(
+            serde_json::to_string(&MotionCommand::StandUp).unwrap(),
+            r#""stand_up""#
+        );
+        assert_eq!(
+            serde_json::to_string(&MotionCommand::seed000_rectangle(
+                LegSet::One(LegId::FL),
+                None
+            ))
+            .unwrap(),
+            r#"{"foot_path":{"path":"rectangle","legs":{"one":"FL"},"stride_m":0.1,"step_height_m":0.05,"duty_factor":0.33333334,"cycle_s":3.0,"duration_s":null}}"#
+        );
+    }
+}

@@ -323,8 +323,6 @@ impl<M: Math> Engine<M> {
 
     /// The law's frame at `t_s`, written into `frame`: the motion's frame with the legs it
     /// does not move at their stance points.
-    // Out of line: the laws' frame code writes through `frame`, in its own small stack frame.
-    #[inline(never)]
     fn law_frame(law: &Law, t_s: f32, frame: &mut Frame) -> Result<(), motion::Error> {
         match &law.motion {
             LawMotion::Sway(m) => m.frame_into::<M>(t_s, frame),
@@ -344,8 +342,6 @@ impl<M: Math> Engine<M> {
     }
 
     /// The law's joint setpoint at `t_s`: its frame through the body IK.
-    // Out of line: one copy for the tick and the start check, the frame off the caller's stack.
-    #[inline(never)]
     pub(super) fn law_setpoint(
         law: &Law,
         t_s: f32,
@@ -361,8 +357,6 @@ impl<M: Math> Engine<M> {
 
     /// The walk's joint setpoint with its feet at `feet` (body frame, the body at the zero pose;
     /// the contacts do not enter the IK), through `solver`.
-    // Out of line: one copy for the tick and the start check, the frame off the caller's stack.
-    #[inline(never)]
     pub(super) fn walk_setpoint(
         solver: &body::Solver<M>,
         order: RotationOrder,

@@ -503,9 +503,6 @@ impl<M: Math> Engine<M> {
     /// One tick after `frames` (≥ 1) frame boundaries, at `now_ms`, with the outputs at `out`,
     /// the motion's frames solved by `solver` (the [`Setup::solver`] it started with): the new
     /// target, if any.
-    // Out of line, as are the law's frame and setpoint: small stack frames on the per-frame
-    // path (see `Device`'s notes on AVR stack frames; the trot's frame in BENCHMARKS.md).
-    #[inline(never)]
     pub fn tick(
         &mut self,
         frames: u32,
