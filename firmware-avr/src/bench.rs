@@ -37,8 +37,8 @@ use core::marker::PhantomData;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::Axis;
 use kin_core::{body, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
-use quad_device::engine::{self, Engine, Limiter, PulseMaps, Setup, Stage, FRAME_MS};
-use quad_protocol::{LegSet, MotionCommand as Request};
+use quad_device::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS};
+use quad_protocol::{LegSet, MotionCommand as Request, MotionStage};
 use quad_device::{default_calibration, Config};
 
 /// Stance height of the body-pose benchmark: seed 000 Table 4 body height, m.
@@ -222,7 +222,7 @@ impl<M: Math> EngineBench<M> {
         }
     }
 
-    fn tick(&mut self) -> Stage {
+    fn tick(&mut self) -> MotionStage {
         self.now_ms += FRAME_MS;
         let tick = self.engine.tick(1, self.now_ms, &self.out, &self.solver);
         if let Some(target) = tick.target {
@@ -280,7 +280,7 @@ impl<M: Math> MotionBench for EngineBench<M> {
             return STATUS_UNREACHABLE;
         }
         for _ in 0..500 {
-            if self.tick() == Stage::Run {
+            if self.tick() == MotionStage::Run {
                 break;
             }
         }

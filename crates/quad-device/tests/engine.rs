@@ -13,9 +13,11 @@ use kin_core::motion::path::PathKind;
 use kin_core::motion::{self, Motion};
 use kin_core::preflight::{Failure, FailureKind};
 use kin_core::{BodyConfig, DefaultMath, LegId, ReachPolicy, Unreachable, Vec3};
-use quad_device::engine::{self, rest_angles, Error, Kind, Stage, FRAME_MS};
+use quad_device::engine::{self, rest_angles, Error, FRAME_MS};
 use quad_device::{Config, Device};
-use quad_protocol::{LegSet, MotionCommand as Request, Request as Wire, ServoId};
+use quad_protocol::{
+    LegSet, MotionCommand as Request, MotionKind, MotionStage, Request as Wire, ServoId,
+};
 
 /// Rounding allowance on the limiter's bound, rad.
 const STEP_TOL_RAD: f32 = 1e-6;
@@ -221,7 +223,7 @@ fn run_law(config: Config, request: Request, expected: impl Fn(f32) -> [f32; 12]
     while rig.dev.motion_status().kind.is_some() {
         rig.frame();
         let st = rig.dev.motion_status();
-        if st.kind.is_some() && st.stage == Stage::Run {
+        if st.kind.is_some() && st.stage == MotionStage::Run {
             ran += 1;
             let target = rig.dev.readback().angles_rad;
             assert_eq!(st.fault, None);
@@ -351,7 +353,7 @@ fn walk_rig(config: Config, timeout_ms: u16) -> Rig {
         *velocity_timeout_ms = timeout_ms;
     }
     rig.start(w);
-    while rig.dev.motion_status().stage == Stage::Approach {
+    while rig.dev.motion_status().stage == MotionStage::Approach {
         rig.frame();
     }
     rig
@@ -374,9 +376,9 @@ fn stop_while_trotting_finishes_the_stride_and_ends_at_the_stance() {
             rig.frame();
             k += 1;
         }
-        assert_eq!(rig.dev.motion_status().kind, Some(Kind::Walk));
+        assert_eq!(rig.dev.motion_status().kind, Some(MotionKind::Walk));
         rig.dev.stop_motion();
-        assert_eq!(rig.dev.motion_status().stage, Stage::Stopping);
+        assert_eq!(rig.dev.motion_status().stage, MotionStage::Stopping);
         assert_eq!(
             rig.dev.set_velocity(Velocity::default()),
             Err(Error::NotWalking)
@@ -407,14 +409,14 @@ fn a_velocity_command_not_refreshed_stops_the_walk_cleanly() {
         .unwrap();
     for _ in 0..15 {
         rig.frame();
-        assert_eq!(rig.dev.motion_status().stage, Stage::Run);
+        assert_eq!(rig.dev.motion_status().stage, MotionStage::Run);
     }
     for _ in 0..2 {
         rig.frame();
     }
     assert_eq!(
         rig.dev.motion_status().stage,
-        Stage::Stopping,
+        MotionStage::Stopping,
         "after 300 ms"
     );
     rig.until_idle();
@@ -556,7 +558,7 @@ fn bad_parameters_are_refused_by_name_and_move_nothing() {
         ),
     ] {
         assert_eq!(parameter(rig.dev.set_velocity(v).unwrap_err()), name);
-        assert_eq!(rig.dev.motion_status().kind, Some(Kind::Walk));
+        assert_eq!(rig.dev.motion_status().kind, Some(MotionKind::Walk));
     }
     assert_eq!(
         parameter(rig.dev.set_joint_speed_limit(0.0).unwrap_err()),

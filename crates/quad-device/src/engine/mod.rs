@@ -99,7 +99,7 @@ use kin_core::preflight::Failure;
 use kin_core::{IkError, Math, Robot, RotationOrder};
 use quad_protocol::servo::{self, PulseMap};
 pub use quad_protocol::DEFAULT_VELOCITY_TIMEOUT_MS;
-use quad_protocol::{MotionCommand, ServoId};
+use quad_protocol::{MotionCommand, MotionKind, MotionStage, ServoId};
 
 /// One servo frame, ms.
 pub const FRAME_MS: u32 = 20;
@@ -165,46 +165,13 @@ impl From<motion::Error> for Error {
     }
 }
 
-/// The kinds of motion.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum Kind {
-    /// [`MotionCommand::StandUp`].
-    StandUp,
-    /// [`MotionCommand::Sit`].
-    Sit,
-    /// [`MotionCommand::Rest`].
-    Rest,
-    /// [`MotionCommand::Sway`].
-    Sway,
-    /// [`MotionCommand::YawTurn`].
-    YawTurn,
-    /// [`MotionCommand::FootPath`].
-    FootPath,
-    /// [`MotionCommand::Walk`].
-    Walk,
-}
-
-/// Where a motion is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Stage {
-    /// Ramping from the outputs to the motion's first setpoint.
-    Approach,
-    /// Running.
-    Run,
-    /// Stop requested: running to the end of the period (or of the strides).
-    Stopping,
-    /// Ramping to the stance (or the rest pose).
-    Leave,
-}
-
 /// What the engine reports.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Status {
     /// The motion running, if any.
-    pub kind: Option<Kind>,
+    pub kind: Option<MotionKind>,
     /// Its stage.
-    pub stage: Stage,
+    pub stage: MotionStage,
     /// Motion time since the run began, s.
     pub t_s: f32,
     /// Phase within the motion's period (the walk's gait phase), in `[0, 1)`.
@@ -291,7 +258,7 @@ enum Program {
     Idle,
     /// Stand-up, sit or rest: one ramp.
     Pose {
-        kind: Kind,
+        kind: MotionKind,
     },
     Law(Law),
     Walk {
@@ -307,8 +274,8 @@ pub struct Engine<M> {
     /// The motion running.
     program: Program,
     /// Where it is.
-    stage: Stage,
-    /// Frames run since [`Stage::Run`] began.
+    stage: MotionStage,
+    /// Frames run since [`MotionStage::Run`] began.
     frame: u32,
     /// The ramp of the approach and the leave.
     ramp: Ramp,
@@ -338,7 +305,7 @@ impl<M: Math> Engine<M> {
     pub const fn new(limiter: Limiter) -> Self {
         Engine {
             program: Program::Idle,
-            stage: Stage::Run,
+            stage: MotionStage::Run,
             ramp: Ramp::idle(),
             home: [0.0; 12],
             frame: 0,
@@ -403,9 +370,9 @@ impl<M: Math> Engine<M> {
                 };
                 self.program = Program::Pose {
                     kind: match request {
-                        MotionCommand::StandUp => Kind::StandUp,
-                        MotionCommand::Sit => Kind::Sit,
-                        _ => Kind::Rest,
+                        MotionCommand::StandUp => MotionKind::StandUp,
+                        MotionCommand::Sit => MotionKind::Sit,
+                        _ => MotionKind::Rest,
                     },
                 };
                 (target, target, out.unwrap_or(rest))
@@ -420,7 +387,7 @@ impl<M: Math> Engine<M> {
                 (first, home, out)
             }
         };
-        self.stage = Stage::Approach;
+        self.stage = MotionStage::Approach;
         self.ramp.restart(&start, &first, &self.limiter);
         self.home = home;
         self.frame = 0;
@@ -439,7 +406,7 @@ impl<M: Math> Engine<M> {
                 walker,
                 last_command_ms,
                 ..
-            } if !walker.is_stopping() && self.stage != Stage::Leave => {
+            } if !walker.is_stopping() && self.stage != MotionStage::Leave => {
                 walker.set_velocity::<M>(v)?;
                 *last_command_ms = now_ms;
                 Ok(())
@@ -453,7 +420,9 @@ impl<M: Math> Engine<M> {
     /// its end.
     pub fn stop(&mut self) {
         match &mut self.program {
-            Program::Law(law) if self.stage == Stage::Run || self.stage == Stage::Approach => {
+            Program::Law(law)
+                if self.stage == MotionStage::Run || self.stage == MotionStage::Approach =>
+            {
                 let t = self.frame as f32 * FRAME_S;
                 let end = frames_to_boundary(t, law.period_s);
                 law.end_frame = Some(law.end_frame.map_or(end, |e| e.min(end)));
@@ -462,23 +431,23 @@ impl<M: Math> Engine<M> {
             _ => return,
         }
         // One tail for both programs: one ramp call site, not two.
-        if self.stage == Stage::Approach {
+        if self.stage == MotionStage::Approach {
             // Not started: ramp back from where the ramp is.
             let from = self.ramp.point();
             self.leave(&from);
-        } else if self.stage == Stage::Run {
-            self.stage = Stage::Stopping;
+        } else if self.stage == MotionStage::Run {
+            self.stage = MotionStage::Stopping;
         }
     }
 
     /// Ends the motion at once (the outputs stopped, or a direct setpoint took over).
     pub fn cancel(&mut self) {
         self.program = Program::Idle;
-        self.stage = Stage::Run;
+        self.stage = MotionStage::Run;
     }
 
     fn leave(&mut self, from: &[f32; 12]) {
-        self.stage = Stage::Leave;
+        self.stage = MotionStage::Leave;
         self.ramp.restart(from, &self.home, &self.limiter);
     }
 
@@ -489,7 +458,7 @@ impl<M: Math> Engine<M> {
             Program::Idle => (None, 0.0),
             Program::Pose { kind } => (Some(*kind), 0.0),
             Program::Law(law) => (Some(law.motion_kind()), motion_phase(t_s, law.period_s)),
-            Program::Walk { walker, .. } => (Some(Kind::Walk), walker.phase()),
+            Program::Walk { walker, .. } => (Some(MotionKind::Walk), walker.phase()),
         };
         Status {
             kind,
@@ -515,7 +484,7 @@ impl<M: Math> Engine<M> {
             disable_outputs: false,
         };
         match self.stage {
-            Stage::Approach | Stage::Leave => {
+            MotionStage::Approach | MotionStage::Leave => {
                 if !self.ramp.finished() {
                     tick.target = Some(self.ramp.advance());
                     return tick;
@@ -524,13 +493,18 @@ impl<M: Math> Engine<M> {
                 if out != self.ramp.to() {
                     return tick;
                 }
-                if self.stage == Stage::Leave || matches!(self.program, Program::Pose { .. }) {
-                    tick.disable_outputs =
-                        matches!(self.program, Program::Pose { kind: Kind::Rest });
+                if self.stage == MotionStage::Leave || matches!(self.program, Program::Pose { .. })
+                {
+                    tick.disable_outputs = matches!(
+                        self.program,
+                        Program::Pose {
+                            kind: MotionKind::Rest
+                        }
+                    );
                     self.cancel();
                     return tick;
                 }
-                self.stage = Stage::Run;
+                self.stage = MotionStage::Run;
                 self.frame = 0;
                 if let Program::Walk {
                     last_command_ms, ..
@@ -540,7 +514,7 @@ impl<M: Math> Engine<M> {
                 }
                 tick
             }
-            Stage::Run | Stage::Stopping => {
+            MotionStage::Run | MotionStage::Stopping => {
                 // Borrowed, not copied: a walker is a few hundred bytes of stack.
                 let (result, ended) = match &mut self.program {
                     Program::Law(law) => {
@@ -560,7 +534,7 @@ impl<M: Math> Engine<M> {
                     } => {
                         if now_ms.wrapping_sub(*last_command_ms) > u32::from(*timeout_ms) {
                             walker.stop();
-                            self.stage = Stage::Stopping;
+                            self.stage = MotionStage::Stopping;
                         }
                         for _ in 0..frames.min(MAX_CATCH_UP_FRAMES) {
                             // FRAME_S > 0: the step cannot fail.
@@ -599,11 +573,11 @@ impl<M: Math> Engine<M> {
 }
 
 impl Law {
-    fn motion_kind(&self) -> Kind {
+    fn motion_kind(&self) -> MotionKind {
         match self.motion {
-            LawMotion::Sway(_) => Kind::Sway,
-            LawMotion::YawTurn(_) => Kind::YawTurn,
-            LawMotion::LegPaths(_) => Kind::FootPath,
+            LawMotion::Sway(_) => MotionKind::Sway,
+            LawMotion::YawTurn(_) => MotionKind::YawTurn,
+            LawMotion::LegPaths(_) => MotionKind::FootPath,
         }
     }
 }

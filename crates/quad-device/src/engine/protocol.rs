@@ -1,33 +1,19 @@
 //! The engine's status and errors on the wire (quad-protocol's motion messages; the engine
 //! takes the protocol's [`quad_protocol::MotionCommand`] as its request).
 
-use super::{Error, Kind, Stage, Status};
+use super::{Error, Status};
 use kin_core::motion;
 use kin_core::preflight::FailureKind;
 use kin_core::Unreachable;
 use quad_protocol::{
-    MotionKind, MotionParam, MotionStage, MotionStatus, NackReason, ParamProblem, PreflightFault,
-    ReachFault,
+    MotionParam, MotionStatus, NackReason, ParamProblem, PreflightFault, ReachFault,
 };
 
 impl From<Status> for MotionStatus {
     fn from(s: Status) -> MotionStatus {
         MotionStatus {
-            kind: s.kind.map(|k| match k {
-                Kind::StandUp => MotionKind::StandUp,
-                Kind::Sit => MotionKind::Sit,
-                Kind::Rest => MotionKind::Rest,
-                Kind::Sway => MotionKind::Sway,
-                Kind::YawTurn => MotionKind::YawTurn,
-                Kind::FootPath => MotionKind::FootPath,
-                Kind::Walk => MotionKind::Walk,
-            }),
-            stage: match s.stage {
-                Stage::Approach => MotionStage::Approach,
-                Stage::Run => MotionStage::Run,
-                Stage::Stopping => MotionStage::Stopping,
-                Stage::Leave => MotionStage::Leave,
-            },
+            kind: s.kind,
+            stage: s.stage,
             t_s: s.t_s,
             phase: s.phase,
             fault: s.fault.map(NackReason::from),
