@@ -557,7 +557,7 @@ const MOTION_FORMS = {
   rest: { label: 'rest (then outputs off)', fields: [] },
   sway: {
     label: 'sway',
-    fields: [['axis', ['Roll', 'Pitch', 'Yaw']], ['amplitude_deg', 8], ['period_s', 2], ['duration_s', 0]],
+    fields: [['axis', ['roll', 'pitch', 'yaw']], ['amplitude_deg', 8], ['period_s', 2], ['duration_s', 0]],
   },
   yaw_turn: {
     label: 'yaw turn',
@@ -565,12 +565,12 @@ const MOTION_FORMS = {
   },
   foot_path: {
     label: 'foot path',
-    fields: [['path', ['Bezier', 'Rectangle', 'Semicircle', 'Ellipse', 'Cycloid']], ['leg', LEGS],
+    fields: [['path', ['bezier', 'rectangle', 'semicircle', 'ellipse', 'cycloid']], ['leg', LEGS],
       ['stride_mm', 60], ['step_height_mm', 30], ['duty_factor', 0.5], ['cycle_s', 1], ['duration_s', 0]],
   },
   walk: {
     label: 'trot / walk',
-    fields: [['gait', ['Trot', 'Walk']], ['body_height_mm', 400], ['step_height_mm', 40], ['cycle_s', 0.8],
+    fields: [['gait', ['trot', 'walk']], ['body_height_mm', 400], ['step_height_mm', 40], ['cycle_s', 0.8],
       ['velocity_timeout_ms', 500]],
   },
 };
@@ -581,22 +581,25 @@ const FIELD_OF_INPUT = {
   stride_mm: 'stride_m', step_height_mm: 'step_height_m', body_height_mm: 'body_height_m',
 };
 
-// The `start_motion` message of the form's values.
+// The `start_motion` message of the form's values: the protocol's motion request in its text
+// form, `"stand_up"` or `{ sway: { axis: 'roll', ... } }` (snake_case names, SI units).
 function motionMessage(kind, values) {
   const v = values;
   const dur = (s) => (Number(s) > 0 ? Number(s) : null);
   const mm = (x) => Number(x) / 1000;
   switch (kind) {
     case 'sway':
-      return { kind, axis: v.axis, amplitude_rad: Number(v.amplitude_deg) * DEG, period_s: Number(v.period_s), duration_s: dur(v.duration_s) };
+      return { sway: { axis: v.axis, amplitude_rad: Number(v.amplitude_deg) * DEG, period_s: Number(v.period_s), duration_s: dur(v.duration_s) } };
     case 'yaw_turn':
-      return { kind, yaw_rate_rad_s: Number(v.yaw_rate_deg_s) * DEG, step_period_s: Number(v.step_period_s), lift_height_m: mm(v.lift_height_mm), duration_s: dur(v.duration_s) };
+      return { yaw_turn: { yaw_rate_rad_s: Number(v.yaw_rate_deg_s) * DEG, step_period_s: Number(v.step_period_s), lift_height_m: mm(v.lift_height_mm), duration_s: dur(v.duration_s) } };
     case 'foot_path':
-      return { kind, path: v.path, leg: v.leg === 'all' ? null : LEGS.indexOf(v.leg) - 1, stride_m: mm(v.stride_mm), step_height_m: mm(v.step_height_mm), duty_factor: Number(v.duty_factor), cycle_s: Number(v.cycle_s), duration_s: dur(v.duration_s) };
+      return { foot_path: { path: v.path, legs: v.leg === 'all' ? 'all' : { one: v.leg }, stride_m: mm(v.stride_mm), step_height_m: mm(v.step_height_mm), duty_factor: Number(v.duty_factor), cycle_s: Number(v.cycle_s), duration_s: dur(v.duration_s) } };
     case 'walk':
-      return { kind, gait: v.gait, body_height_m: mm(v.body_height_mm), step_height_m: mm(v.step_height_mm), cycle_s: Number(v.cycle_s), velocity_timeout_ms: Number(v.velocity_timeout_ms) };
+      return { walk: { gait: v.gait, body_height_m: mm(v.body_height_mm), step_height_m: mm(v.step_height_mm), cycle_s: Number(v.cycle_s), velocity_timeout_ms: Number(v.velocity_timeout_ms) } };
+    case 'stand':
+      return 'stand_up';
     default:
-      return { kind };
+      return kind;
   }
 }
 

@@ -37,9 +37,8 @@ use core::marker::PhantomData;
 use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::Axis;
 use kin_core::{body, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
-use quad_device::engine::{
-    self, Engine, Limiter, PulseMaps, Request, Setup, Stage, WalkRequest, FRAME_MS,
-};
+use quad_device::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS};
+use quad_protocol::{LegSet, MotionCommand as Request, MotionStage};
 use quad_device::{default_calibration, Config};
 
 /// Stance height of the body-pose benchmark: seed 000 Table 4 body height, m.
@@ -216,7 +215,7 @@ impl<M: Math> EngineBench<M> {
         }
     }
 
-    fn tick(&mut self) -> Stage {
+    fn tick(&mut self) -> MotionStage {
         self.now_ms += FRAME_MS;
         let tick = self.engine.tick(1, self.now_ms, &self.out, &self.solver);
         if let Some(target) = tick.target {
@@ -241,7 +240,7 @@ impl<M: Math> MotionBench for EngineBench<M> {
         self.engine.cancel();
         let h = self.config.pose_config.stance_height_m;
         let request = match motion {
-            0 => Request::Walk(WalkRequest::new(Pattern::Trot, h)),
+            0 => Request::walk(Pattern::Trot, h),
             1 => Request::seed001_sway(Axis::Roll, None),
             // Seed 001's rate and period with a lift that this robot reaches (the paper's
             // 0.3 m is for its own, larger robot).
@@ -258,7 +257,7 @@ impl<M: Math> MotionBench for EngineBench<M> {
                 },
                 other => other,
             },
-            3 => Request::seed000_rectangle(None, None),
+            3 => Request::seed000_rectangle(LegSet::All, None),
             _ => return STATUS_UNKNOWN_BACKEND,
         };
         let setup = Setup {
@@ -274,7 +273,7 @@ impl<M: Math> MotionBench for EngineBench<M> {
             return STATUS_UNREACHABLE;
         }
         for _ in 0..500 {
-            if self.tick() == Stage::Run {
+            if self.tick() == MotionStage::Run {
                 break;
             }
         }

@@ -5,7 +5,7 @@ mod cmd;
 mod progress;
 
 use clap::{Parser, Subcommand};
-use quad_device::engine::Request::{Rest, Sit, StandUp};
+use quad_protocol::MotionCommand::{Rest, Sit, StandUp};
 use std::process::ExitCode;
 
 const ABOUT: &str = "Kinematics of a 12-DoF quadruped: leg IK/FK and body poses, as CSV batches.

@@ -9,7 +9,6 @@
 use kin_core::motion::gait::Pattern;
 use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
-use quad_device::engine;
 use quad_host::client::{self, Client, ClientConfig};
 use quad_host::emu::{build, Pulse, CYCLES_PER_TICK};
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink, PULSE_TOLERANCE_CYCLES};
@@ -221,7 +220,7 @@ fn every_motion_field_at_its_extremes_is_refused_as_the_host_refuses_it_and_noth
     let robot = session.info().robot.robot().expect("a preset");
     let ranges = Ranges::of(&robot);
     session
-        .start(&engine::Request::StandUp)
+        .start(&MotionCommand::StandUp)
         .unwrap_or_else(|e| panic!("{e}"));
     session
         .wait_idle(STAND_LIMIT, |_| {})

@@ -227,7 +227,7 @@ impl ValidConfig {
 
 /// The calibration a controller holds from [`crate::Device::stopped`] until
 /// [`crate::Device::boot`]: all zeros, an empty travel (0 µs) that no angle maps into. Zeros so
-/// that it costs a memset, not a 180-byte table copied into SRAM at reset.
+/// that it costs a memset, not a table copied into SRAM at reset.
 pub(crate) const UNBOOTED_CALIBRATION: Table = [Calibration {
     zero_rad: 0.0,
     reversed: false,
@@ -253,7 +253,6 @@ pub fn default_calibration<M: Math>(robot: &Robot, pose_config: &PoseConfig) -> 
 
 /// [`default_calibration`] written in place (no table-sized temporary on the stack), with the
 /// body solver of the robot (a device's own, built once).
-#[inline(never)]
 pub(crate) fn write_default_calibration<M: Math>(
     solver: &body::Solver<M>,
     pose_config: &PoseConfig,

@@ -15,8 +15,9 @@ use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
     check_request_in, encode_frame_in_pieces, is_compatible, Accumulator, DeviceInfo, DeviceToHost,
-    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, NackReason, PoseConfig, Ranges,
-    Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, MotionCommand, NackReason, PoseConfig,
+    Ranges, Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN,
+    PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -124,12 +125,13 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     enabling_frame: bool,
 }
 
-// The request handlers are `#[inline(never)]` on purpose: inlined into one function (as LTO
-// does on the ATmega2560), their locals make a stack frame of several hundred bytes, beyond the
-// AVR's 63-byte frame-pointer displacement. Every access then costs about 8 instructions, which
-// doubled the firmware's flash, and the LLVM AVR backend miscompiled one such access (it saved
-// SREG in r0 while r0 still held a `mul` result: a wrong calibration index). Small frames avoid
-// both; `firmware-avr`'s emulator tests scan the ELF for that pattern.
+// The dispatcher and the handlers that solve the body IK are `#[inline(never)]` on purpose:
+// inlined into one function (as LTO does on the ATmega2560), their locals make one large stack
+// frame, beyond the reach of the AVR's frame-pointer displacement: every access then costs a
+// pointer adjustment (the flash grew by half), and the LLVM AVR backend miscompiled one such
+// access (it saved SREG in r0 while r0 still held a `mul` result: a wrong calibration index).
+// Small frames avoid both; `firmware-avr`'s emulator tests scan the ELF for that pattern. The
+// figures are in docs/benchmark-journal.md.
 impl<O, C, S, M> Device<O, C, S, M>
 where
     O: ServoOutputs,
@@ -208,7 +210,6 @@ where
     /// loads the calibration from storage (the defaults of [`default_calibration`](crate::default_calibration) when none is
     /// valid) and holds
     /// the nominal stance (zero body pose) when it maps within that calibration.
-    #[inline(never)]
     pub fn boot(&mut self) {
         self.calibration_default = !self.load_calibration();
         if self.calibration_default {
@@ -230,9 +231,7 @@ where
         let _ = self.set_body_pose(&Pose::default());
     }
 
-    /// Loads the calibration from storage (true when a valid one was found). Out of line: the
-    /// record buffers stay out of [`Device::boot`]'s frame, which the stance IK's stack adds to.
-    #[inline(never)]
+    /// Loads the calibration from storage (true when a valid one was found).
     fn load_calibration(&mut self) -> bool {
         self.store.load(&mut self.storage, &mut self.calibration)
     }
@@ -359,7 +358,6 @@ where
     /// One servo frame, when a frame boundary has passed: the engine's new target, then one
     /// limiter step of the outputs toward the held target. The boundaries are the outputs' PWM
     /// periods when they count them ([`ServoOutputs::periods_begun`]), else the clock's 20 ms.
-    #[inline(never)]
     fn frame_tick(&mut self) {
         if !self.outputs_enabled {
             return;
@@ -430,12 +428,12 @@ where
     }
 
     /// Starts a motion of the engine (see [`engine`]): validated and start-checked first, refused
-    /// with nothing changed. [`engine::Request::StandUp`] with the outputs off holds the rest
+    /// with nothing changed. [`MotionCommand::StandUp`] with the outputs off holds the rest
     /// pose and enables the outputs at it.
     ///
     /// # Errors
     /// [`engine::Error`].
-    pub fn start_motion(&mut self, request: &engine::Request) -> Result<(), engine::Error> {
+    pub fn start_motion(&mut self, request: &MotionCommand) -> Result<(), engine::Error> {
         let setup = Setup {
             robot: &self.config.robot,
             solver: &self.solver,
@@ -512,7 +510,8 @@ where
     }
 
     /// [`Device::handle`] on a borrowed request: [`Device::receive`] hands it the request
-    /// where the decoder left it (a copy of up to 50 bytes fewer per request on the AVR).
+    /// where the decoder left it (no copy of the request on the way).
+    // Out of line: the receive path's frame stays apart from the dispatcher's (note above).
     #[inline(never)]
     fn handle_ref(&mut self, msg: &HostToDevice) -> DeviceToHost {
         self.last_valid_ms = self.clock.now_ms();
@@ -525,6 +524,7 @@ where
         answer
     }
 
+    // Out of line: the dispatcher's frame holds only the request, each handler its own locals.
     #[inline(never)]
     fn answer(&mut self, msg: &HostToDevice) -> DeviceToHost {
         let seq = msg.seq;
@@ -590,7 +590,7 @@ where
                 .set_joint_speed_limit(joint_speed_limit_rad_s)
                 .map_err(NackReason::from),
             Request::StartMotion(m) => {
-                let r = self.start_motion(&engine::Request::from(m));
+                let r = self.start_motion(&m);
                 return self.motion_answer(seq, r);
             }
             Request::StopMotion => {
@@ -630,8 +630,7 @@ where
     }
 
     /// The answer to a motion request: `MotionAck` with the engine's status and the readback,
-    /// or the nack of `result`'s error. Out of line: one instance for the four requests.
-    #[inline(never)]
+    /// or the nack of `result`'s error.
     fn motion_answer(&self, seq: u16, result: Result<(), engine::Error>) -> DeviceToHost {
         match result {
             Ok(()) => DeviceToHost::MotionAck {
@@ -657,7 +656,6 @@ where
 
     /// The state an `Ack` reports: held angles (zeros when nothing is held), the pulses on the
     /// outputs (zeros while stopped), flags and frame counters.
-    #[inline(never)]
     pub fn readback(&self) -> Readback {
         let flags = Flags::EMPTY
             .with(Flags::CLAMPED, self.clamped)
@@ -730,8 +728,8 @@ where
     }
 
     /// `SetBodyPose`: the pose at the stance of the pose configuration's height, about the body
-    /// centre in its rotation order. Out of line (as `set_feet`), so that the body
-    /// solve's locals stay out of the dispatcher's stack frame.
+    /// centre in its rotation order.
+    // Out of line: the body solve's locals stay out of the dispatcher's stack frame.
     #[inline(never)]
     fn set_body_pose(&mut self, pose: &Pose) -> Result<(), NackReason> {
         let c = &self.config.pose_config;
@@ -749,6 +747,7 @@ where
     }
 
     /// `SetFeet`: the feet in the body frame at the zero pose.
+    // Out of line: the body solve's locals stay out of the dispatcher's stack frame.
     #[inline(never)]
     fn set_feet(&mut self, feet: &[[f32; 3]; 4]) -> Result<(), NackReason> {
         let feet = feet.map(|[x, y, z]| Vec3::new(x, y, z));
@@ -794,7 +793,6 @@ where
     }
 
     /// Maps all twelve angles through the calibration; commits and drives only when all map.
-    #[inline(never)]
     fn apply(
         &mut self,
         angles_rad: &[f32; 12],
@@ -881,7 +879,6 @@ where
         true
     }
 
-    #[inline(never)]
     fn stop_outputs(&mut self) {
         self.outputs.set_enabled(false);
         self.outputs_enabled = false;
@@ -916,7 +913,6 @@ where
         Ok(())
     }
 
-    #[inline(never)]
     fn set_calibration(&mut self, servo: ServoId, c: Calibration) -> Result<(), NackReason> {
         let map = c.pulse_map().map_err(NackReason::BadCalibration)?;
         let i = servo.index();
@@ -954,7 +950,6 @@ where
         Ok(())
     }
 
-    #[inline(never)]
     fn save_calibration(&mut self) -> Result<(), NackReason> {
         self.store
             .save(&mut self.storage, &self.calibration)
@@ -972,9 +967,6 @@ where
 }
 
 /// The device's receive path: the protocol's frame decoder (postcard) on the accumulator.
-/// Out of line, as is [`encode_answer`]: one instance each, and the message's temporaries stay
-/// out of the caller's stack frame.
-#[inline(never)]
 pub fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<'a, HostToDevice> {
     acc.feed::<HostToDevice>(bytes)
 }
@@ -982,13 +974,12 @@ pub fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<
 /// The device's answer encoder: [`encode_frame_in_pieces`] (postcard) of `answer` into `out`,
 /// handed to `tx` in pieces as they are final; the frame's length, 0 (and nothing sent) when
 /// it does not fit.
-#[inline(never)]
 pub fn encode_answer(answer: &DeviceToHost, out: &mut [u8], tx: &mut dyn FnMut(&[u8])) -> usize {
     encode_frame_in_pieces(answer, out, tx).unwrap_or(0)
 }
 
-/// [`check_request_in`], out of line: inlined into [`Device::answer`], its copies of the request's
-/// values took the dispatcher's stack frame beyond the AVR's 63-byte displacement.
+/// [`check_request_in`] for [`Device::answer`].
+// Out of line: inlined, its copies of the request's values enlarge the dispatcher's frame.
 #[inline(never)]
 fn check_range(request: &Request, ranges: &Ranges) -> Result<(), NackReason> {
     check_request_in(request, ranges)

@@ -13,9 +13,11 @@ use kin_core::motion::path::PathKind;
 use kin_core::motion::{self, Motion};
 use kin_core::preflight::{Failure, FailureKind};
 use kin_core::{BodyConfig, DefaultMath, LegId, ReachPolicy, Unreachable, Vec3};
-use quad_device::engine::{self, rest_angles, Error, Kind, Request, Stage, WalkRequest, FRAME_MS};
+use quad_device::engine::{self, rest_angles, Error, FRAME_MS};
 use quad_device::{Config, Device};
-use quad_protocol::{Request as Wire, ServoId};
+use quad_protocol::{
+    LegSet, MotionCommand as Request, MotionKind, MotionStage, Request as Wire, ServoId,
+};
 
 /// Rounding allowance on the limiter's bound, rad.
 const STEP_TOL_RAD: f32 = 1e-6;
@@ -227,7 +229,7 @@ fn run_law(config: Config, request: Request, expected: impl Fn(f32) -> [f32; 12]
     while rig.dev.motion_status().kind.is_some() {
         rig.frame();
         let st = rig.dev.motion_status();
-        if st.kind.is_some() && st.stage == Stage::Run {
+        if st.kind.is_some() && st.stage == MotionStage::Run {
             ran += 1;
             let target = rig.dev.readback().angles_rad;
             assert_eq!(st.fault, None);
@@ -292,13 +294,13 @@ fn seed000_foot_paths_run_on_one_leg_or_all_four() {
                 duty_factor,
                 cycle_s,
                 ..
-            } = Request::seed000_rectangle(leg, None)
+            } = Request::seed000_rectangle(leg.map_or(LegSet::All, LegSet::One), None)
             else {
                 unreachable!()
             };
             let request = Request::FootPath {
                 path,
-                leg,
+                legs: leg.map_or(LegSet::All, LegSet::One),
                 stride_m,
                 step_height_m,
                 duty_factor,
@@ -337,13 +339,27 @@ fn seed000_foot_paths_run_on_one_leg_or_all_four() {
     }
 }
 
+/// A walk's numbers, for the cases that change one of them.
+struct Walk {
+    body_height_m: f32,
+    step_height_m: f32,
+    cycle_s: f32,
+    velocity_timeout_ms: u16,
+}
+
 fn walk_rig(config: Config, timeout_ms: u16) -> Rig {
     let mut rig = Rig::new(config);
     rig.stand();
-    let mut w = WalkRequest::new(Pattern::Trot, config.pose_config.stance_height_m);
-    w.velocity_timeout_ms = timeout_ms;
-    rig.start(Request::Walk(w));
-    while rig.dev.motion_status().stage == Stage::Approach {
+    let mut w = Request::walk(Pattern::Trot, config.pose_config.stance_height_m);
+    if let Request::Walk {
+        velocity_timeout_ms,
+        ..
+    } = &mut w
+    {
+        *velocity_timeout_ms = timeout_ms;
+    }
+    rig.start(w);
+    while rig.dev.motion_status().stage == MotionStage::Approach {
         rig.frame();
     }
     rig
@@ -366,9 +382,9 @@ fn stop_while_trotting_finishes_the_stride_and_ends_at_the_stance() {
             rig.frame();
             k += 1;
         }
-        assert_eq!(rig.dev.motion_status().kind, Some(Kind::Walk));
+        assert_eq!(rig.dev.motion_status().kind, Some(MotionKind::Walk));
         rig.dev.stop_motion();
-        assert_eq!(rig.dev.motion_status().stage, Stage::Stopping);
+        assert_eq!(rig.dev.motion_status().stage, MotionStage::Stopping);
         assert_eq!(
             rig.dev.set_velocity(Velocity::default()),
             Err(Error::NotWalking)
@@ -399,14 +415,14 @@ fn a_velocity_command_not_refreshed_stops_the_walk_cleanly() {
         .unwrap();
     for _ in 0..15 {
         rig.frame();
-        assert_eq!(rig.dev.motion_status().stage, Stage::Run);
+        assert_eq!(rig.dev.motion_status().stage, MotionStage::Run);
     }
     for _ in 0..2 {
         rig.frame();
     }
     assert_eq!(
         rig.dev.motion_status().stage,
-        Stage::Stopping,
+        MotionStage::Stopping,
         "after 300 ms"
     );
     rig.until_idle();
@@ -439,17 +455,38 @@ fn bad_parameters_are_refused_by_name_and_move_nothing() {
     };
     let path = |s: f32, h: f32, c: f32| Request::FootPath {
         path: PathKind::Rectangle,
-        leg: None,
+        legs: LegSet::All,
         stride_m: s,
         step_height_m: h,
         duty_factor: 0.5,
         cycle_s: c,
         duration_s: None,
     };
-    let walk = |f: fn(&mut WalkRequest)| {
-        let mut w = WalkRequest::new(Pattern::Trot, config.pose_config.stance_height_m);
+    let walk = |f: fn(&mut Walk)| {
+        let Request::Walk {
+            gait,
+            body_height_m,
+            step_height_m,
+            cycle_s,
+            velocity_timeout_ms,
+        } = Request::walk(Pattern::Trot, config.pose_config.stance_height_m)
+        else {
+            unreachable!()
+        };
+        let mut w = Walk {
+            body_height_m,
+            step_height_m,
+            cycle_s,
+            velocity_timeout_ms,
+        };
         f(&mut w);
-        Request::Walk(w)
+        Request::Walk {
+            gait,
+            body_height_m: w.body_height_m,
+            step_height_m: w.step_height_m,
+            cycle_s: w.cycle_s,
+            velocity_timeout_ms: w.velocity_timeout_ms,
+        }
     };
     let cases = [
         (sway(0.2, f32::NAN, None), "period_s"),
@@ -527,7 +564,7 @@ fn bad_parameters_are_refused_by_name_and_move_nothing() {
         ),
     ] {
         assert_eq!(parameter(rig.dev.set_velocity(v).unwrap_err()), name);
-        assert_eq!(rig.dev.motion_status().kind, Some(Kind::Walk));
+        assert_eq!(rig.dev.motion_status().kind, Some(MotionKind::Walk));
     }
     assert_eq!(
         parameter(rig.dev.set_joint_speed_limit(0.0).unwrap_err()),

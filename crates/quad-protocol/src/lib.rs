@@ -45,7 +45,7 @@ pub use msg::{
     DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet, LinkLossAction,
     LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
     ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset, ServoId,
-    Setting,
+    Setting, DEFAULT_VELOCITY_TIMEOUT_MS,
 };
 pub use range::{check_request, check_request_in, Ranges};
 

@@ -191,6 +191,76 @@ wire_enum! {
     }
 }
 
+/// Default timeout of a walk's velocity command, ms: five missed commands at the 10 Hz a
+/// teleoperating host sends.
+pub const DEFAULT_VELOCITY_TIMEOUT_MS: u16 = 500;
+
+impl MotionCommand {
+    /// Seed 000 Fig. 8's rectangle (stride 0.1 m, lift 0.05 m, 3 s per loop, duty 1/3) on
+    /// `legs` for `duration_s`.
+    pub fn seed000_rectangle(legs: LegSet, duration_s: Option<f32>) -> MotionCommand {
+        let s = kin_core::motion::path::Rectangle::seed000().stride();
+        MotionCommand::FootPath {
+            path: PathKind::Rectangle,
+            legs,
+            stride_m: s.length_m(),
+            step_height_m: s.height_m(),
+            duty_factor: s.duty_factor(),
+            cycle_s: 3.0,
+            duration_s,
+        }
+    }
+
+    /// Seed 001's sway about `axis` (A = 0.2 rad, T = 20 s) for `duration_s`.
+    pub fn seed001_sway(axis: Axis, duration_s: Option<f32>) -> MotionCommand {
+        let p = kin_core::motion::laws::SwayParams::seed001(axis);
+        MotionCommand::Sway {
+            axis,
+            amplitude_rad: p.amplitude_rad,
+            period_s: p.period_s,
+            duration_s,
+        }
+    }
+
+    /// Seed 001's yaw turn (ω_z = 0.085 rad/s clockwise, T1 = 6 s, h_K = 0.3 m) for
+    /// `duration_s`.
+    pub fn seed001_yaw_turn(duration_s: Option<f32>) -> MotionCommand {
+        let p = kin_core::motion::laws::YawTurnParams::seed001();
+        MotionCommand::YawTurn {
+            yaw_rate_rad_s: p.yaw_rate_rad_s,
+            step_period_s: p.step_period_s,
+            lift_height_m: p.lift_height_m,
+            duration_s,
+        }
+    }
+
+    /// A walk with `gait` at `body_height_m` with kin-core's default cycle and step height
+    /// ([`kin_core::motion::gait::GaitParams::new`]) and [`DEFAULT_VELOCITY_TIMEOUT_MS`].
+    pub fn walk(gait: Pattern, body_height_m: f32) -> MotionCommand {
+        use kin_core::motion::gait::GaitParams;
+        MotionCommand::Walk {
+            gait,
+            body_height_m,
+            step_height_m: GaitParams::DEFAULT_STEP_HEIGHT_FRACTION * body_height_m,
+            cycle_s: GaitParams::DEFAULT_CYCLE_S,
+            velocity_timeout_ms: DEFAULT_VELOCITY_TIMEOUT_MS,
+        }
+    }
+
+    /// What kind of motion this is.
+    pub const fn kind(&self) -> MotionKind {
+        match self {
+            MotionCommand::StandUp => MotionKind::StandUp,
+            MotionCommand::Sit => MotionKind::Sit,
+            MotionCommand::Rest => MotionKind::Rest,
+            MotionCommand::Sway { .. } => MotionKind::Sway,
+            MotionCommand::YawTurn { .. } => MotionKind::YawTurn,
+            MotionCommand::FootPath { .. } => MotionKind::FootPath,
+            MotionCommand::Walk { .. } => MotionKind::Walk,
+        }
+    }
+}
+
 wire_enum! {
     /// The legs a foot path moves.
     #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -16,7 +16,18 @@
 //!   (sizes on the ATmega2560 in docs/benchmark-journal.md).
 //!
 //! Every table is an exhaustive `match`: a variant or field added to kin-core does not compile
-//! until it has its place on the wire. The implementations follow serde's data model as the
+//! until it has its place on the wire.
+//!
+//! ## The text form
+//!
+//! With the feature `text`, a `wire_enum!` type has a second form for human-readable formats
+//! (JSON: the web panel, the command line's summaries), chosen by serde's
+//! `is_human_readable()`: serde's default enum form with snake_case names, from the same
+//! declaration: `"stand_up"`, `{"sway": {"axis": "roll", "amplitude_rad": 0.1, "period_s": 2,
+//! "duration_s": null}}`, `{"one": "FL"}`; unknown fields are refused. Its fields are written
+//! in kin-core's serde form (`kin-core/serde`). postcard is not human-readable: the wire form,
+//! and every wire byte, is the same with and without the feature, and the firmware builds
+//! without it. The implementations follow serde's data model as the
 //! derive does (enum → variant index and name, struct variant → its fields in sequence), so any
 //! index-based format reads them; the protocol uses postcard only.
 
@@ -84,14 +95,14 @@ macro_rules! wire_enum {
         $crate::wire::wire_enum!(@munch
             [$(#[$attr])* $vis $name]
             [serializer variant]
-            [] [] []
+            [] [] [] []
             $($body)*
         );
     };
 
     // A unit variant.
     (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident
         $(, $($rest:tt)*)?
     ) => {
@@ -102,13 +113,14 @@ macro_rules! wire_enum {
                 ::serde::de::VariantAccess::unit_variant($var_access)?;
                 Ok(Target::$var)
             }]
+            [$($text)* $var,]
             $($($rest)*)?
         );
     };
 
     // A one-field tuple variant.
     (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident ( $ty:ty $(as $($with:ident)::+)? )
         $(, $($rest:tt)*)?
     ) => {
@@ -119,13 +131,14 @@ macro_rules! wire_enum {
                 $crate::wire::wire_ser_field!(value, $ty $(, $($with)::+)?)),]
             [$($de_arms)* $idx => $crate::wire::wire_de_newtype!(
                 $var_access, Target::$var, $ty $(, $($with)::+)?),]
+            [$($text)* $var($ty),]
             $($($rest)*)?
         );
     };
 
     // A struct variant.
     (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident {
             $( $(#[$fattr:meta])* $field:ident : $fty:ty $(as $($with:ident)::+)? ),* $(,)?
         }
@@ -169,13 +182,14 @@ macro_rules! wire_enum {
                     Fields,
                 )
             }]
+            [$($text)* $var { $($field: $fty,)* },]
             $($($rest)*)?
         );
     };
 
     // All variants read: the enum and its serde implementations.
     (@munch [$(#[$attr:meta])* $vis:vis $name:ident] [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
     ) => {
         $(#[$attr])*
         $vis enum $name {
@@ -186,12 +200,25 @@ macro_rules! wire_enum {
             const NAME: &str = stringify!($name);
             type Target = $name;
 
+            // The text form (see the module docs): serde's derive of the same variants and
+            // fields, reading and writing this type in place (`remote`), no copy of it.
+            #[cfg(feature = "text")]
+            #[derive(::serde::Serialize, ::serde::Deserialize)]
+            #[serde(remote = "Target", rename_all = "snake_case", deny_unknown_fields)]
+            enum Text {
+                $($text)*
+            }
+
             impl ::serde::Serialize for $name {
                 // The unit variants share one call, their index looked up first: one such call
                 // per enum instead of one per variant (an enum without unit variants never
                 // gets there).
                 #[allow(unreachable_code)]
                 fn serialize<S: ::serde::Serializer>(&self, $ser: S) -> Result<S::Ok, S::Error> {
+                    #[cfg(feature = "text")]
+                    if ::serde::Serializer::is_human_readable(&$ser) {
+                        return Text::serialize(self, $ser);
+                    }
                     let (index, variant): (u32, &'static str) = match self {
                         $($ser_arms)*
                     };
@@ -201,6 +228,10 @@ macro_rules! wire_enum {
 
             impl<'de> ::serde::Deserialize<'de> for $name {
                 fn deserialize<D: ::serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                    #[cfg(feature = "text")]
+                    if ::serde::Deserializer::is_human_readable(&d) {
+                        return Text::deserialize(d);
+                    }
                     struct Variants;
                     impl<'de> ::serde::de::Visitor<'de> for Variants {
                         type Value = $name;

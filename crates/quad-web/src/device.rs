@@ -41,7 +41,7 @@ use quad_host::link::{self, Link, Target};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     DeviceInfo, DeviceToHost, Flags, LinkLossAction, MotionStage, MotionStatus, NackReason,
-    PoseConfig, Readback, Request, RobotPreset, ServoId,
+    PoseConfig, Ranges, Readback, Request, RobotPreset, ServoId,
 };
 use std::time::{Duration, Instant};
 
@@ -119,9 +119,14 @@ pub enum Error {
     /// The link is down; the server keeps serving pages.
     #[error("the device link is down")]
     LinkDown,
-    /// A motion command out of range: not sent.
-    #[error("not sent: {0}")]
-    Motion(motion::Invalid),
+    /// A motion command out of its range (the protocol's range check): not sent.
+    #[error("not sent: {}", motion::words(.reason, .request))]
+    Motion {
+        /// The request.
+        request: Request,
+        /// Why.
+        reason: NackReason,
+    },
     /// The device refused a motion request; a running motion keeps running.
     #[error("the device refused {}: {}", client::request_name(.request), motion::words(.reason, .request))]
     MotionRefused {
@@ -136,8 +141,9 @@ impl Error {
     /// The page's field a refusal names, if it names one.
     pub fn field(&self) -> Option<&'static str> {
         match self {
-            Error::MotionRefused { reason, request } => motion::refused_field(reason, request),
-            Error::Motion(invalid) => Some(invalid.field()),
+            Error::MotionRefused { reason, request } | Error::Motion { reason, request } => {
+                motion::refused_field(reason, request)
+            }
             _ => None,
         }
     }
@@ -147,6 +153,8 @@ impl Error {
 pub struct Session<L> {
     client: Client<L>,
     robot: Robot,
+    /// The protocol's ranges of `robot`.
+    ranges: Ranges,
     info: DeviceInfo,
     pose_config: PoseConfig,
     calibration: [Calibration; 12],
@@ -199,6 +207,7 @@ impl<L: Link> Session<L> {
             motions,
             attempts: 0,
             client,
+            ranges: Ranges::of(&robot),
             robot,
             info,
             pose_config: info.pose_config,
@@ -513,10 +522,11 @@ impl<L: Link> Session<L> {
     ///
     /// # Errors
     /// [`Error::Motion`] (nothing sent), [`Error::MotionRefused`], link failures.
-    pub fn motion_command(&mut self, cmd: &motion::MotionCommand) -> Result<(), Error> {
-        let request = motion::request(cmd).map_err(Error::Motion)?;
+    pub fn motion_command(&mut self, cmd: &motion::Command) -> Result<(), Error> {
+        let request = motion::request(cmd, &self.ranges)
+            .map_err(|(request, reason)| Error::Motion { request, reason })?;
         self.motion(request)?;
-        if matches!(cmd, motion::MotionCommand::Start(_)) {
+        if matches!(cmd, motion::Command::Start(_)) {
             self.pose = None;
         }
         Ok(())

@@ -9,11 +9,11 @@
 //! larger than [`MAX_JOG_US`]). A refused message reaches neither the device thread nor the
 //! device.
 
-use crate::motion::{self, MotionCommand, MotionMsg, VelocityMsg};
+use crate::motion::{self, Command, VelocityMsg};
 use kin_core::body::Pose;
 use kin_core::Robot;
 use quad_protocol::servo::Calibration;
-use quad_protocol::ServoId;
+use quad_protocol::{MotionCommand, ServoId};
 use serde::{Deserialize, Serialize};
 
 /// Largest message a page may send, bytes. The largest command is well under 300 bytes.
@@ -75,8 +75,8 @@ pub enum ClientMsg {
     ReadCalibration,
     /// Starts an onboard motion (see [`crate::motion`]).
     StartMotion {
-        /// The motion and its parameters.
-        motion: MotionMsg,
+        /// The motion and its parameters: the protocol's request in its text form.
+        motion: MotionCommand,
     },
     /// Stops the running motion cleanly.
     StopMotion,
@@ -115,19 +115,6 @@ pub enum Error {
     /// A stance height that is not positive.
     #[error("stance_height_m must be > 0 (got {0})")]
     StanceHeight(f32),
-    /// A motion command's field out of range.
-    #[error(transparent)]
-    Motion(#[from] motion::Invalid),
-}
-
-impl Error {
-    /// The field of the command the refusal names, if it names one (a motion parameter).
-    pub fn field(&self) -> Option<&'static str> {
-        match self {
-            Error::Motion(invalid) => Some(invalid.field()),
-            _ => None,
-        }
-    }
 }
 
 fn finite(name: &'static str, v: f32) -> Result<(), Error> {
@@ -193,26 +180,25 @@ impl ClientMsg {
             ClientMsg::SetCenter { servo: s, .. } | ClientMsg::SetDirection { servo: s, .. } => {
                 servo(s).map(|_| ())
             }
+            // A motion's numbers pass the protocol's range check for the device's robot
+            // (`motion::request`).
             ClientMsg::TakeControl
             | ClientMsg::ReleaseControl
             | ClientMsg::SetOutputs { .. }
             | ClientMsg::SaveCalibration
-            | ClientMsg::ReadCalibration => Ok(()),
-            ClientMsg::StartMotion { .. }
+            | ClientMsg::ReadCalibration
+            | ClientMsg::StartMotion { .. }
             | ClientMsg::StopMotion
-            | ClientMsg::SetVelocity { .. } => {
-                let cmd = self.motion().expect("a motion command");
-                cmd.validate().map_err(Error::from)
-            }
+            | ClientMsg::SetVelocity { .. } => Ok(()),
         }
     }
 
     /// The Motion tab's command this message carries, if it is one.
-    pub fn motion(&self) -> Option<MotionCommand> {
+    pub fn motion(&self) -> Option<Command> {
         match *self {
-            ClientMsg::StartMotion { motion } => Some(MotionCommand::Start(motion)),
-            ClientMsg::StopMotion => Some(MotionCommand::Stop),
-            ClientMsg::SetVelocity { velocity } => Some(MotionCommand::Velocity(velocity)),
+            ClientMsg::StartMotion { motion } => Some(Command::Start(motion)),
+            ClientMsg::StopMotion => Some(Command::Stop),
+            ClientMsg::SetVelocity { velocity } => Some(Command::Velocity(velocity)),
             _ => None,
         }
     }
@@ -391,16 +377,17 @@ mod tests {
 
     #[test]
     fn motion_commands_parse_and_are_range_checked() {
-        use crate::motion::{Invalid, MotionMsg};
+        use crate::motion;
         use kin_core::motion::laws::Axis;
+        use quad_protocol::{MotionParam as P, NackReason, ParamProblem, Ranges};
         let m = ClientMsg::parse(
-            r#"{"type":"start_motion","motion":{"kind":"sway","axis":"Roll","amplitude_rad":0.1,"period_s":2,"duration_s":null}}"#,
+            r#"{"type":"start_motion","motion":{"sway":{"axis":"roll","amplitude_rad":0.1,"period_s":2,"duration_s":null}}}"#,
         )
         .unwrap();
         assert_eq!(
             m,
             ClientMsg::StartMotion {
-                motion: MotionMsg::Sway {
+                motion: MotionCommand::Sway {
                     axis: Axis::Roll,
                     amplitude_rad: 0.1,
                     period_s: 2.0,
@@ -410,6 +397,12 @@ mod tests {
         );
         assert_eq!(m.name(), "start_motion");
         assert_eq!(
+            ClientMsg::parse(r#"{"type":"start_motion","motion":"stand_up"}"#).unwrap(),
+            ClientMsg::StartMotion {
+                motion: MotionCommand::StandUp
+            }
+        );
+        assert_eq!(
             ClientMsg::parse(r#"{"type":"stop_motion"}"#).unwrap(),
             ClientMsg::StopMotion
         );
@@ -418,38 +411,51 @@ mod tests {
         )
         .unwrap();
         assert!(matches!(v, ClientMsg::SetVelocity { .. }));
-        for (text, want) in [
+        // The protocol's range check, the one the host and the device run.
+        let ranges = Ranges::of(&Robot::shahriar2023());
+        for (text, param, problem) in [
             (
-                r#"{"type":"start_motion","motion":{"kind":"sway","axis":"Roll","amplitude_rad":0.1,"period_s":0,"duration_s":null}}"#,
-                Invalid::NotPositive {
-                    name: "period_s",
-                    value: 0.0,
-                },
+                r#"{"type":"start_motion","motion":{"sway":{"axis":"roll","amplitude_rad":0.1,"period_s":0,"duration_s":null}}}"#,
+                P::PeriodS,
+                ParamProblem::NotPositive,
             ),
             (
-                r#"{"type":"start_motion","motion":{"kind":"foot_path","path":"Bezier","leg":4,"stride_m":0.05,"step_height_m":0.03,"duty_factor":0.5,"cycle_s":1,"duration_s":null}}"#,
-                Invalid::Leg(4),
-            ),
-            (
-                r#"{"type":"start_motion","motion":{"kind":"foot_path","path":"Bezier","leg":null,"stride_m":0.05,"step_height_m":0.03,"duty_factor":1,"cycle_s":1,"duration_s":null}}"#,
-                Invalid::DutyFactor(1.0),
+                r#"{"type":"start_motion","motion":{"foot_path":{"path":"bezier","legs":"all","stride_m":0.05,"step_height_m":0.03,"duty_factor":1,"cycle_s":1,"duration_s":null}}}"#,
+                P::DutyFactor,
+                ParamProblem::OutOfRange,
             ),
             (
                 r#"{"type":"set_velocity","velocity":{"forward_m_s":1e39,"lateral_m_s":0,"yaw_rate_rad_s":0}}"#,
-                Invalid::NonFinite("forward_m_s"),
+                P::ForwardMS,
+                ParamProblem::NonFinite,
             ),
             (
-                r#"{"type":"start_motion","motion":{"kind":"walk","gait":"Trot","body_height_m":0.4,"step_height_m":0.05,"cycle_s":0.8,"velocity_timeout_ms":0}}"#,
-                Invalid::Timeout,
+                r#"{"type":"start_motion","motion":{"walk":{"gait":"trot","body_height_m":0.4,"step_height_m":0.05,"cycle_s":0.8,"velocity_timeout_ms":0}}}"#,
+                P::VelocityTimeoutMs,
+                ParamProblem::NotPositive,
             ),
         ] {
-            match ClientMsg::parse(text) {
-                Err(Error::Motion(got)) => assert_eq!(got, want, "{text}"),
+            let cmd = ClientMsg::parse(text).unwrap().motion().unwrap();
+            match motion::request(&cmd, &ranges) {
+                Err((_, reason)) => assert_eq!(
+                    reason,
+                    NackReason::InvalidParameter { param, problem },
+                    "{text}"
+                ),
                 other => panic!("{text}: {other:?}"),
             }
         }
-        let e =
-            ClientMsg::parse(r#"{"type":"start_motion","motion":{"kind":"dance"}}"#).unwrap_err();
+        // A leg the protocol does not have, and the old capitalised spellings, are not read.
+        for text in [
+            r#"{"type":"start_motion","motion":{"foot_path":{"path":"bezier","legs":{"one":"XX"},"stride_m":0.05,"step_height_m":0.03,"duty_factor":0.5,"cycle_s":1,"duration_s":null}}}"#,
+            r#"{"type":"start_motion","motion":{"sway":{"axis":"Roll","amplitude_rad":0.1,"period_s":2,"duration_s":null}}}"#,
+        ] {
+            assert!(
+                matches!(ClientMsg::parse(text), Err(Error::Malformed(_))),
+                "{text}"
+            );
+        }
+        let e = ClientMsg::parse(r#"{"type":"start_motion","motion":"dance"}"#).unwrap_err();
         assert!(e.to_string().contains("unknown variant `dance`"), "{e}");
     }
 

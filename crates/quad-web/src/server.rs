@@ -388,7 +388,7 @@ async fn serve_page(
                 let reply = match ClientMsg::parse(text.as_str()) {
                     Err(e) => {
                         log(id, &format!("refused: {e}"));
-                        ServerMsg::Error { message: e.to_string(), field: e.field() }
+                        ServerMsg::Error { message: e.to_string(), field: None }
                     }
                     Ok(cmd) => {
                         let reply = command(shared, id, cmd).await;

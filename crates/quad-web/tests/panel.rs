@@ -378,7 +378,7 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str) {
         b,
         "sway",
         &[
-            ("axis", "Roll"),
+            ("axis", "roll"),
             ("amplitude_deg", "10"),
             ("period_s", "2"),
             ("duration_s", "0"),
@@ -513,7 +513,7 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str) {
 
     // A trot held by the keyboard: the page refreshes the velocity well within the walk's
     // timeout, so the device keeps walking; Stop ends it.
-    motion_form(b, "walk", &[("gait", "Trot")]).await;
+    motion_form(b, "walk", &[("gait", "trot")]).await;
     b.click("motion-start").await;
     b.wait("panel.walking", WAIT).await;
     b.js("(window.dispatchEvent(new KeyboardEvent('keydown', {key: 'w'})), 1)")

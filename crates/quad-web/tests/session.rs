@@ -7,9 +7,10 @@ use kin_core::motion::laws::Axis;
 use kin_core::Robot;
 use quad_host::client::{AngleCheck, Client, ClientConfig};
 use quad_host::link::{self, sim::SimConfig, Link, Target};
+use quad_protocol::MotionCommand;
 use quad_protocol::{LinkLossAction, LinkTimeout, NackReason, Request, RobotPreset, ServoId};
 use quad_web::device::{Error, Session};
-use quad_web::motion::{MotionMsg, VelocityMsg};
+use quad_web::motion::VelocityMsg;
 use quad_web::msg::ClientMsg;
 use std::time::Duration;
 
@@ -103,7 +104,7 @@ fn run_to_idle(s: &mut Session<Box<dyn Link>>, limit: Duration) {
 
 fn sway(amplitude_rad: f32, period_s: f32) -> ClientMsg {
     ClientMsg::StartMotion {
-        motion: MotionMsg::Sway {
+        motion: MotionCommand::Sway {
             axis: Axis::Roll,
             amplitude_rad,
             period_s,
@@ -116,7 +117,7 @@ fn sway(amplitude_rad: f32, period_s: f32) -> ClientMsg {
 fn motions_run_on_the_device_and_report_its_engine() {
     let mut s = session(LinkLossAction::Hold);
     let stand = ClientMsg::StartMotion {
-        motion: MotionMsg::Stand,
+        motion: MotionCommand::StandUp,
     };
     s.command(&stand).unwrap();
     let m = s.state(0.0).motion;
@@ -173,7 +174,7 @@ fn motions_run_on_the_device_and_report_its_engine() {
 fn a_parameter_the_device_refuses_is_named_and_moves_nothing() {
     let mut s = session(LinkLossAction::Hold);
     s.command(&ClientMsg::StartMotion {
-        motion: MotionMsg::Stand,
+        motion: MotionCommand::StandUp,
     })
     .unwrap();
     run_to_idle(&mut s, Duration::from_secs(10));
@@ -213,7 +214,7 @@ fn a_parameter_the_device_refuses_is_named_and_moves_nothing() {
     // A period of 0 is the page message's own check: nothing sent.
     let frames = s.state(0.0).link.frames_sent;
     let err = s.command(&sway(0.1, 0.0)).unwrap_err();
-    assert!(matches!(err, Error::Motion(_)), "{err}");
+    assert!(matches!(err, Error::Motion { .. }), "{err}");
     assert_eq!(err.field(), Some("period_s"));
     assert_eq!(s.state(0.0).link.frames_sent, frames);
 }
@@ -222,7 +223,7 @@ fn a_parameter_the_device_refuses_is_named_and_moves_nothing() {
 fn losing_the_controlling_page_stops_a_running_motion_cleanly() {
     let mut s = session(LinkLossAction::Hold);
     s.command(&ClientMsg::StartMotion {
-        motion: MotionMsg::Stand,
+        motion: MotionCommand::StandUp,
     })
     .unwrap();
     run_to_idle(&mut s, Duration::from_secs(10));
@@ -240,7 +241,7 @@ fn losing_the_controlling_page_stops_a_running_motion_cleanly() {
     // `disable`: the outputs go off, which cancels the motion.
     let mut s = session(LinkLossAction::Disable);
     s.command(&ClientMsg::StartMotion {
-        motion: MotionMsg::Stand,
+        motion: MotionCommand::StandUp,
     })
     .unwrap();
     run_to_idle(&mut s, Duration::from_secs(10));

@@ -7,8 +7,8 @@ use kin_core::motion::gait::Pattern;
 use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
 use kin_core::LegId;
-use quad_device::engine::{self, WalkRequest};
 use quad_host::ops::onboard::{self, Session, VelocityStep};
+use quad_protocol::{LegSet, MotionCommand};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -213,103 +213,109 @@ impl RunArgs {
         .collect()
     }
 
-    /// The device's request with the defaults of `quad_device::engine` and the options given;
-    /// `stance_height_m` is the device's (the walk's default body height).
-    fn request(&self, stance_height_m: f32) -> (engine::Request, Vec<VelocityStep>) {
+    /// The device's request with the protocol's named defaults
+    /// ([`MotionCommand::seed001_sway`], ...) and the options given; `stance_height_m` is the
+    /// device's (the walk's default body height).
+    fn request(&self, stance_height_m: f32) -> (MotionCommand, Vec<VelocityStep>) {
         let d = self.duration_s;
-        match self.motion {
+        let request = match self.motion {
             Motion::SwayRoll | Motion::SwayPitch => {
                 let axis = if self.motion == Motion::SwayRoll {
                     Axis::Roll
                 } else {
                     Axis::Pitch
                 };
-                let engine::Request::Sway {
+                let MotionCommand::Sway {
                     amplitude_rad,
                     period_s,
                     ..
-                } = engine::Request::seed001_sway(axis, None)
+                } = MotionCommand::seed001_sway(axis, None)
                 else {
                     unreachable!("seed001_sway is a sway")
                 };
                 let period_s = self.period_s.unwrap_or(period_s);
-                let request = engine::Request::Sway {
+                MotionCommand::Sway {
                     axis,
                     amplitude_rad: self.amplitude_rad.unwrap_or(amplitude_rad),
                     period_s,
                     duration_s: Some(d.unwrap_or(one(period_s))),
-                };
-                (request, Vec::new())
+                }
             }
             Motion::YawTurn => {
-                let engine::Request::YawTurn {
+                let MotionCommand::YawTurn {
                     yaw_rate_rad_s,
                     step_period_s,
                     lift_height_m,
                     ..
-                } = engine::Request::seed001_yaw_turn(None)
+                } = MotionCommand::seed001_yaw_turn(None)
                 else {
                     unreachable!("seed001_yaw_turn is a yaw turn")
                 };
                 let step_period_s = self.step_period_s.unwrap_or(step_period_s);
-                let request = engine::Request::YawTurn {
+                MotionCommand::YawTurn {
                     yaw_rate_rad_s: self.yaw_rate_rad_s.unwrap_or(yaw_rate_rad_s),
                     step_period_s,
                     lift_height_m: self.lift_height_m.unwrap_or(lift_height_m),
                     duration_s: Some(d.unwrap_or(one(step_period_s))),
-                };
-                (request, Vec::new())
+                }
             }
             Motion::FootPath => {
-                let engine::Request::FootPath {
+                let legs = self.leg.map_or(LegSet::All, LegSet::One);
+                let MotionCommand::FootPath {
                     path,
                     stride_m,
                     step_height_m,
                     duty_factor,
                     cycle_s,
                     ..
-                } = engine::Request::seed000_rectangle(None, None)
+                } = MotionCommand::seed000_rectangle(legs, None)
                 else {
                     unreachable!("seed000_rectangle is a foot path")
                 };
                 let cycle_s = self.cycle_s.unwrap_or(cycle_s);
-                let request = engine::Request::FootPath {
+                MotionCommand::FootPath {
                     path: self.path.unwrap_or(path),
-                    leg: self.leg,
+                    legs,
                     stride_m: self.stride_m.unwrap_or(stride_m),
                     step_height_m: self.step_height_m.unwrap_or(step_height_m),
                     duty_factor: self.duty_factor.unwrap_or(duty_factor),
                     cycle_s,
                     duration_s: Some(d.unwrap_or(one(cycle_s))),
-                };
-                (request, Vec::new())
+                }
             }
             Motion::Trot | Motion::Walk => {
-                let pattern = if self.motion == Motion::Trot {
+                let gait = if self.motion == Motion::Trot {
                     Pattern::Trot
                 } else {
                     Pattern::Walk
                 };
-                let mut w =
-                    WalkRequest::new(pattern, self.body_height_m.unwrap_or(stance_height_m));
-                if let Some(v) = self.step_height_m {
-                    w.step_height_m = v;
-                }
-                if let Some(v) = self.cycle_s {
-                    w.cycle_s = v;
-                }
-                if let Some(v) = self.velocity_timeout_ms {
-                    w.velocity_timeout_ms = v;
-                }
+                let body_height_m = self.body_height_m.unwrap_or(stance_height_m);
+                let MotionCommand::Walk {
+                    step_height_m,
+                    cycle_s,
+                    velocity_timeout_ms,
+                    ..
+                } = MotionCommand::walk(gait, body_height_m)
+                else {
+                    unreachable!("walk is a walk")
+                };
                 let step = VelocityStep {
                     forward_m_s: self.forward_m_s.unwrap_or(0.0),
                     lateral_m_s: self.lateral_m_s.unwrap_or(0.0),
                     yaw_rate_rad_s: self.yaw_rate_rad_s.unwrap_or(0.0),
                     duration_s: d.unwrap_or(5.0),
                 };
-                (engine::Request::Walk(w), vec![step])
+                let walk = MotionCommand::Walk {
+                    gait,
+                    body_height_m,
+                    step_height_m: self.step_height_m.unwrap_or(step_height_m),
+                    cycle_s: self.cycle_s.unwrap_or(cycle_s),
+                    velocity_timeout_ms: self.velocity_timeout_ms.unwrap_or(velocity_timeout_ms),
+                };
+                return (walk, vec![step]);
             }
-        }
+        };
+        (request, Vec::new())
     }
 }
 
@@ -325,7 +331,7 @@ fn one(period_s: f32) -> f32 {
 
 fn finish<L: quad_host::link::Link>(
     session: &mut Session<L>,
-    request: &engine::Request,
+    request: &MotionCommand,
     walk: &[VelocityStep],
 ) -> ExitCode {
     let summary = match onboard::run(session, request, walk, WAIT_LIMIT, |_| {}) {
@@ -348,7 +354,7 @@ fn session(
 }
 
 /// Runs `quadctl stand`, `sit` or `rest` (`request`) and returns its exit status.
-pub fn posture(args: &PostureArgs, request: engine::Request) -> ExitCode {
+pub fn posture(args: &PostureArgs, request: MotionCommand) -> ExitCode {
     match session(&args.robot, &args.target) {
         Ok(mut s) => finish(&mut s, &request, &[]),
         Err(e) => args::fail("quadctl", &e),

@@ -45,6 +45,7 @@ pub struct Velocity {
 /// A named footfall pattern: phase offsets and duty factor.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Pattern {
     /// Diagonal pairs in antiphase: FL + RR at 0, FR + RL at ½; duty 0.75, so the pairs hand
     /// the body over with all four feet down. At duty ½ each stance pair carries half the body

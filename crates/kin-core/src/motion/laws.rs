@@ -45,6 +45,7 @@ pub const SEED000_SWEEP_STANCE_HEIGHT_M: f32 = 0.40;
 /// The axis a [`Sway`] rotates about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Axis {
     /// Roll θ, about x (seed 001 eq. 6).
     Roll,

@@ -423,6 +423,7 @@ impl FootPath for Bezier {
 /// The shape of a swing, for choosing a path at run time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum PathKind {
     /// [`Rectangle`].
     Rectangle,

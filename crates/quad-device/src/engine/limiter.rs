@@ -122,8 +122,7 @@ impl Ramp {
         ramp
     }
 
-    /// Makes this the ramp [`Ramp::new`] builds, in place: a ramp returned by value is a
-    /// 104-byte copy on the way, beyond the AVR's 63-byte stack displacement.
+    /// Makes this the ramp [`Ramp::new`] builds, in place (no copy of a ramp on the way).
     pub fn restart(&mut self, from: &[f32; 12], to: &[f32; 12], limiter: &Limiter) {
         // `f32::max` by comparison, NaN skipped as `max` does: `max` links a libm routine on
         // the AVR.

@@ -1,155 +1,19 @@
-//! The engine's requests, status and errors on the wire (quad-protocol's motion messages).
+//! The engine's status and errors on the wire (quad-protocol's motion messages; the engine
+//! takes the protocol's [`quad_protocol::MotionCommand`] as its request).
 
-use super::{Error, Kind, Request, Stage, Status, WalkRequest};
+use super::{Error, Status};
 use kin_core::motion;
 use kin_core::preflight::FailureKind;
 use kin_core::Unreachable;
 use quad_protocol::{
-    LegSet, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
-    ParamProblem, PreflightFault, ReachFault,
+    MotionParam, MotionStatus, NackReason, ParamProblem, PreflightFault, ReachFault,
 };
-
-impl From<MotionCommand> for Request {
-    // Inlined into its one caller, the device's request handler, whose frame the copy shares.
-    #[inline(always)]
-    fn from(m: MotionCommand) -> Request {
-        match m {
-            MotionCommand::StandUp => Request::StandUp,
-            MotionCommand::Sit => Request::Sit,
-            MotionCommand::Rest => Request::Rest,
-            MotionCommand::Sway {
-                axis,
-                amplitude_rad,
-                period_s,
-                duration_s,
-            } => Request::Sway {
-                axis,
-                amplitude_rad,
-                period_s,
-                duration_s,
-            },
-            MotionCommand::YawTurn {
-                yaw_rate_rad_s,
-                step_period_s,
-                lift_height_m,
-                duration_s,
-            } => Request::YawTurn {
-                yaw_rate_rad_s,
-                step_period_s,
-                lift_height_m,
-                duration_s,
-            },
-            MotionCommand::FootPath {
-                path,
-                legs,
-                stride_m,
-                step_height_m,
-                duty_factor,
-                cycle_s,
-                duration_s,
-            } => Request::FootPath {
-                path,
-                leg: match legs {
-                    LegSet::All => None,
-                    LegSet::One(leg) => Some(leg),
-                },
-                stride_m,
-                step_height_m,
-                duty_factor,
-                cycle_s,
-                duration_s,
-            },
-            MotionCommand::Walk {
-                gait,
-                body_height_m,
-                step_height_m,
-                cycle_s,
-                velocity_timeout_ms,
-            } => Request::Walk(WalkRequest {
-                pattern: gait,
-                body_height_m,
-                step_height_m,
-                cycle_s,
-                velocity_timeout_ms,
-            }),
-        }
-    }
-}
-
-impl From<&Request> for MotionCommand {
-    fn from(r: &Request) -> MotionCommand {
-        match *r {
-            Request::StandUp => MotionCommand::StandUp,
-            Request::Sit => MotionCommand::Sit,
-            Request::Rest => MotionCommand::Rest,
-            Request::Sway {
-                axis,
-                amplitude_rad,
-                period_s,
-                duration_s,
-            } => MotionCommand::Sway {
-                axis,
-                amplitude_rad,
-                period_s,
-                duration_s,
-            },
-            Request::YawTurn {
-                yaw_rate_rad_s,
-                step_period_s,
-                lift_height_m,
-                duration_s,
-            } => MotionCommand::YawTurn {
-                yaw_rate_rad_s,
-                step_period_s,
-                lift_height_m,
-                duration_s,
-            },
-            Request::FootPath {
-                path,
-                leg,
-                stride_m,
-                step_height_m,
-                duty_factor,
-                cycle_s,
-                duration_s,
-            } => MotionCommand::FootPath {
-                path,
-                legs: leg.map_or(LegSet::All, LegSet::One),
-                stride_m,
-                step_height_m,
-                duty_factor,
-                cycle_s,
-                duration_s,
-            },
-            Request::Walk(w) => MotionCommand::Walk {
-                gait: w.pattern,
-                body_height_m: w.body_height_m,
-                step_height_m: w.step_height_m,
-                cycle_s: w.cycle_s,
-                velocity_timeout_ms: w.velocity_timeout_ms,
-            },
-        }
-    }
-}
 
 impl From<Status> for MotionStatus {
     fn from(s: Status) -> MotionStatus {
         MotionStatus {
-            kind: s.kind.map(|k| match k {
-                Kind::StandUp => MotionKind::StandUp,
-                Kind::Sit => MotionKind::Sit,
-                Kind::Rest => MotionKind::Rest,
-                Kind::Sway => MotionKind::Sway,
-                Kind::YawTurn => MotionKind::YawTurn,
-                Kind::FootPath => MotionKind::FootPath,
-                Kind::Walk => MotionKind::Walk,
-            }),
-            stage: match s.stage {
-                Stage::Approach => MotionStage::Approach,
-                Stage::Run => MotionStage::Run,
-                Stage::Stopping => MotionStage::Stopping,
-                Stage::Leave => MotionStage::Leave,
-            },
+            kind: s.kind,
+            stage: s.stage,
             t_s: s.t_s,
             phase: s.phase,
             fault: s.fault.map(NackReason::from),

@@ -29,9 +29,9 @@ use kin_core::body::{BodyConfig, Pose, Solver};
 use kin_core::motion::laws::{self, Axis};
 use kin_core::motion::Motion as _;
 use kin_core::{ReachPolicy, Robot};
-use quad_device::engine::{self, Request as Motion_, WalkRequest};
+use quad_device::engine;
 use quad_protocol::servo::Calibration;
-use quad_protocol::{Flags, MotionKind, MotionStage, Readback};
+use quad_protocol::{Flags, MotionCommand, MotionKind, MotionStage, Readback};
 use serde::Serialize;
 use std::time::Duration;
 
@@ -39,8 +39,8 @@ use std::time::Duration;
 const FRAME_S: f32 = engine::FRAME_S;
 
 /// The tour's motions and what each does.
-pub fn tour(stance_height_m: f32) -> Vec<(&'static str, Motion_, Vec<VelocityStep>)> {
-    let sway = |axis| Motion_::Sway {
+pub fn tour(stance_height_m: f32) -> Vec<(&'static str, MotionCommand, Vec<VelocityStep>)> {
+    let sway = |axis| MotionCommand::Sway {
         axis,
         amplitude_rad: 0.1,
         period_s: 4.0,
@@ -53,12 +53,12 @@ pub fn tour(stance_height_m: f32) -> Vec<(&'static str, Motion_, Vec<VelocitySte
         duration_s,
     };
     vec![
-        ("stand up", Motion_::StandUp, vec![]),
+        ("stand up", MotionCommand::StandUp, vec![]),
         ("roll sway (seed 001 eq. 6)", sway(Axis::Roll), vec![]),
         ("pitch sway (seed 001 eq. 8)", sway(Axis::Pitch), vec![]),
         (
             "yaw turn (seed 001 eq. 9-11), counter-clockwise",
-            Motion_::YawTurn {
+            MotionCommand::YawTurn {
                 yaw_rate_rad_s: 0.1,
                 step_period_s: 2.0,
                 lift_height_m: 0.05,
@@ -68,13 +68,10 @@ pub fn tour(stance_height_m: f32) -> Vec<(&'static str, Motion_, Vec<VelocitySte
         ),
         (
             "trot: 3 cm/s, then 6 cm/s turning left, then stop",
-            Motion_::Walk(WalkRequest::new(
-                kin_core::motion::gait::Pattern::Trot,
-                stance_height_m,
-            )),
+            MotionCommand::walk(kin_core::motion::gait::Pattern::Trot, stance_height_m),
             vec![step(0.03, 0.0, 2.0), step(0.06, 0.1, 2.0)],
         ),
-        ("sit", Motion_::Sit, vec![]),
+        ("sit", MotionCommand::Sit, vec![]),
     ]
 }
 
@@ -103,14 +100,14 @@ pub struct Leg {
 /// device's stance and rotation order.
 fn host_law_angles(
     robot: &Robot,
-    request: &Motion_,
+    request: &MotionCommand,
     stance_height_m: f32,
     order: kin_core::RotationOrder,
     t_s: f32,
 ) -> Option<[f32; 12]> {
     let stance = robot.stance_feet(stance_height_m);
     let frame = match *request {
-        Motion_::Sway {
+        MotionCommand::Sway {
             axis,
             amplitude_rad,
             period_s,
@@ -129,7 +126,7 @@ fn host_law_angles(
         .ok()?
         .frame::<kin_core::DefaultMath>(t_s)
         .ok()?,
-        Motion_::YawTurn {
+        MotionCommand::YawTurn {
             yaw_rate_rad_s,
             step_period_s,
             lift_height_m,
@@ -248,7 +245,10 @@ pub fn run<L: Link>(
             calibration: &calibration,
             tolerance_rad,
         };
-        let is_law = matches!(request, Motion_::Sway { .. } | Motion_::YawTurn { .. });
+        let is_law = matches!(
+            request,
+            MotionCommand::Sway { .. } | MotionCommand::YawTurn { .. }
+        );
         if is_law {
             c.leg.motion_s = law_run(session, &mut c, robot, &request, h, order)?;
         } else {
@@ -282,7 +282,7 @@ pub fn run<L: Link>(
         let last = session.get()?;
         c.readback(&last.readback);
         match request {
-            Motion_::StandUp => {
+            MotionCommand::StandUp => {
                 let stance = Solver::new(robot)
                     .inverse_at_stance(
                         &Pose::default(),
@@ -296,7 +296,7 @@ pub fn run<L: Link>(
                     Err(e) => c.error(format!("the host cannot solve the stance: {e}")),
                 }
             }
-            Motion_::Sit => match engine::rest_angles(robot) {
+            MotionCommand::Sit => match engine::rest_angles(robot) {
                 Ok(want) => c.angles(&last.readback.angles_rad, &want, "the rest pose"),
                 Err(e) => c.error(format!("the host has no rest pose: {e:?}")),
             },
@@ -328,7 +328,7 @@ fn law_run<L: Link>(
     session: &mut Session<L>,
     c: &mut Checker<'_>,
     robot: &Robot,
-    request: &Motion_,
+    request: &MotionCommand,
     h: f32,
     order: kin_core::RotationOrder,
 ) -> Result<f32, onboard::Error> {
@@ -401,14 +401,14 @@ fn law_run<L: Link>(
 
 /// The motion time at which a law request with a duration ends (its duration rounded up to
 /// whole periods, as the device runs it), s.
-fn law_end_s(request: &Motion_) -> Option<f32> {
+fn law_end_s(request: &MotionCommand) -> Option<f32> {
     let (duration_s, period_s) = match *request {
-        Motion_::Sway {
+        MotionCommand::Sway {
             duration_s,
             period_s,
             ..
         } => (duration_s?, period_s),
-        Motion_::YawTurn {
+        MotionCommand::YawTurn {
             duration_s,
             step_period_s,
             ..

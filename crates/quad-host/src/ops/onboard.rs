@@ -2,8 +2,9 @@
 //! paths, trot and walk): starting them, following them to their end, and the device's
 //! refusals in words. The operations behind `quadctl stand`, `sit`, `rest`, `run` and `drive`.
 //!
-//! A motion's parameters and their defaults are the device's own (`quad_device::engine`'s
-//! requests, sent as `quad_protocol::MotionCommand`). Before sending a motion request the host
+//! A motion and its parameters are the protocol's one declaration,
+//! [`quad_protocol::MotionCommand`], with its named defaults (`MotionCommand::seed001_sway`,
+//! `MotionCommand::walk`, ...); the device's engine runs it as it is. Before sending a motion request the host
 //! runs the range check the device runs first ([`quad_protocol::range`]): a number outside its
 //! field's range is refused here with the device's own reason, [`Error::NotSent`], and nothing
 //! is sent; what depends on the robot's reach and travel stays the device's to check. Refused
@@ -11,7 +12,6 @@
 
 use crate::client::{self, Client, ClientConfig, Outcome, Verdict};
 use crate::link::{self, Link, Target};
-use quad_device::engine;
 use quad_protocol::range::{self, ParamRange, Ranges};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
@@ -217,18 +217,22 @@ pub fn words(reason: &NackReason) -> String {
     words_in(reason, &COMMAND_LINE)
 }
 
+/// What is wrong with a refused parameter, in words after its name ("must be > 0").
+pub fn problem_words(problem: ParamProblem) -> &'static str {
+    match problem {
+        ParamProblem::NonFinite => "is not a finite number",
+        ParamProblem::NotPositive => "must be > 0",
+        ParamProblem::Negative => "must be >= 0",
+        ParamProblem::OutOfRange => "is outside its admissible range",
+        ParamProblem::BeyondReach => "puts a foot out of reach",
+    }
+}
+
 /// A device refusal in words, with a front end's names (see [`Naming`]).
 pub fn words_in(reason: &NackReason, naming: &Naming) -> String {
     match reason {
         NackReason::InvalidParameter { param, problem } => {
-            let what = match problem {
-                ParamProblem::NonFinite => "is not a finite number",
-                ParamProblem::NotPositive => "must be > 0",
-                ParamProblem::Negative => "must be >= 0",
-                ParamProblem::OutOfRange => "is outside its admissible range",
-                ParamProblem::BeyondReach => "puts a foot out of reach",
-            };
-            format!("{} {what}", (naming.param)(*param))
+            format!("{} {}", (naming.param)(*param), problem_words(*problem))
         }
         NackReason::Preflight { leg, fault } => {
             let what = match fault {
@@ -380,8 +384,8 @@ impl<L: Link> Session<L> {
     ///
     /// # Errors
     /// As [`Session::motion`].
-    pub fn start(&mut self, request: &engine::Request) -> Result<MotionAnswer, Error> {
-        self.motion(Request::StartMotion(MotionCommand::from(request)))
+    pub fn start(&mut self, request: &MotionCommand) -> Result<MotionAnswer, Error> {
+        self.motion(Request::StartMotion(*request))
     }
 
     /// The engine's state.
@@ -431,7 +435,7 @@ impl<L: Link> Session<L> {
         if now.readback.flags.contains(Flags::OUTPUTS_ENABLED) {
             return Ok(false);
         }
-        self.start(&engine::Request::StandUp)?;
+        self.start(&MotionCommand::StandUp)?;
         self.wait_idle(limit, |_| {})?;
         Ok(true)
     }
@@ -515,23 +519,23 @@ fn velocity_request(step: &VelocityStep) -> Request {
 /// request or velocity outside the protocol's ranges is refused before it).
 pub fn run<L: Link>(
     session: &mut Session<L>,
-    request: &engine::Request,
+    request: &MotionCommand,
     walk: &[VelocityStep],
     limit: Duration,
     mut each: impl FnMut(&MotionAnswer),
 ) -> Result<Summary, Error> {
     // The range check of the motion and of its velocity commands before anything moves (a
     // stand-up first included).
-    session.check(&Request::StartMotion(MotionCommand::from(request)))?;
+    session.check(&Request::StartMotion(*request))?;
     for step in walk {
         session.check(&velocity_request(step))?;
     }
     let posture = matches!(
         request,
-        engine::Request::StandUp | engine::Request::Sit | engine::Request::Rest
+        MotionCommand::StandUp | MotionCommand::Sit | MotionCommand::Rest
     );
     let stood_up_first = !posture && session.stand_if_off(limit)?;
-    if posture && !matches!(request, engine::Request::StandUp) {
+    if posture && !matches!(request, MotionCommand::StandUp) {
         let now = session.get()?;
         if !now.readback.flags.contains(Flags::OUTPUTS_ENABLED) {
             return Ok(Summary {
@@ -550,7 +554,7 @@ pub fn run<L: Link>(
     each(&first);
     let mut polls = 0u64;
     let mut velocity_commands = 0u64;
-    if matches!(request, engine::Request::Walk(_)) {
+    if matches!(request, MotionCommand::Walk { .. }) {
         for step in walk {
             let until = session.now() + Duration::from_secs_f32(step.duration_s);
             loop {
@@ -628,7 +632,7 @@ impl<L: Link> crate::ops::drive::Walker for SessionWalker<'_, L> {
     ) -> Result<crate::ops::drive::Answer<MotionAnswer>, Error> {
         use crate::ops::drive::Answer;
         self.session.stand_if_off(self.limit)?;
-        let request = engine::Request::Walk(engine::WalkRequest::new(self.pattern, body_height_m));
+        let request = MotionCommand::walk(self.pattern, body_height_m);
         match self.session.start(&request) {
             Ok(a) => Ok(Answer::Accepted(a)),
             Err(e) => refused(e),
@@ -658,7 +662,7 @@ impl<L: Link> crate::ops::drive::Walker for SessionWalker<'_, L> {
 
     fn sit(&mut self) -> Result<(), Error> {
         self.stop()?;
-        self.session.start(&engine::Request::Sit)?;
+        self.session.start(&MotionCommand::Sit)?;
         self.session.wait_idle(self.limit, |_| {})?;
         Ok(())
     }
