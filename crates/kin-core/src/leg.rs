@@ -511,6 +511,9 @@ impl<M: Math> Solver<M> {
     /// knee]`) and `clamped`, the leg's places in the body IK's flat solution, where the caller
     /// reads them (a returned solution would be copied once more on CPUs that return it
     /// through memory). On an error neither place is written.
+    // Out of line: the body IK's loop over the legs then keeps a small stack frame (inlined
+    // there, the AVR's `SetBodyPose` took longer: `BENCHMARKS.md`).
+    #[inline(never)]
     pub(crate) fn inverse_into(
         &self,
         leg: LegId,
