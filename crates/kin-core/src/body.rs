@@ -166,27 +166,6 @@ pub fn unflatten(flat: &[f32; 12]) -> BodyAngles {
     core::array::from_fn(|i| JointAngles::new(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]))
 }
 
-/// The per-request values of the feet-to-hips transform: `R`, the translation plus the pivot
-/// `c` (`offset`), `c`, and the front left hip mount.
-struct FeetToHips<'a> {
-    r: Mat3,
-    offset: Vec3,
-    c: &'a Vec3,
-    hip_fl: &'a Vec3,
-}
-
-/// One foot in its hip frame, written into `out`: `Rᵀ·(foot − offset) + c − hip` (`hip` the
-/// mount of `leg`: the front left one moved to its corner). Out of line: one copy of its
-/// float operations for the four feet. Its inputs by reference and its result written in
-/// place, so that the caller's loop passes addresses only (no vectors copied into its frame
-/// and out of a returned temporary).
-#[inline(never)]
-fn foot_in_hip(t: &FeetToHips, foot: &Vec3, out: &mut Vec3, leg: LegId) {
-    let p = t.r.transpose_mul_vec(*foot - t.offset);
-    let (c, hip) = (t.c, leg.at_corner(*t.hip_fl));
-    *out = Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z);
-}
-
 /// Full-body IK on math backend `M` with the robot's constants prepared once (the leg IK's
 /// [`leg::Solver`], the hip mounts). A caller that solves many poses of one robot keeps one:
 ///
@@ -235,7 +214,6 @@ impl<M: Math> core::fmt::Debug for Solver<M> {
 }
 
 /// True when `v` is (±0, ±0, ±0), from the bits (no float comparison).
-#[inline(always)]
 fn is_zero(v: Vec3) -> bool {
     const ABS: u32 = 0x7fff_ffff;
     (v.x.to_bits() | v.y.to_bits() | v.z.to_bits()) & ABS == 0
@@ -269,79 +247,21 @@ impl<M: Math> Solver<M> {
 
     /// Feet in the world frame → feet in each leg's hip frame:
     /// `Rᵀ·(foot_in_world − t − c) + c − hip_in_body`.
-    #[inline]
     pub fn feet_in_hips(
         &self,
         pose: &Pose,
         config: &BodyConfig,
         feet_in_world: &[Vec3; 4],
     ) -> [Vec3; 4] {
-        if M::SHARE_FLOAT_CODE {
-            let mut out = [Vec3::ZERO; 4];
-            self.feet_in_hips_shared(pose, config, feet_in_world, &mut out);
-            out
-        } else {
-            self.feet_in_hips_inline(pose, config, feet_in_world)
-        }
-    }
-
-    /// [`Solver::feet_in_hips`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]), written
-    /// into `out`: the general solve and the stance solve ([`Solver::inverse_at_stance`])
-    /// share it, and its feet go one at a time through one copy of the per-foot transform,
-    /// each straight into its place in `out`.
-    #[inline(never)]
-    fn feet_in_hips_shared(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        feet_in_world: &[Vec3; 4],
-        out: &mut [Vec3; 4],
-    ) {
-        let c = &config.pivot_m;
-        let mut t = FeetToHips {
-            r: Mat3::ZERO,
-            offset: pose.translation() + *c,
-            c,
-            hip_fl: &self.hip_fl_m,
-        };
-        rotation::matrix_into::<M>(
-            config.order,
-            pose.roll_rad,
-            pose.pitch_rad,
-            pose.yaw_rad,
-            &mut t.r,
-        );
-        for ((foot, o), leg) in feet_in_world.iter().zip(out.iter_mut()).zip(&LegId::ALL) {
-            foot_in_hip(&t, foot, o, *leg);
-        }
-    }
-
-    #[inline(always)]
-    fn feet_in_hips_inline(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        feet_in_world: &[Vec3; 4],
-    ) -> [Vec3; 4] {
-        let r: Mat3 =
-            rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
+        let r = rotation::matrix::<M>(config.order, pose.roll_rad, pose.pitch_rad, pose.yaw_rad);
         let c = config.pivot_m;
-        let pivot = !is_zero(c);
-        let offset = if pivot {
-            pose.translation() + c
-        } else {
-            pose.translation()
-        };
-        // A plain loop rather than `LegId::ALL.map(..)`, whose closure the compiler may leave
-        // as a call per leg that returns through memory.
+        let offset = pose.translation() + c;
         let mut out = [Vec3::ZERO; 4];
-        for (i, leg) in LegId::ALL.into_iter().enumerate() {
-            let mut p = r.transpose_mul_vec(feet_in_world[i] - offset);
-            if pivot {
-                p = p + c;
-            }
+        for ((foot_in_hip, foot), leg) in out.iter_mut().zip(feet_in_world).zip(LegId::ALL) {
+            let p = r.transpose_mul_vec(*foot - offset);
+            // The hip mounts lie in the body's plane z = 0.
             let hip = leg.at_corner(self.hip_fl_m);
-            out[i] = Vec3::new(p.x - hip.x, p.y - hip.y, p.z);
+            *foot_in_hip = Vec3::new(p.x + c.x - hip.x, p.y + c.y - hip.y, p.z + c.z);
         }
         out
     }
@@ -353,9 +273,7 @@ impl<M: Math> Solver<M> {
     /// for the front/rear sign `sx`, the side sign `s` and `K = Rᵀ·(g + (0, 0, H)) − c`,
     /// `g = t + c`: 9 multiplications and 27 additions (15 and 33 with a horizontal
     /// translation or pivot) where the general transform of the four stance feet takes 36 and
-    /// 59. Its vector operations are inline on every backend, the AVR's included (out of line
-    /// they saved 542 B of its flash and cost 1,272 cycles; `docs/benchmark-journal.md`).
-    #[inline(never)]
+    /// 59.
     fn stance_feet_in_hips(
         &self,
         pose: &Pose,
@@ -373,9 +291,7 @@ impl<M: Math> Solver<M> {
             pose.yaw_rad,
             &mut r,
         );
-        // The four feet are built in place, the slots holding the shared terms on the way
-        // (few vectors in the frame: cheap addressing where the frame is addressed by a
-        // short displacement).
+        // The four feet are built in place, the slots holding the shared terms on the way.
         let [fl, fr, rl, rr] = out;
         // −K = Rᵀ·(−g − (0, 0, H)) + c to FR, as the rows of R scaled by the components:
         // −(g_z + H)·r₂ (−H·r₂ without translation and pivot), −g_x·r₀, −g_y·r₁ and c added.
@@ -442,24 +358,6 @@ impl<M: Math> Solver<M> {
         policy: ReachPolicy,
         out: &mut BodySolution,
     ) -> Result<(), IkError> {
-        if M::SHARE_FLOAT_CODE {
-            return self.inverse_shared(pose, config, feet_in_world, policy, out);
-        }
-        check_finite(pose, config)?;
-        let local = self.feet_in_hips(pose, config, feet_in_world);
-        self.legs(&local, policy, out)
-    }
-
-    /// [`Solver::inverse_into`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]).
-    #[inline(never)]
-    fn inverse_shared(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        feet_in_world: &[Vec3; 4],
-        policy: ReachPolicy,
-        out: &mut BodySolution,
-    ) -> Result<(), IkError> {
         check_finite(pose, config)?;
         let local = self.feet_in_hips(pose, config, feet_in_world);
         self.legs(&local, policy, out)
@@ -492,39 +390,9 @@ impl<M: Math> Solver<M> {
         policy: ReachPolicy,
         out: &mut BodySolution,
     ) -> Result<(), IkError> {
-        if M::SHARE_FLOAT_CODE {
-            return self.inverse_at_stance_shared(pose, config, stance_height_m, policy, out);
-        }
-        self.inverse_at_stance_inline(pose, config, stance_height_m, policy, out)
-    }
-
-    /// [`Solver::inverse_at_stance_into`] as one out-of-line copy
-    /// ([`Math::SHARE_FLOAT_CODE`]): the finiteness check once, not at every caller.
-    #[inline(never)]
-    fn inverse_at_stance_shared(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        stance_height_m: f32,
-        policy: ReachPolicy,
-        out: &mut BodySolution,
-    ) -> Result<(), IkError> {
-        self.inverse_at_stance_inline(pose, config, stance_height_m, policy, out)
-    }
-
-    #[inline(always)]
-    fn inverse_at_stance_inline(
-        &self,
-        pose: &Pose,
-        config: &BodyConfig,
-        stance_height_m: f32,
-        policy: ReachPolicy,
-        out: &mut BodySolution,
-    ) -> Result<(), IkError> {
         check_finite(pose, config)?;
         // Four zeros written out, not a repeat expression: the compiler then sees that the
-        // stance transform writes every foot before it reads one and drops the zeroing (the
-        // repeat expression's per-vector zeroing loop stayed).
+        // stance transform writes every foot before it reads one and drops the zeroing.
         let mut local = [Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
         self.stance_feet_in_hips(pose, config, stance_height_m, &mut local);
         self.legs(&local, policy, out)
@@ -546,49 +414,15 @@ impl<M: Math> Solver<M> {
         by_value(|out| self.legs(&local, policy, out))
     }
 
-    /// The four leg solves of feet in their hips' frames, written into `out`: staged across
-    /// the legs when the backend asks for it ([`Math::STAGE_LEGS`]), else (and to name the
-    /// first failure) one after the other through one out-of-line leg solve, each leg's
-    /// angles straight into their place in `out`; the same results either way.
-    #[inline(always)]
+    /// The four leg solves ([`leg::Solver::inverse`]) of feet in their hips' frames, in the
+    /// order of [`LegId::ALL`], each leg's angles written straight into their place in `out`;
+    /// the first leg that fails rejects the pose and is named in the error.
     fn legs(
         &self,
         local: &[Vec3; 4],
         policy: ReachPolicy,
         out: &mut BodySolution,
     ) -> Result<(), IkError> {
-        if M::SHARE_FLOAT_CODE {
-            return self.legs_shared(local, policy, out);
-        }
-        self.legs_inline(local, policy, out)
-    }
-
-    /// [`Solver::legs`] as one out-of-line copy ([`Math::SHARE_FLOAT_CODE`]): the general, the
-    /// stance and the feet-in-body solves share it.
-    #[inline(never)]
-    fn legs_shared(
-        &self,
-        local: &[Vec3; 4],
-        policy: ReachPolicy,
-        out: &mut BodySolution,
-    ) -> Result<(), IkError> {
-        self.legs_inline(local, policy, out)
-    }
-
-    #[inline(always)]
-    fn legs_inline(
-        &self,
-        local: &[Vec3; 4],
-        policy: ReachPolicy,
-        out: &mut BodySolution,
-    ) -> Result<(), IkError> {
-        if M::STAGE_LEGS && policy == ReachPolicy::Reject {
-            if let Some(angles) = self.leg.inverse_all_reject(local) {
-                out.angles_rad = flatten(&angles);
-                out.clamped = [None; 4];
-                return Ok(());
-            }
-        }
         let legs = out.angles_rad.chunks_exact_mut(3).zip(&mut out.clamped);
         for ((angles, clamped), (foot, leg)) in legs.zip(local.iter().zip(&LegId::ALL)) {
             // Chunks of exactly three: the conversion cannot fail (and compiles to nothing).
@@ -602,6 +436,8 @@ impl<M: Math> Solver<M> {
 
 /// The solution that `solve` writes into an empty one ([`BodySolution::default`]), by value:
 /// the by-value forms of the solves that write into a caller's.
+// Always inlined, early: the reach policy its closure captures then stays a constant that the
+// compiler propagates into the solve and drops the other policy's code (`BENCHMARKS.md`).
 #[inline(always)]
 fn by_value(
     solve: impl FnOnce(&mut BodySolution) -> Result<(), IkError>,
@@ -612,9 +448,7 @@ fn by_value(
 }
 
 /// `NonFinite` (named on FL) when the pose or the pivot is not finite: the first check of
-/// [`Solver::inverse`] and [`Solver::inverse_at_stance`]. Out of line: one copy of its nine
-/// checks for the two solves.
-#[inline(never)]
+/// [`Solver::inverse`] and [`Solver::inverse_at_stance`].
 fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = &config.pivot_m;
     // Field by field, without copying the pose into an array first; all nine checked
@@ -653,7 +487,7 @@ pub fn forward(robot: &Robot, pose: &Pose, config: &BodyConfig, angles: &BodyAng
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::{Fast, SoftFloat};
+    use crate::math::SoftFloat;
     use crate::robot::KneeBend;
     use seeded_rng::SplitMix64;
 
@@ -665,22 +499,6 @@ mod tests {
         }
         fn uniform(&mut self, lo: f32, hi: f32) -> f32 {
             self.0.range(lo as f64, hi as f64) as f32
-        }
-    }
-
-    /// [`Fast`]'s kernels with the legs solved one after the other: the other arm of
-    /// [`Math::STAGE_LEGS`].
-    struct Unstaged;
-    impl Math for Unstaged {
-        const STAGE_LEGS: bool = false;
-        fn sqrt(x: f32) -> f32 {
-            Fast::sqrt(x)
-        }
-        fn atan2(y: f32, x: f32) -> f32 {
-            Fast::atan2(y, x)
-        }
-        fn sin_cos(x: f32) -> (f32, f32) {
-            Fast::sin_cos(x)
         }
     }
 
@@ -773,8 +591,8 @@ mod tests {
         }
     }
 
-    /// The four-leg fast path of the body IK (Reject) gives exactly the per-leg results, and
-    /// the same first error when a leg cannot reach.
+    /// The body IK (Reject) gives exactly the per-leg results, and the same first error when a
+    /// leg cannot reach.
     #[test]
     fn body_ik_equals_leg_by_leg_ik_bit_for_bit() {
         let mut rng = Rng::new(7);
@@ -816,19 +634,6 @@ mod tests {
                         );
                         let body =
                             Solver::new(&robot).inverse(&pose, &config, &feet, ReachPolicy::Reject);
-                        // The legs one after the other (the other arm of `Math::STAGE_LEGS`).
-                        let unstaged = Solver::<Unstaged>::with_math(&robot).inverse(
-                            &pose,
-                            &config,
-                            &feet,
-                            ReachPolicy::Reject,
-                        );
-                        match (&body, &unstaged) {
-                            (Ok(b), Ok(u)) => {
-                                assert_eq!(b.flat().map(f32::to_bits), u.flat().map(f32::to_bits))
-                            }
-                            (b, u) => assert_eq!(b, u),
-                        }
                         match (body, one_by_one) {
                             (Ok(b), Ok(l)) => {
                                 solved += 1;

@@ -87,7 +87,6 @@ pub fn leg_inverse_condition(g: &LegGeometry, leg: LegId, q: JointAngles) -> f32
 
 /// [`leg_inverse_condition`] on backend `M` (reached through
 /// [`crate::leg::Solver::inverse_condition`]).
-#[inline(never)]
 pub(crate) fn leg_inverse_condition_on<M: Math>(
     g: &LegGeometry,
     leg: LegId,
@@ -122,7 +121,6 @@ struct Gram {
 /// `r = det(a − qI)/(2p³)`, `φ = acos(r)/3`, the largest is `q + 2p·cos φ` and the smallest
 /// `q + 2p·cos(φ + 2π/3) = q − p·(cos φ + √3·sin φ)` (one sine and cosine); `p = 0` is
 /// `a = q·I`.
-#[inline(never)]
 fn gram_inverse_condition<M: Math>(a: &Gram) -> f32 {
     let [a00, a11, a22] = a.diagonal;
     let [a01, a02, a12] = a.off;

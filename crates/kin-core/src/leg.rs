@@ -323,7 +323,6 @@ struct Consts {
 }
 
 impl Consts {
-    #[inline(always)]
     const fn of(g: &LegGeometry) -> Consts {
         let (l1, l2) = (g.femur_m, g.tibia_m);
         Consts {
@@ -341,7 +340,6 @@ impl Consts {
 /// line `ℓ` to the foot at distance `A` from the abduction axis, `ℓ = √(A² − La²)`. Returns
 /// the un-abducted depth of the foot `w = −ℓ` (the branch with the foot below the hip; 0 when
 /// the foot lies on the offset circle) and `w²`, from `r_sq = A² = y² + z²` (eq. 4.1).
-#[inline(always)]
 fn depth<M: Math>(d_lat_sq: f32, r_sq: f32) -> (f32, f32) {
     let w_sq = r_sq - d_lat_sq;
     // max(w², 0) without a float comparison on the backends that avoid them.
@@ -353,7 +351,6 @@ fn depth<M: Math>(d_lat_sq: f32, r_sq: f32) -> (f32, f32) {
 /// foot's `(y, z)` less that of the leg's own `(s·d_lat, w)` (`sd = s·d_lat`, `w` from
 /// [`depth`]), as the arguments `(y, x)` of one `atan2` of their cross and dot products: every
 /// quadrant of the abduction circle in one formula, in `(−π, π]`.
-#[inline(always)]
 fn abduction_yx(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
     (sd * z - w * y, sd * y + w * z)
 }
@@ -363,7 +360,6 @@ impl Consts {
     /// `v = w + d_ax` below the hip-flexion joint and `v²`, from [`depth`]'s `(w, w²)`;
     /// `(w, w²)` itself when `d_ax = 0` (a multiplication and an addition fewer). The planar
     /// distance is then `R² = x² + v²`.
-    #[inline(always)]
     fn leg_plane(&self, d_ax_m: f32, (w, w_sq): (f32, f32)) -> (f32, f32) {
         if self.d_ax_zero {
             (w, w_sq)
@@ -380,7 +376,6 @@ impl Consts {
     /// `sin² k` in the factored form `(R² − (L1−L2)²)·((L1+L2)² − R²)`, which stays accurate
     /// near a folded or straight knee, where `(2·L1·L2)² − cos²` loses the digits that set the
     /// foot's distance; the sign of `sin k` is the knee bend.
-    #[inline(always)]
     fn knee_yx<M: Math>(
         &self,
         g: &LegGeometry,
@@ -415,6 +410,8 @@ impl Consts {
 /// in the leg plane, less R2 = `angle(L1 + L2·cos k, L2·sin k)`, the femur's angle from R by
 /// the law of cosines; the second vector scaled by `2·L1` is `(R² + L1² − L2², 2·L1·L2·sin k)`
 /// (`diff_sq` = `L1² − L2²`, `s` from [`Consts::knee_yx`]).
+// Always inlined: out of line, its fifth float argument goes on the stack, and LLVM's AVR
+// backend miscompiled that call (wrong hip angles in `cargo xtask avr-bench`).
 #[inline(always)]
 fn hip_yx(u: f32, v: f32, dist2: f32, diff_sq: f32, s: f32) -> (f32, f32) {
     let (bx, by) = (dist2 + diff_sq, s);
@@ -467,7 +464,6 @@ impl<M: Math> Solver<M> {
 
     /// True when all three angles lie within their limits (false for any NaN), compared by
     /// the backend with the limits' keys computed once ([`Math::within_keys`]).
-    #[inline(always)]
     fn admits_all(&self, q: JointAngles) -> bool {
         let (lo, hi, k) = (&self.limits.min_rad, &self.limits.max_rad, &self.limit_keys);
         M::within_keys(q.abduction_rad, lo[0], hi[0], k[0])
@@ -476,7 +472,6 @@ impl<M: Math> Solver<M> {
     }
 
     /// `s·d_lat`: the leg plane's offset with the side sign of `leg`.
-    #[inline(always)]
     fn side_d_lat(&self, leg: LegId) -> f32 {
         if leg.is_left() {
             self.geometry.d_lat_m
@@ -503,19 +498,31 @@ impl<M: Math> Solver<M> {
         foot_in_hip: Vec3,
         policy: ReachPolicy,
     ) -> Result<LegSolution, IkError> {
-        self.inverse_inline(leg, foot_in_hip, policy)
+        let (mut angles_rad, mut clamped) = ([0.0; 3], None);
+        self.inverse_into(leg, &foot_in_hip, policy, &mut angles_rad, &mut clamped)?;
+        let [abduction, hip, knee] = angles_rad;
+        Ok(LegSolution {
+            angles: JointAngles::new(abduction, hip, knee),
+            clamped,
+        })
     }
 
-    /// [`Solver::inverse`], always inlined into its two wrappers: the public one, which the
-    /// compiler may then inline into the caller (a host's loop keeps the solve, its `atan2`
-    /// kernels included, in one piece), and [`Solver::inverse_into`].
-    #[inline(always)]
-    fn inverse_inline(
+    /// [`Solver::inverse`] with its solution written into `angles_rad` (`[abduction, hip,
+    /// knee]`) and `clamped`, the leg's places in the body IK's flat solution, where the caller
+    /// reads them (a returned solution would be copied once more on CPUs that return it
+    /// through memory). On an error neither place is written.
+    // Out of line: the body IK's loop over the legs then keeps a small stack frame (inlined
+    // there, the AVR's `SetBodyPose` took longer: `BENCHMARKS.md`).
+    #[inline(never)]
+    pub(crate) fn inverse_into(
         &self,
         leg: LegId,
-        foot_in_hip: Vec3,
+        foot_in_hip: &Vec3,
         policy: ReachPolicy,
-    ) -> Result<LegSolution, IkError> {
+        angles_rad: &mut [f32; 3],
+        clamped: &mut Option<Clamp>,
+    ) -> Result<(), IkError> {
+        let foot_in_hip = *foot_in_hip;
         let err = |kind| IkError { leg, kind };
         if !(finite(foot_in_hip.x) && finite(foot_in_hip.y) && finite(foot_in_hip.z)) {
             return Err(err(Unreachable::NonFinite));
@@ -535,70 +542,73 @@ impl<M: Math> Solver<M> {
             }
             ReachPolicy::Reject => foot_in_hip,
         };
-        let (mut angles, projected) = self
+        let (angles, projected) = self
             .solve(self.side_d_lat(leg), target, policy)
             .map_err(err)?;
         // Within the limits also means finite: a NaN fails every comparison.
         let within = self.admits_all(angles);
-        let kind = match (within, projected) {
-            (true, None) => {
-                return Ok(LegSolution {
-                    angles,
-                    clamped: None,
-                })
-            }
-            (true, Some(kind)) => kind,
-            (false, _) => {
-                // Some joint is outside (any for a NaN angle).
-                let joint = self
-                    .limits
-                    .first_violation(angles)
-                    .unwrap_or(Joint::Abduction);
-                if policy == ReachPolicy::Reject {
-                    return Err(err(Unreachable::JointLimit(joint)));
-                }
-                angles = self.limits.clamp(angles);
-                projected.unwrap_or(Unreachable::JointLimit(joint))
-            }
-        };
-        // Under Clamp, moved: the distance of the foot the returned angles reach.
-        let foot = forward_on::<M>(&self.geometry, leg, angles);
-        let clamped = Some(Clamp {
-            kind,
-            distance_m: distance::<M>(foot, foot_in_hip),
-        });
-        if !angles.is_finite() {
-            // Unreachable by construction; kept so that no NaN can ever leave this function.
-            return Err(err(Unreachable::NonFinite));
+        if within && projected.is_none() {
+            *angles_rad = angles.to_array();
+            *clamped = None;
+            return Ok(());
         }
-        Ok(LegSolution { angles, clamped })
-    }
-
-    /// [`Solver::inverse`] kept out of line, its solution written into `angles_rad`
-    /// (`[abduction, hip, knee]`) and `clamped`, the leg's places in the body IK's flat
-    /// solution: the body IK's legs one after the other through one copy of the leg solve
-    /// ([`Math::STAGE_LEGS`] false, and the fallback that names the first failing leg). Only
-    /// the small error comes back by value (a returned solution would be copied once more on
-    /// CPUs that return it through memory). On an error neither place is written.
-    #[inline(never)]
-    pub(crate) fn inverse_into(
-        &self,
-        leg: LegId,
-        foot_in_hip: &Vec3,
-        policy: ReachPolicy,
-        angles_rad: &mut [f32; 3],
-        clamped: &mut Option<Clamp>,
-    ) -> Result<(), IkError> {
-        let s = self.inverse_inline(leg, *foot_in_hip, policy)?;
+        let s = self.beyond(leg, &foot_in_hip, policy, &angles, within, projected)?;
         *angles_rad = s.angles.to_array();
         *clamped = s.clamped;
         Ok(())
     }
 
+    /// [`Solver::inverse_into`] for the angles of a target that was projected onto the
+    /// workspace or whose angles lie beyond a joint limit (`within` false): the error under
+    /// [`ReachPolicy::Reject`], the clamped angles and the reported [`Clamp`] under
+    /// [`ReachPolicy::Clamp`].
+    // Out of line: the common path's stack frame then stays within the AVR's short
+    // displacement (`BENCHMARKS.md`, leg IK and body pose).
+    #[inline(never)]
+    fn beyond(
+        &self,
+        leg: LegId,
+        foot_in_hip: &Vec3,
+        policy: ReachPolicy,
+        angles: &JointAngles,
+        within: bool,
+        projected: Option<Unreachable>,
+    ) -> Result<LegSolution, IkError> {
+        let err = |kind| IkError { leg, kind };
+        let mut angles = *angles;
+        let kind = if within {
+            // Within the limits: the target was projected.
+            projected.unwrap_or(Unreachable::TooFar)
+        } else {
+            // Some joint is outside (any for a NaN angle).
+            let joint = self
+                .limits
+                .first_violation(angles)
+                .unwrap_or(Joint::Abduction);
+            if policy == ReachPolicy::Reject {
+                return Err(err(Unreachable::JointLimit(joint)));
+            }
+            angles = self.limits.clamp(angles);
+            projected.unwrap_or(Unreachable::JointLimit(joint))
+        };
+        // Under Clamp, moved: the distance of the foot the returned angles reach.
+        let foot = forward_on::<M>(&self.geometry, leg, angles);
+        if !angles.is_finite() {
+            // Unreachable by construction; kept so that no NaN can ever leave this function.
+            return Err(err(Unreachable::NonFinite));
+        }
+        Ok(LegSolution {
+            angles,
+            clamped: Some(Clamp {
+                kind,
+                distance_m: distance::<M>(foot, *foot_in_hip),
+            }),
+        })
+    }
+
     /// Solves the abduction and planar problem exactly for a point known to be reachable
     /// (after optional projection), for the leg with `sd = s·d_lat`. Returns the angles and,
     /// when projecting, the first reason.
-    #[inline(always)]
     fn solve(
         &self,
         sd: f32,
@@ -673,73 +683,6 @@ impl<M: Math> Solver<M> {
         };
         Ok((angles, projected))
     }
-
-    /// The four legs of [`LegId::ALL`] at once under [`ReachPolicy::Reject`], for the
-    /// full-body IK when [`Math::STAGE_LEGS`]: the arithmetic of [`Solver::inverse`] leg by leg
-    /// (bit-identical results), written stage by stage across the legs so that the four
-    /// independent solves interleave instead of running one after the other. `None` when any
-    /// leg is not cleanly solvable (non-finite input, outside the workspace, beyond a joint
-    /// limit): the caller then solves the legs in order to name the first failure.
-    #[inline]
-    pub(crate) fn inverse_all_reject(&self, feet_in_hip: &[Vec3; 4]) -> Option<[JointAngles; 4]> {
-        let g = &self.geometry;
-        let mut ok = true;
-        // One plain array per quantity (not arrays of structs), which the compiler keeps in
-        // registers.
-        let mut w = [0.0f32; 4];
-        let mut w_sq = [0.0f32; 4];
-        let mut v = [0.0f32; 4];
-        let mut dist2 = [0.0f32; 4];
-        let mut abduction = [0.0f32; 4];
-        for (i, p) in feet_in_hip.iter().enumerate() {
-            // Non-short-circuit `&` and float arithmetic: no branch per lane. `q·0` is ±0 for a
-            // finite q and NaN otherwise.
-            let finite = p.x * 0.0 + p.y * 0.0 + p.z * 0.0 == 0.0;
-            let r_sq = p.y * p.y + p.z * p.z;
-            ok &= finite & !M::lt_nonneg(r_sq, self.c.d_lat_sq);
-            (w[i], w_sq[i]) = depth::<M>(self.c.d_lat_sq, r_sq);
-        }
-        for (i, p) in feet_in_hip.iter().enumerate() {
-            let sd = self.side_d_lat(LegId::ALL[i]);
-            let (abd_y, abd_x) = abduction_yx(sd, p.y, p.z, w[i]);
-            abduction[i] = M::atan2(abd_y, abd_x);
-            let v_sq;
-            (v[i], v_sq) = self.c.leg_plane(g.d_ax_m, (w[i], w_sq[i]));
-            dist2[i] = p.x * p.x + v_sq;
-            ok &= !M::lt_nonneg(self.c.far_sq, dist2[i]) & !M::lt_nonneg(dist2[i], self.c.near_sq);
-        }
-        // Stage by stage across the legs (square roots, then angles), so that the independent
-        // dependency chains sit next to each other in the instruction stream; the abductions
-        // above start as soon as their depths are known. (The same `atan2` calls as
-        // `Math::atan2_3` makes: bit for bit the leg-by-leg results.)
-        // The knee's and the hip's `atan2` arguments as `([knee_y, hip_y], [knee_x, hip_x])`:
-        // pairs of the two joints, which the compiler keeps in registers and evaluates
-        // side by side; as one 4-tuple per leg they went through the stack with loads and
-        // stores of different widths (store-forwarding stalls; see
-        // `docs/benchmark-journal.md`).
-        let mut planar = [([0.0f32; 2], [0.0f32; 2]); 4];
-        for (i, p) in feet_in_hip.iter().enumerate() {
-            let (knee_y, knee_x) = self.c.knee_yx::<M>(g, self.knee_bend, dist2[i], false);
-            let (hip_y, hip_x) = hip_yx(p.x, v[i], dist2[i], self.c.diff_sq, knee_y);
-            planar[i] = ([knee_y, hip_y], [knee_x, hip_x]);
-        }
-        let mut out = [JointAngles::default(); 4];
-        for (i, ([knee_y, hip_y], [knee_x, hip_x])) in planar.iter().enumerate() {
-            let knee = M::atan2(*knee_y, *knee_x);
-            let hip = M::atan2(*hip_y, *hip_x);
-            out[i] = JointAngles::new(abduction[i], hip, knee);
-        }
-        // Within the limits (a NaN fails every comparison, so this also rejects non-finite
-        // angles).
-        for a in &out {
-            ok &= self.admits_all(*a);
-        }
-        if ok {
-            Some(out)
-        } else {
-            None
-        }
-    }
 }
 
 /// Under [`ReachPolicy::Clamp`], targets farther than this along any axis (m) are first
@@ -750,7 +693,6 @@ const FAR_M: f32 = 1.0e6;
 /// `v`'s coordinates could overflow. From the bits, which order as the magnitudes do (no
 /// software-float comparison on CPUs without floating-point hardware); a NaN coordinate
 /// (never passed here: the targets are checked finite first) would count as the largest.
-#[inline(always)]
 fn max_abs(v: Vec3) -> f32 {
     const ABS: u32 = 0x7fff_ffff;
     let (x, y, z) = (
@@ -762,9 +704,7 @@ fn max_abs(v: Vec3) -> f32 {
 }
 
 /// `|a − b|` without overflowing the squares of far targets, with the backend's square root
-/// (a firmware then links one square root, its backend's). Out of line: the solve's common
-/// path keeps a smaller stack frame.
-#[inline(never)]
+/// (a firmware then links one square root, its backend's).
 fn distance<M: Math>(a: Vec3, b: Vec3) -> f32 {
     let d = a - b;
     let m = max_abs(d);

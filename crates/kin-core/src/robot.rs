@@ -64,7 +64,6 @@ impl LegId {
 
     /// `v` (given for the front left corner, `x, y ≥ 0`) moved to this leg's corner of the
     /// body: `x` negated for rear legs, `y` for right legs.
-    #[inline(always)]
     pub const fn at_corner(self, v: Vec3) -> Vec3 {
         Vec3::new(
             if self.is_front() { v.x } else { -v.x },
@@ -459,11 +458,9 @@ impl Robot {
 
     /// Nominal stance for stance height `height_m`: each foot straight below its hip, in the
     /// plane of the zero-abduction leg: `hip_in_body + (0, s·d_lat, −H)` (world = body frame).
-    #[inline(never)]
     pub fn stance_feet(&self, height_m: f32) -> [Vec3; 4] {
         // The front left foot moved to each corner: the same sums as hip plus offset, one set
-        // of float operations instead of one per leg. Out of line: callers on a soft-float
-        // target would each hold a copy of them.
+        // of float operations instead of one per leg.
         let front_left = Vec3::new(
             0.5 * self.body_length_m,
             0.5 * self.body_width_m + self.leg.d_lat_m,

@@ -87,7 +87,6 @@ impl fmt::Display for RotationOrder {
 }
 
 /// Elementary rotation about axis `axis` (0 = x, 1 = y, 2 = z) from `(sin, cos)`.
-#[inline(always)]
 fn elementary(axis: u8, s: f32, c: f32) -> Mat3 {
     match axis {
         0 => Mat3 {
@@ -121,7 +120,6 @@ pub fn rot_z(angle_rad: f32) -> Mat3 {
 }
 
 /// `(sin, cos)` of roll, pitch and yaw on backend `M`.
-#[inline(always)]
 fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32); 3] {
     [
         M::sin_cos(roll_rad),
@@ -132,10 +130,8 @@ fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32)
 
 /// Body rotation matrix for `roll`, `pitch`, `yaw` (rad) in `order`, on backend `M`
 /// (`rotation::matrix::<kin_core::DefaultMath>(…)` on a host): three `sin_cos`, then the
-/// closed form of the order — written out entry by entry for the papers' orders ([`zyx`],
-/// [`zxy`]), from the general Tait–Bryan closed form for the other four; on a backend that
-/// shares its float code ([`Math::SHARE_FLOAT_CODE`]), the general closed form with the
-/// order's axes at run time for all six. The same matrix either way, bit for bit.
+/// general Tait–Bryan closed form with the order's axes, which for the
+/// papers' orders is their entry-by-entry form ([`zyx`], [`zxy`]), bit for bit.
 ///
 /// ```
 /// use kin_core::{rotation::{self, RotationOrder}, DefaultMath, Mat3};
@@ -146,17 +142,14 @@ fn sin_cos3<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> [(f32, f32)
 ///     assert!((a - b).abs() < 1e-6);
 /// }
 /// ```
-#[inline]
 pub fn matrix<M: Math>(order: RotationOrder, roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
     let mut m = Mat3::ZERO;
     matrix_into::<M>(order, roll_rad, pitch_rad, yaw_rad, &mut m);
     m
 }
 
-/// [`matrix`] written into `out` (every entry): the general closed form, where a backend
-/// shares its float code, writes its entries by the order's axes straight into place (a
-/// returned matrix went through a zeroed temporary filled by index and a copy).
-#[inline]
+/// [`matrix`] written into `out` (every entry), where the caller keeps it: on CPUs that
+/// return a matrix through memory, no temporary and no copy.
 pub fn matrix_into<M: Math>(
     order: RotationOrder,
     roll_rad: f32,
@@ -164,31 +157,16 @@ pub fn matrix_into<M: Math>(
     yaw_rad: f32,
     out: &mut Mat3,
 ) {
-    // The three `sin_cos` once, ahead of the order's arm: one copy of the kernels, not one per
-    // arm. One arm per order with the axes as constants, so that each compiles to its own
-    // closed form without index arithmetic; where float operations are library calls, one
-    // closed form instead, whose index arithmetic costs less than five more copies of them.
     let sc = sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
-    if M::SHARE_FLOAT_CODE {
-        let [i, j, k] = order.axes();
-        return closed_form(
-            usize::from(i),
-            usize::from(j),
-            usize::from(k),
-            order.is_even(),
-            &sc,
-            &mut out.rows,
-        );
-    }
-    let rows = &mut out.rows;
-    match order {
-        RotationOrder::Zyx => *out = zyx_of(&sc),
-        RotationOrder::Zxy => *out = zxy_of(&sc),
-        RotationOrder::Xyz => closed_form(0, 1, 2, true, &sc, rows),
-        RotationOrder::Xzy => closed_form(0, 2, 1, false, &sc, rows),
-        RotationOrder::Yxz => closed_form(1, 0, 2, false, &sc, rows),
-        RotationOrder::Yzx => closed_form(1, 2, 0, true, &sc, rows),
-    }
+    let [i, j, k] = order.axes();
+    closed_form(
+        usize::from(i),
+        usize::from(j),
+        usize::from(k),
+        order.is_even(),
+        &sc,
+        &mut out.rows,
+    );
 }
 
 /// Seed 000's default order ([`RotationOrder::Zyx`], seed 000 eq. 5.1–5.3 and Algorithm 2 with
@@ -212,15 +190,9 @@ pub fn matrix_into<M: Math>(
 /// // The general closed form of the order gives the same matrix.
 /// assert_eq!(m, rotation::matrix::<DefaultMath>(RotationOrder::Zyx, roll, pitch, yaw));
 /// ```
-#[inline(always)]
 pub fn zyx<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
-    zyx_of(&sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
-}
-
-/// [`zyx`] from the `(sin, cos)` of roll φ, pitch θ and yaw ψ.
-#[inline(always)]
-fn zyx_of(sc: &[(f32, f32); 3]) -> Mat3 {
-    let [(s_phi, c_phi), (s_theta, c_theta), (s_psi, c_psi)] = *sc;
+    let [(s_phi, c_phi), (s_theta, c_theta), (s_psi, c_psi)] =
+        sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
     // The shared products first (the same roundings as the general closed form).
     let (s_psi_s_theta, c_psi_s_theta) = (s_psi * s_theta, c_psi * s_theta);
     Mat3 {
@@ -260,15 +232,9 @@ fn zyx_of(sc: &[(f32, f32); 3]) -> Mat3 {
 /// }
 /// assert_eq!(m, rotation::matrix::<DefaultMath>(RotationOrder::Zxy, roll, pitch, yaw));
 /// ```
-#[inline(always)]
 pub fn zxy<M: Math>(roll_rad: f32, pitch_rad: f32, yaw_rad: f32) -> Mat3 {
-    zxy_of(&sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad))
-}
-
-/// [`zxy`] from the `(sin, cos)` of roll θ, pitch γ and yaw ψ.
-#[inline(always)]
-fn zxy_of(sc: &[(f32, f32); 3]) -> Mat3 {
-    let [(s_theta, c_theta), (s_gamma, c_gamma), (s_psi, c_psi)] = *sc;
+    let [(s_theta, c_theta), (s_gamma, c_gamma), (s_psi, c_psi)] =
+        sin_cos3::<M>(roll_rad, pitch_rad, yaw_rad);
     let (s_psi_s_theta, c_psi_s_theta) = (s_psi * s_theta, c_psi * s_theta);
     Mat3 {
         rows: [
@@ -299,6 +265,7 @@ fn zxy_of(sc: &[(f32, f32); 3]) -> Mat3 {
 /// | row i | cb·cc | −ε·cb·sc | ε·sb |
 /// | row j | ε·ca·sc + sa·sb·cc | ca·cc − ε·sa·sb·sc | −ε·sa·cb |
 /// | row k | sa·sc − ε·ca·sb·cc | ε·sa·cc + ca·sb·sc | ca·cb |
+// Always inlined into its one caller (`BENCHMARKS.md`, the AVR body pose).
 #[inline(always)]
 fn closed_form(
     i: usize,

@@ -137,10 +137,6 @@ impl GaitParams {
 }
 
 /// `sin(x)/x` from `sin_x` = `sin(x)`, exact at 0.
-///
-/// Out of line: [`displace`] uses it twice, and on a soft-float target each copy of its
-/// operations is a run of calls.
-#[inline(never)]
 fn sinc(sin_x: f32, x: f32) -> f32 {
     if libm::fabsf(x) < 1e-3 {
         1.0 - x * x / 6.0

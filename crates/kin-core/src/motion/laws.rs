@@ -172,9 +172,6 @@ pub struct SwayLaw {
 
 impl SwayLaw {
     /// The parameter checks of [`Sway::new`] without its reach checks: finite values, `T > 0`.
-    /// Out of line, on a reference: the law's reads then stay close to one pointer (on the
-    /// AVR, within its 63-byte displacement) wherever it is kept.
-    #[inline(never)]
     pub fn check(&self) -> Result<(), Error> {
         finite(self.amplitude_rad, Param::AmplitudeRad)?;
         positive(self.period_s, Param::PeriodS)?;
@@ -433,9 +430,7 @@ impl YawTurnLaw {
         })
     }
 
-    /// The parameter checks of [`YawTurnLaw::without_reach_check`], out of line on a reference
-    /// as [`SwayLaw::check`].
-    #[inline(never)]
+    /// The parameter checks of [`YawTurnLaw::without_reach_check`].
     fn check(p: &YawTurnLawParams) -> Result<(), Error> {
         finite(p.yaw_rate_rad_s, Param::YawRateRadS)?;
         positive(p.step_period_s, Param::StepPeriodS)?;
@@ -707,8 +702,7 @@ pub struct LegPathsLaw {
 
 impl LegPathsLaw {
     /// The parameter checks of [`LegPaths::new`] without its reach checks: finite values,
-    /// `cycle_s > 0`; out of line on a reference as [`SwayLaw::check`].
-    #[inline(never)]
+    /// `cycle_s > 0`.
     pub fn check(&self) -> Result<(), Error> {
         positive(self.cycle_s, Param::CycleS)?;
         for o in &self.phase_offsets {

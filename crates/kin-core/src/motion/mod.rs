@@ -284,9 +284,7 @@ pub(crate) fn finite_vec(v: Vec3, name: Param) -> Result<Vec3, Error> {
     }
 }
 
-/// Checks that every component of the four feet is finite. Out of line: one copy for the
-/// laws that check their feet.
-#[inline(never)]
+/// Checks that every component of the four feet is finite.
 pub(crate) fn finite_feet(feet: &[Vec3; 4], name: Param) -> Result<(), Error> {
     for f in feet {
         finite_vec(*f, name)?;

@@ -121,9 +121,6 @@ impl Stride {
     }
 
     /// The offset at `phase`: the stance, or the swing shape `swing` at swing progress `s`.
-    /// One copy of the split and the stance for every shape (a path chosen at run time
-    /// matches only its swing).
-    #[inline(always)]
     fn offset(&self, phase: Phase, swing: impl FnOnce(f32) -> Vec3) -> Vec3 {
         match self.split(phase) {
             Part::Stance(u) => self.stance(u),
@@ -133,7 +130,6 @@ impl Stride {
 }
 
 /// Half-ellipse swing at progress `s`: `(−a·cos πs, 0, b·sin πs)` (the semicircle is `a = b`).
-#[inline(always)]
 fn half_ellipse<M: Math>(a: f32, b: f32, s: f32) -> Vec3 {
     let (sn, cs) = M::sin_cos(PI * s);
     Vec3::new(-(a * cs), 0.0, b * sn)

@@ -165,15 +165,12 @@ struct Span {
 }
 
 /// A trot / walk stepper with a changing velocity command: see the module docs.
-///
-/// The fields are laid out in declaration order, those the step reads most first: on the AVR a
-/// field within 63 bytes of the walker's address is one load instruction, one beyond costs a
-/// pointer adjustment at each access.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C)]
 pub struct Walker {
-    phase: f32,
-    velocity: Velocity,
+    /// The gait's parameters.
+    p: WalkerParams,
+    /// The neutral footholds, body frame, m.
+    neutral: [Vec3; 4],
     /// `R / f`: the radius within which the planned footholds lie and the stance feet stay
     /// (module docs), m; computed once, as are the next two.
     stance_radius_m: f32,
@@ -181,11 +178,16 @@ pub struct Walker {
     swing_end: f32,
     /// `d·T/2`: half a stance, s.
     half_stance_s: f32,
-    p: WalkerParams,
-    stopping: bool,
-    saturated: bool,
-    neutral: [Vec3; 4],
+    /// The velocity command.
+    velocity: Velocity,
+    /// Global gait phase `φ`, cycles in `[0, 1)`.
+    phase: f32,
+    /// Each leg's state, in the order of [`LegId::ALL`](crate::LegId::ALL).
     legs: [Leg; 4],
+    /// A stop was asked for ([`Walker::is_stopping`]).
+    stopping: bool,
+    /// The last step moved the body less than commanded ([`Walker::saturated`]).
+    saturated: bool,
 }
 
 impl Walker {
@@ -296,10 +298,6 @@ impl Walker {
 
     /// True when every lift-off and touch-down point planned under the constant command `v`
     /// lies within `sqrt(radius_sq)` of its neutral foothold, horizontally.
-    ///
-    /// Inline in its one caller: out of line, LLVM passes the command through memory and the
-    /// velocity check grows on the AVR.
-    #[inline(always)]
     fn footholds_within<M: Math>(&self, v: &Velocity, radius_sq: f32) -> bool {
         let half = self.half_stance_s;
         for &n in &self.neutral {
@@ -413,9 +411,6 @@ impl Walker {
     /// command and `s > 0`: a stance foot over `s` seconds of the body moving by `scale` times
     /// the command is `rate = −scale`, a touch-down point planned `s = d·T/2` ahead `rate = 1`.
     /// A zero command leaves `p` exactly where it is (a stop parks on the neutral foothold).
-    ///
-    /// Out of line: one copy of the displacement's call for the three uses of a step.
-    #[inline(never)]
     fn carry<M: Math>(&self, p: &mut Vec3, s: f32, rate: f32) {
         if self.velocity != Velocity::default() && s > 0.0 {
             *p = displace::<M>(&self.velocity, rate * s, *p);
@@ -424,7 +419,6 @@ impl Walker {
 
     /// Advances by `dt_s` (> 0, less than the shorter of swing and stance; one servo frame) on
     /// math backend `M`. A non-finite or non-positive `dt_s` is refused and changes nothing.
-    #[inline(never)]
     pub fn step<M: Math>(&mut self, dt_s: f32) -> Result<(), Error> {
         positive(dt_s, Param::DtS)?;
         let old = self.phase;
@@ -463,10 +457,6 @@ impl Walker {
     /// Advances leg `i`'s state `l` over `span`. False when the leg ends the step in stance
     /// with its foot moved farther out, beyond `R/f` (the step must move the body less). A
     /// foot already outside (it cannot be, by the checks) may stay.
-    ///
-    /// Out of line: one copy in the step's retry loop, and a small stack frame on targets
-    /// where large frames are costly (the ATmega2560).
-    #[inline(never)]
     fn advance_leg<M: Math>(&self, i: usize, l: &mut Leg, span: &Span) -> bool {
         if l.parked {
             return true;
@@ -553,19 +543,11 @@ impl Walker {
 }
 
 /// Squared horizontal distance of `p` from `n`, m².
-///
-/// Out of line and by reference: the step and the velocity check use it at three places, each
-/// then a call with two pointers.
-#[inline(never)]
 fn off_sq(p: &Vec3, n: &Vec3) -> f32 {
     let q = *p - *n;
     q.x * q.x + q.y * q.y
 }
 
-/// Phase of a leg with phase offset `offset` at global phase `phase`, cycles in `[0, 1)`.
-///
-/// Out of line: a step wraps two phases per leg, each a few soft-float calls.
-#[inline(never)]
 /// The smaller of a span `a_s` and the step `dt_s` (finite, > 0): `f32::min` for a `dt_s` that
 /// is never NaN, as one comparison, where `min` links a libm routine on the AVR.
 fn shorter(a_s: f32, dt_s: f32) -> f32 {
@@ -576,6 +558,7 @@ fn shorter(a_s: f32, dt_s: f32) -> f32 {
     }
 }
 
+/// Phase of a leg with phase offset `offset` at global phase `phase`, cycles in `[0, 1)`.
 fn leg_phase(offset: f32, phase: f32) -> f32 {
     fract01(phase + offset)
 }
