@@ -81,3 +81,19 @@ pub fn timed_answer(
     }
     None
 }
+
+/// Sends `request` with sequence number `seq` and returns its one answer (within `patience`,
+/// the line then watched for a second one no longer).
+///
+/// # Panics
+/// When no answer or more than one came, or as [`answers`].
+pub fn ask(
+    link: &mut EmulatorLink,
+    seq: u16,
+    request: Request,
+    patience: Duration,
+) -> DeviceToHost {
+    let answers = answers(link, &frame(seq, request), patience, Some(Duration::ZERO));
+    assert_eq!(answers.len(), 1, "{request:?}: {answers:?}");
+    answers[0]
+}

@@ -4,7 +4,7 @@
 //! (160 cycles), well inside the two-byte receive buffer's cover that the emulator link checks
 //! in every test. `--nocapture` prints the figures of BENCHMARKS.md.
 
-use integration_tests::wire::{self, frame};
+use integration_tests::wire;
 use kin_core::motion::gait::{GaitParams, Pattern};
 use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
@@ -39,19 +39,12 @@ impl Run {
 
     fn ask(&mut self, request: Request) -> DeviceToHost {
         self.seq = self.seq.wrapping_add(1);
-        let answers = wire::answers(
-            &mut self.link,
-            &frame(self.seq, request),
-            Duration::from_secs(2),
-            Some(Duration::ZERO),
-        );
-        assert_eq!(answers.len(), 1, "{request:?}: {answers:?}");
+        let answer = wire::ask(&mut self.link, self.seq, request, Duration::from_secs(2));
         assert!(
-            !matches!(answers[0], DeviceToHost::Nack { .. }),
-            "{request:?}: {:?}",
-            answers[0]
+            !matches!(answer, DeviceToHost::Nack { .. }),
+            "{request:?}: {answer:?}"
         );
-        answers[0]
+        answer
     }
 
     /// `request` every `gap` for `span`.

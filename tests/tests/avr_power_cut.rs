@@ -50,14 +50,7 @@ impl Board {
 
     fn ask(&mut self, request: Request) -> DeviceToHost {
         self.seq += 1;
-        let answers = wire::answers(
-            &mut self.link,
-            &frame(self.seq, request),
-            Duration::from_secs(2),
-            Some(Duration::ZERO),
-        );
-        assert_eq!(answers.len(), 1, "{request:?}: {answers:?}");
-        answers[0]
+        wire::ask(&mut self.link, self.seq, request, Duration::from_secs(2))
     }
 
     fn flags(&mut self) -> Flags {

@@ -3,7 +3,7 @@
 //! and the joint-speed limiter (per joint for a direct setpoint, one synchronised ramp for a
 //! motion's start), seen on the pins. Simulated time.
 
-use integration_tests::wire::{self, frame};
+use integration_tests::wire;
 use quad_host::emu::build;
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::{DeviceToHost, LegSet, MotionCommand, NackReason, Request, PROTOCOL_VERSION};
@@ -18,9 +18,7 @@ fn boot() -> EmulatorLink {
 
 /// Sends `request` with sequence number `seq` and returns its one answer.
 fn ask(link: &mut EmulatorLink, seq: u16, request: Request) -> DeviceToHost {
-    let answers = wire::answers(link, &frame(seq, request), PATIENCE, Some(Duration::ZERO));
-    assert_eq!(answers.len(), 1, "{request:?}: {answers:?}");
-    answers[0]
+    wire::ask(link, seq, request, PATIENCE)
 }
 
 fn hello(link: &mut EmulatorLink) -> quad_protocol::DeviceInfo {

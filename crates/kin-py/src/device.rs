@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use quad_host::client::{Client, ClientConfig, DEFAULT_RETRIES};
 use quad_host::link::serial::SerialLink;
-use quad_host::link::sim::{SimConfig, SimLink, EepromImage};
+use quad_host::link::sim::{EepromImage, SimConfig, SimLink};
 use quad_host::link::{self, Link};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
@@ -587,8 +587,11 @@ fn motion_dict<'py>(
     r: &Readback,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("kind", s.kind.map(|k| snake_of(&format!("{k:?}"))))?;
-    d.set_item("stage", snake_of(&format!("{:?}", s.stage)))?;
+    d.set_item(
+        "kind",
+        s.kind.map(|k| crate::errors::snake(&format!("{k:?}"))),
+    )?;
+    d.set_item("stage", crate::errors::snake(&format!("{:?}", s.stage)))?;
     d.set_item("t_s", s.t_s)?;
     d.set_item("phase", s.phase)?;
     d.set_item("fault", s.fault.map(|f| f.to_string()))?;
@@ -605,20 +608,4 @@ fn calibration_dict<'py>(py: Python<'py>, c: &Calibration) -> PyResult<Bound<'py
     d.set_item("min_us", c.min_us)?;
     d.set_item("max_us", c.max_us)?;
     Ok(d)
-}
-
-/// `StandUp` → `stand_up`.
-fn snake_of(debug: &str) -> String {
-    let mut out = String::new();
-    for (i, c) in debug.chars().enumerate() {
-        if c.is_ascii_uppercase() {
-            if i > 0 {
-                out.push('_');
-            }
-            out.push(c.to_ascii_lowercase());
-        } else {
-            out.push(c);
-        }
-    }
-    out
 }

@@ -182,8 +182,8 @@ fn problem_name(p: &ParamProblem) -> &'static str {
     }
 }
 
-/// snake_case of a `Debug` name (`AmplitudeRad` → `amplitude_rad`).
-fn snake(debug: &str) -> String {
+/// snake_case of a `Debug` name (`AmplitudeRad` → `amplitude_rad`, `StandUp` → `stand_up`).
+pub(crate) fn snake(debug: &str) -> String {
     let mut out = String::new();
     for (i, c) in debug.chars().enumerate() {
         if c.is_ascii_uppercase() {
