@@ -543,7 +543,7 @@ function showHealth(s) {
   $('health').innerHTML = `link ${s.link_up ? 'up' : '<span class="unreachable">down</span>'} · acked ${l.acked} · nacked ${l.nacked} · lost ${l.lost} · retries ${l.retries} · timeouts ${l.timeouts} · bad frames ${l.bad_frames}<br>
     round trip ${l.rtt_ms.toFixed(2)} ms (max ${l.rtt_max_ms.toFixed(2)}) · device frames ok ${l.device_frames_ok}, bad ${l.device_frames_bad}`;
   const f = s.flags;
-  $('device').innerHTML = `outputs <b>${f.outputs_enabled ? 'ON' : 'off'}</b> · failsafe ${f.failsafe_active ? 'ACTIVE' : 'idle'} · calibration ${f.calibration_unsaved ? 'unsaved' : f.calibration_default ? 'defaults' : 'saved'} · motion: ${s.motion.kind ?? 'none'}<br>
+  $('device').innerHTML = `outputs <b>${f.outputs_enabled ? 'ON' : 'off'}</b> · failsafe ${f.failsafe_active ? 'ACTIVE' : 'idle'}${f.watchdog_reset ? ' · <span class="unreachable">WATCHDOG RESET</span>' : ''} · calibration ${f.calibration_unsaved ? 'unsaved' : f.calibration_default ? 'defaults' : 'saved'} · motion: ${s.motion.kind ?? 'none'}<br>
     stance ${(s.stance_height_m * 1000).toFixed(0)} mm · poses sent ${s.poses_sent} · pages ${s.pages}`;
 }
 

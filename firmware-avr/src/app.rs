@@ -68,7 +68,7 @@ pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
         panic!()
     };
     // Clears the reset flags (a set WDRF would keep the watchdog from being reconfigured).
-    let _reset_cause = watchdog::take_reset_cause(&dp.CPU);
+    let reset_cause = watchdog::take_reset_cause(&dp.CPU);
     let mut watchdog = Watchdog::enable(dp.WDT, WATCHDOG_TIMEOUT);
     let servos = Servos::new(
         &dp.TC0, dp.TC1, dp.TC3, dp.TC4, dp.TC5, dp.PORTB, dp.PORTE, dp.PORTH, dp.PORTL,
@@ -83,6 +83,11 @@ pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
     let mut device = new_device(servos, clock, eeprom);
     // In place: the controller exists once, in this frame.
     device.boot();
+    // Reported to the host (`Flags::WATCHDOG_RESET`); the outputs are off as after any reset,
+    // and nothing moves until the host enables them.
+    if reset_cause.watchdog() {
+        device.note_watchdog_reset();
+    }
     loop {
         watchdog.feed();
         serve(&mut device, &mut usart, hold_cycles);

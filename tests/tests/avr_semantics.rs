@@ -255,3 +255,197 @@ fn a_direct_setpoint_moves_each_joint_at_the_limit_and_a_motion_starts_with_one_
     );
     wait_idle(&mut link, &mut seq);
 }
+
+/// `GetMotion`'s status and readback.
+fn motion_status(
+    link: &mut EmulatorLink,
+    seq: u16,
+) -> (quad_protocol::MotionStatus, quad_protocol::Readback) {
+    match ask(link, seq, Request::GetMotion) {
+        DeviceToHost::MotionAck {
+            status, readback, ..
+        } => (status, readback),
+        other => panic!("GetMotion: {other:?}"),
+    }
+}
+
+#[test]
+fn an_idle_device_reports_the_idle_stage_to_a_two_two_host_and_run_at_zero_to_a_two_one_host() {
+    let mut link = boot();
+    hello(&mut link);
+    let mut seq = 1;
+    // A motion gone by: a 2.1 device kept reporting its time.
+    for m in [MotionCommand::StandUp, MotionCommand::Sit] {
+        seq += 1;
+        assert!(matches!(
+            ask(&mut link, seq, Request::StartMotion(m)),
+            DeviceToHost::MotionAck { .. }
+        ));
+        wait_idle(&mut link, &mut seq);
+    }
+    let idle = |stage| quad_protocol::MotionStatus {
+        kind: None,
+        stage,
+        t_s: 0.0,
+        phase: 0.0,
+        fault: None,
+    };
+    seq += 1;
+    assert_eq!(
+        motion_status(&mut link, seq).0,
+        idle(quad_protocol::MotionStage::Idle)
+    );
+    for host in [0x0200u16, 0x0201] {
+        seq += 1;
+        assert!(matches!(
+            ask(&mut link, seq, Request::Hello { version: host }),
+            DeviceToHost::HelloAck { .. }
+        ));
+        seq += 1;
+        assert_eq!(
+            motion_status(&mut link, seq).0,
+            idle(quad_protocol::MotionStage::Run),
+            "to a {host:#06x} host"
+        );
+    }
+}
+
+/// The firmware's watchdog timeout, ms (as in `avr_firmware.rs`).
+const WATCHDOG_TIMEOUT_MS: u64 = 256;
+/// MCUSR's watchdog reset flag.
+const MCUSR_WDRF: u8 = 1 << 3;
+
+#[test]
+fn a_watchdog_reset_while_trotting_brings_the_outputs_up_off_reports_it_and_waits_for_a_stand_up() {
+    use quad_protocol::{Flags, MotionStage};
+    let mut link = boot();
+    hello(&mut link);
+    let mut seq = 1;
+    assert!(matches!(
+        ask(&mut link, seq, Request::StartMotion(MotionCommand::StandUp)),
+        DeviceToHost::MotionAck { .. }
+    ));
+    wait_idle(&mut link, &mut seq);
+    let trot = MotionCommand::Walk {
+        gait: kin_core::motion::gait::Pattern::Trot,
+        body_height_m: 0.277,
+        step_height_m: 0.04,
+        cycle_s: 0.6,
+        velocity_timeout_ms: 2_000,
+    };
+    seq += 1;
+    assert!(matches!(
+        ask(&mut link, seq, Request::StartMotion(trot)),
+        DeviceToHost::MotionAck { .. }
+    ));
+    seq += 1;
+    assert!(matches!(
+        ask(
+            &mut link,
+            seq,
+            Request::SetVelocity {
+                forward_m_s: 0.03,
+                lateral_m_s: 0.0,
+                yaw_rate_rad_s: 0.0
+            }
+        ),
+        DeviceToHost::MotionAck { .. }
+    ));
+    link.idle(Duration::from_millis(800)).expect("runs");
+    seq += 1;
+    let (trotting, _) = motion_status(&mut link, seq);
+    assert_eq!(
+        (trotting.kind, trotting.stage),
+        (Some(quad_protocol::MotionKind::Walk), MotionStage::Run),
+        "{trotting:?}"
+    );
+    assert!(link
+        .next_pulses()
+        .expect("runs")
+        .iter()
+        .all(Option::is_some));
+
+    // Hang the CPU mid-trot (the C runtime's final `cli; rjmp .`): the watchdog resets it.
+    let image = quad_host::emu::elf::Elf::read(link.elf()).expect("ELF");
+    let exit = image.symbol("_exit").expect("_exit in the ELF");
+    link.mcu_mut().jump(exit);
+    link.idle(Duration::from_millis(WATCHDOG_TIMEOUT_MS * 3 / 2))
+        .expect("runs");
+    let resets = link.mcu().resets();
+    assert_eq!(resets.count, 1, "the watchdog reset the MCU");
+    assert_eq!(
+        resets.last_mcusr & MCUSR_WDRF,
+        MCUSR_WDRF,
+        "by the watchdog"
+    );
+
+    // The outputs come up off, and stay off through the handshake and the status requests.
+    assert_eq!(link.mcu().servo_levels(), 0);
+    let before = pulse_periods(&mut link, 10);
+    assert!(
+        before.iter().flatten().all(|&p| p == 0),
+        "no pulse after the reset"
+    );
+    hello(&mut link);
+    let mut seq = 1;
+    let (status, readback) = motion_status(&mut link, seq);
+    assert!(
+        readback.flags.contains(Flags::WATCHDOG_RESET),
+        "{readback:?}"
+    );
+    assert!(
+        !readback.flags.contains(Flags::OUTPUTS_ENABLED),
+        "{readback:?}"
+    );
+    assert!(readback.pulses_half_us.iter().all(|&p| p == 0));
+    assert_eq!((status.kind, status.stage), (None, MotionStage::Idle));
+    seq += 1;
+    match ask(&mut link, seq, Request::GetState) {
+        DeviceToHost::Ack { readback, .. } => assert!(
+            !readback.flags.contains(Flags::WATCHDOG_RESET),
+            "cleared once reported: {readback:?}"
+        ),
+        other => panic!("GetState: {other:?}"),
+    }
+    let idle = pulse_periods(&mut link, 25);
+    assert!(idle.iter().flatten().all(|&p| p == 0), "nothing moves");
+
+    // The soft start: StandUp turns the outputs on at the rest pose and ramps to the stance,
+    // every step within the joint-speed limiter.
+    let mut us_per_rad = [0.0f32; 12];
+    for (i, k) in us_per_rad.iter_mut().enumerate() {
+        seq += 1;
+        let servo = quad_protocol::ServoId::from_index(i).expect("a servo");
+        match ask(&mut link, seq, Request::GetCalibration { servo }) {
+            DeviceToHost::Calibration { calibration, .. } => *k = calibration.us_per_rad,
+            other => panic!("GetCalibration: {other:?}"),
+        }
+    }
+    seq += 1;
+    assert!(matches!(
+        ask(&mut link, seq, Request::StartMotion(MotionCommand::StandUp)),
+        DeviceToHost::MotionAck { .. }
+    ));
+    let ramp = pulse_periods(&mut link, 60);
+    let on: Vec<&[u64; 12]> = ramp.iter().filter(|p| p.iter().all(|&w| w > 0)).collect();
+    assert!(on.len() >= 50, "the outputs came on: {} periods", on.len());
+    // 16 cycles a µs; the limiter's step (3 rad/s × 20 ms) per period, plus the emulator's
+    // edge resolution.
+    const CYCLES_PER_US: f32 = 16.0;
+    const SLACK_CYCLES: f32 = 40.0;
+    let step_rad = 3.0 * 0.020;
+    let mut moved = 0.0f32;
+    for pair in on.windows(2) {
+        for c in 0..12 {
+            let d = pair[1][c].abs_diff(pair[0][c]) as f32;
+            let bound = step_rad * us_per_rad[c].abs() * CYCLES_PER_US + SLACK_CYCLES;
+            assert!(
+                d <= bound,
+                "channel {c}: {d} cycles in one period (≤ {bound})"
+            );
+            moved = moved.max(d);
+        }
+    }
+    assert!(moved > SLACK_CYCLES, "the ramp moved the joints");
+    wait_idle(&mut link, &mut seq);
+}

@@ -480,8 +480,8 @@ impl Device {
         self.motion(py, Request::StopMotion)
     }
 
-    /// The motion engine's state: ``kind`` (None when idle), ``stage``, ``t_s``, ``phase``,
-    /// ``fault``, and the readback.
+    /// The motion engine's state: ``kind`` (None when idle), ``stage`` (``"idle"`` when idle),
+    /// ``t_s`` and ``phase`` (0 when idle), ``fault``, and the readback.
     fn motion_status<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         self.motion(py, Request::GetMotion)
     }
@@ -573,6 +573,7 @@ fn readback_dict<'py>(py: Python<'py>, r: &Readback) -> PyResult<Bound<'py, PyDi
         ("failsafe_active", Flags::FAILSAFE_ACTIVE),
         ("calibration_unsaved", Flags::CALIBRATION_UNSAVED),
         ("calibration_default", Flags::CALIBRATION_DEFAULT),
+        ("watchdog_reset", Flags::WATCHDOG_RESET),
     ] {
         d.set_item(name, r.flags.contains(bit))?;
     }

@@ -14,10 +14,10 @@ use kin_core::{BodyConfig, DefaultMath, Math, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
-    check_request_in, encode_frame_in_pieces, is_compatible, Accumulator, DeviceInfo, DeviceToHost,
-    Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout, MotionCommand, NackReason, PoseConfig,
-    Ranges, Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN,
-    PROTOCOL_VERSION,
+    check_request_in, encode_frame_in_pieces, is_compatible, negotiated_minor, Accumulator,
+    DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout,
+    MotionCommand, MotionStatus, NackReason, PoseConfig, Ranges, Readback, Request, ServoId,
+    Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -71,6 +71,12 @@ struct Held {
 ///   pulses or stops the outputs ([`LinkLossAction`]) and sets [`Flags::FAILSAFE_ACTIVE`],
 ///   latched until an answer that carries a readback has reported it. Stopped outputs stay
 ///   stopped until the host enables them again.
+/// - The protocol minor negotiated at `Hello` (the lower of the host's and this device's) is
+///   remembered: a host of minor 0 or 1 is sent nothing of 2.2 — an idle `MotionStatus` is
+///   stage `Run` with `t_s` and `phase` 0 rather than [`quad_protocol::MotionStage::Idle`], and
+///   [`Flags::WATCHDOG_RESET`] is not sent (it stays latched for a later host of minor 2).
+/// - After a watchdog reset ([`Device::note_watchdog_reset`]) the readback carries
+///   [`Flags::WATCHDOG_RESET`], latched until an answer with a readback has reported it.
 /// - A request received twice in a row as the same frame (a retry) is answered twice with the
 ///   same answer and acts once ([`Device::receive`]).
 /// - Unreadable frames are answered with a nack without a sequence number (`BadCrc`,
@@ -105,7 +111,12 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     limited: bool,
     outputs_enabled: bool,
     hello_done: bool,
+    /// The protocol minor negotiated at the last `Hello` (the lower of the host's and this
+    /// device's; 0 before any): nothing newer is sent to the host.
+    peer_minor: u8,
     failsafe: bool,
+    /// The last reset was the watchdog's ([`Flags::WATCHDOG_RESET`]), not yet reported.
+    watchdog_reset: bool,
     failsafe_armed: bool,
     calibration_unsaved: bool,
     calibration_default: bool,
@@ -192,7 +203,9 @@ where
             limited: false,
             outputs_enabled: false,
             hello_done: false,
+            peer_minor: 0,
             failsafe: false,
+            watchdog_reset: false,
             failsafe_armed: true,
             calibration_unsaved: false,
             calibration_default: true,
@@ -229,6 +242,20 @@ where
         }
         // The stance may not map within a stored calibration: then nothing is held.
         let _ = self.set_body_pose(&Pose::default());
+    }
+
+    /// Records that the last reset was the watchdog's: the readback reports
+    /// [`Flags::WATCHDOG_RESET`] to a host of minor 2 or later until an answer carrying the
+    /// flags has reported it. Called by a firmware at boot that reads its reset cause; the
+    /// outputs stay off as after any reset.
+    pub fn note_watchdog_reset(&mut self) {
+        self.watchdog_reset = true;
+    }
+
+    /// The protocol minor negotiated at the last compatible `Hello` (the lower of the host's and
+    /// this device's), 0 before any.
+    pub fn peer_minor(&self) -> u8 {
+        self.peer_minor
     }
 
     /// Loads the calibration from storage (true when a valid one was found).
@@ -518,8 +545,12 @@ where
         self.failsafe_armed = true;
         let answer = self.answer(msg);
         // Latched until an answer reports it (only the readback carries the flags).
-        if answer.readback().is_some() {
+        if let Some(rb) = answer.readback() {
             self.failsafe = false;
+            // Reported only to a host that knows the bit (minor 2 or later).
+            if rb.flags.contains(Flags::WATCHDOG_RESET) {
+                self.watchdog_reset = false;
+            }
         }
         answer
     }
@@ -534,6 +565,7 @@ where
             Request::Hello { version } => {
                 return if is_compatible(version) {
                     self.hello_done = true;
+                    self.peer_minor = negotiated_minor(version, PROTOCOL_VERSION);
                     DeviceToHost::HelloAck {
                         seq,
                         info: self.info(),
@@ -635,7 +667,7 @@ where
         match result {
             Ok(()) => DeviceToHost::MotionAck {
                 seq,
-                status: self.engine.status().into(),
+                status: MotionStatus::from(self.engine.status()).for_minor(self.peer_minor),
                 readback: self.readback(),
             },
             Err(e) => nack(Some(seq), e.into()),
@@ -663,7 +695,11 @@ where
             .with(Flags::OUTPUTS_ENABLED, self.outputs_enabled)
             .with(Flags::FAILSAFE_ACTIVE, self.failsafe)
             .with(Flags::CALIBRATION_UNSAVED, self.calibration_unsaved)
-            .with(Flags::CALIBRATION_DEFAULT, self.calibration_default);
+            .with(Flags::CALIBRATION_DEFAULT, self.calibration_default)
+            .with(
+                Flags::WATCHDOG_RESET,
+                self.watchdog_reset && self.peer_minor >= 2,
+            );
         let (frames_ok, frames_bad) = (self.acc.frames_ok(), self.acc.frames_bad());
         // One arm per case, so that each array is written once, in place (zeroed first and
         // then copied over from the held target, they were written twice).

@@ -49,8 +49,9 @@ pub use msg::{
 };
 pub use range::{check_request, check_request_in, Ranges};
 
-/// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions).
-pub const PROTOCOL_VERSION: u16 = 0x0201;
+/// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions; 2.2: the idle
+/// motion stage and the watchdog-reset flag).
+pub const PROTOCOL_VERSION: u16 = 0x0202;
 
 /// Major part of a protocol version.
 #[inline]

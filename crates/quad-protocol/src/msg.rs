@@ -305,6 +305,10 @@ wire_enum! {
         2 => Stopping,
         /// Ramping to the stance (or the rest pose).
         3 => Leave,
+        /// No motion runs ([`MotionStatus::kind`] is `None`; since 2.2). A device sends it only
+        /// to a host of minor 2 or later; an older host gets [`MotionStage::Run`] with `t_s`
+        /// and `phase` 0 when idle ([`MotionStatus::for_minor`]).
+        4 => Idle,
     }
 }
 
@@ -313,14 +317,33 @@ wire_enum! {
 pub struct MotionStatus {
     /// The motion running; `None` when idle.
     pub kind: Option<MotionKind>,
-    /// Its stage (`Run` when idle).
+    /// Its stage: [`MotionStage::Idle`] when idle (to a host of minor 2 or later; `Run` to an
+    /// older one).
     pub stage: MotionStage,
-    /// Motion time since the run began, s.
+    /// Motion time since the run began, s; 0 when idle.
     pub t_s: f32,
-    /// Phase within the motion's period (the walk's gait phase), in `[0, 1)`.
+    /// Phase within the motion's period (the walk's gait phase), in `[0, 1)`; 0 when idle.
     pub phase: f32,
     /// Why the last motion stopped early (a run-time sample failed), if it did.
     pub fault: Option<NackReason>,
+}
+
+impl MotionStatus {
+    /// This status as a peer of protocol minor `minor` may receive it: unchanged for minor 2
+    /// or later; for minor 0 or 1, which do not know [`MotionStage::Idle`], an idle status is
+    /// reported as stage [`MotionStage::Run`] (what 2.1 devices sent) with `t_s` and `phase` 0.
+    #[must_use]
+    pub const fn for_minor(self, minor: u8) -> MotionStatus {
+        match self.stage {
+            MotionStage::Idle if minor < 2 => MotionStatus {
+                stage: MotionStage::Run,
+                t_s: 0.0,
+                phase: 0.0,
+                ..self
+            },
+            _ => self,
+        }
+    }
 }
 
 wire_enum! {
@@ -590,6 +613,9 @@ impl Flags {
     pub const CALIBRATION_UNSAVED: u8 = 1 << 4;
     /// No valid stored calibration was found at power-on: defaults are in use.
     pub const CALIBRATION_DEFAULT: u8 = 1 << 5;
+    /// The device's last reset was the watchdog's (since 2.2): set from boot, latched until an
+    /// answer carrying the flags has reported it to a host of minor 2 or later.
+    pub const WATCHDOG_RESET: u8 = 1 << 6;
 
     /// No bit set.
     pub const EMPTY: Flags = Flags(0);

@@ -678,6 +678,7 @@ mod tests {
             MotionStage::Run => 1,
             MotionStage::Stopping => 2,
             MotionStage::Leave => 3,
+            MotionStage::Idle => 4,
         }
     }
 
@@ -1177,11 +1178,12 @@ mod tests {
             MotionStage::Run,
             MotionStage::Stopping,
             MotionStage::Leave,
+            MotionStage::Idle,
         ];
         // MotionAck (05) | seq (09) | None (00) | stage ...
         for (i, s) in stages.iter().enumerate() {
             assert_eq!(usize::from(motion_stage_index(s)), i);
-            check(ack(None, *s), 3, i as u8, 4);
+            check(ack(None, *s), 3, i as u8, 5);
         }
         let params = [
             MotionParam::AmplitudeRad,

@@ -130,11 +130,12 @@ fn hand_written_frames() {
 }
 
 #[test]
-fn version_is_two_one() {
-    // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0.
-    assert_eq!(PROTOCOL_VERSION, 0x0201);
+fn version_is_two_two() {
+    // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0; 2.2 appended
+    // the idle motion stage and the watchdog-reset flag.
+    assert_eq!(PROTOCOL_VERSION, 0x0202);
     assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
-    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 1);
+    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 2);
     assert!(quad_protocol::is_compatible(0x0207));
     assert!(!quad_protocol::is_compatible(0x0100));
     assert!(!quad_protocol::is_compatible(0x0300));
@@ -160,4 +161,63 @@ fn frozen_hello_layout() {
         }
         assert_eq!(bytes, expected);
     }
+}
+
+#[test]
+fn the_appendices_of_two_two_have_their_golden_bytes() {
+    use quad_protocol::{Flags, MotionStage, MotionStatus, Readback};
+    // An idle MotionAck to a 2.2 host: variant 5 | seq 9 | kind None = 0 | stage Idle = 4 |
+    // t 0 | phase 0 | fault None = 0 | 12 angles 0 | pulses 0 | flags WATCHDOG_RESET 0x40 |
+    // frames_ok 2 | frames_bad 0.
+    let idle = DeviceToHost::MotionAck {
+        seq: 9,
+        status: MotionStatus {
+            kind: None,
+            stage: MotionStage::Idle,
+            t_s: 0.0,
+            phase: 0.0,
+            fault: None,
+        },
+        readback: Readback {
+            angles_rad: [0.0; 12],
+            pulses_half_us: [0; 12],
+            flags: Flags(Flags::WATCHDOG_RESET),
+            frames_ok: 2,
+            frames_bad: 0,
+        },
+    };
+    check(
+        "MotionAck Idle WATCHDOG_RESET",
+        &idle,
+        "05 09 00 04 00 00 00 00 00 00 00 00 00 \
+         00 00 00 00 00 00 00 00 00 00 00 00 \
+         00 00 00 00 00 00 00 00 00 00 00 00 \
+         00 00 00 00 00 00 00 00 00 00 00 00 \
+         00 00 00 00 00 00 00 00 00 00 00 00 \
+         00 00 00 00 00 00 00 00 00 00 00 00 \
+         40 02 00",
+    );
+    assert_eq!(Flags::WATCHDOG_RESET, 0x40);
+    // What a 2.0 or 2.1 host gets for the same idle status: stage Run = 1, the rest as sent
+    // to a 2.2 host (t_s and phase 0). A running status is the same for every minor.
+    let DeviceToHost::MotionAck { status, .. } = idle else {
+        unreachable!()
+    };
+    for minor in [0, 1] {
+        let old = status.for_minor(minor);
+        assert_eq!(old.stage, MotionStage::Run);
+        assert_eq!((old.kind, old.t_s, old.phase), (None, 0.0, 0.0));
+        assert_eq!(postcard_bytes(&old)[..3], [0x00, 0x01, 0x00]);
+    }
+    assert_eq!(status.for_minor(2), status);
+    let running = MotionStatus {
+        kind: Some(quad_protocol::MotionKind::Walk),
+        stage: MotionStage::Run,
+        t_s: 3.5,
+        phase: 0.25,
+        fault: None,
+    };
+    assert_eq!(running.for_minor(1), running);
+    // kind None = 0 | stage Idle = 4.
+    assert_eq!(postcard_bytes(&status)[..2], [0x00, 0x04]);
 }

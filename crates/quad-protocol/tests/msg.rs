@@ -122,6 +122,8 @@ fn flags_set_and_clear_single_bits() {
         Flags::CALIBRATION_DEFAULT,
     ];
     assert_eq!(all.iter().fold(0, |a, b| a | b), 0x3F);
+    // 2.2 appended bit 6.
+    assert_eq!(Flags::WATCHDOG_RESET, 0x40);
 }
 
 #[test]

@@ -199,7 +199,7 @@ impl<L: Link> Session<L> {
             link_epoch,
             motion: MotionStatus {
                 kind: None,
-                stage: MotionStage::Run,
+                stage: MotionStage::Idle,
                 t_s: 0.0,
                 phase: 0.0,
                 fault: None,

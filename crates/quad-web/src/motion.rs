@@ -142,7 +142,8 @@ pub struct MotionState {
     /// The motion running (`stand_up`, `sit`, `rest`, `sway`, `yaw_turn`, `foot_path`,
     /// `walk`); `None` when idle.
     pub kind: Option<&'static str>,
-    /// Its stage: `approach`, `run`, `stopping`, `leave` (`run` when idle).
+    /// Its stage: `approach`, `run`, `stopping`, `leave`, `idle` (no motion runs; a device of
+    /// protocol 2.1 or older reports `run` then).
     pub stage: &'static str,
     /// Motion time since the run began, s.
     pub t_s: f32,
@@ -156,7 +157,7 @@ impl Default for MotionState {
     fn default() -> MotionState {
         MotionState {
             kind: None,
-            stage: "run",
+            stage: "idle",
             t_s: 0.0,
             phase: 0.0,
             fault: None,
@@ -173,6 +174,7 @@ impl From<&MotionStatus> for MotionState {
                 MotionStage::Run => "run",
                 MotionStage::Stopping => "stopping",
                 MotionStage::Leave => "leave",
+                MotionStage::Idle => "idle",
             },
             t_s: s.t_s,
             phase: s.phase,

@@ -211,6 +211,8 @@ pub struct FlagsMsg {
     pub outputs_enabled: bool,
     /// The link-loss failsafe has acted.
     pub failsafe_active: bool,
+    /// The device's last reset was its watchdog's (reported once, protocol 2.2).
+    pub watchdog_reset: bool,
     /// A calibration in RAM differs from the stored one.
     pub calibration_unsaved: bool,
     /// No stored calibration was found at power-on.
@@ -227,6 +229,7 @@ impl From<quad_protocol::Flags> for FlagsMsg {
         FlagsMsg {
             outputs_enabled: f.contains(F::OUTPUTS_ENABLED),
             failsafe_active: f.contains(F::FAILSAFE_ACTIVE),
+            watchdog_reset: f.contains(F::WATCHDOG_RESET),
             calibration_unsaved: f.contains(F::CALIBRATION_UNSAVED),
             calibration_default: f.contains(F::CALIBRATION_DEFAULT),
             limited: f.contains(F::LIMITED),

@@ -160,12 +160,13 @@ class Readback(TypedDict):
     failsafe_active: bool
     calibration_unsaved: bool
     calibration_default: bool
+    watchdog_reset: bool
     frames_ok: int
     frames_bad: int
 
 class MotionStatus(TypedDict):
     kind: Optional[str]
-    stage: str
+    stage: str  # approach, run, stopping, leave, idle
     t_s: float
     phase: float
     fault: Optional[str]

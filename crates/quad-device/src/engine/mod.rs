@@ -170,11 +170,11 @@ impl From<motion::Error> for Error {
 pub struct Status {
     /// The motion running, if any.
     pub kind: Option<MotionKind>,
-    /// Its stage.
+    /// Its stage; [`MotionStage::Idle`] when none runs.
     pub stage: MotionStage,
-    /// Motion time since the run began, s.
+    /// Motion time since the run began, s (0 when idle).
     pub t_s: f32,
-    /// Phase within the motion's period (the walk's gait phase), in `[0, 1)`.
+    /// Phase within the motion's period (the walk's gait phase), in `[0, 1)` (0 when idle).
     pub phase: f32,
     /// Why the last motion stopped early, if it did.
     pub fault: Option<Error>,
@@ -273,7 +273,7 @@ enum Program {
 pub struct Engine<M> {
     /// The motion running.
     program: Program,
-    /// Where it is.
+    /// Where it is ([`MotionStage::Idle`] exactly when the program is idle).
     stage: MotionStage,
     /// Frames run since [`MotionStage::Run`] began.
     frame: u32,
@@ -305,7 +305,7 @@ impl<M: Math> Engine<M> {
     pub const fn new(limiter: Limiter) -> Self {
         Engine {
             program: Program::Idle,
-            stage: MotionStage::Run,
+            stage: MotionStage::Idle,
             ramp: Ramp::idle(),
             home: [0.0; 12],
             frame: 0,
@@ -443,7 +443,7 @@ impl<M: Math> Engine<M> {
     /// Ends the motion at once (the outputs stopped, or a direct setpoint took over).
     pub fn cancel(&mut self) {
         self.program = Program::Idle;
-        self.stage = MotionStage::Run;
+        self.stage = MotionStage::Idle;
     }
 
     fn leave(&mut self, from: &[f32; 12]) {
@@ -455,7 +455,16 @@ impl<M: Math> Engine<M> {
     pub fn status(&self) -> Status {
         let t_s = self.frame as f32 * FRAME_S;
         let (kind, phase) = match &self.program {
-            Program::Idle => (None, 0.0),
+            // Idle: no stage, time or phase of a motion gone by (only its fault, if any).
+            Program::Idle => {
+                return Status {
+                    kind: None,
+                    stage: MotionStage::Idle,
+                    t_s: 0.0,
+                    phase: 0.0,
+                    fault: self.fault,
+                };
+            }
             Program::Pose { kind } => (Some(*kind), 0.0),
             Program::Law(law) => (Some(law.motion_kind()), motion_phase(t_s, law.period_s)),
             Program::Walk { walker, .. } => (Some(MotionKind::Walk), walker.phase()),
@@ -484,6 +493,7 @@ impl<M: Math> Engine<M> {
             disable_outputs: false,
         };
         match self.stage {
+            MotionStage::Idle => tick,
             MotionStage::Approach | MotionStage::Leave => {
                 if !self.ramp.finished() {
                     tick.target = Some(self.ramp.advance());

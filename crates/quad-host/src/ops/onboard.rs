@@ -551,6 +551,13 @@ pub fn run<L: Link>(
     }
     let start = session.now();
     let first = session.start(request)?;
+    // The motion's time is read while it runs: an idle device reports `t_s` 0 (protocol 2.2,
+    // and a 2.2 device to older hosts), not the time of the motion that ended.
+    let mut motion_s = 0.0f32;
+    let mut each = |a: &MotionAnswer| {
+        motion_s = motion_s.max(a.status.t_s);
+        each(a);
+    };
     each(&first);
     let mut polls = 0u64;
     let mut velocity_commands = 0u64;
@@ -589,7 +596,7 @@ pub fn run<L: Link>(
     Ok(Summary {
         motion: first.status.kind.map_or("none", kind_name),
         stood_up_first,
-        motion_s: last.status.t_s.max(first.status.t_s),
+        motion_s,
         polls,
         velocity_commands,
         elapsed_s: (session.now() - start).as_secs_f64(),
