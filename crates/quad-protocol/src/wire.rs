@@ -305,11 +305,18 @@ macro_rules! wire_index {
                 s.serialize_unit_variant(stringify!($ty), index(value), name)
             }
 
-            /// Deserializes a value from its wire index (serde's `with`).
+            /// Deserializes a value from its wire index (serde's `with`), or from its name in a
+            /// human-readable format (feature `text`).
             ///
             /// # Errors
             /// The deserializer's, or an invalid value for an index no variant has.
             pub fn deserialize<'de, D: ::serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+                // The text form (module docs) reads the name `serialize` writes: kin-core's
+                // own serde form of the type.
+                #[cfg(feature = "text")]
+                if ::serde::Deserializer::is_human_readable(&d) {
+                    return <$ty as ::serde::Deserialize>::deserialize(d);
+                }
                 struct Variants;
                 impl<'de> ::serde::de::Visitor<'de> for Variants {
                     type Value = $ty;
