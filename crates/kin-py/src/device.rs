@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use quad_host::client::{Client, ClientConfig, DEFAULT_RETRIES};
 use quad_host::link::serial::SerialLink;
-use quad_host::link::sim::{SimConfig, SimLink, EepromImage};
+use quad_host::link::sim::{EepromImage, SimConfig, SimLink};
 use quad_host::link::{self, Link};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
