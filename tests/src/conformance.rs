@@ -37,7 +37,7 @@ pub fn file_name(baud: u32) -> String {
 const STANCE_HEIGHT_M: f32 = 0.277;
 
 /// The longest any answer may take before the recorder calls it lost.
-const PATIENCE: Duration = Duration::from_secs(5);
+pub const PATIENCE: Duration = Duration::from_secs(5);
 
 /// Absolute tolerance of the joint angles a device computes (its IK in f32, its own sine and
 /// cosine), rad.
