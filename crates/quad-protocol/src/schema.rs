@@ -3,8 +3,10 @@
 //! `wire_index!` emit each enum's `VARIANTS`), and the unit and admissible range of the fields
 //! that have them (the unit from the field's name, the range from [`crate::range`]).
 //! `docs/protocol-schema.json` is this schema written out (by
-//! `cargo run -p quad-protocol --example schema`), and a test holds it and the message tables
-//! of docs/protocol.md to it.
+//! `cargo run -p quad-protocol --example schema`), with the structs of the messages beside the
+//! enums (their fields and types recorded from their own serde implementations by the
+//! example's recording serializer), and a test holds it and the message tables of
+//! docs/protocol.md to it.
 //!
 //! Why not postcard-schema's derive: it takes a variant's index from its position in the
 //! declaration, while this protocol writes every index beside its variant (`wire_enum!`,
