@@ -54,6 +54,10 @@ enum Check {
     /// unless the line sets an address): the device must open, the address bind and the page
     /// be complete, then it stops; on a board's port, as [`Check::BoardPort`].
     Serve,
+    /// `QUAD_RECORD=1 cargo test --release -p integration-tests --test NAME`: re-records the
+    /// files that test compares (its own run, without the variable, is part of the test
+    /// suite): the test must exist.
+    Recorder,
 }
 
 /// (how the command starts, how it is checked), first match wins.
@@ -73,6 +77,10 @@ const RULES: &[(&str, Check)] = &[
     (
         "cd firmware-avr && cargo build --release",
         Check::FirmwareBuild,
+    ),
+    (
+        "QUAD_RECORD=1 cargo test --release -p integration-tests --test ",
+        Check::Recorder,
     ),
     ("cargo run --release -p quadctl -- sim ", Check::SimArgs),
     ("cargo run --release -p quadctl -- serve ", Check::Serve),
@@ -296,6 +304,16 @@ fn check_command(command: &str, check: Check, dir: &Path) {
                 ),
                 None => assert!(dir.join("benches").is_dir(), "{command}: no benches"),
             }
+        }
+        Check::Recorder => {
+            let name = command.split_whitespace().last().expect("a test name");
+            assert!(
+                repo_root()
+                    .join("tests/tests")
+                    .join(format!("{name}.rs"))
+                    .is_file(),
+                "{command}: no test {name}"
+            );
         }
         Check::FirmwareBuild => {
             let manifest = std::fs::read_to_string(repo_root().join("firmware-avr/Cargo.toml"))

@@ -21,7 +21,7 @@ use std::time::Duration;
 const STANCE_HEIGHT_M: f32 = 0.277;
 
 /// The longest any answer may take before the measurement calls it lost.
-const PATIENCE: Duration = Duration::from_secs(5);
+pub const PATIENCE: Duration = Duration::from_secs(5);
 
 /// One measured exchange.
 #[derive(Debug, Clone)]

@@ -4,6 +4,7 @@
 //! - [`budget`]: the firmware's flash and SRAM against its budget (`cargo xtask ci budget`).
 //! - [`pins`]: a servo pin's step between two pulses against the joint-speed limiter.
 //! - [`symbols`]: which routines a firmware ELF links (`avr-nm`).
+//! - [`conformance`]: the conformance kit, exchanges with the firmware recorded as JSON lines.
 //! - [`wire`]: raw frames to the emulated firmware and the answers that come back.
 //! - [`kernels`], [`kernel_edges`]: the AVR kernels against their twins at their edges.
 //! - [`end_to_end`]: the firmware's IK against the host's and f64.
@@ -14,6 +15,7 @@
 pub mod answer_times;
 pub mod avr_bench;
 pub mod budget;
+pub mod conformance;
 pub mod end_to_end;
 pub mod kernel_edges;
 pub mod kernels;

@@ -33,6 +33,7 @@ pub mod crc;
 pub mod frame;
 pub mod msg;
 pub mod range;
+pub mod schema;
 pub mod servo;
 pub mod timing;
 pub mod wire;

@@ -36,6 +36,38 @@ use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
 use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 
+/// One variant of a protocol enum as its declaration writes it (`wire_enum!`, `wire_index!`):
+/// the data of the machine-readable schema (`quad_protocol::schema`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VariantSchema {
+    /// The wire index (postcard's varint before the fields).
+    pub index: u32,
+    /// The variant's name as declared (CamelCase).
+    pub name: &'static str,
+    /// Its fields.
+    pub fields: FieldsSchema,
+}
+
+/// The fields of a [`VariantSchema`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FieldsSchema {
+    /// No fields.
+    Unit,
+    /// One unnamed field of this type (as written in the declaration).
+    Newtype(&'static str),
+    /// Named fields in wire order.
+    Struct(&'static [FieldSchema]),
+}
+
+/// A named field of a [`FieldsSchema::Struct`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FieldSchema {
+    /// The field's name.
+    pub name: &'static str,
+    /// Its type as written in the declaration.
+    pub ty: &'static str,
+}
+
 /// Serializes the field `$value` (a reference) of type `$ty`, through the table `$with` when one
 /// is named.
 macro_rules! wire_ser_field {
@@ -95,14 +127,14 @@ macro_rules! wire_enum {
         $crate::wire::wire_enum!(@munch
             [$(#[$attr])* $vis $name]
             [serializer variant]
-            [] [] [] []
+            [] [] [] [] []
             $($body)*
         );
     };
 
     // A unit variant.
     (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident
         $(, $($rest:tt)*)?
     ) => {
@@ -114,13 +146,15 @@ macro_rules! wire_enum {
                 Ok(Target::$var)
             }]
             [$($text)* $var,]
+            [$($schema)* $crate::wire::VariantSchema {
+                index: $idx, name: stringify!($var), fields: $crate::wire::FieldsSchema::Unit },]
             $($($rest)*)?
         );
     };
 
     // A one-field tuple variant.
     (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident ( $ty:ty $(as $($with:ident)::+)? )
         $(, $($rest:tt)*)?
     ) => {
@@ -132,13 +166,16 @@ macro_rules! wire_enum {
             [$($de_arms)* $idx => $crate::wire::wire_de_newtype!(
                 $var_access, Target::$var, $ty $(, $($with)::+)?),]
             [$($text)* $var($ty),]
+            [$($schema)* $crate::wire::VariantSchema {
+                index: $idx, name: stringify!($var),
+                fields: $crate::wire::FieldsSchema::Newtype(stringify!($ty)) },]
             $($($rest)*)?
         );
     };
 
     // A struct variant.
     (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident {
             $( $(#[$fattr:meta])* $field:ident : $fty:ty $(as $($with:ident)::+)? ),* $(,)?
         }
@@ -183,17 +220,27 @@ macro_rules! wire_enum {
                 )
             }]
             [$($text)* $var { $($field: $fty,)* },]
+            [$($schema)* $crate::wire::VariantSchema {
+                index: $idx, name: stringify!($var),
+                fields: $crate::wire::FieldsSchema::Struct(&[$($crate::wire::FieldSchema {
+                    name: stringify!($field), ty: stringify!($fty) }),*]) },]
             $($($rest)*)?
         );
     };
 
     // All variants read: the enum and its serde implementations.
     (@munch [$(#[$attr:meta])* $vis:vis $name:ident] [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
     ) => {
         $(#[$attr])*
         $vis enum $name {
             $($decl)*
+        }
+
+        impl $name {
+            /// The variants as declared, in declaration order: their wire indices, names and
+            /// fields (the machine-readable schema, `quad_protocol::schema`).
+            pub const VARIANTS: &'static [$crate::wire::VariantSchema] = &[$($schema)*];
         }
 
         const _: () = {
@@ -279,6 +326,14 @@ macro_rules! wire_index {
         $vis mod $module {
             use super::$ty;
 
+            /// The variants as declared: their wire indices and names (the machine-readable
+            /// schema, `quad_protocol::schema`).
+            pub const VARIANTS: &[$crate::wire::VariantSchema] = &[$($crate::wire::VariantSchema {
+                index: $idx,
+                name: stringify!($var),
+                fields: $crate::wire::FieldsSchema::Unit,
+            }),+];
+
             /// The wire index of `value`.
             pub const fn index(value: &$ty) -> u32 {
                 match value {
@@ -305,11 +360,18 @@ macro_rules! wire_index {
                 s.serialize_unit_variant(stringify!($ty), index(value), name)
             }
 
-            /// Deserializes a value from its wire index (serde's `with`).
+            /// Deserializes a value from its wire index (serde's `with`), or from its name in a
+            /// human-readable format (feature `text`).
             ///
             /// # Errors
             /// The deserializer's, or an invalid value for an index no variant has.
             pub fn deserialize<'de, D: ::serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+                // The text form (module docs) reads the name `serialize` writes: kin-core's
+                // own serde form of the type.
+                #[cfg(feature = "text")]
+                if ::serde::Deserializer::is_human_readable(&d) {
+                    return <$ty as ::serde::Deserialize>::deserialize(d);
+                }
                 struct Variants;
                 impl<'de> ::serde::de::Visitor<'de> for Variants {
                     type Value = $ty;

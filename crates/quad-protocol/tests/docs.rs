@@ -1,5 +1,4 @@
-//! `docs/protocol.md` shows what the code does: its size table and example frames are exactly
-//! the output of `cargo run -p quad-protocol --example wire_examples`.
+//! `docs/protocol.md` shows what the code does: its size table is exactly the output of `cargo run -p quad-protocol --example wire_examples`.
 
 #[path = "../examples/wire_examples.rs"]
 mod wire_examples;

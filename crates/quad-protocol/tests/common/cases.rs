@@ -2,7 +2,7 @@
 //! format: varint u16/u32 (7 bits per byte, least significant group first, high bit = more),
 //! f32 as 4 bytes little-endian, enum variant index as a varint, bool and option tags as one
 //! byte, fixed arrays without a length, struct fields in declaration order.
-//! Shared by the golden test, the docs test and the `wire_examples` example.
+//! Shared by the golden tests.
 
 use kin_core::motion::gait::Pattern;
 use kin_core::motion::laws::Axis;
