@@ -449,3 +449,82 @@ fn a_watchdog_reset_while_trotting_brings_the_outputs_up_off_reports_it_and_wait
     assert!(moved > SLACK_CYCLES, "the ramp moved the joints");
     wait_idle(&mut link, &mut seq);
 }
+
+/// Whether every channel of `pins` (high times, cycles) shows `readback` (half-µs) within one
+/// timer tick and the emulator's edge resolution.
+fn pins_show(pins: &[u64; 12], readback: &[u16; 12]) -> bool {
+    const SLACK_CYCLES: u64 = 40;
+    pins.iter()
+        .zip(readback)
+        .all(|(&p, &r)| p.abs_diff(u64::from(r) * 8) <= SLACK_CYCLES)
+}
+
+#[test]
+fn a_readback_reports_the_target_which_the_pins_show_from_the_next_periods() {
+    let mut link = boot();
+    hello(&mut link);
+    let mut seq = 1;
+    let readback = |answer: DeviceToHost| match answer {
+        DeviceToHost::Ack { readback, .. } | DeviceToHost::MotionAck { readback, .. } => readback,
+        other => panic!("{other:?}"),
+    };
+    seq += 1;
+    ask(&mut link, seq, Request::SetOutputs { enabled: true });
+    seq += 1;
+    ask(&mut link, seq, Request::StartMotion(MotionCommand::StandUp));
+    wait_idle(&mut link, &mut seq);
+    // During a motion: the frame the engine computed at the last frame boundary before the
+    // answer, on the pins from the period after it was computed (the compare registers are
+    // staged and taken over at a period's start) — at 115,200 baud usually while the answer is
+    // still on the wire, so the pins' last complete period or the next one shows it.
+    seq += 1;
+    ask(
+        &mut link,
+        seq,
+        Request::StartMotion(MotionCommand::Sway {
+            axis: kin_core::motion::laws::Axis::Roll,
+            amplitude_rad: 0.1,
+            period_s: 2.0,
+            duration_s: None,
+        }),
+    );
+    link.idle(Duration::from_millis(500)).expect("runs");
+    for poll in 0..20 {
+        seq += 1;
+        let r = readback(ask(&mut link, seq, Request::GetMotion));
+        let last: [u64; 12] =
+            core::array::from_fn(|c| link.last_pulses()[c].map_or(0, |p| p.high_cycles));
+        let mut seen = vec![last];
+        seen.extend(pulse_periods(&mut link, 1));
+        assert!(
+            seen.iter().any(|p| pins_show(p, &r.pulses_half_us)),
+            "poll {poll}: the readback {:?} is on neither the last period nor the next {seen:?}",
+            r.pulses_half_us
+        );
+        link.idle(Duration::from_millis(37)).expect("runs");
+    }
+    seq += 1;
+    ask(&mut link, seq, Request::StopMotion);
+    wait_idle(&mut link, &mut seq);
+    // A direct setpoint: the target at once, while the pins still ramp under the limiter.
+    let leg = [0.3f32, 0.7, -1.4];
+    let target: [f32; 12] = core::array::from_fn(|i| leg[i % 3]);
+    seq += 1;
+    let r = readback(ask(
+        &mut link,
+        seq,
+        Request::SetJoints { angles_rad: target },
+    ));
+    assert_eq!(r.angles_rad, target);
+    let next = pulse_periods(&mut link, 2);
+    assert!(
+        !next.iter().any(|p| pins_show(p, &r.pulses_half_us)),
+        "the pins reached a far target at once"
+    );
+    link.idle(Duration::from_secs(2)).expect("runs");
+    let later = pulse_periods(&mut link, 1);
+    assert!(
+        pins_show(&later[0], &r.pulses_half_us),
+        "the pins reach the target"
+    );
+}
