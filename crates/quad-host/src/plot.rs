@@ -200,6 +200,71 @@ pub fn leg_color(leg: LegId) -> RGBColor {
     }
 }
 
+/// Line width of a leg's curve in the joint-angle figure, px: widest for FL, narrowest for RR,
+/// so that legs with the same curve (a sway's left and right legs) show as nested stripes,
+/// every colour visible, where equal widths would hide all but the last drawn.
+fn leg_width(leg: LegId) -> u32 {
+    match leg {
+        LegId::FL => 8,
+        LegId::FR => 6,
+        LegId::RL => 4,
+        LegId::RR => 2,
+    }
+}
+
+/// A tick label with `decimals` decimals, never `-0.0` (a value that rounds to zero is `0`).
+fn tick_label(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    match s.strip_prefix('-') {
+        Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_owned(),
+        _ => s,
+    }
+}
+
+/// The legs' legend in a strip of its own above the panels (so that it covers no data): a
+/// swatch of each leg's colour (and, with `widths`, its line width) and its name, and the
+/// body in black when `body` is set.
+fn draw_leg_legend<DB: DrawingBackend>(
+    strip: &DrawingArea<DB, Shift>,
+    widths: bool,
+    body: bool,
+) -> Result<(), Error> {
+    let (w, h) = strip.dim_in_pixel();
+    let y = h as i32 / 2;
+    let item = 110;
+    let count = 4 + i32::from(body);
+    let mut x = (w as i32 - count * item) / 2;
+    let font = ("sans-serif", 15).into_font();
+    let mut entry = |name: &str, color: RGBColor, width: u32| -> Result<(), Error> {
+        strip
+            .draw(&PathElement::new(
+                vec![(x, y), (x + 36, y)],
+                color.stroke_width(width),
+            ))
+            .map_err(backend_err)?;
+        strip
+            .draw(&Text::new(
+                name.to_owned(),
+                (x + 44, y - 8),
+                font.clone().color(&BLACK),
+            ))
+            .map_err(backend_err)?;
+        x += item;
+        Ok(())
+    };
+    for leg in LegId::ALL {
+        entry(
+            leg.name(),
+            leg_color(leg),
+            if widths { leg_width(leg) } else { 3 },
+        )?;
+    }
+    if body {
+        entry("body", BLACK, 3)?;
+    }
+    Ok(())
+}
+
 /// Joint angles over time: `t_s[k]` and the twelve angles (rad, order FL, FR, RL, RR ×
 /// abduction, hip, knee) of sample `k`; `None` where the sample was unreachable.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -333,6 +398,8 @@ fn draw_joints<DB: DrawingBackend>(
         let root = root
             .titled(title, ("sans-serif", 22))
             .map_err(backend_err)?;
+        let (strip, root) = root.split_vertically(26);
+        draw_leg_legend(&strip, true, false)?;
         let panels = root.split_evenly((3, 1));
         let (t0, t1) = (series.t_s[0], *series.t_s.last().expect("non-empty"));
         let t1 = if t1 > t0 { t1 } else { t0 + 1.0 };
@@ -356,34 +423,24 @@ fn draw_joints<DB: DrawingBackend>(
                 .configure_mesh()
                 .x_desc("t (s)")
                 .y_desc("deg")
+                .x_label_formatter(&|v| tick_label(*v, 1))
+                .y_label_formatter(&|v| tick_label(*v, 1))
                 .draw()
                 .map_err(backend_err)?;
             for leg in LegId::ALL {
-                let c = leg_color(leg);
+                let style = leg_color(leg).stroke_width(leg_width(leg));
                 let pts = idx.iter().map(|&k| {
                     (
                         series.t_s[k],
                         series.angles[k].map(|a| f64::from(a[3 * leg.index() + j]).to_degrees()),
                     )
                 });
-                let mut first = true;
                 for run in runs(pts) {
-                    let s = chart
-                        .draw_series(LineSeries::new(run, c.stroke_width(2)))
+                    chart
+                        .draw_series(LineSeries::new(run, style))
                         .map_err(backend_err)?;
-                    if std::mem::take(&mut first) {
-                        s.label(leg.name()).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
-                        });
-                    }
                 }
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()
-                .map_err(backend_err)?;
         }
         Ok(())
     }
@@ -467,7 +524,7 @@ pub fn robot_views(
         * 1.1
         + 0.02;
     let ground = zs.0;
-    let size = (1200u32, 400 * snapshots.len() as u32 + 40);
+    let size = (1200u32, 400 * snapshots.len() as u32 + 66);
     let frame = ViewFrame {
         ranges: [xs, ys, zs],
         half,
@@ -506,6 +563,8 @@ fn draw_views<DB: DrawingBackend>(
         let root = root
             .titled(title, ("sans-serif", 22))
             .map_err(backend_err)?;
+        let (strip, root) = root.split_vertically(26);
+        draw_leg_legend(&strip, false, true)?;
         let cells = root.split_evenly((rows, 3));
         for (row, (snap, d)) in snapshots.iter().zip(drawings).enumerate() {
             for (col, (name, a, b)) in views.iter().enumerate() {
@@ -523,6 +582,8 @@ fn draw_views<DB: DrawingBackend>(
                     .configure_mesh()
                     .x_desc("m")
                     .light_line_style(WHITE)
+                    .x_label_formatter(&|v| tick_label(*v, 1))
+                    .y_label_formatter(&|v| tick_label(*v, 1))
                     .draw()
                     .map_err(backend_err)?;
                 if *b == 2 {
@@ -610,6 +671,8 @@ fn draw_accuracy<DB: DrawingBackend>(
                 .configure_mesh()
                 .x_desc("sample")
                 .y_desc("deg")
+                .x_label_formatter(&|v| tick_label(*v, 0))
+                .y_label_formatter(&|v| tick_label(*v, 1))
                 .draw()
                 .map_err(backend_err)?;
             for (name, data, color) in [
@@ -678,6 +741,28 @@ mod tests {
             .into_iter(),
         );
         assert_eq!(r, vec![vec![(0.0, 1.0)], vec![(2.0, 2.0), (3.0, 3.0)]]);
+    }
+
+    #[test]
+    fn tick_labels_never_read_minus_zero() {
+        assert_eq!(tick_label(-0.0, 1), "0.0");
+        assert_eq!(tick_label(-0.04, 1), "0.0");
+        assert_eq!(tick_label(-1e-17, 1), "0.0");
+        assert_eq!(tick_label(-0.05001, 1), "-0.1");
+        assert_eq!(tick_label(-0.4, 0), "0");
+        assert_eq!(tick_label(12.25, 1), "12.2");
+        assert_eq!(tick_label(-3.0, 1), "-3.0");
+    }
+
+    #[test]
+    fn each_leg_has_its_own_width_so_equal_curves_stay_visible() {
+        let mut w: Vec<u32> = LegId::ALL.iter().map(|&l| leg_width(l)).collect();
+        w.dedup();
+        assert_eq!(w.len(), 4);
+        assert!(
+            w.windows(2).all(|p| p[0] > p[1]),
+            "drawn widest first: {w:?}"
+        );
     }
 
     #[test]
