@@ -18,6 +18,7 @@ pub mod bridge;
 pub mod device;
 pub mod errors;
 pub mod motion;
+pub mod protocol;
 pub mod robot;
 
 use pyo3::prelude::*;
@@ -29,6 +30,8 @@ fn _quadkin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<device::Device>()?;
     m.add_function(wrap_pyfunction!(motion::sample_motion, m)?)?;
     m.add_function(wrap_pyfunction!(motion::motion_laws, m)?)?;
+    m.add_function(wrap_pyfunction!(protocol::encode_request, m)?)?;
+    m.add_function(wrap_pyfunction!(protocol::decode_answer, m)?)?;
     m.add("OK", robot::OK)?;
     m.add("TOO_FAR", robot::TOO_FAR)?;
     m.add("TOO_CLOSE", robot::TOO_CLOSE)?;

@@ -34,6 +34,8 @@ from ._quadkin import (  # noqa: F401
     Robot,
     UnreachableError,
     VersionError,
+    decode_answer,
+    encode_request,
     motion_laws,
     sample_motion,
 )

@@ -268,3 +268,12 @@ class Device:
     ) -> MotionStatus: ...
     def idle(self, duration_s: float) -> None: ...
 
+
+
+def encode_request(message_json: str) -> bytes:
+    """The frame (COBS, CRC, both delimiters) of a host-to-device message in its JSON form,
+    e.g. ``'{"seq": 1, "request": "get_state"}'``; ``ValueError`` names what is wrong."""
+
+def decode_answer(frame: bytes) -> str:
+    """The JSON form of the device-to-host message in one whole frame; ``ValueError`` when the
+    bytes are not one readable frame."""
