@@ -31,6 +31,15 @@ pub enum Error {
         /// The TOML error.
         source: toml::de::Error,
     },
+    /// A file without any servo table: nothing would be sent.
+    #[error(
+        "{}: no servo calibration in the file (expected tables such as FL_knee = {{ zero_rad = ... }}; `quadctl calibrate get` prints all twelve)",
+        path.display()
+    )]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
     /// A table name that is not a servo.
     #[error("{}: `{name}` is not a servo (FL_abduction, FL_hip, FL_knee, ..., RR_knee)", path.display())]
     Servo {
@@ -206,7 +215,11 @@ pub fn run(target: &Target, retries: u32, action: &Action) -> Result<[Calibratio
                 path: file.clone(),
                 source,
             })?;
-            Some(parse_toml(&text, file)?)
+            let edits = parse_toml(&text, file)?;
+            if edits.is_empty() {
+                return Err(Error::Empty { path: file.clone() });
+            }
+            Some(edits)
         }
         _ => None,
     };
