@@ -107,6 +107,31 @@ impl Session {
     }
 }
 
+/// True when `angle_rad` is most likely a value in degrees given where radians are asked: its
+/// magnitude is beyond a full turn (2π). No angle of this project means anything beyond one
+/// turn (joints are limited to [-π, π], body rotations and sway amplitudes far less), whereas
+/// the angles people think of in degrees (10°, 30°, 45°, 90°) are all beyond it. Below it the
+/// value is left to the ordinary range checks: 5 could be 5° as well as 5 rad.
+pub fn looks_like_degrees(angle_rad: f32) -> bool {
+    angle_rad.is_finite() && angle_rad.abs() > core::f32::consts::TAU
+}
+
+/// The hint for the first of `angles` (column name, value in rad) that
+/// [`looks_like_degrees`]: "`roll_rad` = 30 rad = 1719°; angles are in radians (30° = 0.5236
+/// rad)".
+pub fn degrees_hint(angles: &[(&str, f32)]) -> Option<String> {
+    angles
+        .iter()
+        .find(|(_, v)| looks_like_degrees(*v))
+        .map(|(name, v)| {
+            format!(
+                "`{name}` = {v} rad = {:.0}°; angles are in radians ({v}° = {:.4} rad)",
+                v.to_degrees(),
+                v.to_radians()
+            )
+        })
+}
+
 /// What to report of an answer: `None` when acked, else one line.
 pub fn report(result: &PoseResult) -> Option<String> {
     match result {
