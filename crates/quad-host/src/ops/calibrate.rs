@@ -215,15 +215,18 @@ pub fn run(target: &Target, retries: u32, action: &Action) -> Result<[Calibratio
                 path: file.clone(),
                 source,
             })?;
-            let edits = parse_toml(&text, file)?;
-            if edits.is_empty() {
-                return Err(Error::Empty { path: file.clone() });
-            }
-            Some(edits)
+            Some(parse_toml(&text, file)?)
         }
         _ => None,
     };
     let link = link::open(target)?;
+    // Refused once the device is known to be there (a missing port is the first thing to
+    // report), before anything is sent.
+    if let (Some(edits), Action::Set { file, .. }) = (&edits, action) {
+        if edits.is_empty() {
+            return Err(Error::Empty { path: file.clone() });
+        }
+    }
     let mut client = Client::new(link, ClientConfig::for_target(target, retries));
     client.hello()?;
     for (id, calibration) in edits.iter().flatten() {
