@@ -590,9 +590,13 @@ pub fn degrees_hint(v: f32) -> Option<ArgError> {
     quad_host::ops::session::looks_like_degrees(v).then_some(ArgError::DegreesNotRadians(v))
 }
 
-/// Value parser: a finite angle in radians within one turn ([`degrees_hint`]).
+/// Value parser: an angle in radians, refused when it looks like degrees ([`degrees_hint`]);
+/// any other number (a NaN, a value far out of range) is left to the range checks of its use.
 pub fn parse_angle_rad(s: &str) -> Result<f32, ArgError> {
-    let v = parse_finite(s)?;
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| ArgError::NotANumber(s.trim().to_owned()))?;
     match degrees_hint(v) {
         Some(e) => Err(e),
         None => Ok(v),
