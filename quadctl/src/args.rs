@@ -583,7 +583,7 @@ pub fn parse_positive_m(s: &str) -> Result<f32, ArgError> {
     }
 }
 
-/// `Some` hint when `v` (an angle, rad) looks like degrees: beyond a full turn
+/// `Some` hint when `v` (an angle, rad) looks like degrees: beyond a full turn, up to 360
 /// ([`quad_host::ops::session::looks_like_degrees`], which says why), so that such a value is
 /// refused as degrees with its conversion before anything reports it as merely out of range.
 pub fn degrees_hint(v: f32) -> Option<ArgError> {
