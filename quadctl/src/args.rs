@@ -33,6 +33,10 @@ pub const EXIT_MALFORMED: u8 = 1;
 pub const EXIT_FATAL: u8 = 2;
 /// Exit status when a readback, a nack or a pulse disagreed with the host (`stream`, `demo`).
 pub const EXIT_CHECK_FAILED: u8 = 3;
+/// Exit status of `stream` and `play` when every check passed but at least one pose or row was
+/// refused by the device (nacked) or lost (no answer after every retry); `--allow-refused`
+/// turns it back into [`EXIT_OK`].
+pub const EXIT_REFUSED: u8 = 4;
 
 /// The one place where an error becomes an exit status: reported on stderr as
 /// `<prefix>: error: <message>`, then [`EXIT_FATAL`].
@@ -103,7 +107,7 @@ pub fn batch_help(examples: &str) -> String {
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 pub struct RobotArgs {
     /// Robot: a preset (shahriar2023, fernando2025) or a TOML robot file.
-    #[arg(long, value_name = "PRESET|FILE.toml")]
+    #[arg(long, value_name = "PRESET|FILE.toml", value_parser = parse_robot)]
     pub robot: String,
 }
 
@@ -229,6 +233,10 @@ pub struct SessionArgs {
     /// host's).
     #[arg(long, value_name = "RAD")]
     pub angle_tolerance_rad: Option<f32>,
+    /// Exit with status 0 even when poses or rows were refused (nacked) or lost, as long as
+    /// every answer passed its check (without it: status 4).
+    #[arg(long)]
+    pub allow_refused: bool,
 }
 
 impl SessionArgs {
@@ -244,6 +252,27 @@ impl SessionArgs {
             rotation_order: self.rotation_order,
             angle_tolerance_rad: self.angle_tolerance_rad,
         }
+    }
+}
+
+/// The exit status of a stream that ran to its end (`stream`, `play`): [`EXIT_CHECK_FAILED`]
+/// when a check failed, else [`EXIT_REFUSED`] when a pose was nacked or lost (unless
+/// `allow_refused`), else [`EXIT_MALFORMED`] when input records were malformed, else
+/// [`EXIT_OK`].
+pub fn stream_status(
+    stream: &quad_host::client::StreamStats,
+    check_failed: bool,
+    malformed: usize,
+    allow_refused: bool,
+) -> u8 {
+    if check_failed {
+        EXIT_CHECK_FAILED
+    } else if !allow_refused && stream.nacked + stream.lost > 0 {
+        EXIT_REFUSED
+    } else if malformed > 0 {
+        EXIT_MALFORMED
+    } else {
+        EXIT_OK
     }
 }
 
@@ -265,7 +294,7 @@ pub struct LawArgs {
     #[arg(long, value_parser = rotation_order())]
     pub rotation_order: Option<RotationOrder>,
     /// Sways: amplitude A, rad [default: 0.2].
-    #[arg(long, value_name = "RAD")]
+    #[arg(long, value_name = "RAD", value_parser = parse_angle_rad)]
     pub amplitude_rad: Option<f32>,
     /// Sways: period T, s [default: 20].
     #[arg(long, value_name = "S")]
@@ -487,6 +516,15 @@ pub enum ArgError {
     UnknownLeg(String),
     /// Not one speed or three.
     SpeedCount(String),
+    /// An angle beyond a full turn: most likely degrees where radians are asked.
+    DegreesNotRadians(f32),
+    /// Neither a preset nor an existing file, but close to a preset's name.
+    MistypedPreset {
+        /// What was given.
+        given: String,
+        /// The preset it is closest to.
+        preset: &'static str,
+    },
 }
 
 impl fmt::Display for ArgError {
@@ -505,6 +543,17 @@ impl fmt::Display for ArgError {
             ArgError::SpeedCount(s) => write!(
                 f,
                 "expected one value or three (abduction,hip,knee), got `{s}`"
+            ),
+            ArgError::DegreesNotRadians(v) => write!(
+                f,
+                "{v} rad = {:.0}°; angles are in radians (did you mean {v}° = {:.4} rad?)",
+                v.to_degrees(),
+                v.to_radians()
+            ),
+            ArgError::MistypedPreset { given, preset } => write!(
+                f,
+                "`{given}` is not a preset ({}) nor an existing file: did you mean `{preset}`?",
+                Robot::PRESETS.join(", ")
             ),
         }
     }
@@ -531,6 +580,75 @@ pub fn parse_positive_m(s: &str) -> Result<f32, ArgError> {
         Ok(v)
     } else {
         Err(ArgError::NotPositive(v))
+    }
+}
+
+/// `Some` hint when `v` (an angle, rad) looks like degrees: beyond a full turn, up to 360
+/// ([`quad_host::ops::session::looks_like_degrees`], which says why), so that such a value is
+/// refused as degrees with its conversion before anything reports it as merely out of range.
+pub fn degrees_hint(v: f32) -> Option<ArgError> {
+    quad_host::ops::session::looks_like_degrees(v).then_some(ArgError::DegreesNotRadians(v))
+}
+
+/// Value parser: an angle in radians, refused when it looks like degrees ([`degrees_hint`]);
+/// any other number (a NaN, a value far out of range) is left to the range checks of its use.
+pub fn parse_angle_rad(s: &str) -> Result<f32, ArgError> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| ArgError::NotANumber(s.trim().to_owned()))?;
+    match degrees_hint(v) {
+        Some(e) => Err(e),
+        None => Ok(v),
+    }
+}
+
+/// The preset `given` is most likely a misspelling of: within a third of the preset's name in
+/// edits (ignoring case), or a prefix of it of at least four characters.
+pub fn close_preset(given: &str) -> Option<&'static str> {
+    let given = given.trim().to_ascii_lowercase();
+    if given.is_empty() {
+        return None;
+    }
+    Robot::PRESETS
+        .iter()
+        .map(|&p| (edit_distance(&given, p), p))
+        .filter(|&(d, p)| {
+            d <= (p.len() / 3).max(1) || (given.len() >= 4 && p.starts_with(given.as_str()))
+        })
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, p)| p)
+}
+
+/// Levenshtein distance of two strings, in characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let substitute = diagonal + usize::from(ca != cb);
+            diagonal = row[j + 1];
+            row[j + 1] = substitute.min(row[j] + 1).min(diagonal + 1);
+        }
+    }
+    row[b.len()]
+}
+
+/// Value parser of `--robot`: kept as given (a preset or a file, resolved later), except a
+/// value that is neither a preset nor an existing file but close to a preset's name, which is
+/// refused with "did you mean".
+pub fn parse_robot(s: &str) -> Result<String, ArgError> {
+    let is_file = Path::new(s).exists();
+    match close_preset(s) {
+        Some(preset) if !is_file && Robot::preset(s.trim()).is_none() => {
+            Err(ArgError::MistypedPreset {
+                given: s.to_owned(),
+                preset,
+            })
+        }
+        _ => Ok(s.to_owned()),
     }
 }
 
@@ -645,7 +763,44 @@ mod tests {
     }
 
     #[test]
+    fn a_refused_or_lost_pose_has_its_own_status() {
+        let stats = |nacked, lost| quad_host::client::StreamStats {
+            nacked,
+            lost,
+            ..Default::default()
+        };
+        assert_eq!(stream_status(&stats(0, 0), false, 0, false), EXIT_OK);
+        assert_eq!(stream_status(&stats(1, 0), false, 0, false), EXIT_REFUSED);
+        assert_eq!(stream_status(&stats(0, 2), false, 0, false), EXIT_REFUSED);
+        assert_eq!(stream_status(&stats(0, 2), false, 0, true), EXIT_OK);
+        assert_eq!(stream_status(&stats(1, 1), false, 3, false), EXIT_REFUSED);
+        assert_eq!(stream_status(&stats(1, 1), false, 3, true), EXIT_MALFORMED);
+        assert_eq!(
+            stream_status(&stats(1, 0), true, 3, false),
+            EXIT_CHECK_FAILED
+        );
+    }
+
+    #[test]
+    fn presets_are_suggested_for_near_misses_only() {
+        assert_eq!(close_preset("shahriar2024"), Some("shahriar2023"));
+        assert_eq!(close_preset("FERNANDO"), Some("fernando2025"));
+        assert_eq!(close_preset("fern"), Some("fernando2025"));
+        assert_eq!(close_preset("robot.toml"), None);
+        assert_eq!(close_preset(""), None);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert!(parse_robot("shahriar2023").is_ok());
+        assert!(parse_robot("examples/robots/missing.toml").is_ok());
+        assert!(parse_robot("shahriar-2023").is_err());
+    }
+
+    #[test]
     fn value_parsers_refuse_what_they_cannot_use() {
+        assert_eq!(parse_angle_rad("6.2"), Ok(6.2));
+        assert_eq!(
+            parse_angle_rad("-90"),
+            Err(ArgError::DegreesNotRadians(-90.0))
+        );
         assert_eq!(parse_positive_m("0.9294"), Ok(0.9294));
         assert_eq!(parse_positive_m("0"), Err(ArgError::NotPositive(0.0)));
         assert_eq!(

@@ -577,3 +577,118 @@ fn ik_pipes_into_fk_and_back_with_the_input_lines() {
     assert_eq!((fk.code, ik.code), (0, 0), "{}{}", fk.stderr, ik.stderr);
     assert_eq!(lines_of(&fk.stdout), lines_of(&ik.stdout));
 }
+
+#[test]
+fn an_angle_in_degrees_is_called_so() {
+    // An option in radians given degrees: refused before anything is sent, with the conversion.
+    let run = quadctl(
+        &[
+            "run",
+            "sway-roll",
+            "--robot",
+            "shahriar2023",
+            "--sim",
+            "--amplitude-rad",
+            "30",
+        ],
+        "",
+    );
+    assert_refused(&run, 2, "30 rad = 1719°; angles are in radians");
+    assert!(run.stderr.contains("--amplitude-rad"), "{}", run.stderr);
+    let run = quadctl(
+        &[
+            "motion",
+            "roll-sway",
+            "--robot",
+            "shahriar2023",
+            "--amplitude-rad",
+            "-45",
+        ],
+        "",
+    );
+    assert_refused(&run, 2, "-45 rad = -2578°; angles are in radians");
+    // A pose angle in degrees: the device's refusal comes with the hint.
+    let run = quadctl(
+        &["stream", "--robot", "shahriar2023", "--sim", "--input", "-"],
+        "roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m\n30,0,0,0,0,0\n",
+    );
+    assert_refused(
+        &run,
+        4,
+        "<stdin>:2: nacked: out of range: roll_rad (the host's kin-core agrees); `roll_rad` = 30 \
+         rad = 1719°; angles are in radians (30° = 0.5236 rad)",
+    );
+    // Within a turn, a value is left to the range checks (0.2 rad is a plausible amplitude).
+    let run = quadctl(
+        &[
+            "motion",
+            "roll-sway",
+            "--robot",
+            "shahriar2023",
+            "--amplitude-rad",
+            "0.2",
+            "--duration-s",
+            "1",
+            "--rate-hz",
+            "10",
+        ],
+        "",
+    );
+    assert_eq!(run.code, 0, "{}", run.stderr);
+}
+
+#[test]
+fn a_misspelt_preset_gets_did_you_mean() {
+    for (given, preset) in [
+        ("shahriar2O23", "shahriar2023"),
+        ("shahriar", "shahriar2023"),
+        ("fernando2052", "fernando2025"),
+        ("Fernando2025", "fernando2025"),
+    ] {
+        for args in [
+            &["fk", "--robot", given][..],
+            &["stream", "--sim", "--robot", given],
+            &["calibrate", "--sim", "--robot", given, "get"],
+            &["serve", "--sim", "--robot", given, "--check"],
+        ] {
+            let run = quadctl(args, "");
+            assert_refused(&run, 2, &format!("did you mean `{preset}`?"));
+            assert!(run.stderr.contains(given), "{}", run.stderr);
+        }
+    }
+    // A name like no preset keeps the file error.
+    let run = quadctl(&["fk", "--robot", "my-robot.toml"], "");
+    assert_refused(&run, 2, "cannot be read as a robot file");
+    assert!(!run.stderr.contains("did you mean"), "{}", run.stderr);
+}
+
+#[test]
+fn a_misspelt_option_gets_the_similar_one() {
+    let run = quadctl(&["stream", "--robt", "shahriar2023", "--sim"], "");
+    assert_refused(&run, 2, "a similar argument exists: '--robot'");
+    let run = quadctl(
+        &[
+            "run",
+            "sway-roll",
+            "--robot",
+            "shahriar2023",
+            "--sim",
+            "--amplitude",
+            "0.1",
+        ],
+        "",
+    );
+    assert_refused(&run, 2, "a similar argument exists: '--amplitude-rad'");
+}
+
+#[test]
+fn an_empty_calibration_file_is_refused_by_name() {
+    let dir = temp_dir("empty-calibration");
+    for (name, text) in [("empty.toml", ""), ("comments.toml", "# nothing here\n\n")] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).expect("file written");
+        let run = quadctl(&["calibrate", "--sim", "set", s(&path)], "");
+        assert_refused(&run, 2, &format!("{}: no servo calibration", s(&path)));
+        assert_eq!(run.stdout, "", "nothing printed as if it were set");
+    }
+}

@@ -20,6 +20,7 @@ fn stream_on_the_emulator_checks_readbacks_and_pins() {
             "--emulator",
             "--robot",
             "shahriar2023",
+            "--allow-refused",
             "--input",
             "-",
         ],

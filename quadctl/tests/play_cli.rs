@@ -95,7 +95,17 @@ fn unreachable_rows_are_nacked_as_the_host_predicts() {
 0.5,0.1,0,0,0,0,0
 1,0,0,0,0,0,1
 ";
-    let run = quadctl(&["play", "-", "--robot", "fernando2025", "--sim"], csv);
+    let run = quadctl(
+        &[
+            "play",
+            "-",
+            "--robot",
+            "fernando2025",
+            "--sim",
+            "--allow-refused",
+        ],
+        csv,
+    );
     assert_eq!(run.code, 0, "{}{}", run.stdout, run.stderr);
     let json = last_line_json(&run);
     assert_eq!(
@@ -253,4 +263,33 @@ fn motion_uses_the_devices_rotation_order_for_a_preset() {
             "{law} {robot}: {first}"
         );
     }
+}
+
+#[test]
+fn a_refused_row_makes_the_exit_status_4_unless_allowed() {
+    let csv = "t_s,roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m
+0,0,0,0,0,0,0
+1,0,0,0,0,0,1
+";
+    let run = quadctl(&["play", "-", "--robot", "fernando2025", "--sim"], csv);
+    assert_eq!(run.code, 4, "{}{}", run.stdout, run.stderr);
+    assert_eq!(last_line_json(&run)["nacked"], 1);
+    assert!(run.stderr.contains("<stdin>:3: nacked"), "{}", run.stderr);
+    let run = quadctl(
+        &[
+            "play",
+            "-",
+            "--robot",
+            "fernando2025",
+            "--sim",
+            "--allow-refused",
+        ],
+        csv,
+    );
+    assert_eq!(run.code, 0, "{}{}", run.stdout, run.stderr);
+    let run = quadctl(
+        &["play", "-", "--robot", "fernando2025", "--sim"],
+        "t_s,roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m\n0,0,0,0,0,0,0\n1,0.1,0,0,0,0,0\n",
+    );
+    assert_eq!(run.code, 0, "every row acked: {}", run.stderr);
 }

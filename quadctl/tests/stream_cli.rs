@@ -28,6 +28,7 @@ fn stream_sim_on_the_example_poses() {
             "0.9294",
             "--rotation-order",
             "zxy",
+            "--allow-refused",
             "--input",
             "examples/poses.csv",
         ],
@@ -71,6 +72,7 @@ fn stream_with_faults_is_reproducible_and_reads_stdin() {
         "drop=0.01,flip=0.001,dup=0.05,trunc=0.05",
         "--seed",
         "42",
+        "--allow-refused",
         "--input",
         "-",
     ];
@@ -221,4 +223,85 @@ fn calibrate_get_set_save_through_a_simulated_eeprom() {
     let run = quadctl(&["calibrate", "--sim", "set", file_s], "");
     assert_eq!(run.code, 2);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The example poses of the README's `pose` command: one of them (line 21) is out of reach of
+/// fernando2025 at this stance height, and the device refuses it.
+const REFUSED_ONE: [&str; 10] = [
+    "stream",
+    "--robot",
+    "fernando2025",
+    "--sim",
+    "--stance-height-m",
+    "0.9294",
+    "--rotation-order",
+    "zxy",
+    "--input",
+    "examples/poses.csv",
+];
+
+#[test]
+fn a_refused_pose_makes_the_exit_status_4_unless_allowed() {
+    let args = &REFUSED_ONE[..];
+    let run = quadctl(args, "");
+    assert_eq!(run.code, 4, "{}", run.stderr);
+    let s = last_line_json(&run);
+    assert_eq!(
+        (s["acked"].as_u64(), s["nacked"].as_u64()),
+        (Some(7), Some(1))
+    );
+    assert!(run.stderr.contains(":21: nacked:"), "{}", run.stderr);
+    let mut allowed = args.to_vec();
+    allowed.push("--allow-refused");
+    let run = quadctl(&allowed, "");
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    // Every pose acked: 0 without the flag.
+    let run = quadctl(
+        &[
+            "stream",
+            "--robot",
+            "shahriar2023",
+            "--sim",
+            "--input",
+            "examples/poses.csv",
+        ],
+        "",
+    );
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert_eq!(last_line_json(&run)["acked"], 8);
+    // Refused and malformed: the refusal's status comes first.
+    let run = quadctl(
+        &["stream", "--robot", "shahriar2023", "--sim", "--input", "-"],
+        "roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m\n0,0,0,0,0,1\n0,0,zero,0,0,0\n",
+    );
+    assert_eq!(run.code, 4, "{}", run.stderr);
+    let run = quadctl(
+        &[
+            "stream",
+            "--robot",
+            "shahriar2023",
+            "--sim",
+            "--allow-refused",
+            "--input",
+            "-",
+        ],
+        "roll_rad,pitch_rad,yaw_rad,x_m,y_m,z_m\n0,0,0,0,0,1\n0,0,zero,0,0,0\n",
+    );
+    assert_eq!(run.code, 1, "{}", run.stderr);
+}
+
+#[test]
+fn the_exit_statuses_are_in_the_help() {
+    for cmd in ["stream", "play"] {
+        let run = quadctl(&[cmd, "--help"], "");
+        assert_eq!(run.code, 0);
+        assert!(
+            run.stdout
+                .contains("4 every check\npassed but at least one")
+                || run.stdout.contains("; 4 every check"),
+            "{cmd}: {}",
+            run.stdout
+        );
+        assert!(run.stdout.contains("--allow-refused"), "{}", run.stdout);
+    }
 }

@@ -76,7 +76,7 @@ pub struct Args {
     #[allow(missing_docs)]
     pub target: TargetArgs,
     /// Robot of the simulated device.
-    #[arg(long, value_name = "PRESET", default_value = "fernando2025")]
+    #[arg(long, value_name = "PRESET", default_value = "fernando2025", value_parser = crate::args::parse_robot)]
     pub robot: String,
     #[command(subcommand)]
     #[allow(missing_docs)]

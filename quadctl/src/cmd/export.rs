@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long, value_parser = format())]
     pub format: Format,
     /// Robot: a preset (shahriar2023, fernando2025), a TOML robot file or a URDF.
-    #[arg(long, value_name = "PRESET|FILE", default_value = "shahriar2023")]
+    #[arg(long, value_name = "PRESET|FILE", default_value = "shahriar2023", value_parser = crate::args::parse_robot)]
     pub robot: String,
     /// Another servo preset on every joint: mg996r, ds3235, qdd17, qdd33.
     #[arg(long, value_name = "NAME")]

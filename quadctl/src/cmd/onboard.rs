@@ -116,7 +116,7 @@ pub struct RunArgs {
     #[allow(missing_docs)]
     pub target: TargetArgs,
     /// Sways: amplitude A, rad.
-    #[arg(long, value_name = "RAD", allow_negative_numbers = true)]
+    #[arg(long, value_name = "RAD", allow_negative_numbers = true, value_parser = crate::args::parse_angle_rad)]
     pub amplitude_rad: Option<f32>,
     /// Sways: period T, s.
     #[arg(long, value_name = "S", allow_negative_numbers = true)]

@@ -2,7 +2,7 @@
 //! output) played to the device in real time, every answer checked; a JSON summary as the last
 //! line of stdout.
 
-use crate::args::{self, SessionArgs, EXIT_CHECK_FAILED, EXIT_OK};
+use crate::args::{self, SessionArgs};
 use quad_host::csv::play::ColumnKind;
 use quad_host::ops::play::{self, Request};
 use std::io;
@@ -36,9 +36,11 @@ Output: the last line of stdout is one JSON object: kind, rows, late_mean_ms, la
 motion_s, then the fields of `quadctl stream`'s summary (sent, acked, nacked, retries, lost,
 readback_mismatches, ...) and with --emulator pulses_checked and pulse_width_errors.
 
-Exit status: 0 every row answered or lost, every check passed; 2 nothing or not everything
-could be played (arguments, robot, file, link, handshake); 3 a readback mismatch, a pulse out
-of its travel or a pulse width error on the pins.";
+Exit status: 0 every row sent was acked, every check passed (skipped rows do not count); 2
+nothing or not everything could be played (arguments, robot, file, link, handshake); 3 a
+readback mismatch, a pulse out of its travel or a pulse width error on the pins; 4 every check
+passed but at least one row was refused by the device (nacked, e.g. unreachable) or lost (no
+answer after every retry). --allow-refused: nacked and lost rows leave the status 0.";
 
 /// `--help`'s examples, run from the repository root (the files of `examples/`).
 pub const EXAMPLES: &str = "\
@@ -85,9 +87,10 @@ pub fn main(args: &Args) -> ExitCode {
     if let Err(status) = args::print_json_line(&summary) {
         return status;
     }
-    ExitCode::from(if summary.check_failed() {
-        EXIT_CHECK_FAILED
-    } else {
-        EXIT_OK
-    })
+    ExitCode::from(args::stream_status(
+        &summary.stream,
+        summary.check_failed(),
+        0,
+        args.session.allow_refused,
+    ))
 }

@@ -61,7 +61,7 @@ pub struct Args {
     #[allow(missing_docs)]
     pub target: TargetArgs,
     /// Robot of the device (a preset; the firmware runs shahriar2023).
-    #[arg(long, value_name = "PRESET", default_value = "shahriar2023")]
+    #[arg(long, value_name = "PRESET", default_value = "shahriar2023", value_parser = crate::args::parse_robot)]
     pub robot: String,
     /// Address to listen on.
     #[arg(long, value_name = "ADDR:PORT", default_value = "127.0.0.1:8080")]

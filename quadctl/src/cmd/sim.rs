@@ -53,7 +53,7 @@ pub struct Args {
     #[arg(value_parser = motion())]
     pub motion: MotionKind,
     /// Robot: a preset (shahriar2023, fernando2025), a TOML robot file or a URDF.
-    #[arg(long, value_name = "PRESET|FILE", default_value = "shahriar2023")]
+    #[arg(long, value_name = "PRESET|FILE", default_value = "shahriar2023", value_parser = crate::args::parse_robot)]
     pub robot: String,
     /// The device controller in-process (the simulated link's device); the default.
     #[arg(long, conflicts_with = "emulator")]

@@ -2,7 +2,7 @@
 //! real (`--port`), every answer checked against the host's own kin-core; a JSON summary as the
 //! last line of stdout.
 
-use crate::args::{self, InputArgs, SessionArgs, EXIT_CHECK_FAILED, EXIT_MALFORMED, EXIT_OK};
+use crate::args::{self, InputArgs, SessionArgs};
 use quad_host::ops::stream::{self, Request};
 use std::io;
 use std::process::ExitCode;
@@ -36,10 +36,13 @@ force when it started (the last one sent before it, or the next), an error when 
 more than one 0.5 us timer tick. poses_per_s counts acked + nacked poses per second of link time
 (simulated time with --sim and --emulator).
 
-Exit status: 0 all poses answered or lost, every check passed; 1 malformed input records (the
-others were streamed); 2 nothing or not everything could be streamed (arguments, robot, input,
+Exit status: 0 every pose acked, every check passed; 1 malformed input records (the others were
+streamed and acked); 2 nothing or not everything could be streamed (arguments, robot, input,
 link, firmware build, handshake); 3 a readback mismatch, a pulse out of its travel, a pulse
-width error on the pins or a receive overrun.";
+width error on the pins or a receive overrun; 4 every check passed but at least one pose was
+refused by the device (nacked, e.g. unreachable) or lost (no answer after every retry). When
+several apply, the first of 3, 4, 1. --allow-refused: nacked and lost poses leave the status
+0 (or 1).";
 
 /// `--help`'s examples, run from the repository root (the files of `examples/`).
 pub const EXAMPLES: &str = "\
@@ -79,11 +82,10 @@ pub fn main(args: &Args) -> ExitCode {
     if let Err(status) = args::print_json_line(&outcome.summary) {
         return status;
     }
-    ExitCode::from(if outcome.summary.check_failed() {
-        EXIT_CHECK_FAILED
-    } else if outcome.malformed > 0 {
-        EXIT_MALFORMED
-    } else {
-        EXIT_OK
-    })
+    ExitCode::from(args::stream_status(
+        &outcome.summary.stream,
+        outcome.summary.check_failed(),
+        outcome.malformed,
+        args.session.allow_refused,
+    ))
 }

@@ -31,6 +31,15 @@ pub enum Error {
         /// The TOML error.
         source: toml::de::Error,
     },
+    /// A file without any servo table: nothing would be sent.
+    #[error(
+        "{}: no servo calibration in the file (expected tables such as FL_knee = {{ zero_rad = ... }}; `quadctl calibrate get` prints all twelve)",
+        path.display()
+    )]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
     /// A table name that is not a servo.
     #[error("{}: `{name}` is not a servo (FL_abduction, FL_hip, FL_knee, ..., RR_knee)", path.display())]
     Servo {
@@ -211,6 +220,13 @@ pub fn run(target: &Target, retries: u32, action: &Action) -> Result<[Calibratio
         _ => None,
     };
     let link = link::open(target)?;
+    // Refused once the device is known to be there (a missing port is the first thing to
+    // report), before anything is sent.
+    if let (Some(edits), Action::Set { file, .. }) = (&edits, action) {
+        if edits.is_empty() {
+            return Err(Error::Empty { path: file.clone() });
+        }
+    }
     let mut client = Client::new(link, ClientConfig::for_target(target, retries));
     client.hello()?;
     for (id, calibration) in edits.iter().flatten() {

@@ -107,6 +107,33 @@ impl Session {
     }
 }
 
+/// True when `angle_rad` is most likely a value in degrees given where radians are asked: its
+/// magnitude is beyond a full turn (2π) and within one in degrees (360). No angle of this
+/// project means anything beyond one turn (joints are limited to [-π, π], body rotations and
+/// sway amplitudes far less), whereas the angles people think of in degrees (10°, 30°, 45°,
+/// 90°) are all beyond it. Below 2π the value is left to the ordinary range checks (5 could be
+/// 5° as well as 5 rad), and so is a value beyond 360, which is no angle in degrees either.
+pub fn looks_like_degrees(angle_rad: f32) -> bool {
+    let magnitude = angle_rad.abs();
+    magnitude > core::f32::consts::TAU && magnitude <= 360.0
+}
+
+/// The hint for the first of `angles` (column name, value in rad) that
+/// [`looks_like_degrees`]: "`roll_rad` = 30 rad = 1719°; angles are in radians (30° = 0.5236
+/// rad)".
+pub fn degrees_hint(angles: &[(&str, f32)]) -> Option<String> {
+    angles
+        .iter()
+        .find(|(_, v)| looks_like_degrees(*v))
+        .map(|(name, v)| {
+            format!(
+                "`{name}` = {v} rad = {:.0}°; angles are in radians ({v}° = {:.4} rad)",
+                v.to_degrees(),
+                v.to_radians()
+            )
+        })
+}
+
 /// What to report of an answer: `None` when acked, else one line.
 pub fn report(result: &PoseResult) -> Option<String> {
     match result {

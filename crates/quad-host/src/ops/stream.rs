@@ -103,7 +103,11 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
                 }
             };
             if let Some(r) = session::report(&result) {
-                writeln!(diag.borrow_mut(), "{name}:{}: {r}", row.line)?;
+                let angles = [("roll_rad", v[0]), ("pitch_rad", v[1]), ("yaw_rad", v[2])];
+                match session::degrees_hint(&angles) {
+                    Some(hint) => writeln!(diag.borrow_mut(), "{name}:{}: {r}; {hint}", row.line)?,
+                    None => writeln!(diag.borrow_mut(), "{name}:{}: {r}", row.line)?,
+                }
             }
             Ok(())
         },
