@@ -1,8 +1,8 @@
 //! What docs/protocol.md ("Device behaviour") says the device does, on the firmware in simavr:
 //! the version a `HelloAck` reports, what may start while the outputs are off, the rest pose,
 //! the joint-speed limiter (per joint for a direct setpoint, one synchronised ramp for a
-//! motion's start), seen on the pins, the idle motion status (2.2 and older hosts) and a
-//! watchdog reset mid-trot. Simulated time.
+//! motion's start), seen on the pins, which frame a readback describes, the idle motion status
+//! (2.2 and older hosts) and a watchdog reset mid-trot. Simulated time.
 
 use integration_tests::wire;
 use quad_host::emu::build;
