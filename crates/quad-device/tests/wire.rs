@@ -439,6 +439,10 @@ fn same_as_reference(chunks: &[Vec<u8>]) {
     let mut twin = device(Config::fernando2025());
     let mut reference = Accumulator::<MAX_DECODED_LEN>::new();
     let mut framing_nacked = false;
+    // The link rules' retry memory: an exact repeat (same seq, same frame CRC) of the last
+    // request answered gets that answer again, as it was, without acting (a `Busy` nack is
+    // not remembered).
+    let mut last: Option<(u16, Option<u16>, DeviceToHost)> = None;
     for chunk in chunks {
         let mut wire = Vec::new();
         dev.receive(chunk, |f| wire.extend_from_slice(f));
@@ -448,6 +452,16 @@ fn same_as_reference(chunks: &[Vec<u8>]) {
         loop {
             let feed = reference.feed::<HostToDevice>(input);
             input = feed.remaining();
+            let key = match &feed {
+                Feed::Frame { msg, .. } => Some((msg.seq, reference.frame_crc())),
+                _ => None,
+            };
+            if let (Some((seq, crc)), Some((last_seq, last_crc, answer))) = (key, &last) {
+                if seq == *last_seq && crc == *last_crc {
+                    expected.push(*answer);
+                    continue;
+                }
+            }
             match expected_answer(&mut twin, &mut framing_nacked, feed) {
                 Some(Some(mut a)) => {
                     if let DeviceToHost::Ack { readback, .. }
@@ -456,6 +470,16 @@ fn same_as_reference(chunks: &[Vec<u8>]) {
                     {
                         readback.frames_ok = reference.frames_ok();
                         readback.frames_bad = reference.frames_bad();
+                    }
+                    if let Some((seq, crc)) = key {
+                        let busy = matches!(
+                            a,
+                            DeviceToHost::Nack {
+                                reason: NackReason::Busy,
+                                ..
+                            }
+                        );
+                        last = crc.filter(|_| !busy).map(|c| (seq, Some(c), a));
                     }
                     expected.push(a);
                 }
@@ -504,4 +528,20 @@ fn answers_fit_the_frame_limit() {
     for a in answers() {
         assert!(device_encode(&a).len() <= MAX_FRAME_LEN);
     }
+}
+
+/// The retry memory in the differential: an exact repeat of the last request, alone or in
+/// the same chunk, gets the same answer with the frame counters as they were (a case the
+/// random payloads found).
+#[test]
+fn an_exact_repeat_gets_the_remembered_answer_in_the_reference_too() {
+    let hello = frame(
+        0,
+        Request::Hello {
+            version: quad_protocol::PROTOCOL_VERSION,
+        },
+    );
+    let state = frame(0, Request::GetState);
+    let twice: Vec<u8> = state.iter().chain(&state).copied().collect();
+    same_as_reference(&[hello, state.clone(), state, twice]);
 }
