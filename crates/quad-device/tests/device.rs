@@ -402,15 +402,7 @@ fn the_latest_valid_setpoint_wins() {
 }
 
 fn failsafe_case(action: LinkLossAction) -> (Dev, VirtualClock) {
-    let clock = VirtualClock::default();
-    clock.set_ms(1_000);
-    let mut dev = Device::new(
-        Config::fernando2025(),
-        Outputs::logging(),
-        clock.clone(),
-        RamEeprom::erased(),
-    )
-    .unwrap();
+    let (mut dev, clock) = clocked_device();
     hello(&mut dev);
     ack(ask(
         &mut dev,

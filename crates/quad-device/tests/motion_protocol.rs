@@ -7,39 +7,15 @@ use common::*;
 use kin_core::motion::gait::Pattern;
 use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
-use quad_device::engine::FRAME_MS;
-use quad_device::{Config, Device};
 use quad_protocol::{
-    DeviceToHost, LegSet, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus,
-    NackReason, ParamProblem, Request,
+    DeviceToHost, LegSet, MotionCommand, MotionKind, MotionParam, MotionStage, NackReason,
+    ParamProblem, Request,
 };
 
 fn rig() -> (Dev, VirtualClock) {
-    let clock = VirtualClock::default();
-    clock.set_ms(1_000);
-    let mut dev = Device::new(
-        Config::fernando2025(),
-        Outputs::logging(),
-        clock.clone(),
-        RamEeprom::erased(),
-    )
-    .unwrap();
+    let (mut dev, clock) = clocked_device();
     hello(&mut dev);
     (dev, clock)
-}
-
-fn frames(dev: &mut Dev, clock: &VirtualClock, n: u32) {
-    for _ in 0..n {
-        clock.advance_ms(FRAME_MS);
-        dev.poll();
-    }
-}
-
-fn status(a: DeviceToHost) -> MotionStatus {
-    match a {
-        DeviceToHost::MotionAck { status, .. } => status,
-        other => panic!("not a motion ack: {other:?}"),
-    }
 }
 
 fn refused(a: DeviceToHost) -> NackReason {

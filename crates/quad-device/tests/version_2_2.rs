@@ -6,7 +6,6 @@ mod common;
 
 use common::*;
 use kin_core::motion::laws::Axis;
-use quad_device::engine::FRAME_MS;
 use quad_device::{Config, Device};
 use quad_protocol::{
     DeviceToHost, Flags, MotionCommand, MotionKind, MotionStage, MotionStatus, Request,
@@ -14,15 +13,7 @@ use quad_protocol::{
 };
 
 fn rig(host_version: u16) -> (Dev, VirtualClock) {
-    let clock = VirtualClock::default();
-    clock.set_ms(1_000);
-    let mut dev = Device::new(
-        Config::fernando2025(),
-        Outputs::logging(),
-        clock.clone(),
-        RamEeprom::erased(),
-    )
-    .unwrap();
+    let (mut dev, clock) = clocked_device();
     assert!(matches!(
         ask(
             &mut dev,
@@ -34,20 +25,6 @@ fn rig(host_version: u16) -> (Dev, VirtualClock) {
         DeviceToHost::HelloAck { info, .. } if info.version == PROTOCOL_VERSION
     ));
     (dev, clock)
-}
-
-fn frames(dev: &mut Dev, clock: &VirtualClock, n: u32) {
-    for _ in 0..n {
-        clock.advance_ms(FRAME_MS);
-        dev.poll();
-    }
-}
-
-fn status(a: DeviceToHost) -> MotionStatus {
-    match a {
-        DeviceToHost::MotionAck { status, .. } => status,
-        other => panic!("not a motion ack: {other:?}"),
-    }
 }
 
 fn flags(a: DeviceToHost) -> Flags {

@@ -22,6 +22,36 @@ pub fn device(config: Config) -> Dev {
     .unwrap()
 }
 
+/// The fernando2025 device on logging outputs, with its virtual clock at 1 s (not yet greeted).
+pub fn clocked_device() -> (Dev, VirtualClock) {
+    let clock = VirtualClock::default();
+    clock.set_ms(1_000);
+    let dev = Device::new(
+        Config::fernando2025(),
+        Outputs::logging(),
+        clock.clone(),
+        RamEeprom::erased(),
+    )
+    .unwrap();
+    (dev, clock)
+}
+
+/// `n` servo frames: the clock a frame on, the device polled, each time.
+pub fn frames(dev: &mut Dev, clock: &VirtualClock, n: u32) {
+    for _ in 0..n {
+        clock.advance_ms(quad_device::engine::FRAME_MS);
+        dev.poll();
+    }
+}
+
+/// The status of a `MotionAck`.
+pub fn status(a: DeviceToHost) -> quad_protocol::MotionStatus {
+    match a {
+        DeviceToHost::MotionAck { status, .. } => status,
+        other => panic!("not a motion ack: {other:?}"),
+    }
+}
+
 pub fn frame(seq: u16, request: Request) -> Vec<u8> {
     let mut buf = [0u8; MAX_FRAME_LEN];
     encode_frame(&HostToDevice { seq, request }, &mut buf)
