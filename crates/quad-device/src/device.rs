@@ -7,6 +7,7 @@ use crate::config::{
 };
 use crate::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS};
 use crate::hal::{Clock, ServoOutputs, Storage};
+use crate::imu::{ImuReading, ImuState};
 use crate::store::{Store, Table};
 use kin_core::body::{self, BodySolution, Pose};
 use kin_core::motion::gait::Velocity;
@@ -134,6 +135,8 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     next_frame: u32,
     /// True until the first frame boundary after enabling.
     enabling_frame: bool,
+    /// The inertial sensor's readings ([`Device::on_imu`]).
+    imu: ImuState,
 }
 
 // The dispatcher and the handlers that solve the body IK are `#[inline(never)]` on purpose:
@@ -216,6 +219,7 @@ where
             out_rad: [0.0; 12],
             next_frame: now,
             enabling_frame: false,
+            imu: ImuState::default(),
         }
     }
 
@@ -354,6 +358,17 @@ where
         if let Some(buf) = self.acc.scratch() {
             encode_answer(answer, buf, tx);
         }
+    }
+
+    /// Takes one reading of the inertial sensor (or the fault that kept the driver from reading
+    /// one), pushed by the target's driver; see [`crate::imu`].
+    pub fn on_imu(&mut self, reading: ImuReading) {
+        self.imu.push(reading);
+    }
+
+    /// What the controller knows of its inertial sensor.
+    pub fn imu(&self) -> &ImuState {
+        &self.imu
     }
 
     /// Runs the link-loss failsafe and, at each servo frame boundary, the motion engine and the

@@ -61,6 +61,7 @@ pub mod config;
 pub mod device;
 pub mod engine;
 pub mod hal;
+pub mod imu;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod store;
@@ -68,3 +69,4 @@ pub mod store;
 pub use config::{default_calibration, Config, ConfigError, ValidConfig};
 pub use device::Device;
 pub use hal::{Clock, ServoOutputs, Storage};
+pub use imu::{ImuFault, ImuReading, ImuSample};
