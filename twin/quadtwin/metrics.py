@@ -1,4 +1,5 @@
-"""Figures of a run: fall, yaw, travel, slip, torque, tracking.
+"""Figures of a run: fall, yaw, travel, slip, torque, tracking, the response to a slope, a
+tilting floor or a push, and the IMU's samples with the true attitude.
 
 Thresholds are named constants here; docs/twin.md says why each has its value."""
 
@@ -21,6 +22,10 @@ TRAVEL_MIN_M = 0.05
 SWAY_MIN_RAD = 0.05
 #: Stance frames skipped after a touchdown before the slip is measured (landing transient).
 SLIP_SKIP_FRAMES = 1
+#: The body's settled roll and pitch: their means over the run's last this many seconds.
+SETTLED_WINDOW_S = 0.5
+#: Settled: roll and pitch stay within this of their settled values, rad (0.5°).
+SETTLE_BAND_RAD = math.radians(0.5)
 
 
 def feet_contact(twin, d):
@@ -47,9 +52,13 @@ def body_on_floor(twin, d):
 class Recorder:
     """Samples of a run: torques every physics step, the body every frame."""
 
-    def __init__(self, twin, start):
+    def __init__(self, twin, start, scenario):
         self.twin = twin
         self.start = start
+        self.scenario = scenario
+        self.height = []
+        self.imu = []
+        self.estimate = []
         self.torque = []
         self.saturated = []
         self.t = []
@@ -84,8 +93,19 @@ class Recorder:
         self.saturated.append(bool(np.any(np.abs(u) >= 1.0)))
 
     def frame(self, d, msg, state):
-        self.t.append(float(d.time) - self.t0)
+        t = float(d.time) - self.t0
+        self.t.append(t)
         self.pos.append(state["pos_m"])
+        # Height of the body centre over the (possibly inclined) floor plane through the origin.
+        self.height.append(float(self.scenario.floor_normal(t) @ np.array(state["pos_m"])))
+        for s in state["imu"]:
+            self.imu.append(
+                [s["t_s"] - self.t0, *s["accel_m_s2"], *s["gyro_rad_s"], *s["rpy_rad"]]
+            )
+        # The device's attitude estimate at the frame's start, when it reports one.
+        est = msg.get("estimated_rpy_rad")
+        if est is not None:
+            self.estimate.append([msg["t_s"], *est])
         self.rpy.append(state["rpy_rad"])
         self.cmd.append(msg["commanded_pose"])
         self.stance.append(msg["stance"])
@@ -143,7 +163,18 @@ class Recorder:
             torque_peak_nm=np.array(self.frame_peak),
             torque_frame_mean_nm=np.array(self.frame_mean),
             stance_height_m=self.start["stance_height_m"],
+            height_over_floor_m=np.array(self.height),
+            # The IMU's samples: time (motion clock), accelerometer, gyroscope, true roll,
+            # pitch, yaw (body frame, SI).
+            imu_t_s=self.imu_array()[:, 0],
+            imu_accel_m_s2=self.imu_array()[:, 1:4],
+            imu_gyro_rad_s=self.imu_array()[:, 4:7],
+            imu_true_rpy_rad=self.imu_array()[:, 7:10],
+            estimate_rpy_rad=np.array(self.estimate).reshape(-1, 4),
         )
+
+    def imu_array(self):
+        return np.array(self.imu, dtype=float).reshape(-1, 10)
 
     def commanded_height_m(self, cmd):
         return self.start["stance_height_m"] + cmd[:, 5] + self.twin.foot_radius_m
@@ -163,6 +194,61 @@ class Recorder:
         out["torque"] = self.torques()
         out["tracking"] = self.tracking(rpy, cmd)
         out["stepping"] = self.stepping(stance)
+        out["scenario"] = self.disturbance(t, rpy)
+        out["attitude"] = self.attitude()
+        return out
+
+    def disturbance(self, t, rpy):
+        """How the body answered the run's slope, tilting floor or push: its largest |roll| and
+        |pitch| from the disturbance's start, their settled values (means over the last
+        SETTLED_WINDOW_S), and the settling time: from the disturbance's end until roll and
+        pitch stay within SETTLE_BAND_RAD of their settled values (none when they never do)."""
+        described = self.scenario.describe()
+        if described is None or len(t) == 0:
+            return None
+        start, end = self.scenario.disturbance_s()
+        after = t >= start
+        last = t >= t[-1] - SETTLED_WINDOW_S
+        settled = rpy[last, 0:2].mean(axis=0)
+        outside = np.any(np.abs(rpy[:, 0:2] - settled) > SETTLE_BAND_RAD, axis=1) & (t >= end)
+        settling = None
+        if not outside[-1]:
+            late = np.nonzero(outside)[0]
+            settling = float(t[late[-1] + 1] - end) if len(late) else 0.0
+        described.update(
+            {
+                "disturbance_start_s": start,
+                "disturbance_end_s": end,
+                "max_abs_roll_rad": float(np.max(np.abs(rpy[after, 0]))),
+                "max_abs_pitch_rad": float(np.max(np.abs(rpy[after, 1]))),
+                "settled_roll_rad": float(settled[0]),
+                "settled_pitch_rad": float(settled[1]),
+                "settling_time_s": settling,
+            }
+        )
+        return described
+
+    def attitude(self):
+        """The IMU's sample count and rate, and, when the device reported an attitude
+        estimate, its error against the true attitude at the same time (RMS and largest, roll
+        and pitch)."""
+        imu = self.imu_array()
+        if len(imu) == 0:
+            return None
+        out = {
+            "imu_samples": len(imu),
+            "imu_rate_hz": float((len(imu) - 1) / (imu[-1, 0] - imu[0, 0])) if len(imu) > 1 else None,
+            "estimate": None,
+        }
+        if self.estimate:
+            est = np.array(self.estimate)
+            true = np.column_stack([np.interp(est[:, 0], imu[:, 0], imu[:, 7 + i]) for i in range(2)])
+            err = est[:, 1:3] - true
+            out["estimate"] = {
+                "roll_rms_error_rad": float(np.sqrt(np.mean(err[:, 0] ** 2))),
+                "pitch_rms_error_rad": float(np.sqrt(np.mean(err[:, 1] ** 2))),
+                "max_error_rad": float(np.max(np.abs(err))),
+            }
         return out
 
     def stepping(self, stance):
@@ -209,14 +295,15 @@ class Recorder:
 
     def fall(self, t, pos, rpy, cmd):
         h_cmd = self.commanded_height_m(cmd)
-        low = pos[:, 2] < FALL_HEIGHT_FRACTION * h_cmd
+        height = np.array(self.height)
+        low = height < FALL_HEIGHT_FRACTION * h_cmd
         tilt = np.max(np.abs(rpy[:, :2]), axis=1)
         tilted = tilt > FALL_TILT_RAD
         touch = np.array(self.body_touch, dtype=bool)
         reason = None
         for i in range(len(t)):
             if low[i]:
-                reason = f"body height {pos[i, 2]:.3f} m < {FALL_HEIGHT_FRACTION} x commanded {h_cmd[i]:.3f} m at t = {t[i]:.2f} s"
+                reason = f"body height {height[i]:.3f} m < {FALL_HEIGHT_FRACTION} x commanded {h_cmd[i]:.3f} m at t = {t[i]:.2f} s"
             elif tilted[i]:
                 reason = f"tilt {tilt[i]:.2f} rad > {FALL_TILT_RAD} rad at t = {t[i]:.2f} s"
             elif touch[i]:
@@ -226,7 +313,7 @@ class Recorder:
         return {
             "fell": reason is not None,
             "fall_reason": reason,
-            "min_height_m": float(np.min(pos[:, 2])),
+            "min_height_m": float(np.min(height)),
             "max_tilt_rad": float(np.max(tilt)),
         }
 

@@ -22,12 +22,15 @@ def plots(rec, summary, out_dir):
     t, pos, rpy, cmd, stance, feet = rec.arrays()
     stepping = summary.get("stepping") is not None
     fig, ax = plt.subplots(2, 3 if stepping else 2, figsize=(16 if stepping else 11, 7))
-    title = f"{summary['robot']} / {summary['motion']} / {summary['servo']}" + (
-        "  — FELL" if summary["fell"] else ""
+    label = rec.scenario.label()
+    title = (
+        f"{summary['robot']} / {summary['motion']} / {summary['servo']}"
+        + (f" / {label}" if label else "")
+        + ("  — FELL" if summary["fell"] else "")
     )
     fig.suptitle(title)
     a = ax[0, 0]
-    a.plot(t, pos[:, 2], label="body height")
+    a.plot(t, np.array(rec.height), label="body height over the floor")
     a.plot(t, rec.commanded_height_m(cmd), "--", label="commanded")
     a.set_xlabel("t (s)")
     a.set_ylabel("m")
@@ -36,6 +39,10 @@ def plots(rec, summary, out_dir):
     for i, name in enumerate(("roll", "pitch")):
         a.plot(t, np.degrees(rpy[:, i]), label=name)
         a.plot(t, np.degrees(cmd[:, i]), "--", label=f"{name} commanded")
+    if summary.get("scenario") is not None:
+        start, end = rec.scenario.disturbance_s()
+        if end > start:
+            a.axvspan(start, end, color="tab:red", alpha=0.15, label="disturbance")
     a.set_xlabel("t (s)")
     a.set_ylabel("deg")
     a.legend(fontsize=8)
@@ -101,7 +108,28 @@ def step_panels(a, b, rec, t, stance):
     b.legend(fontsize=7)
 
 
-def pictures(twin, snapshots, out_dir):
+#: Length of the push's arrow per N·s of impulse, m, and its largest length as a share of the
+#: body's length.
+ARROW_M_PER_N_S, ARROW_MAX_BODY_LENGTHS = 0.05, 1.5
+
+
+def push_arrow(scene, d, body, impulse_n_s, body_length_m):
+    """Adds an arrow to ``scene`` pointing at the body along the push (world +y)."""
+    if scene.ngeom >= scene.maxgeom:
+        return
+    length = min(abs(impulse_n_s) * ARROW_M_PER_N_S, ARROW_MAX_BODY_LENGTHS * body_length_m)
+    length = max(length, 0.3 * body_length_m)
+    sign = 1.0 if impulse_n_s >= 0 else -1.0
+    tip = d.xpos[body].copy()
+    tail = tip - sign * np.array([0.0, length, 0.0])
+    g = scene.geoms[scene.ngeom]
+    mujoco.mjv_initGeom(g, mujoco.mjtGeom.mjGEOM_ARROW, np.zeros(3), np.zeros(3), np.zeros(9),
+                        np.array([0.85, 0.1, 0.1, 1.0], dtype=np.float32))
+    mujoco.mjv_connector(g, mujoco.mjtGeom.mjGEOM_ARROW, 0.08 * body_length_m, tail, tip)
+    scene.ngeom += 1
+
+
+def pictures(twin, snapshots, out_dir, scenario):
     m = twin.model
     d = mujoco.MjData(m)
     renderer = mujoco.Renderer(m, HEIGHT, WIDTH)
@@ -112,13 +140,23 @@ def pictures(twin, snapshots, out_dir):
     cam.azimuth = 140.0
     cam.elevation = -18.0
     images = []
-    for t_s, qpos in snapshots:
+    body_length_m = 2.0 * float(m.geom_size[twin.body_geom][0])
+    label = scenario.label()
+    for t_s, qpos, mocap_quat, push_n_s in snapshots:
         d.qpos[:] = qpos
+        d.mocap_quat[:] = mocap_quat
         mujoco.mj_forward(m, d)
         cam.lookat[:] = [d.qpos[0], d.qpos[1], 0.5 * d.qpos[2]]
         renderer.update_scene(d, cam)
+        if push_n_s:
+            push_arrow(renderer.scene, d, twin.body, push_n_s, body_length_m)
         img = Image.fromarray(renderer.render())
-        ImageDraw.Draw(img).text((8, 8), f"t = {t_s:5.2f} s", fill=(0, 0, 0))
+        draw = ImageDraw.Draw(img)
+        draw.text((8, 8), f"t = {t_s:5.2f} s", fill=(0, 0, 0))
+        if label:
+            draw.text((8, 22), label, fill=(0, 0, 0))
+        if push_n_s:
+            draw.text((8, 36), f"push {push_n_s:.1f} N·s", fill=(160, 0, 0))
         images.append(img)
     renderer.close()
     gif = os.path.join(out_dir, "motion.gif")

@@ -7,8 +7,17 @@
 //!
 //! Names the twin relies on: body `body` (free joint `root`, site `imu`), joints and actuators
 //! `{leg}_{joint}` (`FL_abduction`, `FL_hip`, `FL_knee`, …, canonical order), foot geoms and
-//! sites `{leg}_foot`, numeric custom fields `servo_*` (the servo model) and
+//! sites `{leg}_foot`, the floor `floor` (a plane geom on a mocap body of the same name, so
+//! that the twin can incline it or tilt it during a run), sensors `accel`, `gyro` (the IMU)
+//! and `body_quat` (the true attitude), numeric custom fields `servo_*` (the servo model) and
 //! `foot_radius_m`, text field `servo_name`.
+//!
+//! The IMU: site `imu` where the controller board carries its MPU-6050, on the body's top face
+//! above the body frame's origin ([`imu_site_m`]), its axes the body frame's (x forward, y
+//! left, z up, as kin-core's). MuJoCo's `accelerometer` there reads the specific force (level
+//! and still: `(0, 0, +g)`), its `gyro` the body's angular rate about those axes; both are
+//! what the driver hands the controller (`quad_device::ImuSample`) once the chip's mounting is
+//! applied.
 
 use crate::physical::{Error, Model};
 use core::fmt::Write as _;
@@ -32,6 +41,13 @@ pub(crate) fn num(v: f64) -> String {
     } else {
         format!("{v}")
     }
+}
+
+/// Where the IMU site sits in the body frame, m: the controller board on the body's top face,
+/// above the body frame's origin (the board's MPU-6050; an offset from the centre of rotation
+/// adds the rotation's own accelerations to the accelerometer's reading, as on the robot).
+pub fn imu_site_m(model: &Model) -> [f64; 3] {
+    [0.0, 0.0, 0.5 * f(model.physical().body_height_m)]
 }
 
 fn vec3(v: [f64; 3]) -> String {
@@ -81,12 +97,14 @@ pub fn to_string(model: &Model) -> String {
          \x20 </default>\n\
          \x20 <worldbody>\n\
          \x20   <light name=\"sun\" directional=\"true\" pos=\"0 0 5\" dir=\"-0.3 0.2 -1\" castshadow=\"true\"/>\n\
-         \x20   <geom name=\"floor\" type=\"plane\" size=\"0 0 0.05\" material=\"grid\" contype=\"1\" conaffinity=\"1\" condim=\"3\" friction=\"{mu} 0.005 0.0001\"/>\n\
+         \x20   <body name=\"floor\" mocap=\"true\">\n\
+         \x20     <geom name=\"floor\" type=\"plane\" size=\"0 0 0.05\" material=\"grid\" contype=\"1\" conaffinity=\"1\" condim=\"3\" friction=\"{mu} 0.005 0.0001\"/>\n\
+         \x20   </body>\n\
          \x20   <body name=\"body\" pos=\"0 0 {z0}\">\n\
          \x20     <freejoint name=\"root\"/>\n\
          \x20     <inertial pos=\"{bcom}\" mass=\"{bm}\" diaginertia=\"{bdiag}\"/>\n\
          \x20     <geom name=\"body\" class=\"contact\" type=\"box\" size=\"{bsize}\" rgba=\".25 .35 .55 1\"/>\n\
-         \x20     <site name=\"imu\" pos=\"0 0 0\" size=\"0.01\"/>",
+         \x20     <site name=\"imu\" pos=\"{imu}\" size=\"0.01\"/>",
         name = robot_name(model),
         dt = num(PHYSICS_TIMESTEP_S),
         servo_name = servo.name,
@@ -105,6 +123,7 @@ pub fn to_string(model: &Model) -> String {
         bcom = vec3(body.com_m),
         bm = num(body.mass_kg),
         bdiag = vec3(body.diag_kg_m2),
+        imu = vec3(imu_site_m(model)),
         bsize = vec3([
             0.5 * f(robot.body_length_m),
             0.5 * f(robot.body_width_m),

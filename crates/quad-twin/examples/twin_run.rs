@@ -5,7 +5,8 @@
 //! # options: --servo NAME (another servo preset), --stance-height-m H (another stance),
 //! #          --emulator (the firmware in simavr instead of the in-process device);
 //! #          the trot's shape: --cycle-s T, --duty D, --step-height-fraction F (of H),
-//! #          --speed-heights-per-s V (kin-core's own trot: --duty 0.5 --cycle-s 0.8)
+//! #          --speed-heights-per-s V (kin-core's own trot: --duty 0.5 --cycle-s 0.8);
+//! #          the world: --slope-deg D, --slope-axis roll|pitch, --tilt-floor, --push-n-s I
 //! ```
 //!
 //! `quadctl sim` is the command; this example keeps the parameter studies scriptable.
@@ -13,6 +14,7 @@
 use quad_device::Config;
 use quad_model::Physical;
 use quad_protocol::RobotPreset;
+use quad_twin::scenario::{Scenario, SlopeAxis};
 use quad_twin::{run_plan, MotionKind, Plan, RunOptions, TrotShape};
 use std::process::ExitCode;
 
@@ -65,6 +67,35 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let scenario = (|| -> Result<Scenario, String> {
+        let number = |flag: &str| -> Result<Option<f32>, String> {
+            value(flag)
+                .map(|v| {
+                    v.parse::<f32>()
+                        .map_err(|_| format!("{flag}: `{v}` is not a number"))
+                })
+                .transpose()
+        };
+        let axis = match value("--slope-axis").map(String::as_str) {
+            None | Some("roll") => SlopeAxis::Roll,
+            Some("pitch") => SlopeAxis::Pitch,
+            Some(other) => return Err(format!("--slope-axis: `{other}` is not roll or pitch")),
+        };
+        Scenario::new(
+            axis,
+            number("--slope-deg")?.unwrap_or(0.0),
+            args.iter().any(|a| a == "--tilt-floor"),
+            number("--push-n-s")?,
+        )
+        .map_err(|e| e.to_string())
+    })();
+    let scenario = match scenario {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+    };
     let options = RunOptions {
         out_dir: args.get(2).filter(|a| !a.starts_with("--")).map(Into::into),
         render: args.iter().any(|a| a == "--render"),
@@ -74,6 +105,7 @@ fn main() -> ExitCode {
             quad_twin::Driver::Device
         },
         onboard: args.iter().any(|a| a == "--onboard"),
+        scenario,
         ..RunOptions::default()
     };
     let number = |flag: &str| -> Result<Option<f32>, String> {

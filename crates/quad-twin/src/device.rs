@@ -1,9 +1,11 @@
 //! The device controller (`quad-device`) in this process, as the twin drives it, on the shared
 //! in-memory fakes (`quad_device::sim`): an erased EEPROM, a clock the loop advances by one
-//! servo frame at a time, outputs that keep the last pulses.
+//! servo frame at a time (stopping at each IMU sample's time within the frame to hand the
+//! sample over), outputs that keep the last pulses.
 
+use quad_device::imu::ImuState;
 use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
-use quad_device::{Config, ConfigError, Device};
+use quad_device::{Config, ConfigError, Device, ImuReading};
 use quad_protocol::servo::Error as ServoError;
 use quad_protocol::{DeviceToHost, HostToDevice, NackReason, Request, ServoId, PROTOCOL_VERSION};
 
@@ -100,6 +102,34 @@ impl InProcess {
     pub fn tick(&mut self, frame_ms: u32) {
         self.clock.advance_ms(frame_ms);
         self.device.poll();
+    }
+
+    /// Advances the device clock by one frame of `frame_ms`, handing each of `readings` to the
+    /// device at its time within the frame: the clock advanced to the reading's time, the
+    /// reading pushed ([`Device::on_imu`]), the main loop polled; then the rest of the frame
+    /// and its poll, as [`InProcess::tick`]. Readings are `(ns after the frame's start,
+    /// reading)`, in time order; one at or past the frame's end is pushed at its end, before
+    /// the frame boundary's poll.
+    pub fn tick_with_imu(&mut self, frame_ms: u32, readings: &[(u64, ImuReading)]) {
+        let start_ns = self.clock.now_ns();
+        let frame_ns = u64::from(frame_ms) * 1_000_000;
+        for &(after_ns, reading) in readings {
+            let t_ns = start_ns + after_ns.min(frame_ns);
+            if t_ns > self.clock.now_ns() {
+                self.clock.set_ns(t_ns);
+            }
+            self.device.on_imu(reading);
+            if t_ns < start_ns + frame_ns {
+                self.device.poll();
+            }
+        }
+        self.clock.set_ns(start_ns + frame_ns);
+        self.device.poll();
+    }
+
+    /// What the device knows of its inertial sensor.
+    pub fn imu(&self) -> &ImuState {
+        self.device.imu()
     }
 
     /// The outputs now.

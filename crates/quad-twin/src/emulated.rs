@@ -13,13 +13,24 @@
 //! ([`crate::source::onboard_request`]). Its engine keeps time by the MCU's clock, so the
 //! emulator runs exactly one PWM period of MCU time per frame (a request's exchange included)
 //! and the frame is the last complete pulse of each pin.
+//!
+//! The twin's IMU samples go into a [`TwinImu`] ([`Emulated::imu_feed`]) timed on the MCU's
+//! clock: the twin holds a frame's pulses from the MCU time at which they were measured, so a
+//! sample taken `δ` into that frame is due at that time plus `δ`. The samples of frame `k`
+//! arrive before the MCU runs on for frame `k + 1`, so a sensor that reads the feed as the
+//! MCU runs always finds the samples up to its time. The emulator's MPU-6050 reads them
+//! through a callback source (`move |t_s| feed.read(t_s)`, `t_s` the MCU's cycle count over
+//! [`F_CPU_HZ`]) once the emulator link takes one; until then the feed only fills.
 
 use crate::device::DeviceError;
+use crate::imu::{TwinImu, GRAVITY_M_S2};
 use crate::link::BodyState;
 use crate::motions::Plan;
-use crate::source::{onboard_request, DeviceFrame, FrameSource};
+use crate::scenario::Scenario;
+use crate::source::{imu_readings, onboard_request, DeviceFrame, FrameSource};
 use kin_core::motion::gait::Velocity;
 use quad_device::Config;
+use quad_device::{ImuReading, ImuSample};
 use quad_host::client::{Client, ClientConfig};
 use quad_host::emu::{CYCLES_PER_TICK, F_CPU_HZ, PERIOD_CYCLES};
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
@@ -39,6 +50,11 @@ pub struct Emulated {
     onboard: Option<(MotionCommand, Option<Velocity>)>,
     /// The MCU cycle at which an onboard run's frame 0 began.
     start_cycle: Option<u64>,
+    /// The twin's IMU samples on the MCU's clock.
+    imu: TwinImu,
+    /// The MCU cycle at which the last frame's pulses were measured: when the twin began to
+    /// hold them.
+    frame_cycle: Option<u64>,
 }
 
 impl Emulated {
@@ -57,12 +73,33 @@ impl Emulated {
         elf: Option<&Path>,
         onboard: bool,
     ) -> Result<Emulated, crate::Error> {
+        Emulated::boot_on(plan, config, elf, onboard, &Scenario::default())
+    }
+
+    /// [`Emulated::boot`] for a run on `scenario`'s floor: the IMU feed reads the robot at
+    /// rest on it until the twin's first sample.
+    ///
+    /// # Errors
+    /// As [`Emulated::boot`].
+    pub fn boot_on(
+        plan: Plan,
+        config: &Config,
+        elf: Option<&Path>,
+        onboard: bool,
+        scenario: &Scenario,
+    ) -> Result<Emulated, crate::Error> {
         let onboard = match onboard {
             false => None,
             true => Some(plan.onboard().ok_or(crate::Error::NotOnboard {
                 motion: plan.kind().name(),
             })?),
         };
+        // The feed the emulated sensor reads; the robot at rest on the floor until the twin's
+        // first sample.
+        let imu = TwinImu::new(ImuSample {
+            accel_m_s2: scenario.at_rest_accel_m_s2(GRAVITY_M_S2),
+            gyro_rad_s: [0.0; 3],
+        });
         let emulator = EmulatorConfig::new(FIRMWARE_BAUD);
         let link = match elf {
             Some(path) => EmulatorLink::boot(path, emulator),
@@ -91,7 +128,32 @@ impl Emulated {
             calibration,
             onboard,
             start_cycle: None,
+            imu,
+            frame_cycle: None,
         })
+    }
+
+    /// The twin's IMU samples, timed on the MCU's clock (a clone sharing the queue): what the
+    /// emulated sensor reads ([`TwinImu::read`] with the MCU's time).
+    pub fn imu_feed(&self) -> TwinImu {
+        self.imu.clone()
+    }
+
+    /// Queues the IMU samples of the frame the twin answered with `state`: due at the MCU
+    /// time the frame's pulses were measured plus their time into the frame.
+    fn queue_imu(&mut self, state: &BodyState) -> Result<(), crate::Error> {
+        let Some(cycle) = self.frame_cycle else {
+            return Ok(());
+        };
+        let frame_start_s = cycle as f64 / f64::from(F_CPU_HZ);
+        for (after_ns, reading) in imu_readings(state)? {
+            if let ImuReading::Sample(sample) = reading {
+                self.imu
+                    .push(frame_start_s + after_ns as f64 * 1e-9, sample)
+                    .map_err(|_| crate::Error::Protocol("IMU samples out of time order"))?;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -100,7 +162,10 @@ impl FrameSource for Emulated {
         crate::source::frame_count(&self.plan)
     }
 
-    fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
+    fn next(&mut self, k: u32, feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
+        if let Some(state) = feedback {
+            self.queue_imu(state)?;
+        }
         let t_s = k as f32 * crate::source::FRAME_S;
         let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
         let pulses = match self.onboard {
@@ -159,6 +224,7 @@ impl FrameSource for Emulated {
                         error: DeviceError::Unmappable { servo: s, fault },
                     })?;
         }
+        self.frame_cycle = Some(self.client.link().mcu().cycle());
         Ok(DeviceFrame {
             t_s,
             enabled: true,
@@ -166,6 +232,7 @@ impl FrameSource for Emulated {
             angles_rad,
             commanded_pose: target.pose,
             stance: target.stance,
+            estimated_rpy_rad: None,
         })
     }
 }

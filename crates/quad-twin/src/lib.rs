@@ -15,18 +15,24 @@
 //!   host sending `SetFeet` every frame to the in-process device;
 //!   [`emulated::Emulated`]: the firmware ELF in simavr, its pin pulses measured).
 //! - [`link`]: the JSON-lines protocol and the twin process.
+//! - [`imu`]: the twin's IMU samples on their way to the device ([`imu::TwinImu`], the feed
+//!   of the emulated sensor).
+//! - [`scenario`]: the floor (level, a slope, tilting) and a push on the body.
 //! - [`command`]: `quadctl sim` and `quadctl export` (robot argument to a run or a file).
 
 pub mod command;
 pub mod device;
 pub mod emulated;
+pub mod imu;
 pub mod link;
 pub mod motions;
+pub mod scenario;
 pub mod source;
 
 use core::fmt;
 use quad_device::Config;
 use quad_model::{Model, Physical};
+use scenario::Scenario;
 use serde::Deserialize;
 use source::FrameSource;
 use std::path::{Path, PathBuf};
@@ -213,6 +219,56 @@ pub struct SteppingMetric {
     pub legs: [LegStepping; 4],
 }
 
+/// How the body answered the run's slope, tilting floor or push ([`scenario`]).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct ScenarioMetric {
+    /// The slope's axis (`roll`, `pitch`).
+    pub axis: scenario::SlopeAxis,
+    /// The floor's slope from the start, rad.
+    pub slope_rad: f64,
+    /// The floor's tilt during the run, rad.
+    pub tilt_by_rad: Option<f64>,
+    /// The push's impulse, N·s.
+    pub push_n_s: Option<f64>,
+    /// Start of the tilt or the push, motion clock, s (0 on a fixed slope).
+    pub disturbance_start_s: f64,
+    /// End of the tilt or the push, s (0 on a fixed slope).
+    pub disturbance_end_s: f64,
+    /// Largest body |roll| from the disturbance's start, rad.
+    pub max_abs_roll_rad: f64,
+    /// Largest body |pitch| from the disturbance's start, rad.
+    pub max_abs_pitch_rad: f64,
+    /// Body roll settled at the run's end (mean of its last 0.5 s), rad.
+    pub settled_roll_rad: f64,
+    /// Body pitch settled at the run's end, rad.
+    pub settled_pitch_rad: f64,
+    /// From the disturbance's end until roll and pitch stay within 0.5° of their settled
+    /// values, s (none: they never do).
+    pub settling_time_s: Option<f64>,
+}
+
+/// The device's attitude estimate against the body's true attitude.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct EstimateMetric {
+    /// RMS error of the roll, rad.
+    pub roll_rms_error_rad: f64,
+    /// RMS error of the pitch, rad.
+    pub pitch_rms_error_rad: f64,
+    /// Largest roll or pitch error, rad.
+    pub max_error_rad: f64,
+}
+
+/// The IMU's samples of a run (`trace.npz` keeps them with the true attitude).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct AttitudeMetric {
+    /// Samples taken.
+    pub imu_samples: u64,
+    /// Their rate, Hz.
+    pub imu_rate_hz: Option<f64>,
+    /// The device's estimate against the true attitude, when the device reports one.
+    pub estimate: Option<EstimateMetric>,
+}
+
 /// The metrics of one run (the twin's `summary.json`).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct Summary {
@@ -232,7 +288,8 @@ pub struct Summary {
     pub fell: bool,
     /// Which threshold the fall crossed, and when.
     pub fall_reason: Option<String>,
-    /// Lowest body-centre height over the floor during the motion, m.
+    /// Lowest body-centre height over the floor (along its normal, on a slope) during the
+    /// motion, m.
     pub min_height_m: f64,
     /// Largest |roll| or |pitch| during the motion, rad.
     pub max_tilt_rad: f64,
@@ -249,6 +306,12 @@ pub struct Summary {
     /// Stance sweep and contact timing, for motions that lift feet.
     #[serde(default)]
     pub stepping: Option<SteppingMetric>,
+    /// The answer to the run's slope, tilt or push (none on a level floor without a push).
+    #[serde(default)]
+    pub scenario: Option<ScenarioMetric>,
+    /// The IMU's samples and the device's attitude estimate against the truth.
+    #[serde(default)]
+    pub attitude: Option<AttitudeMetric>,
     /// Files written (summary, plots, pictures).
     #[serde(default)]
     pub files: Vec<PathBuf>,
@@ -285,6 +348,8 @@ pub struct RunOptions {
     /// The device runs the motion itself (its motion engine, started once; a walk's velocity
     /// sent every frame) instead of getting every frame's feet from the host.
     pub onboard: bool,
+    /// The floor and a push ([`scenario`]); the default: a level floor, no push.
+    pub scenario: Scenario,
 }
 
 /// Time the first frame is held before the motion starts, s: the robot, placed with its feet
@@ -369,6 +434,52 @@ impl fmt::Display for Run {
                 per_leg(|l| l.knee_error_in_stance_rad)
             )?;
         }
+        if let Some(sc) = &s.scenario {
+            let deg = f64::to_degrees;
+            write!(
+                f,
+                "  scenario: slope {:.1}° {}",
+                deg(sc.slope_rad),
+                sc.axis.name()
+            )?;
+            if let Some(tilt) = sc.tilt_by_rad {
+                write!(f, ", floor tilting {:+.1}°", deg(tilt))?;
+            }
+            if let Some(push) = sc.push_n_s {
+                write!(f, ", push {push:.2} N·s")?;
+            }
+            writeln!(
+                f,
+                " ({:.2}–{:.2} s): body |roll| max {:.2}°, |pitch| max {:.2}°, settled roll {:.2}° pitch {:.2}°, settling time {}",
+                sc.disturbance_start_s,
+                sc.disturbance_end_s,
+                deg(sc.max_abs_roll_rad),
+                deg(sc.max_abs_pitch_rad),
+                deg(sc.settled_roll_rad),
+                deg(sc.settled_pitch_rad),
+                sc.settling_time_s
+                    .map_or_else(|| "none (not settled)".to_owned(), |t| format!("{t:.2} s"))
+            )?;
+        }
+        if let Some(a) = &s.attitude {
+            write!(
+                f,
+                "  imu: {} samples at {} Hz",
+                a.imu_samples,
+                a.imu_rate_hz
+                    .map_or_else(|| "-".to_owned(), |r| format!("{r:.0}"))
+            )?;
+            match &a.estimate {
+                Some(e) => writeln!(
+                    f,
+                    "; estimate error roll rms {:.2}°, pitch rms {:.2}°, max {:.2}°",
+                    e.roll_rms_error_rad.to_degrees(),
+                    e.pitch_rms_error_rad.to_degrees(),
+                    e.max_error_rad.to_degrees()
+                )?,
+                None => writeln!(f)?,
+            }
+        }
         writeln!(
             f,
             "  speed: physics {:.1} sim s / wall s; whole loop {:.2} sim s / wall s ({:.2} s wall)",
@@ -417,7 +528,10 @@ pub fn run_plan(
         ),
         ..*config
     };
-    let plan = *plan;
+    let plan = match options.scenario.min_duration_s() {
+        Some(d) => plan.lasting_at_least(d),
+        None => *plan,
+    };
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {
             let device = device::InProcess::start(*config)
@@ -430,11 +544,12 @@ pub fn run_plan(
                 Box::new(source::HostDriven::new(plan, device))
             }
         }
-        Driver::Emulator { elf } => Box::new(emulated::Emulated::boot(
+        Driver::Emulator { elf } => Box::new(emulated::Emulated::boot_on(
             plan,
             config,
             elf.as_deref(),
             options.onboard,
+            &options.scenario,
         )?),
     };
     let tmp = tempfile::tempdir().map_err(Error::Io)?;
@@ -449,13 +564,14 @@ pub fn run_plan(
     let model_path = link::model_path(out_dir, tmp.path());
     quad_model::mjcf::write(&model, &model_path).map_err(Error::Model)?;
     let robot_name = quad_model::mjcf::robot_name(&model);
-    let mut run = run_source(
+    let mut run = run_source_in(
         source.as_mut(),
         &model_path,
         robot_name,
         &plan,
         out_dir,
         options.render || options.picture.is_some(),
+        &options.scenario,
     )?;
     if let (Some(picture), Some(dir)) = (&options.picture, out_dir) {
         let strip = picture
@@ -490,7 +606,7 @@ pub fn config_for(robot: &kin_core::Robot, stance_height_m: Option<f32>) -> Conf
     config
 }
 
-/// The loop on any frame source.
+/// The loop on any frame source, on a level floor without a push.
 ///
 /// # Errors
 /// [`Error`].
@@ -501,6 +617,31 @@ pub fn run_source(
     plan: &Plan,
     out_dir: Option<&Path>,
     render: bool,
+) -> Result<Run, Error> {
+    run_source_in(
+        source,
+        model_path,
+        robot_name,
+        plan,
+        out_dir,
+        render,
+        &Scenario::default(),
+    )
+}
+
+/// The loop on any frame source, in `scenario`'s world (its floor and push; the plan should
+/// last [`Scenario::min_duration_s`]).
+///
+/// # Errors
+/// [`Error`].
+pub fn run_source_in(
+    source: &mut dyn FrameSource,
+    model_path: &Path,
+    robot_name: &str,
+    plan: &Plan,
+    out_dir: Option<&Path>,
+    render: bool,
+    scenario: &Scenario,
 ) -> Result<Run, Error> {
     let started = Instant::now();
     let mut twin = link::Twin::spawn(&quad_model::venv::workspace_root())?;
@@ -513,6 +654,8 @@ pub fn run_source(
         settle_s: SETTLE_S,
         out_dir,
         render: render && out_dir.is_some(),
+        imu_period_s: imu::IMU_PERIOD_S,
+        scenario: (!scenario.is_plain()).then_some(scenario),
     })? {
         link::FromTwin::Ready { .. } => {}
         _ => return Err(Error::Protocol("expected `ready`")),

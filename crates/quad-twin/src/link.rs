@@ -4,9 +4,11 @@
 //! IMU's reading) can be handed to the device before its next frame.
 //!
 //! ```text
-//! → {"type":"start", "model":…, "frame_s":0.02, …}      ← {"type":"ready", "timestep_s":0.001}
+//! → {"type":"start", "model":…, "frame_s":0.02, "imu_period_s":0.005, "scenario":…, …}
+//!                                                        ← {"type":"ready", "timestep_s":0.001}
 //! → {"type":"frame", "k":0, "pulses_half_us":[…], "angles_rad":[…], …}
-//!                                                        ← {"type":"state", "t_s":0.02, "quat":[…], "gyro_rad_s":[…], …}
+//!                                                        ← {"type":"state", "t_s":0.02, "quat":[…], "gyro_rad_s":[…],
+//!                                                           "imu":[{"t_s":…, "accel_m_s2":[…], "gyro_rad_s":[…], "rpy_rad":[…]}, …], …}
 //! → … one frame, one state …
 //! → {"type":"end"}                                       ← {"type":"summary", …}
 //! ```
@@ -41,6 +43,11 @@ pub enum ToTwin<'a> {
         out_dir: Option<&'a Path>,
         /// Render a GIF and a strip of frames.
         render: bool,
+        /// The IMU's sample period, s ([`crate::imu::IMU_PERIOD_S`]).
+        imu_period_s: f32,
+        /// The floor and the push ([`crate::scenario`]); none: a level floor, no push.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        scenario: Option<&'a crate::scenario::Scenario>,
     },
     /// One servo frame, held for `frame_s`.
     Frame {
@@ -58,6 +65,10 @@ pub enum ToTwin<'a> {
         commanded_pose: [f32; 6],
         /// The feet the motion has on the ground.
         stance: [bool; 4],
+        /// The device's own estimate of the body's roll, pitch, yaw at the frame's start, rad,
+        /// when it reports one (scored against the true attitude in the summary).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        estimated_rpy_rad: Option<[f32; 3]>,
     },
     /// The run is over: compute the metrics, write the files, answer the summary.
     End,
@@ -80,6 +91,35 @@ pub struct BodyState {
     pub accel_m_s2: [f64; 3],
     /// Feet touching the floor.
     pub feet_contact: [bool; 4],
+    /// The IMU's samples during the frame, in time order (every `imu_period_s`).
+    #[serde(default)]
+    pub imu: Vec<ImuSampleAt>,
+}
+
+/// One IMU sample of the twin: MuJoCo's accelerometer and gyroscope on the body's `imu` site
+/// (kin-core's body frame: x forward, y left, z up) and the body's true attitude, all at one
+/// simulated time.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct ImuSampleAt {
+    /// Simulated time of the sample, s (the clock of [`BodyState::t_s`]).
+    pub t_s: f64,
+    /// Specific force, m/s² (level and still: `(0, 0, +g)`).
+    pub accel_m_s2: [f64; 3],
+    /// Angular rate about the body axes, rad/s.
+    pub gyro_rad_s: [f64; 3],
+    /// The body's true roll, pitch, yaw (`zyx` order), rad.
+    pub rpy_rad: [f64; 3],
+}
+
+impl ImuSampleAt {
+    /// The reading as the device takes it.
+    pub fn sample(&self) -> quad_device::ImuSample {
+        // The device's maths is f32; the twin's f64 values round to the nearest.
+        quad_device::ImuSample {
+            accel_m_s2: self.accel_m_s2.map(|v| v as f32),
+            gyro_rad_s: self.gyro_rad_s.map(|v| v as f32),
+        }
+    }
 }
 
 /// Messages from the twin.

@@ -392,6 +392,15 @@ impl Plan {
         Some((command, None))
     }
 
+    /// The plan run for at least `duration_s` (a longer run than the motion's own: a stand-up
+    /// holds its stance, a law runs on), to watch the answer to a disturbance.
+    pub fn lasting_at_least(self, duration_s: f32) -> Plan {
+        Plan {
+            duration_s: self.duration_s.max(duration_s),
+            ..self
+        }
+    }
+
     /// The motion.
     pub const fn kind(&self) -> MotionKind {
         self.kind

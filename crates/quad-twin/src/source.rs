@@ -1,11 +1,14 @@
 //! Where the frames come from: a host sending every frame's feet ([`HostDriven`]), or the
-//! device running the motion itself ([`Onboard`]).
+//! device running the motion itself ([`Onboard`]). Both hand the twin's IMU samples of the
+//! previous frame to the in-process device at their times before its next frame boundary
+//! ([`imu_readings`], [`InProcess::tick_with_imu`]).
 
 use crate::device::{DeviceError, InProcess};
 use crate::link::{BodyState, ToTwin};
 use crate::motions::Plan;
 use kin_core::motion::gait::Velocity;
 use kin_core::Pose;
+use quad_device::ImuReading;
 use quad_protocol::{MotionCommand, Request};
 
 /// The device's servo period, s (50 Hz hobby-servo frames).
@@ -28,6 +31,9 @@ pub struct DeviceFrame {
     pub commanded_pose: Pose,
     /// The feet the motion has on the ground (for the slip metric).
     pub stance: [bool; 4],
+    /// The device's estimate of the body's roll, pitch, yaw, rad, when it reports one (none
+    /// today: the device has no estimator yet); the twin scores it against the true attitude.
+    pub estimated_rpy_rad: Option<[f32; 3]>,
 }
 
 impl DeviceFrame {
@@ -41,8 +47,32 @@ impl DeviceFrame {
             angles_rad: self.angles_rad,
             commanded_pose: self.commanded_pose.to_array(),
             stance: self.stance,
+            estimated_rpy_rad: self.estimated_rpy_rad,
         }
     }
+}
+
+/// The IMU samples of the frame the twin answered with `state`, as readings for the device:
+/// `(ns after the frame's start, reading)`, the frame starting [`FRAME_S`] before
+/// `state.t_s` (the twin's frames last one servo period).
+///
+/// # Errors
+/// [`crate::Error::Protocol`] when a sample lies outside its frame.
+pub fn imu_readings(state: &BodyState) -> Result<Vec<(u64, ImuReading)>, crate::Error> {
+    let frame_start_s = state.t_s - f64::from(FRAME_S);
+    state
+        .imu
+        .iter()
+        .map(|s| {
+            let after_s = s.t_s - frame_start_s;
+            // A microsecond's slack for the sum of the twin's time steps.
+            if !(-1e-6..=f64::from(FRAME_S) + 1e-6).contains(&after_s) {
+                return Err(crate::Error::Protocol("an IMU sample outside its frame"));
+            }
+            let after_ns = (after_s.max(0.0) * 1e9).round() as u64;
+            Ok((after_ns, ImuReading::Sample(s.sample())))
+        })
+        .collect()
 }
 
 /// A producer of servo frames, given the twin's answer to the previous one (the body state an
@@ -70,6 +100,11 @@ impl HostDriven {
     pub fn new(plan: Plan, device: InProcess) -> HostDriven {
         HostDriven { plan, device }
     }
+
+    /// The device.
+    pub fn device(&self) -> &InProcess {
+        &self.device
+    }
 }
 
 /// Frames of a run of `plan`: its duration in frames and the final one.
@@ -82,7 +117,7 @@ impl FrameSource for HostDriven {
         frame_count(&self.plan)
     }
 
-    fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
+    fn next(&mut self, k: u32, feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
         let target = self
             .plan
             .target(k as f32 * FRAME_S)
@@ -90,7 +125,7 @@ impl FrameSource for HostDriven {
         let request = Request::SetFeet {
             feet_in_body_m: target.feet_in_body_m,
         };
-        step(&mut self.device, k, Some(request), &target)
+        step(&mut self.device, k, Some(request), &target, feedback)
     }
 }
 
@@ -148,29 +183,36 @@ impl FrameSource for Onboard {
         frame_count(&self.plan)
     }
 
-    fn next(&mut self, k: u32, _feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
+    fn next(&mut self, k: u32, feedback: Option<&BodyState>) -> Result<DeviceFrame, crate::Error> {
         let target = self
             .plan
             .target(k as f32 * FRAME_S)
             .map_err(crate::Error::Motion)?;
         let request = onboard_request(k, self.command, self.velocity);
-        step(&mut self.device, k, request, &target)
+        step(&mut self.device, k, request, &target, feedback)
     }
 }
 
-/// Frame `k` of an in-process run: `request` (if any) sent, one frame of the device's clock,
-/// its outputs read; the commanded pose and the feet on the ground are `target`'s.
+/// Frame `k` of an in-process run: `request` (if any) sent, one frame of the device's clock
+/// with the IMU samples of `feedback` (the twin's answer to frame `k − 1`: the frame the
+/// outputs held while the clock runs to the next boundary) pushed at their times, its outputs
+/// read; the commanded pose and the feet on the ground are `target`'s.
 fn step(
     device: &mut InProcess,
     k: u32,
     request: Option<Request>,
     target: &crate::motions::Target,
+    feedback: Option<&BodyState>,
 ) -> Result<DeviceFrame, crate::Error> {
     let device_error = |error: DeviceError| crate::Error::Device { frame: k, error };
     if let Some(request) = request {
         device.request(request).map_err(device_error)?;
     }
-    device.tick(FRAME_MS);
+    let readings = match feedback {
+        Some(state) => imu_readings(state)?,
+        None => Vec::new(),
+    };
+    device.tick_with_imu(FRAME_MS, &readings);
     let outputs = device.outputs();
     Ok(DeviceFrame {
         t_s: k as f32 * FRAME_S,
@@ -179,5 +221,6 @@ fn step(
         angles_rad: device.output_angles_rad().map_err(device_error)?,
         commanded_pose: target.pose,
         stance: target.stance,
+        estimated_rpy_rad: None,
     })
 }

@@ -158,6 +158,8 @@ fn each_frame_is_answered_with_the_body_state_an_imu_would_read() {
             settle_s: 0.5,
             out_dir: None,
             render: false,
+            imu_period_s: quad_twin::imu::IMU_PERIOD_S,
+            scenario: None,
         })
         .unwrap();
     assert!(matches!(ready, FromTwin::Ready { timestep_s } if timestep_s <= 1.0 / 500.0));
@@ -174,6 +176,7 @@ fn each_frame_is_answered_with_the_body_state_an_imu_would_read() {
             angles_rad: angles,
             commanded_pose: [0.0; 6],
             stance: [true; 4],
+            estimated_rpy_rad: None,
         };
         match twin.exchange(&msg).unwrap() {
             FromTwin::State(s) => source_state = Some(s),

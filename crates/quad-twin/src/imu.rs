@@ -1,0 +1,200 @@
+//! The twin's IMU readings on their way to the device.
+//!
+//! The twin samples MuJoCo's accelerometer and gyroscope on the body's `imu` site every
+//! [`IMU_PERIOD_S`] of simulated time (four samples a 20 ms servo frame) and answers each frame
+//! with that frame's samples, each with its time and the body's true attitude
+//! ([`crate::link::ImuSampleAt`]). They reach the device by two routes:
+//!
+//! - **In-process** ([`crate::source::HostDriven`], [`crate::source::Onboard`]): before the
+//!   device's next frame boundary, its virtual clock is advanced to each sample's time within
+//!   the frame the twin has just simulated and the sample pushed through
+//!   [`quad_device::Device::on_imu`] ([`crate::device::InProcess::tick_with_imu`]).
+//! - **Emulated firmware** ([`crate::emulated::Emulated`]): the samples go into a [`TwinImu`],
+//!   timed on the emulated MCU's clock, for the emulated MPU-6050 to read as the MCU runs:
+//!   [`TwinImu::read`] is the callback a sensor source calls with the MCU's time (see
+//!   [`TwinImu`]).
+//!
+//! Readings are in the body frame of kin-core (x forward, y left, z up), SI units: level and
+//! still the accelerometer reads `(0, 0, +g)`, and a roll that lowers the right side reads a
+//! positive rate about +x.
+
+use quad_device::{ImuReading, ImuSample};
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::rc::Rc;
+
+/// The twin's IMU sample period, s (200 Hz: four samples in each 20 ms servo frame; the
+/// MPU-6050 is read at ≥ 100 Hz on the board).
+pub const IMU_PERIOD_S: f32 = 0.005;
+
+/// Standard gravity, m/s²: MuJoCo's default gravity, which the twin's models keep.
+pub const GRAVITY_M_S2: f32 = 9.81;
+
+/// Samples a [`TwinImu`] keeps when nothing reads them (5 s at [`IMU_PERIOD_S`]); the oldest
+/// goes first.
+pub const TWIN_IMU_CAPACITY: usize = 1024;
+
+#[derive(Debug)]
+struct Queue {
+    /// Samples in time order, `(t_s, sample)`.
+    samples: VecDeque<(f64, ImuSample)>,
+    /// What the sensor reads before the first sample.
+    at_rest: ImuSample,
+    /// Samples dropped because the queue was full.
+    dropped: u64,
+}
+
+/// The twin's IMU samples as a sensor source reads them: a queue of samples timed on the
+/// reader's clock (for the emulated firmware: the MCU's time since its reset, its cycle
+/// count over its clock frequency), filled frame by frame as the physics advances.
+/// [`TwinImu::read`] answers with the latest sample at or before the time asked; before the
+/// first sample, with the robot at rest on the run's floor (the accelerometer reading
+/// gravity's reaction, [`crate::scenario::Scenario::at_rest_accel_m_s2`]; the gyroscope zero).
+///
+/// Clones share one queue (as [`quad_device::sim::VirtualClock`]'s clones share one time): the
+/// frame source pushes into one clone, the emulated sensor reads another. A sensor source of
+/// the emulator with a callback feed takes it as `move |t_s| feed.read(t_s)`; reading is
+/// infallible (the twin's sensor has no bus faults of its own: faults are the emulated
+/// chip's).
+///
+/// Reads must come in time order (an MCU's clock only advances): a read drops the samples
+/// before the one it answers with. Samples pushed out of time order are refused
+/// ([`TwinImu::push`]).
+#[derive(Debug, Clone)]
+pub struct TwinImu(Rc<RefCell<Queue>>);
+
+/// A sample pushed earlier than the last one ([`TwinImu::push`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutOfOrder {
+    /// The sample's time, s.
+    pub t_s: f64,
+    /// The last sample's time, s.
+    pub last_s: f64,
+}
+
+impl core::fmt::Display for OutOfOrder {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "an IMU sample at {:.6} s follows one at {:.6} s",
+            self.t_s, self.last_s
+        )
+    }
+}
+
+impl std::error::Error for OutOfOrder {}
+
+impl TwinImu {
+    /// An empty feed that reads `at_rest` until the first sample.
+    pub fn new(at_rest: ImuSample) -> TwinImu {
+        TwinImu(Rc::new(RefCell::new(Queue {
+            samples: VecDeque::new(),
+            at_rest,
+            dropped: 0,
+        })))
+    }
+
+    /// Appends `sample`, taken at `t_s` on the reader's clock.
+    ///
+    /// # Errors
+    /// [`OutOfOrder`] when `t_s` is earlier than the last sample's time (or not a number).
+    pub fn push(&self, t_s: f64, sample: ImuSample) -> Result<(), OutOfOrder> {
+        let mut q = self.0.borrow_mut();
+        if let Some(&(last_s, _)) = q.samples.back() {
+            // `!(a >= b)` also refuses NaN.
+            if !(t_s >= last_s) {
+                return Err(OutOfOrder { t_s, last_s });
+            }
+        } else if t_s.is_nan() {
+            return Err(OutOfOrder {
+                t_s,
+                last_s: f64::NEG_INFINITY,
+            });
+        }
+        if q.samples.len() == TWIN_IMU_CAPACITY {
+            q.samples.pop_front();
+            q.dropped += 1;
+        }
+        q.samples.push_back((t_s, sample));
+        Ok(())
+    }
+
+    /// What the sensor reads at `t_s`: the latest sample at or before `t_s`; before the first
+    /// sample, the robot at rest. Drops the samples before the one it answers with.
+    pub fn read(&self, t_s: f64) -> ImuReading {
+        let mut q = self.0.borrow_mut();
+        // Keep the latest sample at or before t_s at the front.
+        while q.samples.len() > 1 && q.samples[1].0 <= t_s {
+            q.samples.pop_front();
+        }
+        let sample = match q.samples.front() {
+            Some(&(t0, sample)) if t0 <= t_s => sample,
+            _ => q.at_rest,
+        };
+        ImuReading::Sample(sample)
+    }
+
+    /// Samples waiting (the one a read last answered with included).
+    pub fn len(&self) -> usize {
+        self.0.borrow().samples.len()
+    }
+
+    /// True when no sample waits.
+    pub fn is_empty(&self) -> bool {
+        self.0.borrow().samples.is_empty()
+    }
+
+    /// Samples dropped unread because the queue was full ([`TWIN_IMU_CAPACITY`]).
+    pub fn dropped(&self) -> u64 {
+        self.0.borrow().dropped
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(x: f32) -> ImuSample {
+        ImuSample {
+            accel_m_s2: [x, 0.0, GRAVITY_M_S2],
+            gyro_rad_s: [0.0; 3],
+        }
+    }
+
+    #[test]
+    fn a_read_answers_the_latest_sample_at_or_before_its_time() {
+        let feed = TwinImu::new(sample(-1.0));
+        let reader = feed.clone();
+        assert_eq!(reader.read(0.0), ImuReading::Sample(sample(-1.0)));
+        for (i, t) in [0.004, 0.009, 0.014, 0.019].into_iter().enumerate() {
+            feed.push(t, sample(i as f32)).unwrap();
+        }
+        assert_eq!(reader.read(0.003), ImuReading::Sample(sample(-1.0)));
+        assert_eq!(reader.read(0.004), ImuReading::Sample(sample(0.0)));
+        assert_eq!(reader.read(0.0135), ImuReading::Sample(sample(1.0)));
+        assert_eq!(reader.len(), 3);
+        assert_eq!(reader.read(1.0), ImuReading::Sample(sample(3.0)));
+        assert_eq!(reader.len(), 1);
+        // The last sample stays until a later one replaces it.
+        assert_eq!(reader.read(2.0), ImuReading::Sample(sample(3.0)));
+    }
+
+    #[test]
+    fn samples_out_of_order_are_refused_and_a_full_queue_drops_the_oldest() {
+        let feed = TwinImu::new(sample(0.0));
+        feed.push(1.0, sample(1.0)).unwrap();
+        assert_eq!(
+            feed.push(0.5, sample(2.0)),
+            Err(OutOfOrder {
+                t_s: 0.5,
+                last_s: 1.0
+            })
+        );
+        assert!(feed.push(f64::NAN, sample(2.0)).is_err());
+        for i in 0..TWIN_IMU_CAPACITY {
+            feed.push(2.0 + i as f64, sample(0.0)).unwrap();
+        }
+        assert_eq!(feed.len(), TWIN_IMU_CAPACITY);
+        assert_eq!(feed.dropped(), 1);
+    }
+}
