@@ -108,24 +108,39 @@ def step_panels(a, b, rec, t, stance):
     b.legend(fontsize=7)
 
 
+#: The camera's azimuth and elevation, degrees: a three-quarter view from the front left; on
+#: an inclined or tilting floor, nearly along the slope's axis and lower, so that the horizon
+#: shows the floor's angle.
+VIEW_DEG = (140.0, -18.0)
+VIEW_ROLL_SLOPE_DEG = (165.0, -12.0)
+VIEW_PITCH_SLOPE_DEG = (125.0, -12.0)
+
+
+def view(scenario):
+    if scenario.slope_rad or scenario.tilt:
+        return VIEW_ROLL_SLOPE_DEG if scenario.axis_name == "roll" else VIEW_PITCH_SLOPE_DEG
+    return VIEW_DEG
+
+
 #: Length of the push's arrow per N·s of impulse, m, and its largest length as a share of the
 #: body's length.
 ARROW_M_PER_N_S, ARROW_MAX_BODY_LENGTHS = 0.05, 1.5
 
 
-def push_arrow(scene, d, body, impulse_n_s, body_length_m):
+def push_arrow(scene, d, body, impulse_n_s, body_length_m, half_width_m):
     """Adds an arrow to ``scene`` pointing at the body along the push (world +y)."""
     if scene.ngeom >= scene.maxgeom:
         return
     length = min(abs(impulse_n_s) * ARROW_M_PER_N_S, ARROW_MAX_BODY_LENGTHS * body_length_m)
     length = max(length, 0.3 * body_length_m)
     sign = 1.0 if impulse_n_s >= 0 else -1.0
-    tip = d.xpos[body].copy()
+    # The tip at the body's side, the arrow along the push.
+    tip = d.xpos[body] - sign * np.array([0.0, half_width_m * 1.1, 0.0])
     tail = tip - sign * np.array([0.0, length, 0.0])
     g = scene.geoms[scene.ngeom]
     mujoco.mjv_initGeom(g, mujoco.mjtGeom.mjGEOM_ARROW, np.zeros(3), np.zeros(3), np.zeros(9),
                         np.array([0.85, 0.1, 0.1, 1.0], dtype=np.float32))
-    mujoco.mjv_connector(g, mujoco.mjtGeom.mjGEOM_ARROW, 0.08 * body_length_m, tail, tip)
+    mujoco.mjv_connector(g, mujoco.mjtGeom.mjGEOM_ARROW, 0.03 * body_length_m, tail, tip)
     scene.ngeom += 1
 
 
@@ -137,10 +152,10 @@ def pictures(twin, snapshots, out_dir, scenario):
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     extent = float(m.stat.extent)
     cam.distance = 1.0 * extent
-    cam.azimuth = 140.0
-    cam.elevation = -18.0
+    cam.azimuth, cam.elevation = view(scenario)
     images = []
     body_length_m = 2.0 * float(m.geom_size[twin.body_geom][0])
+    half_width_m = float(m.geom_size[twin.body_geom][1])
     label = scenario.label()
     for t_s, qpos, mocap_quat, push_n_s in snapshots:
         d.qpos[:] = qpos
@@ -149,19 +164,25 @@ def pictures(twin, snapshots, out_dir, scenario):
         cam.lookat[:] = [d.qpos[0], d.qpos[1], 0.5 * d.qpos[2]]
         renderer.update_scene(d, cam)
         if push_n_s:
-            push_arrow(renderer.scene, d, twin.body, push_n_s, body_length_m)
+            push_arrow(renderer.scene, d, twin.body, push_n_s, body_length_m, half_width_m)
         img = Image.fromarray(renderer.render())
         draw = ImageDraw.Draw(img)
         draw.text((8, 8), f"t = {t_s:5.2f} s", fill=(0, 0, 0))
         if label:
             draw.text((8, 22), label, fill=(0, 0, 0))
         if push_n_s:
-            draw.text((8, 36), f"push {push_n_s:.1f} N·s", fill=(160, 0, 0))
+            draw.text((8, 36), f"push {push_n_s:.1f} N s", fill=(160, 0, 0))
         images.append(img)
     renderer.close()
     gif = os.path.join(out_dir, "motion.gif")
     images[0].save(gif, save_all=True, append_images=images[1:], duration=100, loop=0)
     picks = np.linspace(0, len(images) - 1, min(STRIP_FRAMES, len(images))).round().astype(int)
+    # The push in the strip: its first picture in place of the nearest pick.
+    pushed = [i for i, snap in enumerate(snapshots) if snap[3]]
+    if pushed:
+        nearest = int(np.argmin(np.abs(picks - pushed[0])))
+        picks[nearest] = pushed[0]
+        picks = np.unique(picks)
     strip = Image.new("RGB", (WIDTH * len(picks), HEIGHT), "white")
     for i, k in enumerate(picks):
         strip.paste(images[k], (i * WIDTH, 0))

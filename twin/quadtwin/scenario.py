@@ -115,5 +115,5 @@ class Scenario:
         if self.tilt:
             parts.append(f"floor tilting {math.degrees(self.tilt['by_rad']):+.0f}° {self.axis_name}")
         if self.push:
-            parts.append(f"push {self.push['impulse_n_s']:.1f} N·s")
+            parts.append(f"push {self.push['impulse_n_s']:.1f} N s")
         return ", ".join(parts)
