@@ -561,7 +561,8 @@ impl fmt::Display for ArgError {
 
 impl std::error::Error for ArgError {}
 
-fn parse_finite(s: &str) -> Result<f32, ArgError> {
+/// A finite number (no NaN, no infinity).
+pub fn parse_finite(s: &str) -> Result<f32, ArgError> {
     let v: f32 = s
         .trim()
         .parse()

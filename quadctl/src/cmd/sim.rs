@@ -3,6 +3,7 @@
 
 use crate::args;
 use quad_twin::command::{self, Sim};
+use quad_twin::scenario::{Scenario, SlopeAxis};
 use quad_twin::{Driver, MotionKind, RunOptions};
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -23,6 +24,16 @@ With --onboard the device runs the motion itself: its motion engine gets the mot
 (StartMotion; the trots are its walker with the velocity command sent every frame), and the
 host only watches (all but stand).
 
+The world: --slope-deg D inclines the floor by D degrees about --slope-axis (roll, the default:
+positive raises the floor on the robot's left; pitch: positive lowers it ahead), the robot
+placed on it; --tilt-floor tilts the floor by 10° more about that axis over 1 s from 2.5 s into
+the motion; --push-n-s I pushes the body sideways with an impulse of I N·s (a 0.1 s force pulse
+at its centre of mass along the world's +y, the robot's left; negative: to the right) at 2.5 s.
+A tilt or a push makes the run last 3 s past it; the report adds the body's largest |roll| and
+|pitch| from the disturbance, their settled values and the settling time. Every run reports the
+IMU's samples (200 Hz: accelerometer, gyroscope and the true attitude, in trace.npz), which the
+device receives at their times.
+
 --render FILE writes an animation of the run (GIF; a strip of frames when FILE ends in .png);
 --out-dir DIR keeps the model, summary.json, plots.png, and with --render, motion.gif and
 strip.png. Needs the twin's Python environment (scripts/install-deps.sh creates .venv-twin).
@@ -39,7 +50,10 @@ Examples (from the repository root):
   quadctl sim stand --robot fernando2025
   quadctl sim trot --robot shahriar2023 --out-dir trot
   quadctl sim stand --emulator --out-dir stand --render stand.gif
-  quadctl sim trot --onboard";
+  quadctl sim trot --onboard
+  quadctl sim stand --slope-deg 10 --render target/twin/slope.png
+  quadctl sim stand --tilt-floor --slope-axis pitch
+  quadctl sim stand --push-n-s 2";
 
 /// Arguments of `quadctl sim`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -80,6 +94,29 @@ pub struct Args {
     /// Another stance height than the device's default, m.
     #[arg(long, value_name = "M", value_parser = args::parse_positive_m)]
     pub stance_height_m: Option<f32>,
+    /// Incline the floor by D degrees about --slope-axis (at most ±30°).
+    #[arg(long, value_name = "D", default_value_t = 0.0, allow_negative_numbers = true, value_parser = args::parse_finite)]
+    pub slope_deg: f32,
+    /// The axis of --slope-deg and --tilt-floor.
+    #[arg(long, value_name = "AXIS", default_value = "roll", value_parser = slope_axis())]
+    pub slope_axis: SlopeAxis,
+    /// Tilt the floor by 10° more about --slope-axis over 1 s, from 2.5 s into the motion.
+    #[arg(long)]
+    pub tilt_floor: bool,
+    /// Push the body sideways with an impulse of I N·s at 2.5 s (along +y, the robot's left).
+    #[arg(long, value_name = "I", allow_negative_numbers = true, value_parser = args::parse_finite)]
+    pub push_n_s: Option<f32>,
+}
+
+/// `--slope-axis`: roll or pitch.
+fn slope_axis() -> impl clap::builder::TypedValueParser<Value = SlopeAxis> {
+    args::choice(&SlopeAxis::ALL, SlopeAxis::name, |a| {
+        match a {
+            SlopeAxis::Roll => "about the robot's forward axis: it rolls with the floor",
+            SlopeAxis::Pitch => "about the robot's left axis: it pitches with the floor",
+        }
+        .to_owned()
+    })
 }
 
 /// `--motion`: the twin's catalogue by name.
@@ -91,6 +128,15 @@ fn motion() -> impl clap::builder::TypedValueParser<Value = MotionKind> {
 
 /// `quadctl sim`.
 pub fn run(args: &Args) -> ExitCode {
+    let scenario = match Scenario::new(
+        args.slope_axis,
+        args.slope_deg,
+        args.tilt_floor,
+        args.push_n_s,
+    ) {
+        Ok(s) => s,
+        Err(e) => return args::fail("quadctl sim", &e),
+    };
     let request = Sim {
         robot: args.robot.clone(),
         motion: args.motion,
@@ -108,6 +154,7 @@ pub fn run(args: &Args) -> ExitCode {
                 Driver::Device
             },
             onboard: args.onboard,
+            scenario,
         },
     };
     match command::sim(&request) {
