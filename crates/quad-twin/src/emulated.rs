@@ -15,10 +15,12 @@
 //! and the frame is the last complete pulse of each pin.
 //!
 //! The twin's IMU samples go into a [`TwinImu`] ([`Emulated::imu_feed`]) timed on the MCU's
-//! clock: the twin holds a frame's pulses from the MCU time at which they were measured, so a
-//! sample taken `δ` into that frame is due at that time plus `δ`. The samples of frame `k`
-//! arrive before the MCU runs on for frame `k + 1`, so a sensor that reads the feed as the
-//! MCU runs always finds the samples up to its time. The emulator's MPU-6050 reads them
+//! clock: the twin holds a frame's pulses from the MCU time at which they were measured (run
+//! onboard: the end of the frame's PWM period, exactly one period after the last), so a sample
+//! taken `δ` into that frame is due at that time plus `δ`. The samples of frame `k` arrive
+//! before the MCU runs on for frame `k + 1`, so a sensor that reads the feed as the MCU runs
+//! finds the samples up to its time. Host-driven, a frame's exchange can take the MCU less
+//! than a period; the next frame's samples then replace the overlapped ones. The emulator's MPU-6050 reads them
 //! through a callback source (`move |t_s| feed.read(t_s)`, `t_s` the MCU's cycle count over
 //! [`F_CPU_HZ`]) once the emulator link takes one; until then the feed only fills.
 
@@ -150,7 +152,7 @@ impl Emulated {
             if let ImuReading::Sample(sample) = reading {
                 self.imu
                     .push(frame_start_s + after_ns as f64 * 1e-9, sample)
-                    .map_err(|_| crate::Error::Protocol("IMU samples out of time order"))?;
+                    .map_err(|_| crate::Error::Protocol("an IMU sample's time is not finite"))?;
             }
         }
         Ok(())
@@ -168,6 +170,9 @@ impl FrameSource for Emulated {
         }
         let t_s = k as f32 * crate::source::FRAME_S;
         let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
+        // The MCU cycle from which the twin holds this frame's pulses: the end of its PWM
+        // period onboard, else when they were measured.
+        let mut held_from = None;
         let pulses = match self.onboard {
             None => {
                 self.client
@@ -190,6 +195,7 @@ impl FrameSource for Emulated {
                         .map_err(crate::Error::Emulator)?;
                 }
                 let end = start + (u64::from(k) + 1) * PERIOD_CYCLES;
+                held_from = Some(end);
                 let now = self.client.link().mcu().cycle();
                 if now < end {
                     let idle = std::time::Duration::from_nanos(
@@ -224,7 +230,7 @@ impl FrameSource for Emulated {
                         error: DeviceError::Unmappable { servo: s, fault },
                     })?;
         }
-        self.frame_cycle = Some(self.client.link().mcu().cycle());
+        self.frame_cycle = Some(held_from.unwrap_or_else(|| self.client.link().mcu().cycle()));
         Ok(DeviceFrame {
             t_s,
             enabled: true,

@@ -42,6 +42,8 @@ struct Queue {
     at_rest: ImuSample,
     /// Samples dropped because the queue was full.
     dropped: u64,
+    /// Samples replaced by an earlier one pushed later.
+    replaced: u64,
 }
 
 /// The twin's IMU samples as a sensor source reads them: a queue of samples timed on the
@@ -58,31 +60,26 @@ struct Queue {
 /// chip's).
 ///
 /// Reads must come in time order (an MCU's clock only advances): a read drops the samples
-/// before the one it answers with. Samples pushed out of time order are refused
-/// ([`TwinImu::push`]).
+/// before the one it answers with. A sample pushed earlier than queued ones replaces them
+/// ([`TwinImu::push`]): where two frames overlap on the reader's clock, the later physics
+/// wins.
 #[derive(Debug, Clone)]
 pub struct TwinImu(Rc<RefCell<Queue>>);
 
-/// A sample pushed earlier than the last one ([`TwinImu::push`]).
+/// A sample's time is not a finite number ([`TwinImu::push`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct OutOfOrder {
-    /// The sample's time, s.
+pub struct NotFinite {
+    /// The time given, s.
     pub t_s: f64,
-    /// The last sample's time, s.
-    pub last_s: f64,
 }
 
-impl core::fmt::Display for OutOfOrder {
+impl core::fmt::Display for NotFinite {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f,
-            "an IMU sample at {:.6} s follows one at {:.6} s",
-            self.t_s, self.last_s
-        )
+        write!(f, "an IMU sample's time {} is not finite", self.t_s)
     }
 }
 
-impl std::error::Error for OutOfOrder {}
+impl std::error::Error for NotFinite {}
 
 impl TwinImu {
     /// An empty feed that reads `at_rest` until the first sample.
@@ -91,25 +88,23 @@ impl TwinImu {
             samples: VecDeque::new(),
             at_rest,
             dropped: 0,
+            replaced: 0,
         })))
     }
 
-    /// Appends `sample`, taken at `t_s` on the reader's clock.
+    /// Appends `sample`, taken at `t_s` on the reader's clock; queued samples at or after
+    /// `t_s` are replaced by it (they came from physics that a later frame has overtaken).
     ///
     /// # Errors
-    /// [`OutOfOrder`] when `t_s` is earlier than the last sample's time (or not a number).
-    pub fn push(&self, t_s: f64, sample: ImuSample) -> Result<(), OutOfOrder> {
+    /// [`NotFinite`] when `t_s` is not a finite number.
+    pub fn push(&self, t_s: f64, sample: ImuSample) -> Result<(), NotFinite> {
+        if !t_s.is_finite() {
+            return Err(NotFinite { t_s });
+        }
         let mut q = self.0.borrow_mut();
-        if let Some(&(last_s, _)) = q.samples.back() {
-            // `!(a >= b)` also refuses NaN.
-            if !(t_s >= last_s) {
-                return Err(OutOfOrder { t_s, last_s });
-            }
-        } else if t_s.is_nan() {
-            return Err(OutOfOrder {
-                t_s,
-                last_s: f64::NEG_INFINITY,
-            });
+        while q.samples.back().is_some_and(|&(last_s, _)| last_s >= t_s) {
+            q.samples.pop_back();
+            q.replaced += 1;
         }
         if q.samples.len() == TWIN_IMU_CAPACITY {
             q.samples.pop_front();
@@ -148,6 +143,11 @@ impl TwinImu {
     pub fn dropped(&self) -> u64 {
         self.0.borrow().dropped
     }
+
+    /// Samples replaced by an earlier one pushed after them (overlapping frames).
+    pub fn replaced(&self) -> u64 {
+        self.0.borrow().replaced
+    }
 }
 
 #[cfg(test)]
@@ -180,17 +180,17 @@ mod tests {
     }
 
     #[test]
-    fn samples_out_of_order_are_refused_and_a_full_queue_drops_the_oldest() {
+    fn an_earlier_sample_replaces_later_ones_and_a_full_queue_drops_the_oldest() {
         let feed = TwinImu::new(sample(0.0));
+        feed.push(0.4, sample(0.4)).unwrap();
         feed.push(1.0, sample(1.0)).unwrap();
-        assert_eq!(
-            feed.push(0.5, sample(2.0)),
-            Err(OutOfOrder {
-                t_s: 0.5,
-                last_s: 1.0
-            })
-        );
+        feed.push(1.1, sample(1.1)).unwrap();
+        feed.push(0.5, sample(2.0)).unwrap();
+        assert_eq!(feed.len(), 2);
+        assert_eq!(feed.replaced(), 2);
+        assert_eq!(feed.read(1.05), ImuReading::Sample(sample(2.0)));
         assert!(feed.push(f64::NAN, sample(2.0)).is_err());
+        assert!(feed.push(f64::INFINITY, sample(2.0)).is_err());
         for i in 0..TWIN_IMU_CAPACITY {
             feed.push(2.0 + i as f64, sample(0.0)).unwrap();
         }
