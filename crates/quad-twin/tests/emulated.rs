@@ -92,3 +92,58 @@ fn the_firmwares_own_trot_walks_in_the_twin() {
     let travel = s.travel.expect("a travelling motion");
     assert!(travel.ratio >= 0.5, "{travel:?}");
 }
+
+#[test]
+fn the_twins_imu_samples_queue_on_the_mcus_clock_for_the_emulated_sensor() {
+    // Standing on a 10° roll slope: before the twin's first sample the feed reads the robot at
+    // rest on the slope; after the run, the latest sample is the body at rest on it.
+    let config = Config::shahriar2023();
+    let physical = quad_model::Physical::shahriar2023();
+    let scenario =
+        quad_twin::scenario::Scenario::new(quad_twin::scenario::SlopeAxis::Roll, 10.0, false, None)
+            .unwrap();
+    let plan = Plan::new(MotionKind::Stand, &config).unwrap();
+    let mut firmware =
+        Emulated::boot_on(plan, &config, None, false, &scenario).unwrap_or_else(|e| panic!("{e}"));
+    let feed = firmware.imu_feed();
+    let g = f64::from(quad_twin::imu::GRAVITY_M_S2);
+    let roll_of = |reading: quad_device::ImuReading| match reading {
+        quad_device::ImuReading::Sample(s) => {
+            f64::from(s.accel_m_s2[1]).atan2(f64::from(s.accel_m_s2[2]))
+        }
+        other => panic!("{other:?}"),
+    };
+    assert!(feed.is_empty());
+    assert!((roll_of(feed.read(0.0)) - 10f64.to_radians()).abs() < 1e-6);
+    let model = quad_model::Model::new(config.robot, physical).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.xml");
+    quad_model::mjcf::write(&model, &path).unwrap();
+    let run = quad_twin::run_source_in(
+        &mut firmware,
+        &path,
+        "shahriar2023",
+        &plan,
+        None,
+        false,
+        &scenario,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(!run.summary.fell);
+    // Four samples a frame, the last frame's excepted (the run ends before they are due),
+    // some replaced where two frames overlapped on the MCU's clock; nothing dropped.
+    let frames = firmware.frame_count() as usize;
+    assert_eq!(feed.len() + feed.replaced() as usize, 4 * (frames - 1));
+    assert_eq!(feed.dropped(), 0);
+    let settled = run.summary.scenario.unwrap().settled_roll_rad;
+    let last = feed.read(f64::MAX);
+    assert!(
+        (roll_of(last) - settled).abs() < 0.5f64.to_radians(),
+        "{last:?}"
+    );
+    assert_eq!(feed.len(), 1);
+    if let quad_device::ImuReading::Sample(s) = last {
+        let a = s.accel_m_s2.map(f64::from);
+        assert!(((a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt() - g).abs() < 0.2);
+    }
+}
