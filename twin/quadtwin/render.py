@@ -124,10 +124,10 @@ def view(scenario):
 
 #: Length of the push's arrow per N·s of impulse, m, and its largest length as a share of the
 #: body's length.
-ARROW_M_PER_N_S, ARROW_MAX_BODY_LENGTHS = 0.05, 1.5
+ARROW_M_PER_N_S, ARROW_MAX_BODY_LENGTHS = 0.1, 1.5
 
 
-def push_arrow(scene, d, body, impulse_n_s, body_length_m, half_width_m):
+def push_arrow(scene, d, body, impulse_n_s, body_length_m, half_width_m, half_height_m):
     """Adds an arrow to ``scene`` pointing at the body along the push (world +y)."""
     if scene.ngeom >= scene.maxgeom:
         return
@@ -135,7 +135,8 @@ def push_arrow(scene, d, body, impulse_n_s, body_length_m, half_width_m):
     length = max(length, 0.3 * body_length_m)
     sign = 1.0 if impulse_n_s >= 0 else -1.0
     # The tip at the body's side, the arrow along the push.
-    tip = d.xpos[body] - sign * np.array([0.0, half_width_m * 1.1, 0.0])
+    # Level with the body's top face, clear of the legs.
+    tip = d.xpos[body] + np.array([0.0, -sign * half_width_m * 1.1, half_height_m])
     tail = tip - sign * np.array([0.0, length, 0.0])
     g = scene.geoms[scene.ngeom]
     mujoco.mjv_initGeom(g, mujoco.mjtGeom.mjGEOM_ARROW, np.zeros(3), np.zeros(3), np.zeros(9),
@@ -156,6 +157,7 @@ def pictures(twin, snapshots, out_dir, scenario):
     images = []
     body_length_m = 2.0 * float(m.geom_size[twin.body_geom][0])
     half_width_m = float(m.geom_size[twin.body_geom][1])
+    half_height_m = float(m.geom_size[twin.body_geom][2])
     label = scenario.label()
     for t_s, qpos, mocap_quat, push_n_s in snapshots:
         d.qpos[:] = qpos
@@ -164,7 +166,7 @@ def pictures(twin, snapshots, out_dir, scenario):
         cam.lookat[:] = [d.qpos[0], d.qpos[1], 0.5 * d.qpos[2]]
         renderer.update_scene(d, cam)
         if push_n_s:
-            push_arrow(renderer.scene, d, twin.body, push_n_s, body_length_m, half_width_m)
+            push_arrow(renderer.scene, d, twin.body, push_n_s, body_length_m, half_width_m, half_height_m)
         img = Image.fromarray(renderer.render())
         draw = ImageDraw.Draw(img)
         draw.text((8, 8), f"t = {t_s:5.2f} s", fill=(0, 0, 0))
