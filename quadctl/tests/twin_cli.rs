@@ -163,3 +163,73 @@ fn sim_stand_runs_in_the_twin_and_keeps_its_summary() {
     assert_eq!(summary["robot"], "shahriar2023");
     assert!(dir.join("plots.png").exists() && dir.join("model.xml").exists());
 }
+
+#[test]
+fn sim_refuses_a_slope_out_of_range_or_an_impulse_that_is_not_a_number() {
+    let gif = temp_path("refused-scenario.gif");
+    for (args, field) in [
+        (
+            vec!["sim", "stand", "--slope-deg", "45", "--render", s(&gif)],
+            "slope_deg",
+        ),
+        (
+            vec![
+                "sim",
+                "stand",
+                "--slope-deg",
+                "25",
+                "--tilt-floor",
+                "--render",
+                s(&gif),
+            ],
+            "slope_deg",
+        ),
+        (
+            vec!["sim", "stand", "--push-n-s", "inf", "--render", s(&gif)],
+            "push-n-s",
+        ),
+        (
+            vec!["sim", "stand", "--slope-axis", "yaw", "--render", s(&gif)],
+            "slope-axis",
+        ),
+    ] {
+        let run = quadctl(&args, "");
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(run.stderr.contains(field), "{args:?}: {}", run.stderr);
+        assert!(!gif.exists(), "{args:?}: picture left behind");
+    }
+}
+
+#[test]
+fn sim_stand_on_a_slope_reports_the_body_going_with_the_floor() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sim-slope");
+    let _ = std::fs::remove_dir_all(&dir);
+    let run = quadctl(
+        &[
+            "sim",
+            "stand",
+            "--slope-deg",
+            "-10",
+            "--slope-axis",
+            "pitch",
+            "--out-dir",
+            s(&dir),
+        ],
+        "",
+    );
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stdout.contains("scenario: slope -10.0° pitch"),
+        "{}",
+        run.stdout
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
+            .expect("summary.json");
+    let pitch = summary["scenario"]["settled_pitch_rad"].as_f64().unwrap();
+    assert!((pitch.to_degrees() + 10.0).abs() < 1.5, "{summary}");
+    assert_eq!(
+        summary["attitude"]["imu_rate_hz"].as_f64().unwrap().round(),
+        200.0
+    );
+}

@@ -12,8 +12,10 @@ Modules:
 - ``model``: loading a model written by ``quad-model`` and the names it relies on.
 - ``servo``: the servo controller (duty cycle from the position error; the MJCF actuator
   applies the DC-motor law).
-- ``runner``: the frame loop (``python -m quadtwin.runner``).
-- ``metrics``: fall, yaw, distance, slip, torque and tracking figures of a run.
+- ``runner``: the frame loop (``python -m quadtwin.runner``), with the IMU's samples.
+- ``scenario``: the floor (level, a slope, tilting during the run) and a push on the body.
+- ``metrics``: fall, yaw, distance, slip, torque and tracking figures of a run, the answer to
+  a slope, a tilt or a push, and the IMU's samples with the true attitude.
 - ``render``: offscreen pictures (GIF and PNG strip) and the metric plots.
 - ``check_fk``: foot sites at given joint angles (the forward-kinematics agreement test).
 """
