@@ -4,9 +4,9 @@
 //! twin (the `twin/` Python package) across a process boundary ([`link`]): every 20 ms servo
 //! frame, the device's twelve pulses and the joint angles they map to through the device's
 //! own calibration go to the twin, which holds them for the frame, steps the physics at the
-//! model's time step and answers with the body state (an IMU's reading, for a closed loop
-//! later). At the end the twin computes the run's metrics ([`Summary`]) and, when asked, its
-//! plots and pictures.
+//! model's time step and answers with the body state and the frame's IMU samples, which reach
+//! the device at their times before its next frame ([`imu`]). At the end the twin computes the
+//! run's metrics ([`Summary`]) and, when asked, its plots and pictures.
 //!
 //! - [`device`]: the controller in this process ([`device::InProcess`], on the shared in-memory
 //!   fakes of `quad_device::sim`).

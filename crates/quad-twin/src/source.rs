@@ -75,8 +75,8 @@ pub fn imu_readings(state: &BodyState) -> Result<Vec<(u64, ImuReading)>, crate::
         .collect()
 }
 
-/// A producer of servo frames, given the twin's answer to the previous one (the body state an
-/// IMU would measure; unused while the loop is open).
+/// A producer of servo frames, given the twin's answer to the previous one (the body state
+/// and the IMU's samples during that frame, which the source hands to its device).
 pub trait FrameSource {
     /// Number of frames of the run.
     fn frame_count(&self) -> u32;
