@@ -341,7 +341,8 @@ pub struct RunOptions {
     /// Render a GIF and a strip of frames (into `out_dir`).
     pub render: bool,
     /// Also copy the rendered animation to this file (a GIF; the strip of frames, a PNG, when
-    /// the name ends in `.png`); renders even without `render` and `out_dir`.
+    /// the name ends in `.png`; its directory made if missing); renders even without `render`
+    /// and `out_dir`.
     pub picture: Option<PathBuf>,
     /// Where the frames come from.
     pub driver: Driver,
@@ -579,6 +580,10 @@ pub fn run_plan(
             .is_some_and(|e| e.eq_ignore_ascii_case("png"));
         let rendered = dir.join(if strip { "strip.png" } else { "motion.gif" });
         let bytes = std::fs::read(&rendered).map_err(Error::Io)?;
+        // The picture's directory is made as `out_dir` is (`--render target/twin/run.gif`).
+        if let Some(parent) = picture.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent).map_err(Error::Io)?;
+        }
         quad_model::write_atomic(picture, &bytes).map_err(Error::Picture)?;
         if options.out_dir.is_none() {
             run.summary.files.clear();
