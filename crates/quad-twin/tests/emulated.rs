@@ -133,6 +133,11 @@ fn the_twins_imu_samples_queue_on_the_mcus_clock_for_the_emulated_sensor() {
     // Four samples a frame, the last frame's excepted (the run ends before they are due),
     // some replaced where two frames overlapped on the MCU's clock; nothing dropped.
     let frames = firmware.frame_count() as usize;
+    eprintln!(
+        "IMU feed after {frames} frames: {} samples queued, {} replaced by overlapping frames",
+        feed.len(),
+        feed.replaced()
+    );
     assert_eq!(feed.len() + feed.replaced() as usize, 4 * (frames - 1));
     assert_eq!(feed.dropped(), 0);
     let settled = run.summary.scenario.unwrap().settled_roll_rad;
