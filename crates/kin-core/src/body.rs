@@ -274,7 +274,7 @@ impl<M: Math> Solver<M> {
     /// `g = t + c`: 9 multiplications and 27 additions (15 and 33 with a horizontal
     /// translation or pivot) where the general transform of the four stance feet takes 36 and
     /// 59.
-    fn stance_feet_in_hips(
+    pub(crate) fn stance_feet_in_hips(
         &self,
         pose: &Pose,
         config: &BodyConfig,
@@ -449,7 +449,7 @@ fn by_value(
 
 /// `NonFinite` (named on FL) when the pose or the pivot is not finite: the first check of
 /// [`Solver::inverse`] and [`Solver::inverse_at_stance`].
-fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
+pub(crate) fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = &config.pivot_m;
     // Field by field, without copying the pose into an array first; all nine checked
     // together (`&`, no branch per value).
