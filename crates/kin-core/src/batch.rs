@@ -136,7 +136,8 @@ pub(crate) struct LegLanes<const N: usize> {
 /// The scalar solve returns at the first failing check; here every lane runs every stage and
 /// the code keeps the first failure in the scalar order (non-finite, inside the offset, too
 /// far, too close, a joint limit).
-#[inline]
+// Always inlined: into the AVX2 entry points too, which compile it for AVX2.
+#[inline(always)]
 pub(crate) fn leg_lanes<M: Math, const N: usize>(
     s: &leg::Solver<M>,
     sd: &[f32; N],
@@ -155,7 +156,8 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
     }
     let root = M::sqrt_lanes(&w_sq);
     // The leg plane, the reach checks, the abduction's arguments and the knee's sin² k.
-    let mut code = [code::OK; N];
+    // The codes as 32-bit lanes beside the f32 values (one vector width), bytes at the end.
+    let mut code = [u32::from(code::OK); N];
     let (mut v, mut dist2, mut s_sq) = ([0.0f32; N], [0.0f32; N], [0.0f32; N]);
     let (mut abd_y, mut abd_x, mut knee_x) = ([0.0f32; N], [0.0f32; N], [0.0f32; N]);
     for i in 0..N {
@@ -172,10 +174,10 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
         let far = M::lt_nonneg(c.far_sq, d2);
         let close = M::lt_nonneg(d2, c.near_sq);
         // The first failure in the scalar order, by selects.
-        let mut k = if close { code::TOO_CLOSE } else { code::OK };
-        k = if far { code::TOO_FAR } else { k };
-        k = if inside { code::INSIDE_OFFSET } else { k };
-        code[i] = if non_finite { code::NON_FINITE } else { k };
+        let mut k = select(close, code::TOO_CLOSE, u32::from(code::OK));
+        k = select(far, code::TOO_FAR, k);
+        k = select(inside, code::INSIDE_OFFSET, k);
+        code[i] = select(non_finite, code::NON_FINITE, k);
     }
     let s_abs = M::sqrt_lanes(&s_sq);
     let (mut knee_y, mut hip_y, mut hip_x) = ([0.0f32; N], [0.0f32; N], [0.0f32; N]);
@@ -194,52 +196,85 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
         abduction_rad: [0.0; N],
         hip_rad: [0.0; N],
         knee_rad: [0.0; N],
-        code,
+        code: [code::OK; N],
     };
     for i in 0..N {
         let within = s.admits_all(JointAngles::new(abduction[i], hip[i], knee[i]));
-        let k = out.code[i];
-        let k = if k == code::OK && !within {
-            code::JOINT_LIMIT
-        } else {
-            k
-        };
-        out.code[i] = k;
-        let ok = k == code::OK;
-        out.abduction_rad[i] = if ok { abduction[i] } else { 0.0 };
-        out.hip_rad[i] = if ok { hip[i] } else { 0.0 };
-        out.knee_rad[i] = if ok { knee[i] } else { 0.0 };
+        let k = code[i];
+        let k = select((k == u32::from(code::OK)) & !within, code::JOINT_LIMIT, k);
+        // All ones where solved, zero elsewhere: the angles or +0.0.
+        let keep = 0u32.wrapping_sub(u32::from(k == u32::from(code::OK)));
+        out.abduction_rad[i] = f32::from_bits(abduction[i].to_bits() & keep);
+        out.hip_rad[i] = f32::from_bits(hip[i].to_bits() & keep);
+        out.knee_rad[i] = f32::from_bits(knee[i].to_bits() & keep);
+        code[i] = k;
+    }
+    for (o, k) in out.code.iter_mut().zip(code) {
+        *o = k as u8;
     }
     out
 }
 
-/// A failed lane under [`ReachPolicy::Clamp`] solved by the scalar solve: its angles (zeros
-/// when it still fails) and code.
-fn clamp_one<M: Math>(s: &leg::Solver<M>, leg: LegId, foot: Vec3) -> ([f32; 3], u8) {
-    match s.inverse(leg, foot, ReachPolicy::Clamp) {
-        Ok(sol) => (
-            sol.angles.to_array(),
-            sol.clamped.map_or(code::OK, |c| code_of(c.kind)),
-        ),
-        Err(e) => ([0.0; 3], code_of(e.kind)),
-    }
+/// `code` where `cond`, else `other`, as a 32-bit lane (by a mask: no branch).
+#[inline(always)]
+fn select(cond: bool, code: u8, other: u32) -> u32 {
+    let m = 0u32.wrapping_sub(u32::from(cond));
+    (m & u32::from(code)) | (!m & other)
 }
 
-/// The lanes of chunk `k` of `n` targets read by `at(i)`; lanes past `n` hold the first
-/// target of the chunk (their results are dropped).
+/// [`leg_lanes`] of one chunk under `policy`: under [`ReachPolicy::Clamp`] a lane the chunk
+/// found unreachable (not [`code::NON_FINITE`]) is solved again by the scalar solve: its
+/// clamped angles and the code of why it was clamped.
 #[inline(always)]
-fn gather<const N: usize>(
-    first: usize,
-    n: usize,
-    at: impl Fn(usize) -> [f32; 3],
-) -> ([f32; N], [f32; N], [f32; N]) {
-    let (mut x, mut y, mut z) = ([0.0f32; N], [0.0f32; N], [0.0f32; N]);
-    let pad = at(first);
-    for i in 0..N {
-        let [a, b, c] = if first + i < n { at(first + i) } else { pad };
-        (x[i], y[i], z[i]) = (a, b, c);
+fn leg_chunk<M: Math>(
+    s: &leg::Solver<M>,
+    leg: LegId,
+    policy: ReachPolicy,
+    sd: &[f32; LANES],
+    x: &[f32; LANES],
+    y: &[f32; LANES],
+    z: &[f32; LANES],
+) -> LegLanes<LANES> {
+    let mut r = leg_lanes(s, sd, x, y, z);
+    if policy == ReachPolicy::Clamp {
+        let mut redo = false;
+        for k in r.code {
+            redo |= (k != code::OK) & (k != code::NON_FINITE);
+        }
+        if redo {
+            clamp_lanes(s, leg, x, y, z, &mut r);
+        }
     }
-    (x, y, z)
+    r
+}
+
+/// The lanes of `r` that [`leg_lanes`] found unreachable (not non-finite), solved again by
+/// the scalar solve under [`ReachPolicy::Clamp`]: their angles (zeros when it still fails)
+/// and codes.
+// Out of line: rare, and the chunk's vector code stays small.
+#[inline(never)]
+fn clamp_lanes<M: Math, const N: usize>(
+    s: &leg::Solver<M>,
+    leg: LegId,
+    x: &[f32; N],
+    y: &[f32; N],
+    z: &[f32; N],
+    r: &mut LegLanes<N>,
+) {
+    for i in 0..N {
+        if r.code[i] == code::OK || r.code[i] == code::NON_FINITE {
+            continue;
+        }
+        let (a, k) = match s.inverse(leg, Vec3::new(x[i], y[i], z[i]), ReachPolicy::Clamp) {
+            Ok(sol) => (
+                sol.angles.to_array(),
+                sol.clamped.map_or(code::OK, |c| code_of(c.kind)),
+            ),
+            Err(e) => ([0.0; 3], code_of(e.kind)),
+        };
+        (r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]) = (a[0], a[1], a[2]);
+        r.code[i] = k;
+    }
 }
 
 /// Leg IK of many feet of one leg: `feet_in_hip_m[i]` (the hip frame of `leg`, m) → the
@@ -250,7 +285,20 @@ fn gather<const N: usize>(
 /// # Errors
 /// [`LengthMismatch`] when `angles_rad` or `codes` is not as long as `feet_in_hip_m` (nothing
 /// is written).
+#[inline]
 pub fn leg_inverse<M: Math>(
+    solver: &leg::Solver<M>,
+    leg: LegId,
+    policy: ReachPolicy,
+    feet_in_hip_m: &[[f32; 3]],
+    angles_rad: &mut [[f32; 3]],
+    codes: &mut [u8],
+) -> Result<(), LengthMismatch> {
+    leg_inverse_impl(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
+}
+
+#[inline(always)]
+fn leg_inverse_impl<M: Math>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
@@ -262,20 +310,48 @@ pub fn leg_inverse<M: Math>(
     check_len("angles_rad", n, angles_rad.len())?;
     check_len("codes", n, codes.len())?;
     let sd = [solver.side_d_lat(leg); LANES];
-    for first in (0..n).step_by(LANES) {
-        let (x, y, z) = gather::<LANES>(first, n, |i| feet_in_hip_m[i]);
-        let r = leg_lanes(solver, &sd, &x, &y, &z);
-        let m = LANES.min(n - first);
-        for i in 0..m {
-            let (mut a, mut k) = ([r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]], r.code[i]);
-            if policy == ReachPolicy::Clamp && k != code::OK && k != code::NON_FINITE {
-                (a, k) = clamp_one(solver, leg, Vec3::new(x[i], y[i], z[i]));
-            }
-            angles_rad[first + i] = a;
-            codes[first + i] = k;
-        }
+    let solve = |f: &[[f32; 3]], a: &mut [[f32; 3]], c: &mut [u8]| {
+        leg_rows_chunk(solver, leg, policy, &sd, f, a, c)
+    };
+    let mut feet = feet_in_hip_m.chunks_exact(LANES);
+    let mut angles = angles_rad.chunks_exact_mut(LANES);
+    let mut out_codes = codes.chunks_exact_mut(LANES);
+    for ((f, a), c) in (&mut feet).zip(&mut angles).zip(&mut out_codes) {
+        solve(f, a, c);
+    }
+    let (f, a, c) = (
+        feet.remainder(),
+        angles.into_remainder(),
+        out_codes.into_remainder(),
+    );
+    if !f.is_empty() {
+        solve(f, a, c);
     }
     Ok(())
+}
+
+/// One chunk of [`leg_inverse`]: `f` (at most [`LANES`] rows; a tail is padded with its first
+/// row, whose results are dropped) → `a`, `c`.
+#[inline(always)]
+fn leg_rows_chunk<M: Math>(
+    solver: &leg::Solver<M>,
+    leg: LegId,
+    policy: ReachPolicy,
+    sd: &[f32; LANES],
+    f: &[[f32; 3]],
+    a: &mut [[f32; 3]],
+    c: &mut [u8],
+) {
+    let m = f.len();
+    let at = |i: usize| if i < m { f[i] } else { f[0] };
+    let x: [f32; LANES] = core::array::from_fn(|i| at(i)[0]);
+    let y: [f32; LANES] = core::array::from_fn(|i| at(i)[1]);
+    let z: [f32; LANES] = core::array::from_fn(|i| at(i)[2]);
+    let r = leg_chunk(solver, leg, policy, sd, &x, &y, &z);
+    for (i, (a, c)) in a.iter_mut().zip(c.iter_mut()).enumerate() {
+        *a = [r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]];
+        *c = r.code[i];
+    }
 }
 
 /// [`leg_inverse`] on a structure of arrays: the feet's coordinates `x_m`, `y_m`, `z_m` (one
@@ -284,7 +360,32 @@ pub fn leg_inverse<M: Math>(
 /// # Errors
 /// [`LengthMismatch`] when the slices differ in length from `x_m` (nothing is written).
 #[allow(clippy::too_many_arguments)] // Three coordinates in, three angles and a code out.
+#[inline]
 pub fn leg_inverse_soa<M: Math>(
+    solver: &leg::Solver<M>,
+    leg: LegId,
+    policy: ReachPolicy,
+    [x_m, y_m, z_m]: [&[f32]; 3],
+    abduction_rad: &mut [f32],
+    hip_rad: &mut [f32],
+    knee_rad: &mut [f32],
+    codes: &mut [u8],
+) -> Result<(), LengthMismatch> {
+    leg_inverse_soa_impl(
+        solver,
+        leg,
+        policy,
+        [x_m, y_m, z_m],
+        abduction_rad,
+        hip_rad,
+        knee_rad,
+        codes,
+    )
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn leg_inverse_soa_impl<M: Math>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
@@ -303,23 +404,36 @@ pub fn leg_inverse_soa<M: Math>(
     check_len("codes", n, codes.len())?;
     let sd = [solver.side_d_lat(leg); LANES];
     for first in (0..n).step_by(LANES) {
-        let (x, y, z) = gather::<LANES>(first, n, |i| [x_m[i], y_m[i], z_m[i]]);
-        let r = leg_lanes(solver, &sd, &x, &y, &z);
         let m = LANES.min(n - first);
-        for i in 0..m {
-            let (mut a, mut k) = ([r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]], r.code[i]);
-            if policy == ReachPolicy::Clamp && k != code::OK && k != code::NON_FINITE {
-                (a, k) = clamp_one(solver, leg, Vec3::new(x[i], y[i], z[i]));
-            }
-            (
-                abduction_rad[first + i],
-                hip_rad[first + i],
-                knee_rad[first + i],
-            ) = (a[0], a[1], a[2]);
-            codes[first + i] = k;
-        }
+        let lanes = |v: &[f32]| -> [f32; LANES] {
+            let v = &v[first..first + m];
+            core::array::from_fn(|i| if i < m { v[i] } else { v[0] })
+        };
+        let (x, y, z) = (lanes(x_m), lanes(y_m), lanes(z_m));
+        let r = leg_chunk(solver, leg, policy, &sd, &x, &y, &z);
+        abduction_rad[first..first + m].copy_from_slice(&r.abduction_rad[..m]);
+        hip_rad[first..first + m].copy_from_slice(&r.hip_rad[..m]);
+        knee_rad[first..first + m].copy_from_slice(&r.knee_rad[..m]);
+        codes[first..first + m].copy_from_slice(&r.code[..m]);
     }
     Ok(())
+}
+
+/// The lanes of the chunk from `first` of `n` rows read by `at(i)`; lanes past `n` hold the
+/// chunk's first row (their results are dropped).
+#[inline(always)]
+fn gather<const N: usize>(
+    first: usize,
+    n: usize,
+    at: impl Fn(usize) -> [f32; 3],
+) -> ([f32; N], [f32; N], [f32; N]) {
+    let (mut x, mut y, mut z) = ([0.0f32; N], [0.0f32; N], [0.0f32; N]);
+    let pad = at(first);
+    for i in 0..N {
+        let [a, b, c] = if first + i < n { at(first + i) } else { pad };
+        (x[i], y[i], z[i]) = (a, b, c);
+    }
+    (x, y, z)
 }
 
 /// Leg FK of many joint-angle rows of one leg on backend `M`: `angles_rad[i]`
@@ -330,7 +444,20 @@ pub fn leg_inverse_soa<M: Math>(
 ///
 /// # Errors
 /// [`LengthMismatch`] when `feet_in_hip_m` or `codes` is not as long as `angles_rad`.
+#[inline]
 pub fn leg_forward<M: Math>(
+    geometry: &LegGeometry,
+    leg: LegId,
+    angles_rad: &[[f32; 3]],
+    feet_in_hip_m: &mut [[f32; 3]],
+    codes: &mut [u8],
+) -> Result<(), LengthMismatch> {
+    leg_forward_impl::<M>(geometry, leg, angles_rad, feet_in_hip_m, codes)
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn leg_forward_impl<M: Math>(
     geometry: &LegGeometry,
     leg: LegId,
     angles_rad: &[[f32; 3]],
@@ -394,7 +521,23 @@ pub const NO_LEG: i8 = -1;
 /// [`LengthMismatch`] when `angles_rad`, `codes`, `legs` or the feet of
 /// [`BodyFeet::PerPose`] are not as long as `poses`.
 #[allow(clippy::too_many_arguments)] // Poses and feet in, angles, codes and legs out.
+#[inline]
 pub fn body_inverse<M: Math>(
+    solver: &body::Solver<M>,
+    config: &BodyConfig,
+    policy: ReachPolicy,
+    poses: &[[f32; 6]],
+    feet: BodyFeet<'_>,
+    angles_rad: &mut [[f32; 12]],
+    codes: &mut [u8],
+    legs: &mut [i8],
+) -> Result<(), LengthMismatch> {
+    body_inverse_impl(solver, config, policy, poses, feet, angles_rad, codes, legs)
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn body_inverse_impl<M: Math>(
     solver: &body::Solver<M>,
     config: &BodyConfig,
     policy: ReachPolicy,
@@ -501,5 +644,107 @@ fn body_scalar<M: Math>(
             None => (sol.angles_rad, code::OK, NO_LEG),
         },
         Err(e) => ([0.0; 12], code_of(e.kind), e.leg.index() as i8),
+    }
+}
+
+/// The batch solves compiled for x86-64 CPUs with AVX2: the same functions, each value in one
+/// 256-bit register of 8 lanes and three-operand instructions instead of two SSE registers
+/// and the moves between them. The results are the same bits: the same operations in the
+/// same order (AVX2 alone enables no fused multiply–add, and the compiler never contracts
+/// a multiplication and an addition into one). A host checks the CPU once
+/// (`std::is_x86_feature_detected!("avx2")`) and calls these, else the portable ones.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)] // `#[target_feature]` functions are unsafe to call: the CPU must have it.
+pub mod avx2 {
+    use super::*;
+
+    /// [`super::leg_inverse`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    ///
+    /// # Errors
+    /// As [`super::leg_inverse`].
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn leg_inverse<M: Math>(
+        solver: &leg::Solver<M>,
+        leg: LegId,
+        policy: ReachPolicy,
+        feet_in_hip_m: &[[f32; 3]],
+        angles_rad: &mut [[f32; 3]],
+        codes: &mut [u8],
+    ) -> Result<(), LengthMismatch> {
+        leg_inverse_impl(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
+    }
+
+    /// [`super::leg_inverse_soa`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    ///
+    /// # Errors
+    /// As [`super::leg_inverse_soa`].
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn leg_inverse_soa<M: Math>(
+        solver: &leg::Solver<M>,
+        leg: LegId,
+        policy: ReachPolicy,
+        feet_in_hip_m: [&[f32]; 3],
+        abduction_rad: &mut [f32],
+        hip_rad: &mut [f32],
+        knee_rad: &mut [f32],
+        codes: &mut [u8],
+    ) -> Result<(), LengthMismatch> {
+        leg_inverse_soa_impl(
+            solver,
+            leg,
+            policy,
+            feet_in_hip_m,
+            abduction_rad,
+            hip_rad,
+            knee_rad,
+            codes,
+        )
+    }
+
+    /// [`super::leg_forward`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    ///
+    /// # Errors
+    /// As [`super::leg_forward`].
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn leg_forward<M: Math>(
+        geometry: &LegGeometry,
+        leg: LegId,
+        angles_rad: &[[f32; 3]],
+        feet_in_hip_m: &mut [[f32; 3]],
+        codes: &mut [u8],
+    ) -> Result<(), LengthMismatch> {
+        leg_forward_impl::<M>(geometry, leg, angles_rad, feet_in_hip_m, codes)
+    }
+
+    /// [`super::body_inverse`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    ///
+    /// # Errors
+    /// As [`super::body_inverse`].
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn body_inverse<M: Math>(
+        solver: &body::Solver<M>,
+        config: &BodyConfig,
+        policy: ReachPolicy,
+        poses: &[[f32; 6]],
+        feet: BodyFeet<'_>,
+        angles_rad: &mut [[f32; 12]],
+        codes: &mut [u8],
+        legs: &mut [i8],
+    ) -> Result<(), LengthMismatch> {
+        body_inverse_impl(solver, config, policy, poses, feet, angles_rad, codes, legs)
     }
 }

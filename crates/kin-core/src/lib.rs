@@ -59,8 +59,10 @@
 //! every backend swappable — and nalgebra (f64) is the independent oracle of the tests.
 
 #![no_std]
-// `deny`, not `forbid`: the one exception is the AVR's flash tables of `math` (their
-// `link_section`), which only the `Math` backend's reads can reach.
+// `deny`, not `forbid`: the exceptions are the AVR's flash tables of `math` (their
+// `link_section`), which only the `Math` backend's reads can reach, the x86-64 square root of
+// the batch solves' lanes (`math::lanes`, SSE's `sqrtps`), and the AVX2 entry points of
+// `batch::avx2` (unsafe to call: the CPU must have AVX2).
 #![deny(unsafe_code)]
 
 pub mod batch;

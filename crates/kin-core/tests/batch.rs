@@ -4,7 +4,11 @@
 //! policies. Targets: proptest over a box enclosing the whole workspace with special values
 //! mixed in (±0, NaN, ±∞, huge, subnormal), and enumerated edges (the reach boundaries ± a
 //! few ulps, the offset circle, the quadrant boundaries y = 0 / z = 0 with both zeros, the
-//! joint limits ± an ulp), on every tail length `0..=LANES + 1` and beyond.
+//! joint limits ± an ulp), on every tail length `0..=LANES + 1` and beyond. The AVX2 entry
+//! points (`batch::avx2`) give the portable ones' bits, where the CPU has AVX2.
+
+// The AVX2 entry points are unsafe to call: each call is behind the CPU's check.
+#![allow(unsafe_code)]
 
 use kin_core::batch::{self, code, BodyFeet, LANES, NO_LEG};
 use kin_core::math::{Fast, Libm, SoftFloat};
@@ -67,6 +71,38 @@ fn check_leg_on<M: Math>(robot: &Robot, leg: LegId, policy: ReachPolicy, feet: &
         &mut codes_soa,
     )
     .unwrap();
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        let mut angles2 = vec![[f32::NAN; 3]; n];
+        let mut codes2 = vec![u8::MAX; n];
+        // SAFETY: the CPU supports AVX2 (checked above).
+        unsafe { batch::avx2::leg_inverse(&s, leg, policy, feet, &mut angles2, &mut codes2) }
+            .unwrap();
+        assert_eq!(
+            angles2.iter().map(|a| bits3(*a)).collect::<Vec<_>>(),
+            angles.iter().map(|a| bits3(*a)).collect::<Vec<_>>()
+        );
+        assert_eq!(codes2, codes);
+        let (mut a2, mut h2, mut k2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        // SAFETY: as above.
+        unsafe {
+            batch::avx2::leg_inverse_soa(
+                &s,
+                leg,
+                policy,
+                [&cols[0], &cols[1], &cols[2]],
+                &mut a2,
+                &mut h2,
+                &mut k2,
+                &mut codes2,
+            )
+        }
+        .unwrap();
+        for i in 0..n {
+            assert_eq!(bits3([a2[i], h2[i], k2[i]]), bits3(angles[i]));
+        }
+        assert_eq!(codes2, codes);
+    }
     for (i, p) in feet.iter().enumerate() {
         let (want, want_code) = scalar_leg(&s, leg, policy, *p);
         let name = core::any::type_name::<M>();
@@ -295,6 +331,14 @@ proptest! {
         let mut feet = vec![[f32::NAN; 3]; q.len()];
         let mut codes = vec![u8::MAX; q.len()];
         batch::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, &q, &mut feet, &mut codes).unwrap();
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            let (mut feet2, mut codes2) = (vec![[0.0; 3]; q.len()], vec![0; q.len()]);
+            // SAFETY: the CPU supports AVX2 (checked above).
+            unsafe { batch::avx2::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, &q, &mut feet2, &mut codes2) }.unwrap();
+            prop_assert_eq!(feet2.iter().map(|f| bits3(*f)).collect::<Vec<_>>(), feet.iter().map(|f| bits3(*f)).collect::<Vec<_>>());
+            prop_assert_eq!(&codes2, &codes);
+        }
         for (i, a) in q.iter().enumerate() {
             if a.iter().all(|v| v.is_finite()) {
                 let want = leg::forward(&robot.leg, leg, kin_core::JointAngles::from_array(*a));
@@ -361,6 +405,30 @@ fn check_body_on<M: Math>(
         &mut legs,
     )
     .unwrap();
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        let mut angles2 = vec![[f32::NAN; 12]; n];
+        let (mut codes2, mut legs2) = (vec![u8::MAX; n], vec![i8::MAX; n]);
+        // SAFETY: the CPU supports AVX2 (checked above).
+        unsafe {
+            batch::avx2::body_inverse(
+                &s,
+                config,
+                policy,
+                poses,
+                feet,
+                &mut angles2,
+                &mut codes2,
+                &mut legs2,
+            )
+        }
+        .unwrap();
+        let bits = |v: &Vec<[f32; 12]>| v.iter().map(|a| a.map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(
+            (bits(&angles2), &codes2, &legs2),
+            (bits(&angles), &codes, &legs)
+        );
+    }
     for (j, p) in poses.iter().enumerate() {
         let (want, c, l) = scalar_body(&s, config, policy, *p, feet, j);
         assert_eq!(
