@@ -52,8 +52,8 @@ fn batch_benches(c: &mut Criterion) {
             &solvers[*r],
             *leg,
             ReachPolicy::Reject,
-            rows,
-            &mut angles[k],
+            rows.as_flattened(),
+            angles[k].as_flattened_mut(),
             &mut codes[k],
         )
         .expect("lengths match");
@@ -77,8 +77,8 @@ fn batch_benches(c: &mut Criterion) {
                     &solvers[*r],
                     *leg,
                     ReachPolicy::Reject,
-                    rows,
-                    &mut angles[k],
+                    rows.as_flattened(),
+                    angles[k].as_flattened_mut(),
                     &mut codes[k],
                 );
             }
@@ -96,8 +96,8 @@ fn batch_benches(c: &mut Criterion) {
                             &solvers[*r],
                             *leg,
                             ReachPolicy::Reject,
-                            rows,
-                            &mut angles[k],
+                            rows.as_flattened(),
+                            angles[k].as_flattened_mut(),
                             &mut codes[k],
                         )
                     };
@@ -161,9 +161,9 @@ fn batch_benches(c: &mut Criterion) {
                 &solver,
                 &config,
                 ReachPolicy::Reject,
-                black_box(&pose_rows),
+                black_box(pose_rows.as_flattened()),
                 BodyFeet::Stance { height_m },
-                &mut body_angles,
+                body_angles.as_flattened_mut(),
                 &mut body_codes,
                 &mut body_legs,
             );

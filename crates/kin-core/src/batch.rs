@@ -25,9 +25,16 @@
 //! let robot = Robot::shahriar2023();
 //! let solver = leg::Solver::new(&robot);
 //! let feet_in_hip_m = [[0.02, 0.05, -0.25], [0.0, 0.05, -0.9], [f32::NAN, 0.0, 0.0]];
-//! let mut angles_rad = [[0.0; 3]; 3];
+//! let mut angles_rad = [[0.0f32; 3]; 3];
 //! let mut codes = [0; 3];
-//! batch::leg_inverse(&solver, LegId::FL, ReachPolicy::Reject, &feet_in_hip_m, &mut angles_rad, &mut codes)?;
+//! batch::leg_inverse(
+//!     &solver,
+//!     LegId::FL,
+//!     ReachPolicy::Reject,
+//!     feet_in_hip_m.as_flattened(),
+//!     angles_rad.as_flattened_mut(),
+//!     &mut codes,
+//! )?;
 //! assert_eq!(codes, [batch::code::OK, batch::code::TOO_FAR, batch::code::NON_FINITE]);
 //! let one = solver.inverse(LegId::FL, Vec3::from_array(feet_in_hip_m[0]), ReachPolicy::Reject)?;
 //! assert_eq!(angles_rad[0], one.angles.to_array());
@@ -84,14 +91,15 @@ pub const fn code_of(kind: Unreachable) -> u8 {
     }
 }
 
-/// An output slice whose length differs from the input's number of targets.
+/// A slice whose length does not fit the batch: an input not a whole number of rows, or an
+/// output not as long as the input's rows need.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LengthMismatch {
     /// Which slice: `"angles_rad"`, `"codes"`, ….
     pub what: &'static str,
-    /// The number of targets.
+    /// The length it needs (for an input: the whole rows within its length).
     pub expected: usize,
-    /// The slice's length.
+    /// Its length.
     pub got: usize,
 }
 
@@ -99,13 +107,20 @@ impl fmt::Display for LengthMismatch {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{}: {} elements for {} targets",
+            "{}: {} elements, expected {}",
             self.what, self.got, self.expected
         )
     }
 }
 
 impl core::error::Error for LengthMismatch {}
+
+/// The number of rows of `width` floats in `rows`, refused when `rows` is not whole rows.
+fn row_count(what: &'static str, rows: &[f32], width: usize) -> Result<usize, LengthMismatch> {
+    let n = rows.len() / width;
+    check_len(what, n * width, rows.len())?;
+    Ok(n)
+}
 
 fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), LengthMismatch> {
     if expected == got {
@@ -277,21 +292,22 @@ fn clamp_lanes<M: Math, const N: usize>(
     }
 }
 
-/// Leg IK of many feet of one leg: `feet_in_hip_m[i]` (the hip frame of `leg`, m) → the
-/// joint angles `angles_rad[i]` (`[abduction, hip, knee]`, rad) and the reach code
-/// `codes[i]`, each equal to what `solver.inverse(leg, feet_in_hip_m[i], policy)` returns
-/// (a failure: zeros and its code). See the [module docs](self).
+/// Leg IK of many feet of one leg: `feet_in_hip_m`, rows `[x, y, z]` (the hip frame of
+/// `leg`, m) one after the other (`rows.as_flattened()` of `&[[f32; 3]]`) → `angles_rad`,
+/// rows `[abduction, hip, knee]` (rad), and one reach code per row in `codes`, each row equal
+/// to what `solver.inverse(leg, foot, policy)` returns (a failure: zeros and its code). See
+/// the [module docs](self).
 ///
 /// # Errors
-/// [`LengthMismatch`] when `angles_rad` or `codes` is not as long as `feet_in_hip_m` (nothing
-/// is written).
+/// [`LengthMismatch`] when `feet_in_hip_m` is not whole rows of 3, or `angles_rad` or `codes`
+/// does not fit its rows (nothing is written).
 #[inline]
 pub fn leg_inverse<M: Math>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
-    feet_in_hip_m: &[[f32; 3]],
-    angles_rad: &mut [[f32; 3]],
+    feet_in_hip_m: &[f32],
+    angles_rad: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
     leg_inverse_impl(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
@@ -302,19 +318,18 @@ fn leg_inverse_impl<M: Math>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
-    feet_in_hip_m: &[[f32; 3]],
-    angles_rad: &mut [[f32; 3]],
+    feet_in_hip_m: &[f32],
+    angles_rad: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    let n = feet_in_hip_m.len();
-    check_len("angles_rad", n, angles_rad.len())?;
+    let n = row_count("feet_in_hip_m", feet_in_hip_m, 3)?;
+    check_len("angles_rad", 3 * n, angles_rad.len())?;
     check_len("codes", n, codes.len())?;
     let sd = [solver.side_d_lat(leg); LANES];
-    let solve = |f: &[[f32; 3]], a: &mut [[f32; 3]], c: &mut [u8]| {
-        leg_rows_chunk(solver, leg, policy, &sd, f, a, c)
-    };
-    let mut feet = feet_in_hip_m.chunks_exact(LANES);
-    let mut angles = angles_rad.chunks_exact_mut(LANES);
+    let solve =
+        |f: &[f32], a: &mut [f32], c: &mut [u8]| leg_rows_chunk(solver, leg, policy, &sd, f, a, c);
+    let mut feet = feet_in_hip_m.chunks_exact(3 * LANES);
+    let mut angles = angles_rad.chunks_exact_mut(3 * LANES);
     let mut out_codes = codes.chunks_exact_mut(LANES);
     for ((f, a), c) in (&mut feet).zip(&mut angles).zip(&mut out_codes) {
         solve(f, a, c);
@@ -324,32 +339,32 @@ fn leg_inverse_impl<M: Math>(
         angles.into_remainder(),
         out_codes.into_remainder(),
     );
-    if !f.is_empty() {
+    if !c.is_empty() {
         solve(f, a, c);
     }
     Ok(())
 }
 
-/// One chunk of [`leg_inverse`]: `f` (at most [`LANES`] rows; a tail is padded with its first
-/// row, whose results are dropped) → `a`, `c`.
+/// One chunk of [`leg_inverse`]: `f` (at most [`LANES`] rows of 3; a tail is padded with its
+/// first row, whose results are dropped) → `a`, `c` (as many rows).
 #[inline(always)]
 fn leg_rows_chunk<M: Math>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
     sd: &[f32; LANES],
-    f: &[[f32; 3]],
-    a: &mut [[f32; 3]],
+    f: &[f32],
+    a: &mut [f32],
     c: &mut [u8],
 ) {
-    let m = f.len();
-    let at = |i: usize| if i < m { f[i] } else { f[0] };
-    let x: [f32; LANES] = core::array::from_fn(|i| at(i)[0]);
-    let y: [f32; LANES] = core::array::from_fn(|i| at(i)[1]);
-    let z: [f32; LANES] = core::array::from_fn(|i| at(i)[2]);
+    let m = c.len();
+    let at = |i: usize, k: usize| if i < m { f[3 * i + k] } else { f[k] };
+    let x: [f32; LANES] = core::array::from_fn(|i| at(i, 0));
+    let y: [f32; LANES] = core::array::from_fn(|i| at(i, 1));
+    let z: [f32; LANES] = core::array::from_fn(|i| at(i, 2));
     let r = leg_chunk(solver, leg, policy, sd, &x, &y, &z);
-    for (i, (a, c)) in a.iter_mut().zip(c.iter_mut()).enumerate() {
-        *a = [r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]];
+    for (i, (a, c)) in a.chunks_exact_mut(3).zip(c.iter_mut()).enumerate() {
+        a.copy_from_slice(&[r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]]);
         *c = r.code[i];
     }
 }
@@ -419,56 +434,46 @@ fn leg_inverse_soa_impl<M: Math>(
     Ok(())
 }
 
-/// The lanes of the chunk from `first` of `n` rows read by `at(i)`; lanes past `n` hold the
-/// chunk's first row (their results are dropped).
-#[inline(always)]
-fn gather<const N: usize>(
-    first: usize,
-    n: usize,
-    at: impl Fn(usize) -> [f32; 3],
-) -> ([f32; N], [f32; N], [f32; N]) {
-    let (mut x, mut y, mut z) = ([0.0f32; N], [0.0f32; N], [0.0f32; N]);
-    let pad = at(first);
-    for i in 0..N {
-        let [a, b, c] = if first + i < n { at(first + i) } else { pad };
-        (x[i], y[i], z[i]) = (a, b, c);
-    }
-    (x, y, z)
-}
-
-/// Leg FK of many joint-angle rows of one leg on backend `M`: `angles_rad[i]`
-/// (`[abduction, hip, knee]`, rad) → `feet_in_hip_m[i]` (the hip frame, m), equal to
-/// [`leg::forward`] on the same backend (`DefaultMath`: bit for bit), and `codes[i]`:
-/// [`code::NON_FINITE`] (and zeros) for a row with a NaN or infinite angle, else
-/// [`code::OK`] (the joint limits are not checked).
+/// Leg FK of many joint-angle rows of one leg on backend `M`: `angles_rad`, rows
+/// `[abduction, hip, knee]` (rad) one after the other → `feet_in_hip_m`, rows `[x, y, z]`
+/// (the hip frame, m), equal to [`leg::forward`] on the same backend (`DefaultMath`: bit for
+/// bit), and one code per row in `codes`: [`code::NON_FINITE`] (and zeros) for a row with a
+/// NaN or infinite angle, else [`code::OK`] (the joint limits are not checked).
 ///
 /// # Errors
-/// [`LengthMismatch`] when `feet_in_hip_m` or `codes` is not as long as `angles_rad`.
+/// [`LengthMismatch`] when `angles_rad` is not whole rows of 3, or `feet_in_hip_m` or `codes`
+/// does not fit its rows (nothing is written).
 #[inline]
 pub fn leg_forward<M: Math>(
     geometry: &LegGeometry,
     leg: LegId,
-    angles_rad: &[[f32; 3]],
-    feet_in_hip_m: &mut [[f32; 3]],
+    angles_rad: &[f32],
+    feet_in_hip_m: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
     leg_forward_impl::<M>(geometry, leg, angles_rad, feet_in_hip_m, codes)
 }
 
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn leg_forward_impl<M: Math>(
     geometry: &LegGeometry,
     leg: LegId,
-    angles_rad: &[[f32; 3]],
-    feet_in_hip_m: &mut [[f32; 3]],
+    angles_rad: &[f32],
+    feet_in_hip_m: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    let n = angles_rad.len();
-    check_len("feet_in_hip_m", n, feet_in_hip_m.len())?;
+    let n = row_count("angles_rad", angles_rad, 3)?;
+    check_len("feet_in_hip_m", 3 * n, feet_in_hip_m.len())?;
     check_len("codes", n, codes.len())?;
     for first in (0..n).step_by(LANES) {
-        let (a, h, k) = gather::<LANES>(first, n, |i| angles_rad[i]);
+        let m = LANES.min(n - first);
+        let at = |i: usize, k: usize| {
+            let i = if i < m { first + i } else { first };
+            angles_rad[3 * i + k]
+        };
+        let a: [f32; LANES] = core::array::from_fn(|i| at(i, 0));
+        let h: [f32; LANES] = core::array::from_fn(|i| at(i, 1));
+        let k: [f32; LANES] = core::array::from_fn(|i| at(i, 2));
         let mut out = [[0.0f32; 3]; LANES];
         let mut ok = [false; LANES];
         for i in 0..LANES {
@@ -477,9 +482,8 @@ fn leg_forward_impl<M: Math>(
             let f = leg::forward_on::<M>(geometry, leg, q);
             out[i] = if ok[i] { f.to_array() } else { [0.0; 3] };
         }
-        let m = LANES.min(n - first);
         for i in 0..m {
-            feet_in_hip_m[first + i] = out[i];
+            feet_in_hip_m[3 * (first + i)..3 * (first + i) + 3].copy_from_slice(&out[i]);
             codes[first + i] = if ok[i] { code::OK } else { code::NON_FINITE };
         }
     }
@@ -498,17 +502,18 @@ pub enum BodyFeet<'a> {
     /// The same four feet in the world frame (FL, FR, RL, RR), m, for every pose
     /// ([`body::Solver::inverse`]).
     Same(&'a [Vec3; 4]),
-    /// Four feet per pose in the world frame, `[FL, FR, RL, RR]` of `[x, y, z]`, m, one entry
-    /// per pose ([`body::Solver::inverse`]).
-    PerPose(&'a [[[f32; 3]; 4]]),
+    /// Four feet per pose in the world frame, m: per pose `[FL, FR, RL, RR]` of `[x, y, z]`,
+    /// 12 floats, one pose after the other ([`body::Solver::inverse`]).
+    PerPose(&'a [f32]),
 }
 
 /// No leg named in a body code: the pose was solved (`legs[i]` of [`body_inverse`]).
 pub const NO_LEG: i8 = -1;
 
-/// Full-body IK of many poses: `poses[i]` (`[roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m]`,
-/// [`Pose::from_array`]) with the feet of `feet` → `angles_rad[i]` (the twelve angles in the
-/// order of [`BodySolution::angles_rad`]), `codes[i]` and `legs[i]`, equal to what the scalar
+/// Full-body IK of many poses: `poses`, rows `[roll_rad, pitch_rad, yaw_rad, x_m, y_m, z_m]`
+/// ([`Pose::from_array`]) one after the other, with the feet of `feet` → `angles_rad`, rows of
+/// the twelve angles in the order of [`BodySolution::angles_rad`], and per pose `codes[i]` and
+/// `legs[i]`, equal to what the scalar
 /// body IK returns for that pose, all-or-nothing as it is: a pose that fails holds zeros, the
 /// code of the first leg (FL, FR, RL, RR) that fails and that leg's index (a non-finite pose:
 /// [`code::NON_FINITE`] on FL); under [`ReachPolicy::Clamp`] a clamped pose holds its angles,
@@ -518,17 +523,17 @@ pub const NO_LEG: i8 = -1;
 /// four legs' IK runs over [`LANES`] poses at a time.
 ///
 /// # Errors
-/// [`LengthMismatch`] when `angles_rad`, `codes`, `legs` or the feet of
-/// [`BodyFeet::PerPose`] are not as long as `poses`.
+/// [`LengthMismatch`] when `poses` is not whole rows of 6, or `angles_rad`, `codes`, `legs`
+/// or the feet of [`BodyFeet::PerPose`] do not fit its rows (nothing is written).
 #[allow(clippy::too_many_arguments)] // Poses and feet in, angles, codes and legs out.
 #[inline]
 pub fn body_inverse<M: Math>(
     solver: &body::Solver<M>,
     config: &BodyConfig,
     policy: ReachPolicy,
-    poses: &[[f32; 6]],
+    poses: &[f32],
     feet: BodyFeet<'_>,
-    angles_rad: &mut [[f32; 12]],
+    angles_rad: &mut [f32],
     codes: &mut [u8],
     legs: &mut [i8],
 ) -> Result<(), LengthMismatch> {
@@ -541,18 +546,18 @@ fn body_inverse_impl<M: Math>(
     solver: &body::Solver<M>,
     config: &BodyConfig,
     policy: ReachPolicy,
-    poses: &[[f32; 6]],
+    poses: &[f32],
     feet: BodyFeet<'_>,
-    angles_rad: &mut [[f32; 12]],
+    angles_rad: &mut [f32],
     codes: &mut [u8],
     legs: &mut [i8],
 ) -> Result<(), LengthMismatch> {
-    let n = poses.len();
-    check_len("angles_rad", n, angles_rad.len())?;
+    let n = row_count("poses", poses, 6)?;
+    check_len("angles_rad", 12 * n, angles_rad.len())?;
     check_len("codes", n, codes.len())?;
     check_len("legs", n, legs.len())?;
     if let BodyFeet::PerPose(f) = feet {
-        check_len("feet_in_world_m", n, f.len())?;
+        check_len("feet_in_world_m", 12 * n, f.len())?;
     }
     let leg_solver = solver.leg();
     let sd: [[f32; LANES]; 4] = LegId::ALL.map(|leg| [leg_solver.side_d_lat(leg); LANES]);
@@ -562,7 +567,7 @@ fn body_inverse_impl<M: Math>(
         let mut local = [[[0.0f32; LANES]; 3]; 4];
         let mut pose_ok = [false; LANES];
         for i in 0..m {
-            let pose = Pose::from_array(poses[first + i]);
+            let pose = Pose::from_array(pose_at(poses, first + i));
             pose_ok[i] = body::check_finite(&pose, config).is_ok();
             if !pose_ok[i] {
                 continue;
@@ -574,8 +579,7 @@ fn body_inverse_impl<M: Math>(
                 }
                 BodyFeet::Same(f) => hips = solver.feet_in_hips(&pose, config, f),
                 BodyFeet::PerPose(f) => {
-                    let f = f[first + i].map(Vec3::from_array);
-                    hips = solver.feet_in_hips(&pose, config, &f);
+                    hips = solver.feet_in_hips(&pose, config, &feet_at(f, first + i));
                 }
             }
             for (k, h) in hips.iter().enumerate() {
@@ -605,12 +609,26 @@ fn body_inverse_impl<M: Math>(
                 (true, Some(k)) if policy == ReachPolicy::Reject => {
                     ([0.0; 12], solved[k].code[i], k as i8)
                 }
-                (true, Some(_)) => body_scalar(solver, config, poses[j], feet, j),
+                (true, Some(_)) => body_scalar(solver, config, pose_at(poses, j), feet, j),
             };
-            (angles_rad[j], codes[j], legs[j]) = (out, code, leg);
+            angles_rad[12 * j..12 * j + 12].copy_from_slice(&out);
+            (codes[j], legs[j]) = (code, leg);
         }
     }
     Ok(())
+}
+
+/// Row `j` of the poses.
+fn pose_at(poses: &[f32], j: usize) -> [f32; 6] {
+    core::array::from_fn(|k| poses[6 * j + k])
+}
+
+/// The four feet of pose `j` of [`BodyFeet::PerPose`].
+fn feet_at(feet: &[f32], j: usize) -> [Vec3; 4] {
+    core::array::from_fn(|k| {
+        let b = 12 * j + 3 * k;
+        Vec3::new(feet[b], feet[b + 1], feet[b + 2])
+    })
 }
 
 /// Pose `j` of [`body_inverse`] under [`ReachPolicy::Clamp`] by the scalar body IK.
@@ -630,8 +648,7 @@ fn body_scalar<M: Math>(
         }
         BodyFeet::Same(f) => solver.inverse_into(&pose, config, f, policy, &mut sol),
         BodyFeet::PerPose(f) => {
-            let f = f[j].map(Vec3::from_array);
-            solver.inverse_into(&pose, config, &f, policy, &mut sol)
+            solver.inverse_into(&pose, config, &feet_at(f, j), policy, &mut sol)
         }
     };
     match r {
@@ -670,8 +687,8 @@ pub mod avx2 {
         solver: &leg::Solver<M>,
         leg: LegId,
         policy: ReachPolicy,
-        feet_in_hip_m: &[[f32; 3]],
-        angles_rad: &mut [[f32; 3]],
+        feet_in_hip_m: &[f32],
+        angles_rad: &mut [f32],
         codes: &mut [u8],
     ) -> Result<(), LengthMismatch> {
         leg_inverse_impl(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
@@ -719,8 +736,8 @@ pub mod avx2 {
     pub unsafe fn leg_forward<M: Math>(
         geometry: &LegGeometry,
         leg: LegId,
-        angles_rad: &[[f32; 3]],
-        feet_in_hip_m: &mut [[f32; 3]],
+        angles_rad: &[f32],
+        feet_in_hip_m: &mut [f32],
         codes: &mut [u8],
     ) -> Result<(), LengthMismatch> {
         leg_forward_impl::<M>(geometry, leg, angles_rad, feet_in_hip_m, codes)
@@ -739,9 +756,9 @@ pub mod avx2 {
         solver: &body::Solver<M>,
         config: &BodyConfig,
         policy: ReachPolicy,
-        poses: &[[f32; 6]],
+        poses: &[f32],
         feet: BodyFeet<'_>,
-        angles_rad: &mut [[f32; 12]],
+        angles_rad: &mut [f32],
         codes: &mut [u8],
         legs: &mut [i8],
     ) -> Result<(), LengthMismatch> {

@@ -56,7 +56,15 @@ fn check_leg_on<M: Math>(robot: &Robot, leg: LegId, policy: ReachPolicy, feet: &
     let n = feet.len();
     let mut angles = vec![[f32::NAN; 3]; n];
     let mut codes = vec![u8::MAX; n];
-    batch::leg_inverse(&s, leg, policy, feet, &mut angles, &mut codes).unwrap();
+    batch::leg_inverse(
+        &s,
+        leg,
+        policy,
+        feet.as_flattened(),
+        angles.as_flattened_mut(),
+        &mut codes,
+    )
+    .unwrap();
     let cols: [Vec<f32>; 3] = core::array::from_fn(|k| feet.iter().map(|p| p[k]).collect());
     let (mut a, mut h, mut k) = (vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]);
     let mut codes_soa = vec![u8::MAX; n];
@@ -76,8 +84,17 @@ fn check_leg_on<M: Math>(robot: &Robot, leg: LegId, policy: ReachPolicy, feet: &
         let mut angles2 = vec![[f32::NAN; 3]; n];
         let mut codes2 = vec![u8::MAX; n];
         // SAFETY: the CPU supports AVX2 (checked above).
-        unsafe { batch::avx2::leg_inverse(&s, leg, policy, feet, &mut angles2, &mut codes2) }
-            .unwrap();
+        unsafe {
+            batch::avx2::leg_inverse(
+                &s,
+                leg,
+                policy,
+                feet.as_flattened(),
+                angles2.as_flattened_mut(),
+                &mut codes2,
+            )
+        }
+        .unwrap();
         assert_eq!(
             angles2.iter().map(|a| bits3(*a)).collect::<Vec<_>>(),
             angles.iter().map(|a| bits3(*a)).collect::<Vec<_>>()
@@ -253,7 +270,15 @@ fn leg_batch_failed_rows_hold_zeros_and_never_nan() {
     let mut angles = vec![[1.0; 3]; feet.len()];
     let mut codes = vec![0; feet.len()];
     for policy in POLICIES {
-        batch::leg_inverse(&s, LegId::RL, policy, &feet, &mut angles, &mut codes).unwrap();
+        batch::leg_inverse(
+            &s,
+            LegId::RL,
+            policy,
+            feet.as_flattened(),
+            angles.as_flattened_mut(),
+            &mut codes,
+        )
+        .unwrap();
         for (a, c) in angles.iter().zip(&codes) {
             assert!(a.iter().all(|v| v.is_finite()), "{a:?}");
             if policy == ReachPolicy::Reject && *c != code::OK {
@@ -274,13 +299,25 @@ fn wrong_lengths_are_refused_before_anything_is_written() {
         &s,
         LegId::FL,
         ReachPolicy::Reject,
-        &feet,
-        &mut angles,
+        feet.as_flattened(),
+        angles.as_flattened_mut(),
         &mut codes,
     )
     .unwrap_err();
-    assert_eq!((e.what, e.expected, e.got), ("angles_rad", 3, 2));
+    assert_eq!((e.what, e.expected, e.got), ("angles_rad", 9, 6));
     assert_eq!((angles, codes), ([[7.0; 3]; 2], [9; 3]));
+    // Not whole rows.
+    let e = batch::leg_inverse(
+        &s,
+        LegId::FL,
+        ReachPolicy::Reject,
+        &feet.as_flattened()[..8],
+        &mut [0.0; 6],
+        &mut codes[..2],
+    )
+    .unwrap_err();
+    assert_eq!((e.what, e.expected, e.got), ("feet_in_hip_m", 6, 8));
+    assert_eq!(e.to_string(), "feet_in_hip_m: 8 elements, expected 6");
 }
 
 /// A foot coordinate: mostly a uniform value over the box, sometimes a special one.
@@ -330,12 +367,12 @@ proptest! {
         let q: Vec<[f32; 3]> = rows.iter().map(|&(a, h, k)| [a, h, k]).collect();
         let mut feet = vec![[f32::NAN; 3]; q.len()];
         let mut codes = vec![u8::MAX; q.len()];
-        batch::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, &q, &mut feet, &mut codes).unwrap();
+        batch::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, q.as_flattened(), feet.as_flattened_mut(), &mut codes).unwrap();
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             let (mut feet2, mut codes2) = (vec![[0.0; 3]; q.len()], vec![0; q.len()]);
             // SAFETY: the CPU supports AVX2 (checked above).
-            unsafe { batch::avx2::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, &q, &mut feet2, &mut codes2) }.unwrap();
+            unsafe { batch::avx2::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, q.as_flattened(), feet2.as_flattened_mut(), &mut codes2) }.unwrap();
             prop_assert_eq!(feet2.iter().map(|f| bits3(*f)).collect::<Vec<_>>(), feet.iter().map(|f| bits3(*f)).collect::<Vec<_>>());
             prop_assert_eq!(&codes2, &codes);
         }
@@ -367,7 +404,14 @@ fn scalar_body<M: Math>(
         }
         BodyFeet::Same(f) => s.inverse_into(&pose, config, f, policy, &mut sol),
         BodyFeet::PerPose(f) => {
-            s.inverse_into(&pose, config, &f[j].map(Vec3::from_array), policy, &mut sol)
+            let feet: [Vec3; 4] = core::array::from_fn(|k| {
+                Vec3::new(
+                    f[12 * j + 3 * k],
+                    f[12 * j + 3 * k + 1],
+                    f[12 * j + 3 * k + 2],
+                )
+            });
+            s.inverse_into(&pose, config, &feet, policy, &mut sol)
         }
     };
     match r {
@@ -398,9 +442,9 @@ fn check_body_on<M: Math>(
         &s,
         config,
         policy,
-        poses,
+        poses.as_flattened(),
         feet,
-        &mut angles,
+        angles.as_flattened_mut(),
         &mut codes,
         &mut legs,
     )
@@ -415,9 +459,9 @@ fn check_body_on<M: Math>(
                 &s,
                 config,
                 policy,
-                poses,
+                poses.as_flattened(),
                 feet,
-                &mut angles2,
+                angles2.as_flattened_mut(),
                 &mut codes2,
                 &mut legs2,
             )
@@ -501,7 +545,7 @@ fn body_batch_equals_scalar_on_every_feet_form_and_order() {
                         let forms = [
                             BodyFeet::Stance { height_m: stance },
                             BodyFeet::Same(&same),
-                            BodyFeet::PerPose(&per_pose),
+                            BodyFeet::PerPose(per_pose.as_flattened().as_flattened()),
                         ];
                         for feet in forms {
                             check_body(&robot, &config, policy, &poses, feet);
