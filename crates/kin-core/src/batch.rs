@@ -590,10 +590,10 @@ fn body_inverse_impl<M: Math>(
             let [x, y, z] = &local[k];
             leg_lanes(leg_solver, &sd[k], x, y, z)
         });
-        for i in 0..m {
+        for (i, &ok) in pose_ok.iter().enumerate().take(m) {
             let j = first + i;
             let failed = (0..4).find(|&k| solved[k].code[i] != code::OK);
-            let (out, code, leg) = match (pose_ok[i], failed) {
+            let (out, code, leg) = match (ok, failed) {
                 (false, _) => ([0.0; 12], code::NON_FINITE, 0),
                 (true, None) => {
                     let mut a = [0.0f32; 12];

@@ -131,7 +131,7 @@ mod tests {
         let mut rng = SplitMix64::new(0x1a2e_5a7a);
         let mut ys = [0.0f32; 8];
         let mut xs = [0.0f32; 8];
-        let mut check = |ys: &[f32; 8], xs: &[f32; 8]| {
+        let check = |ys: &[f32; 8], xs: &[f32; 8]| {
             let got = atan2_deg15_lanes(ys, xs);
             for i in 0..8 {
                 let want = poly::atan2_deg15(ys[i], xs[i]);
