@@ -231,6 +231,7 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
 }
 
 /// `code` where `cond`, else `other`, as a 32-bit lane (by a mask: no branch).
+// Always inlined: a select inside the lanes' loops, which must stay branch-free.
 #[inline(always)]
 fn select(cond: bool, code: u8, other: u32) -> u32 {
     let m = 0u32.wrapping_sub(u32::from(cond));
@@ -240,6 +241,8 @@ fn select(cond: bool, code: u8, other: u32) -> u32 {
 /// [`leg_lanes`] of one chunk under `policy`: under [`ReachPolicy::Clamp`] a lane the chunk
 /// found unreachable (not [`code::NON_FINITE`]) is solved again by the scalar solve: its
 /// clamped angles and the code of why it was clamped.
+// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
+// (a call out of line would run the portable code).
 #[inline(always)]
 fn leg_chunk<M: Math>(
     s: &leg::Solver<M>,
@@ -313,6 +316,8 @@ pub fn leg_inverse<M: Math>(
     leg_inverse_impl(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
 }
 
+// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
+// (a call out of line would run the portable code).
 #[inline(always)]
 fn leg_inverse_impl<M: Math>(
     solver: &leg::Solver<M>,
@@ -347,6 +352,8 @@ fn leg_inverse_impl<M: Math>(
 
 /// One chunk of [`leg_inverse`]: `f` (at most [`LANES`] rows of 3; a tail is padded with its
 /// first row, whose results are dropped) → `a`, `c` (as many rows).
+// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
+// (a call out of line would run the portable code).
 #[inline(always)]
 fn leg_rows_chunk<M: Math>(
     solver: &leg::Solver<M>,
@@ -398,6 +405,8 @@ pub fn leg_inverse_soa<M: Math>(
     )
 }
 
+// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
+// (a call out of line would run the portable code).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn leg_inverse_soa_impl<M: Math>(
@@ -454,6 +463,8 @@ pub fn leg_forward<M: Math>(
     leg_forward_impl::<M>(geometry, leg, angles_rad, feet_in_hip_m, codes)
 }
 
+// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
+// (a call out of line would run the portable code).
 #[inline(always)]
 fn leg_forward_impl<M: Math>(
     geometry: &LegGeometry,
@@ -540,6 +551,8 @@ pub fn body_inverse<M: Math>(
     body_inverse_impl(solver, config, policy, poses, feet, angles_rad, codes, legs)
 }
 
+// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
+// (a call out of line would run the portable code).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn body_inverse_impl<M: Math>(
