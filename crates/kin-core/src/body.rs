@@ -274,7 +274,7 @@ impl<M: Math> Solver<M> {
     /// `g = t + c`: 9 multiplications and 27 additions (15 and 33 with a horizontal
     /// translation or pivot) where the general transform of the four stance feet takes 36 and
     /// 59.
-    fn stance_feet_in_hips(
+    pub(crate) fn stance_feet_in_hips(
         &self,
         pose: &Pose,
         config: &BodyConfig,
@@ -423,6 +423,25 @@ impl<M: Math> Solver<M> {
         policy: ReachPolicy,
         out: &mut BodySolution,
     ) -> Result<(), IkError> {
+        // Hosts: the four legs as the four lanes of the batch solve (`crate::batch`, the
+        // scalar solve's bits), whose stages the compiler interleaves across the legs; a pose
+        // with a leg that fails goes through the scalar loop below for its error or clamps.
+        // Not on the AVR, which gains nothing from it (in order, no vector unit).
+        #[cfg(not(target_arch = "avr"))]
+        {
+            let x = [local[0].x, local[1].x, local[2].x, local[3].x];
+            let y = [local[0].y, local[1].y, local[2].y, local[3].y];
+            let z = [local[0].z, local[1].z, local[2].z, local[3].z];
+            let sd = LegId::ALL.map(|leg| self.leg.side_d_lat(leg));
+            let r = crate::batch::leg_lanes(&self.leg, &sd, &x, &y, &z);
+            if u32::from_ne_bytes(r.code) == 0 {
+                for (k, a) in out.angles_rad.chunks_exact_mut(3).enumerate() {
+                    a.copy_from_slice(&[r.abduction_rad[k], r.hip_rad[k], r.knee_rad[k]]);
+                }
+                out.clamped = [None; 4];
+                return Ok(());
+            }
+        }
         let legs = out.angles_rad.chunks_exact_mut(3).zip(&mut out.clamped);
         for ((angles, clamped), (foot, leg)) in legs.zip(local.iter().zip(&LegId::ALL)) {
             // Chunks of exactly three: the conversion cannot fail (and compiles to nothing).
@@ -449,7 +468,7 @@ fn by_value(
 
 /// `NonFinite` (named on FL) when the pose or the pivot is not finite: the first check of
 /// [`Solver::inverse`] and [`Solver::inverse_at_stance`].
-fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
+pub(crate) fn check_finite(pose: &Pose, config: &BodyConfig) -> Result<(), IkError> {
     let p = &config.pivot_m;
     // Field by field, without copying the pose into an array first; all nine checked
     // together (`&`, no branch per value).

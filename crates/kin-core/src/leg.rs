@@ -162,7 +162,7 @@ fn abduct(s_a: f32, c_a: f32, v: Vec3) -> Vec3 {
 
 /// Forward kinematics on backend `M`, closed form.
 #[inline]
-fn forward_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
+pub(crate) fn forward_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
     let (_, _, u, w) = planar::<M>(g, q.hip_rad, q.knee_rad);
     let (sa, ca) = M::sin_cos(q.abduction_rad);
     abduct(sa, ca, Vec3::new(u, leg.side() * g.d_lat_m, w))
@@ -273,12 +273,12 @@ pub fn forward_dh(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
 /// [`Solver::new`] takes the [`DefaultMath`] backend, [`Solver::with_math`] any other
 /// (`leg::Solver::<kin_core::math::Libm>::with_math(&robot)`); both are `const fn`.
 pub struct Solver<M: Math = DefaultMath> {
-    geometry: LegGeometry,
-    limits: JointLimits,
+    pub(crate) geometry: LegGeometry,
+    pub(crate) limits: JointLimits,
     /// The limits' [`crate::math::interval_keys`], computed once for [`Math::within_keys`].
-    limit_keys: [(i32, i32); 3],
-    knee_bend: KneeBend,
-    c: Consts,
+    pub(crate) limit_keys: [(i32, i32); 3],
+    pub(crate) knee_bend: KneeBend,
+    pub(crate) c: Consts,
     math: PhantomData<M>,
 }
 
@@ -308,18 +308,18 @@ impl<M: Math> fmt::Debug for Solver<M> {
 
 /// Constants of the leg IK derived from the link lengths.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Consts {
+pub(crate) struct Consts {
     /// `d_lat²` (seed 000's `La²`).
-    d_lat_sq: f32,
+    pub(crate) d_lat_sq: f32,
     /// `(L1 + L2)²` and `(L1 − L2)²`: the squared reach limits of the leg plane.
-    far_sq: f32,
-    near_sq: f32,
+    pub(crate) far_sq: f32,
+    pub(crate) near_sq: f32,
     /// `L1² + L2²` and `L1² − L2²`: the law of cosines.
-    sum_sq: f32,
-    diff_sq: f32,
+    pub(crate) sum_sq: f32,
+    pub(crate) diff_sq: f32,
     /// `d_ax = 0` (seed 000's leg): the hip-flexion joint lies on the abduction axis, and the
     /// planar distance needs no extra term.
-    d_ax_zero: bool,
+    pub(crate) d_ax_zero: bool,
 }
 
 impl Consts {
@@ -351,7 +351,7 @@ fn depth<M: Math>(d_lat_sq: f32, r_sq: f32) -> (f32, f32) {
 /// foot's `(y, z)` less that of the leg's own `(s·d_lat, w)` (`sd = s·d_lat`, `w` from
 /// [`depth`]), as the arguments `(y, x)` of one `atan2` of their cross and dot products: every
 /// quadrant of the abduction circle in one formula, in `(−π, π]`.
-fn abduction_yx(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
+pub(crate) fn abduction_yx(sd: f32, y: f32, z: f32, w: f32) -> (f32, f32) {
     (sd * z - w * y, sd * y + w * z)
 }
 
@@ -360,7 +360,7 @@ impl Consts {
     /// `v = w + d_ax` below the hip-flexion joint and `v²`, from [`depth`]'s `(w, w²)`;
     /// `(w, w²)` itself when `d_ax = 0` (a multiplication and an addition fewer). The planar
     /// distance is then `R² = x² + v²`.
-    fn leg_plane(&self, d_ax_m: f32, (w, w_sq): (f32, f32)) -> (f32, f32) {
+    pub(crate) fn leg_plane(&self, d_ax_m: f32, (w, w_sq): (f32, f32)) -> (f32, f32) {
         if self.d_ax_zero {
             (w, w_sq)
         } else {
@@ -413,7 +413,7 @@ impl Consts {
 // Always inlined: out of line, its fifth float argument goes on the stack, and LLVM's AVR
 // backend miscompiled that call (wrong hip angles in `cargo xtask avr-bench`).
 #[inline(always)]
-fn hip_yx(u: f32, v: f32, dist2: f32, diff_sq: f32, s: f32) -> (f32, f32) {
+pub(crate) fn hip_yx(u: f32, v: f32, dist2: f32, diff_sq: f32, s: f32) -> (f32, f32) {
     let (bx, by) = (dist2 + diff_sq, s);
     let (ax, ay) = (-v, -u);
     (bx * ay - by * ax, bx * ax + by * ay)
@@ -464,7 +464,7 @@ impl<M: Math> Solver<M> {
 
     /// True when all three angles lie within their limits (false for any NaN), compared by
     /// the backend with the limits' keys computed once ([`Math::within_keys`]).
-    fn admits_all(&self, q: JointAngles) -> bool {
+    pub(crate) fn admits_all(&self, q: JointAngles) -> bool {
         let (lo, hi, k) = (&self.limits.min_rad, &self.limits.max_rad, &self.limit_keys);
         M::within_keys(q.abduction_rad, lo[0], hi[0], k[0])
             & M::within_keys(q.hip_rad, lo[1], hi[1], k[1])
@@ -472,7 +472,7 @@ impl<M: Math> Solver<M> {
     }
 
     /// `s·d_lat`: the leg plane's offset with the side sign of `leg`.
-    fn side_d_lat(&self, leg: LegId) -> f32 {
+    pub(crate) fn side_d_lat(&self, leg: LegId) -> f32 {
         if leg.is_left() {
             self.geometry.d_lat_m
         } else {

@@ -39,6 +39,8 @@
 //!   [`Robot::fernando2025`].
 //! - [`leg`]: FK (closed form and DH form), IK, reachability, [`ReachPolicy`].
 //! - [`rotation`], [`body`]: body rotation in six orders, full-body IK/FK.
+//! - [`batch`]: leg IK/FK and body IK over many targets, in fixed-width chunks of lanes that
+//!   the compiler vectorises; each result the scalar solve's, bit for bit.
 //! - [`jacobian`]: velocity kinematics and the singularity measure.
 //! - [`paper`]: seed 000 (θ1, θ2, θ3) and seed 001 (β, α, φ) angle adapters.
 //! - [`math`]: the [`Math`] backend trait (`libm`, fast polynomials, the soft-float choices of
@@ -57,10 +59,13 @@
 //! every backend swappable — and nalgebra (f64) is the independent oracle of the tests.
 
 #![no_std]
-// `deny`, not `forbid`: the one exception is the AVR's flash tables of `math` (their
-// `link_section`), which only the `Math` backend's reads can reach.
+// `deny`, not `forbid`: the exceptions are the AVR's flash tables of `math` (their
+// `link_section`), which only the `Math` backend's reads can reach, the x86-64 square root of
+// the batch solves' lanes (`math::lanes`, SSE's `sqrtps`), and the AVX2 entry points of
+// `batch::avx2` (unsafe to call: the CPU must have AVX2).
 #![deny(unsafe_code)]
 
+pub mod batch;
 pub mod body;
 pub mod jacobian;
 pub mod leg;

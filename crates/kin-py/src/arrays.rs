@@ -1,16 +1,16 @@
-//! numpy arrays in and out, and the batch runner: every row solved on its own, its result and its
-//! code written in place, the GIL released, rayon across cores for large batches.
-//!
-//! The runner is the one place that loops over rows: a batch solver in kin-core (structure of
-//! arrays, fixed-width chunks) replaces the per-row closure here without changing any Python
-//! signature.
+//! numpy arrays in and out, and the row runner of the calls without a batch solve in kin-core
+//! (the Jacobian, the singularity measure, the body FK): every row solved on its own, its
+//! result and its code written in place, the GIL released, rayon across cores for large
+//! batches. Leg IK/FK and body IK go through kin-core's batch solves instead
+//! ([`crate::batch`]).
 
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-/// Rows per rayon task; batches of fewer than two chunks run on the calling thread.
+/// Rows per rayon task (a multiple of `kin_core::batch::LANES`, so that every task's chunks
+/// are full); batches of fewer than two chunks run on the calling thread.
 pub const CHUNK_ROWS: usize = 16_384;
 
 /// A float array read from Python: float32 used as it is, float64 narrowed to f32 row by row
@@ -31,6 +31,14 @@ pub enum Slice<'a> {
 }
 
 impl Slice<'_> {
+    /// The elements as f32: borrowed when they are float32, else narrowed into a copy.
+    pub fn to_f32(&self) -> std::borrow::Cow<'_, [f32]> {
+        match self {
+            Slice::F32(s) => std::borrow::Cow::Borrowed(s),
+            Slice::F64(s) => std::borrow::Cow::Owned(s.par_iter().map(|&v| v as f32).collect()),
+        }
+    }
+
     /// Element `i` as f32.
     #[inline(always)]
     pub fn get(&self, i: usize) -> f32 {

@@ -9,11 +9,13 @@
 //!   simavr (through the `quad-link-bridge` process, [`bridge`]) or a serial port, with typed
 //!   exceptions ([`errors`]).
 //!
-//! Batch calls run kin-core's scalar solves row by row ([`arrays::for_rows`]) with the GIL
-//! released, over rayon's threads for large batches. No Rust panic is meant to reach Python;
-//! PyO3 would turn one into `pyo3_runtime.PanicException`.
+//! Batch calls run with the GIL released, over rayon's threads for large batches: leg IK/FK
+//! and body IK through kin-core's batch solves (`kin_core::batch`, the AVX2 form where the
+//! CPU has it; [`batch`]), the others row by row ([`arrays::for_rows`]). No Rust panic is
+//! meant to reach Python; PyO3 would turn one into `pyo3_runtime.PanicException`.
 
 pub mod arrays;
+pub mod batch;
 pub mod bridge;
 pub mod device;
 pub mod errors;

@@ -2,11 +2,11 @@
 //! numpy arrays: leg IK/FK, body IK/FK, the leg Jacobian and the singularity measure.
 
 use crate::arrays::{self, for_rows};
-use kin_core::body::{self, BodyConfig, BodySolution, Pose};
+use kin_core::body::{self, BodyConfig, Pose};
 use kin_core::jacobian;
 use kin_core::{
-    leg, IkError, JointAngles, KneeBend, LegId, ReachPolicy, Robot as KinRobot, RotationOrder,
-    Unreachable, Vec3,
+    leg, JointAngles, KneeBend, LegId, ReachPolicy, Robot as KinRobot, RotationOrder, Unreachable,
+    Vec3,
 };
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -276,22 +276,16 @@ impl Robot {
         let solver = self.leg_solver();
         let n = rows.n;
         let input = rows.slice();
-        let (out, codes) = py.detach(|| {
-            let mut out = vec![0.0f32; n * 3];
-            let mut codes = vec![OK; n];
-            for_rows(n, 3, &mut out, &mut codes, |i, o| {
-                let [x, y, z] = input.row::<3>(3 * i);
-                match solver.inverse(leg, Vec3::new(x, y, z), policy) {
-                    Ok(s) => {
-                        o.copy_from_slice(&s.angles.to_array());
-                        s.clamped.map_or(OK, |c| code_of(c.kind))
-                    }
-                    Err(e) => code_of(e.kind),
-                }
-            });
-            (out, codes)
-        });
-        finish2(py, out, n, 3, codes)
+        let (out, codes) = py
+            .detach(|| {
+                let feet = input.to_f32();
+                let mut out = vec![0.0f32; n * 3];
+                let mut codes = vec![0u8; n];
+                crate::batch::leg_inverse(&solver, leg, policy, &feet, &mut out, &mut codes)?;
+                Ok((out, codes))
+            })
+            .map_err(length_err)?;
+        finish2(py, out, n, 3, signed(codes))
     }
 
     /// One leg IK: the foot ``(x_m, y_m, z_m)`` in the hip frame of ``leg`` → ``(abduction_rad,
@@ -333,20 +327,16 @@ impl Robot {
         let g = self.robot.leg;
         let n = rows.n;
         let input = rows.slice();
-        let (out, codes) = py.detach(|| {
-            let mut out = vec![0.0f32; n * 3];
-            let mut codes = vec![OK; n];
-            for_rows(n, 3, &mut out, &mut codes, |i, o| {
-                let q = JointAngles::from_array(input.row::<3>(3 * i));
-                if !q.is_finite() {
-                    return NON_FINITE;
-                }
-                o.copy_from_slice(&leg::forward(&g, leg, q).to_array());
-                OK
-            });
-            (out, codes)
-        });
-        finish2(py, out, n, 3, codes)
+        let (out, codes) = py
+            .detach(|| {
+                let q = input.to_f32();
+                let mut out = vec![0.0f32; n * 3];
+                let mut codes = vec![0u8; n];
+                crate::batch::leg_forward(&g, leg, &q, &mut out, &mut codes)?;
+                Ok((out, codes))
+            })
+            .map_err(length_err)?;
+        finish2(py, out, n, 3, signed(codes))
     }
 
     /// The leg Jacobian ``∂foot_in_hip/∂(abduction, hip, knee)`` at many joint-angle rows:
@@ -446,30 +436,36 @@ impl Robot {
             Feet::Stance(h) => FeetSlice::Stance(*h),
             Feet::Rows(r) => FeetSlice::Rows(r.slice()),
         };
-        let (out, codes) = py.detach(|| {
-            let mut out = vec![0.0f32; n * 12];
-            let mut codes = vec![(OK, -1i8); n];
-            for_rows(n, 12, &mut out, &mut codes, |i, o| {
-                let p = Pose::from_array(input.row::<6>(6 * i));
-                let mut sol = BodySolution::default();
-                let r = match &feet {
-                    FeetSlice::Stance(h) => {
-                        solver.inverse_at_stance_into(&p, &config, *h, policy, &mut sol)
-                    }
-                    FeetSlice::Rows(f) => {
-                        let base = if f_len(f) == 12 { 0 } else { 12 * i };
-                        let feet: [Vec3; 4] = core::array::from_fn(|k| {
-                            let [x, y, z] = f.row::<3>(base + 3 * k);
-                            Vec3::new(x, y, z)
-                        });
-                        solver.inverse_into(&p, &config, &feet, policy, &mut sol)
-                    }
+        let (out, c, l) = py
+            .detach(|| {
+                let poses = input.to_f32();
+                let feet_rows = match &feet {
+                    FeetSlice::Stance(_) => None,
+                    FeetSlice::Rows(f) => Some(f.to_f32()),
                 };
-                body_code(r, &sol, o)
-            });
-            (out, codes)
-        });
-        let (c, l): (Vec<i8>, Vec<i8>) = codes.into_iter().unzip();
+                let same: Option<[Vec3; 4]> = match (&feet, &feet_rows) {
+                    (FeetSlice::Rows(f), Some(rows)) if f_len(f) == 12 => {
+                        Some(core::array::from_fn(|k| {
+                            Vec3::new(rows[3 * k], rows[3 * k + 1], rows[3 * k + 2])
+                        }))
+                    }
+                    _ => None,
+                };
+                let form = match (&feet, &same, &feet_rows) {
+                    (FeetSlice::Stance(h), _, _) => crate::batch::Feet::Stance(*h),
+                    (_, Some(same), _) => crate::batch::Feet::Same(same),
+                    (_, None, Some(rows)) => crate::batch::Feet::PerPose(rows),
+                    (_, None, None) => crate::batch::Feet::PerPose(&[]),
+                };
+                let mut out = vec![0.0f32; n * 12];
+                let (mut codes, mut legs) = (vec![0u8; n], vec![0i8; n]);
+                crate::batch::body_inverse(
+                    &solver, &config, policy, &poses, form, &mut out, &mut codes, &mut legs,
+                )?;
+                Ok((out, codes, legs))
+            })
+            .map_err(length_err)?;
+        let c = signed(c);
         let arr = PyArray1::from_vec(py, out).reshape([n, 4, 3])?;
         Ok((arr, PyArray1::from_vec(py, c), PyArray1::from_vec(py, l)))
     }
@@ -593,18 +589,14 @@ fn feet_arg<'py>(
     }
 }
 
-/// Writes a body solution's angles into `o` and returns `(code, leg)`.
-fn body_code(r: Result<(), IkError>, sol: &BodySolution, o: &mut [f32]) -> (i8, i8) {
-    match r {
-        Ok(()) => {
-            o.copy_from_slice(&sol.angles_rad);
-            match sol.clamped.iter().position(Option::is_some) {
-                Some(k) => (sol.clamped[k].map_or(OK, |c| code_of(c.kind)), k as i8),
-                None => (OK, -1),
-            }
-        }
-        Err(e) => (code_of(e.kind), e.leg.index() as i8),
-    }
+/// kin-core's reach codes (0–5) as the int8 codes of the Python API (the same numbers).
+fn signed(codes: Vec<u8>) -> Vec<i8> {
+    codes.into_iter().map(|c| c as i8).collect()
+}
+
+/// A batch whose slices do not fit (never for the arrays built here): `ValueError`.
+fn length_err(e: kin_core::batch::LengthMismatch) -> PyErr {
+    PyValueError::new_err(e.to_string())
 }
 
 /// `(out reshaped (n, w), codes)` as numpy arrays.

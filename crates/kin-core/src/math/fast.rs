@@ -1,6 +1,6 @@
 //! The default backend, for hosts with floating-point hardware.
 
-use super::{poly, Math};
+use super::{lanes, poly, Math};
 
 /// Polynomial backend for hosts: [`poly::atan2_deg15`], [`poly::sin_cos_deg9`], `libm` for
 /// `sqrt` (one instruction on hosts). It keeps the default [`Math::atan2_3`]: the compiler
@@ -24,6 +24,16 @@ impl Math for Fast {
     #[inline]
     fn sin_cos(x: f32) -> (f32, f32) {
         poly::sin_cos_deg9(x)
+    }
+
+    #[inline]
+    fn atan2_lanes<const N: usize>(y: &[f32; N], x: &[f32; N]) -> [f32; N] {
+        lanes::atan2_deg15_lanes(y, x)
+    }
+
+    #[inline]
+    fn sqrt_lanes<const N: usize>(x: &[f32; N]) -> [f32; N] {
+        lanes::sqrt_lanes(x)
     }
 }
 

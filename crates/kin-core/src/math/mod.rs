@@ -29,6 +29,7 @@
 
 mod bits;
 mod fast;
+mod lanes;
 mod libm;
 pub mod poly;
 mod soft_float;
@@ -63,6 +64,21 @@ pub trait Math {
             Self::atan2(y[1], x[1]),
             Self::atan2(y[2], x[2]),
         ]
+    }
+    /// `N` independent arctangents `atan2(y[i], x[i])`, lane by lane (the batch solves of
+    /// [`crate::batch`]): exactly what `N` [`Math::atan2`] calls return. The default makes the
+    /// calls; a backend overrides it with a form the compiler vectorises, bit for bit the same
+    /// ([`Fast`]'s selects its octant's offset where its scalar form reads a table).
+    #[inline]
+    fn atan2_lanes<const N: usize>(y: &[f32; N], x: &[f32; N]) -> [f32; N] {
+        core::array::from_fn(|i| Self::atan2(y[i], x[i]))
+    }
+    /// `N` square roots, lane by lane (the batch solves of [`crate::batch`]): exactly what `N`
+    /// [`Math::sqrt`] calls return. The default makes the calls; a backend overrides it with a
+    /// vector form where it has one, bit for bit the same.
+    #[inline]
+    fn sqrt_lanes<const N: usize>(x: &[f32; N]) -> [f32; N] {
+        core::array::from_fn(|i| Self::sqrt(x[i]))
     }
     /// `x > 0.0`.
     fn gt_zero(x: f32) -> bool {

@@ -1,0 +1,178 @@
+//! Group `batch`: the batch solves of `kin_core::batch` on one thread against the scalar
+//! solves over the same inputs, in the same run. One iteration solves the whole set, so the
+//! time per target is criterion's time per iteration over the set's size (criterion prints it
+//! as the throughput, elements/s).
+//!
+//! - `leg_ik_scalar`: the 10,000 seeded reachable leg targets (both presets, all legs, see
+//!   `common/mod.rs`), one `leg::Solver::inverse` each (the solvers kept).
+//! - `leg_ik_batch`: the same targets grouped by robot and leg, one `batch::leg_inverse` per
+//!   group (rows `[x, y, z]` in, rows of angles out).
+//! - `leg_ik_batch_soa`: the same with `batch::leg_inverse_soa` (one slice per coordinate).
+//! - `body_ik_scalar` / `body_ik_batch`: the 10,000 seeded body poses at seed 000's nominal
+//!   stance, `body::Solver::inverse_at_stance_into` each / one `batch::body_inverse`.
+
+// The AVX2 entry points of `kin_core::batch::avx2` are unsafe to call (the CPU must have
+// AVX2, checked before each use).
+#![allow(unsafe_code)]
+
+mod common;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use kin_core::batch::{self, BodyFeet};
+use kin_core::{body, leg, BodyConfig, BodySolution, LegId, ReachPolicy, Robot};
+use std::hint::black_box;
+
+fn batch_benches(c: &mut Criterion) {
+    let robots = common::robots();
+    let targets = common::leg_targets();
+    let n = targets.len();
+    let solvers = robots.map(|r| leg::Solver::new(&r));
+
+    // The targets grouped by (robot, leg): rows and columns.
+    let mut groups: Vec<(usize, LegId, Vec<[f32; 3]>)> = Vec::new();
+    for r in 0..robots.len() {
+        for leg in LegId::ALL {
+            let rows: Vec<[f32; 3]> = targets
+                .iter()
+                .filter(|t| t.robot == r && t.leg == leg)
+                .map(|t| t.foot_in_hip.to_array())
+                .collect();
+            groups.push((r, leg, rows));
+        }
+    }
+    let columns: Vec<[Vec<f32>; 3]> = groups
+        .iter()
+        .map(|(_, _, rows)| core::array::from_fn(|k| rows.iter().map(|p| p[k]).collect()))
+        .collect();
+    let mut angles: Vec<Vec<[f32; 3]>> = groups.iter().map(|g| vec![[0.0; 3]; g.2.len()]).collect();
+    let mut codes: Vec<Vec<u8>> = groups.iter().map(|g| vec![0; g.2.len()]).collect();
+    // Every target solves, in the batch as in the scalar solve.
+    for (k, (r, leg, rows)) in groups.iter().enumerate() {
+        batch::leg_inverse(
+            &solvers[*r],
+            *leg,
+            ReachPolicy::Reject,
+            rows.as_flattened(),
+            angles[k].as_flattened_mut(),
+            &mut codes[k],
+        )
+        .expect("lengths match");
+        assert!(codes[k].iter().all(|&c| c == batch::code::OK));
+    }
+
+    let mut group = c.benchmark_group("batch");
+    group.throughput(Throughput::Elements(n as u64));
+    group.bench_function("leg_ik_scalar", |b| {
+        b.iter(|| {
+            for t in black_box(&targets) {
+                let _ =
+                    black_box(solvers[t.robot].inverse(t.leg, t.foot_in_hip, ReachPolicy::Reject));
+            }
+        });
+    });
+    group.bench_function("leg_ik_batch", |b| {
+        b.iter(|| {
+            for (k, (r, leg, rows)) in black_box(&groups).iter().enumerate() {
+                let _ = batch::leg_inverse(
+                    &solvers[*r],
+                    *leg,
+                    ReachPolicy::Reject,
+                    rows.as_flattened(),
+                    angles[k].as_flattened_mut(),
+                    &mut codes[k],
+                );
+            }
+            black_box(&angles);
+        });
+    });
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        group.bench_function("leg_ik_batch_avx2", |b| {
+            b.iter(|| {
+                for (k, (r, leg, rows)) in black_box(&groups).iter().enumerate() {
+                    // SAFETY: the CPU supports AVX2 (checked above).
+                    let _ = unsafe {
+                        batch::avx2::leg_inverse(
+                            &solvers[*r],
+                            *leg,
+                            ReachPolicy::Reject,
+                            rows.as_flattened(),
+                            angles[k].as_flattened_mut(),
+                            &mut codes[k],
+                        )
+                    };
+                }
+                black_box(&angles);
+            });
+        });
+    }
+    let mut soa_out: Vec<[Vec<f32>; 3]> = groups
+        .iter()
+        .map(|g| core::array::from_fn(|_| vec![0.0; g.2.len()]))
+        .collect();
+    group.bench_function("leg_ik_batch_soa", |b| {
+        b.iter(|| {
+            for (k, (r, leg, _)) in black_box(&groups).iter().enumerate() {
+                let [x, y, z] = &columns[k];
+                let [a, h, q] = &mut soa_out[k];
+                let _ = batch::leg_inverse_soa(
+                    &solvers[*r],
+                    *leg,
+                    ReachPolicy::Reject,
+                    [x, y, z],
+                    a,
+                    h,
+                    q,
+                    &mut codes[k],
+                );
+            }
+            black_box(&soa_out);
+        });
+    });
+
+    let robot = Robot::shahriar2023();
+    let config = BodyConfig::default();
+    let height_m = common::STANCE_HEIGHT_SHAHRIAR_M;
+    let poses = common::body_poses();
+    let pose_rows: Vec<[f32; 6]> = poses.iter().map(|p| p.to_array()).collect();
+    let solver = body::Solver::new(&robot);
+    let m = poses.len();
+    let mut body_angles = vec![[0.0f32; 12]; m];
+    let (mut body_codes, mut body_legs) = (vec![0u8; m], vec![0i8; m]);
+    group.throughput(Throughput::Elements(m as u64));
+    group.bench_function("body_ik_scalar", |b| {
+        let mut sol = BodySolution::default();
+        b.iter(|| {
+            for p in black_box(&poses) {
+                let _ = solver.inverse_at_stance_into(
+                    p,
+                    &config,
+                    height_m,
+                    ReachPolicy::Reject,
+                    &mut sol,
+                );
+                black_box(&sol);
+            }
+        });
+    });
+    group.bench_function("body_ik_batch", |b| {
+        b.iter(|| {
+            let _ = batch::body_inverse(
+                &solver,
+                &config,
+                ReachPolicy::Reject,
+                black_box(pose_rows.as_flattened()),
+                BodyFeet::Stance { height_m },
+                body_angles.as_flattened_mut(),
+                &mut body_codes,
+                &mut body_legs,
+            );
+            black_box(&body_angles);
+        });
+    });
+    assert!(body_codes.iter().all(|&c| c == batch::code::OK));
+    group.finish();
+}
+
+criterion_group!(benches, batch_benches);
+criterion_main!(benches);

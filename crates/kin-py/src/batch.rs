@@ -1,0 +1,173 @@
+//! The batch kinematics of `kin_core::batch` on the host: large batches split into slices of
+//! [`CHUNK_ROWS`] rows over rayon's threads, each slice solved by the form compiled for this
+//! CPU (`kin_core::batch::avx2` where the CPU has AVX2, else the portable one; both give the
+//! same bits).
+//!
+//! Rows are flat slices: `width` floats per row, one row after the other (numpy's C order).
+
+use crate::arrays::CHUNK_ROWS;
+use kin_core::batch::{self, BodyFeet, LengthMismatch};
+use kin_core::{body, leg, BodyConfig, DefaultMath, LegGeometry, LegId, ReachPolicy};
+use rayon::prelude::*;
+
+/// True when this CPU runs `kin_core::batch::avx2` (the standard library caches the check).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Runs `solve(input, out, codes)` on the whole batch of `codes.len()` rows, or on slices of
+/// [`CHUNK_ROWS`] rows in parallel when there are at least two of them. `input` has `in_w`
+/// floats per row, `out` `out_w` (other lengths: one call, which refuses them).
+fn split<F>(
+    input: &[f32],
+    in_w: usize,
+    out: &mut [f32],
+    out_w: usize,
+    codes: &mut [u8],
+    solve: F,
+) -> Result<(), LengthMismatch>
+where
+    F: Fn(&[f32], &mut [f32], &mut [u8]) -> Result<(), LengthMismatch> + Sync,
+{
+    let n = codes.len();
+    if n < 2 * CHUNK_ROWS || input.len() != in_w * n || out.len() != out_w * n {
+        return solve(input, out, codes);
+    }
+    input
+        .par_chunks(in_w * CHUNK_ROWS)
+        .zip(out.par_chunks_mut(out_w * CHUNK_ROWS))
+        .zip(codes.par_chunks_mut(CHUNK_ROWS))
+        .try_for_each(|((i, o), c)| solve(i, o, c))
+}
+
+/// Leg IK of `feet_in_hip_m` (rows of 3) into `angles_rad` (rows of 3) and `codes`, as
+/// `kin_core::batch::leg_inverse`.
+///
+/// # Errors
+/// As `kin_core::batch::leg_inverse`.
+pub fn leg_inverse(
+    solver: &leg::Solver,
+    leg: LegId,
+    policy: ReachPolicy,
+    feet_in_hip_m: &[f32],
+    angles_rad: &mut [f32],
+    codes: &mut [u8],
+) -> Result<(), LengthMismatch> {
+    let avx2 = has_avx2();
+    split(feet_in_hip_m, 3, angles_rad, 3, codes, |f, a, c| {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: the CPU has AVX2 (`has_avx2`).
+            #[allow(unsafe_code)]
+            return unsafe { batch::avx2::leg_inverse(solver, leg, policy, f, a, c) };
+        }
+        let _ = avx2;
+        batch::leg_inverse(solver, leg, policy, f, a, c)
+    })
+}
+
+/// Leg FK of `angles_rad` (rows of 3) into `feet_in_hip_m` (rows of 3) and `codes`, as
+/// `kin_core::batch::leg_forward` on the default backend.
+///
+/// # Errors
+/// As `kin_core::batch::leg_forward`.
+pub fn leg_forward(
+    geometry: &LegGeometry,
+    leg: LegId,
+    angles_rad: &[f32],
+    feet_in_hip_m: &mut [f32],
+    codes: &mut [u8],
+) -> Result<(), LengthMismatch> {
+    let avx2 = has_avx2();
+    split(angles_rad, 3, feet_in_hip_m, 3, codes, |q, f, c| {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: the CPU has AVX2 (`has_avx2`).
+            #[allow(unsafe_code)]
+            return unsafe { batch::avx2::leg_forward::<DefaultMath>(geometry, leg, q, f, c) };
+        }
+        let _ = avx2;
+        batch::leg_forward::<DefaultMath>(geometry, leg, q, f, c)
+    })
+}
+
+/// The feet of a body batch: the stance, one set for every pose (12 floats), or one per pose
+/// (rows of 12).
+#[derive(Clone, Copy)]
+pub enum Feet<'a> {
+    /// The nominal stance of this height, m.
+    Stance(f32),
+    /// The same four feet for every pose.
+    Same(&'a [kin_core::Vec3; 4]),
+    /// Four feet per pose, rows of 12.
+    PerPose(&'a [f32]),
+}
+
+/// Body IK of `poses` (rows of 6) with `feet` into `angles_rad` (rows of 12), `codes` and
+/// `legs`, as `kin_core::batch::body_inverse`.
+///
+/// # Errors
+/// As `kin_core::batch::body_inverse`.
+#[allow(clippy::too_many_arguments)] // Poses and feet in, angles, codes and legs out.
+pub fn body_inverse(
+    solver: &body::Solver,
+    config: &BodyConfig,
+    policy: ReachPolicy,
+    poses: &[f32],
+    feet: Feet<'_>,
+    angles_rad: &mut [f32],
+    codes: &mut [u8],
+    legs: &mut [i8],
+) -> Result<(), LengthMismatch> {
+    let avx2 = has_avx2();
+    // Per-pose feet are split with the poses: their slice of rows goes with each slice.
+    let n = codes.len();
+    let per_pose = match feet {
+        Feet::PerPose(f) => Some(f),
+        _ => None,
+    };
+    let solve = |first_row: usize, p: &[f32], a: &mut [f32], c: &mut [u8], l: &mut [i8]| {
+        let f = match feet {
+            Feet::Stance(h) => BodyFeet::Stance { height_m: h },
+            Feet::Same(f) => BodyFeet::Same(f),
+            Feet::PerPose(f) => {
+                let end = (12 * (first_row + c.len())).min(f.len());
+                BodyFeet::PerPose(&f[(12 * first_row).min(end)..end])
+            }
+        };
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: the CPU has AVX2 (`has_avx2`).
+            #[allow(unsafe_code)]
+            return unsafe { batch::avx2::body_inverse(solver, config, policy, p, f, a, c, l) };
+        }
+        let _ = avx2;
+        batch::body_inverse(solver, config, policy, p, f, a, c, l)
+    };
+    if let Some(f) = per_pose {
+        if f.len() != 12 * n {
+            return Err(LengthMismatch {
+                what: "feet_in_world_m",
+                expected: 12 * n,
+                got: f.len(),
+            });
+        }
+    }
+    if n < 2 * CHUNK_ROWS || poses.len() != 6 * n || angles_rad.len() != 12 * n {
+        return solve(0, poses, angles_rad, codes, legs);
+    }
+    poses
+        .par_chunks(6 * CHUNK_ROWS)
+        .zip(angles_rad.par_chunks_mut(12 * CHUNK_ROWS))
+        .zip(codes.par_chunks_mut(CHUNK_ROWS))
+        .zip(legs.par_chunks_mut(CHUNK_ROWS))
+        .enumerate()
+        .try_for_each(|(k, (((p, a), c), l))| solve(k * CHUNK_ROWS, p, a, c, l))
+}
