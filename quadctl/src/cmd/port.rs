@@ -35,13 +35,12 @@ d2h_bytes, d2h_dropped (device bytes nobody read), behind_max_ms.
 Exit status: 0 after an interrupt; 2 when the port or the device could not be set up or the
 link failed.";
 
-/// `--help`'s examples.
+/// `--help`'s examples (then, in another terminal: `quadctl stand --robot shahriar2023 --port
+/// /tmp/quad-port`).
 pub const EXAMPLES: &str = "\
 Examples:
   quadctl port --sim --robot shahriar2023
-  quadctl port --emulator --link /tmp/quad-port &
-  quadctl stand --robot shahriar2023 --port /tmp/quad-port
-  kill %1";
+  quadctl port --emulator --link /tmp/quad-port";
 
 /// Arguments of `quadctl port`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
