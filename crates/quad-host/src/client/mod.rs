@@ -50,7 +50,9 @@ pub use checks::{
     check_readback, expected, judge, AngleCheck, Expected, Mismatch, AVR_ANGLE_TOLERANCE_RAD,
 };
 pub use exchange::{Client, Counters, Exchange, Outcome, Verdict};
-pub use stream::{PoseResult, PoseStream, Setpoint, StreamSetup, StreamStats};
+pub use stream::{
+    PoseResult, PoseStream, Setpoint, Settled, StreamSetup, StreamStats, DEFAULT_WINDOW, MAX_WINDOW,
+};
 
 use crate::link;
 use quad_protocol::{DeviceToHost, NackReason, Request, RobotPreset, PROTOCOL_VERSION};
@@ -189,6 +191,15 @@ pub enum Error {
     Version {
         /// The device's version.
         device: u16,
+    },
+    /// A window of requests in flight the device does not take.
+    #[error(
+        "{window} requests in flight: the device takes 1 to {}",
+        stream::MAX_WINDOW
+    )]
+    Window {
+        /// The window asked for.
+        window: usize,
     },
     /// The device runs another robot than the host was asked for.
     #[error(
