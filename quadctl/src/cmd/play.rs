@@ -79,6 +79,7 @@ pub fn main(args: &Args) -> ExitCode {
         speed: args.speed,
         send: args.send,
         input: args.file.clone(),
+        window: args.session.window(),
     };
     let summary = match play::run(&request, &mut io::stderr().lock()) {
         Ok(s) => s,
