@@ -150,6 +150,10 @@ fn every_command_of_first_steps_runs_on_the_virtual_port_one_device_throughout()
                 );
                 runs += 1;
             }
+            "play" => {
+                // The page's files ask no joint more than the device's limiter allows.
+                assert_eq!(summary(&stdout)["slowed_rows"], 0, "{}", command.line);
+            }
             "sit" | "rest" => {
                 // The robot is found standing: the posture has something to do.
                 assert_eq!(summary(&stdout)["motion"], verb, "{}", command.line);

@@ -529,11 +529,9 @@ impl<L: Link> PoseStream<L> {
             }
             self.step(Some(until))?;
         }
-        let mut settled = Vec::new();
         if self.in_flight.front().is_some_and(|f| f.done.is_some()) {
-            self.settle_oldest(&mut settled)?;
+            self.settle_oldest(&mut done)?;
         }
-        done.extend(settled);
         Ok(done)
     }
 
