@@ -237,9 +237,23 @@ pub struct SessionArgs {
     /// every answer passed its check (without it: status 4).
     #[arg(long)]
     pub allow_refused: bool,
+    /// Send one request and wait for its answer before the next (default: two in flight, the
+    /// device solving the next while the answer to the previous one is on the wire).
+    #[arg(long)]
+    pub one_at_a_time: bool,
 }
 
 impl SessionArgs {
+    /// The requests kept in flight: 1 with `--one-at-a-time`, else
+    /// [`quad_host::client::DEFAULT_WINDOW`].
+    pub fn window(&self) -> usize {
+        if self.one_at_a_time {
+            1
+        } else {
+            quad_host::client::DEFAULT_WINDOW
+        }
+    }
+
     /// The library's session. The simulated device runs the robot given; the session refuses
     /// a robot that is not a preset before the link is opened.
     pub fn session(&self) -> Session {
@@ -283,9 +297,10 @@ pub struct LawArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub robot: RobotArgs,
-    /// Stance height H (m): feet straight below the hips, H below them. Default: seed 001's
-    /// initial pose (φ=120°, α=60°, β=0) through forward kinematics (0.9294 m for
-    /// fernando2025); rect-path: 0.2 m (seed 000 Fig. 8).
+    /// Stance height H (m): feet straight below the hips, H below them. Default: the
+    /// device's stance for a preset (shahriar2023 0.40 m, fernando2025 seed 001's initial
+    /// pose, 0.9294 m), seed 001's initial pose (φ=120°, α=60°, β=0) through forward
+    /// kinematics for a robot file; rect-path: 0.2 m (seed 000 Fig. 8).
     #[arg(long, value_name = "M")]
     pub stance_height_m: Option<f32>,
     /// Rotation order of the body pose [default: a preset's device order (fernando2025 zxy,
@@ -299,9 +314,10 @@ pub struct LawArgs {
     /// Sways: period T, s [default: 20].
     #[arg(long, value_name = "S")]
     pub period_s: Option<f32>,
-    /// yaw-turn: yaw rate, rad/s; positive turns counter-clockwise seen from above (REP 103,
-    /// as trot's --yaw-rad-s; seed 001's ω_z = 0.085 clockwise is −0.085) [default: -0.085].
-    #[arg(long, value_name = "RAD_S")]
+    /// yaw-turn, trot, walk: yaw rate, rad/s; positive turns counter-clockwise seen from
+    /// above (REP 103; seed 001's ω_z = 0.085 clockwise is −0.085) [default: yaw-turn -0.085,
+    /// gaits 0]. `--yaw-rad-s` is the same option (its former name for the gaits).
+    #[arg(long, value_name = "RAD_S", alias = "yaw-rad-s")]
     pub yaw_rate_rad_s: Option<f32>,
     /// yaw-turn: step period T1, s [default: 6].
     #[arg(long, value_name = "S")]
@@ -332,9 +348,6 @@ pub struct LawArgs {
     /// trot, walk: lateral speed (left positive), m/s [default: 0].
     #[arg(long, value_name = "M_S")]
     pub lateral_m_s: Option<f32>,
-    /// trot, walk: yaw rate (counter-clockwise positive), rad/s [default: 0].
-    #[arg(long, value_name = "RAD_S")]
-    pub yaw_rad_s: Option<f32>,
 }
 
 impl LawArgs {
@@ -355,7 +368,7 @@ impl LawArgs {
             cycle_s: self.cycle_s,
             forward_m_s: self.forward_m_s,
             lateral_m_s: self.lateral_m_s,
-            yaw_rad_s: self.yaw_rad_s,
+            yaw_rad_s: None,
             rotation_order: self.rotation_order,
         }
     }

@@ -37,6 +37,7 @@ enum Command {
     Play(cmd::play::Args),
     Sim(cmd::sim::Args),
     Export(cmd::export::Args),
+    Port(cmd::port::Args),
     /// Stand up: outputs on at the rest pose, then up to the stance (onboard motion).
     #[command(after_help = cmd::onboard::STAND_EXAMPLES)]
     Stand(cmd::onboard::PostureArgs),
@@ -73,6 +74,7 @@ fn main() -> ExitCode {
         Command::Play(args) => cmd::play::main(&args),
         Command::Sim(args) => cmd::sim::run(&args),
         Command::Export(args) => cmd::export::run(&args),
+        Command::Port(args) => cmd::port::main(&args),
         Command::Stand(args) => cmd::onboard::posture(&args, StandUp),
         Command::Sit(args) => cmd::onboard::posture(&args, Sit),
         Command::Rest(args) => cmd::onboard::posture(&args, Rest),

@@ -54,6 +54,10 @@ enum Check {
     /// unless the line sets an address): the device must open, the address bind and the page
     /// be complete, then it stops; on a board's port, as [`Check::BoardPort`].
     Serve,
+    /// `quadctl port`: serves a virtual serial port until interrupted. Started as written: the
+    /// first line of its output must be the port's path (and a `--link` must point to it);
+    /// then SIGTERM must end it with status 0. `first_steps` runs a page's commands against it.
+    Port,
     /// `QUAD_RECORD=1 cargo test --release -p integration-tests --test NAME`: re-records the
     /// files that test compares (its own run, without the variable, is part of the test
     /// suite): the test must exist.
@@ -84,6 +88,7 @@ const RULES: &[(&str, Check)] = &[
     ),
     ("cargo run --release -p quadctl -- sim ", Check::SimArgs),
     ("cargo run --release -p quadctl -- serve ", Check::Serve),
+    ("cargo run --release -p quadctl -- port ", Check::Port),
     ("cargo run --release -p quadctl -- ", Check::Run),
 ];
 
@@ -212,6 +217,35 @@ fn check_command(command: &str, check: Check, dir: &Path) {
                 assert_ok(&run, "checked with --check");
                 assert!(run.stdout.contains("page complete"), "{}", run.stdout);
             }
+        }
+        Check::Port => {
+            let line = as_quadctl(command);
+            let args: Vec<&str> = line.split_whitespace().skip(1).collect();
+            let mut server = Command::new(env!("CARGO_BIN_EXE_quadctl"))
+                .args(&args)
+                .current_dir(dir)
+                .stdout(std::process::Stdio::piped())
+                .spawn()
+                .expect("quadctl port starts");
+            let mut out = std::io::BufReader::new(server.stdout.take().expect("piped"));
+            let mut path = String::new();
+            std::io::BufRead::read_line(&mut out, &mut path).expect("the port's path");
+            let link = args.iter().skip_while(|&&a| a != "--link").nth(1);
+            let linked = link.map(|l| std::fs::read_link(dir.join(l)));
+            let stopped = Command::new("kill")
+                .arg(server.id().to_string())
+                .status()
+                .expect("kill runs");
+            let status = server.wait().expect("the server ends");
+            assert!(path.starts_with("/dev/"), "{command}: {path}");
+            if let Some(linked) = linked {
+                assert_eq!(
+                    linked.expect("the link").to_str(),
+                    Some(path.trim()),
+                    "{command}"
+                );
+            }
+            assert!(stopped.success() && status.code() == Some(0), "{command}");
         }
         Check::SimArgs => assert_ok(
             &run_line(&format!("{} --help", as_quadctl(command)), dir),

@@ -26,6 +26,14 @@ const NOT_RUN: &[(&str, &str)] = &[
         "quadctl serve --sim --listen 127.0.0.1:0",
         "serves until Ctrl-C; crates/quad-web's browser tests run the server on the simulated device",
     ),
+    (
+        "quadctl port --sim --robot shahriar2023",
+        "serves until Ctrl-C; docs_commands runs the port of first-steps.md and stops it",
+    ),
+    (
+        "quadctl port --emulator --link /tmp/quad-port",
+        "serves until Ctrl-C; first_steps runs every command of first-steps.md against it",
+    ),
 ];
 
 /// The subcommands listed by `quadctl --help`.

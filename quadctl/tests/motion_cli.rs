@@ -212,10 +212,11 @@ fn output_file_appears_complete_and_bad_input_leaves_nothing() {
                 "1",
                 "--rate-hz",
                 "10",
-                "--yaw-rate-rad-s",
+                // yaw-turn's own option (--yaw-rate-rad-s is the gaits' yaw rate too).
+                "--step-period-s",
                 "1",
             ],
-            "--yaw-rate-rad-s",
+            "--step-period-s",
         ),
         (
             &["moonwalk", "--duration-s", "1", "--rate-hz", "10"],

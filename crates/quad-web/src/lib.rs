@@ -16,7 +16,7 @@
 //! Modules: [`msg`] (the WebSocket messages and their validation), [`device`] (the thread
 //! that owns the link and the checks every command passes), [`motion`] (the Motion tab's
 //! commands and their device requests), [`server`] (HTTP, WebSockets, who
-//! controls), [`assets`] (the embedded files).
+//! controls, the state as JSON for scripts at `GET /api/state`), [`assets`] (the embedded files).
 
 pub mod assets;
 pub mod device;

@@ -1,4 +1,5 @@
-//! The web server: the embedded page, and one WebSocket per page (`/ws`).
+//! The web server: the embedded page, one WebSocket per page (`/ws`), and the device's state
+//! as JSON for scripts (`GET /api/state`: the WebSocket's `state` message without its `type`).
 //!
 //! Every page receives the device's state on each change. One page at a time controls: it
 //! sends `take_control` first; a second page asking gets a refusal naming the one in control,
@@ -199,6 +200,7 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
     });
     let app = Router::new()
         .route("/ws", get(ws_upgrade))
+        .route(STATE_PATH, get(api_state))
         .fallback(get(asset))
         .with_state(shared.clone());
     let (shutdown_tx, shutdown_rx) = tokio::sync::oneshot::channel::<()>();
@@ -234,6 +236,26 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
         shutdown: Some(shutdown_tx),
         thread: Some(thread),
     })
+}
+
+/// The path of the state for scripts.
+pub const STATE_PATH: &str = "/api/state";
+
+/// `GET /api/state`: the device's state as the pages last received it ([`State`]), one JSON
+/// object; read-only (commands go through a controlling page's WebSocket).
+async fn api_state(AxumState(shared): AxumState<Arc<Shared>>) -> Response {
+    let state = shared.state.borrow().clone();
+    match serde_json::to_string(&state) {
+        Ok(json) => (
+            [
+                (header::CONTENT_TYPE, "application/json"),
+                (header::CACHE_CONTROL, "no-cache"),
+            ],
+            json,
+        )
+            .into_response(),
+        Err(e) => (StatusCode::INTERNAL_SERVER_ERROR, e.to_string()).into_response(),
+    }
 }
 
 async fn asset(uri: Uri) -> Response {

@@ -4,6 +4,7 @@
 use crate::args::{self, LawArgs, EXIT_MALFORMED, EXIT_OK};
 use crate::progress::Bar;
 use quad_host::ops::check::{self, Request, Source};
+use quad_host::ops::defaults;
 use quad_host::ops::motion::Law;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -18,7 +19,8 @@ Preflight report of a motion: sweeps it and reports, per leg and overall,
   - minimum singularity measure: inverse condition number σmin/σmax of the leg Jacobian
     (1 = isotropic, 0 = singular), failing below 0.05;
   - maximum joint speed (rad/s), finite differences between samples, against
-    --max-joint-speed-rad-s.
+    --max-joint-speed-rad-s (default: the device's joint-speed limiter, 3 rad/s, which slows
+    every output that would move faster).
 
 Source: a CSV written by `quadctl motion` (FILE, `-` for stdin; rows with feet and pose are
 solved again, rows with angles only are checked as they are; the rotation order is read from the
@@ -63,9 +65,10 @@ pub struct Args {
     /// With --motion: sampling rate, Hz [default: 100].
     #[arg(long, value_name = "F")]
     pub rate_hz: Option<f32>,
-    /// Joint speed limit, rad/s: one value for all joints or ABDUCTION,HIP,KNEE.
-    #[arg(long, value_name = "RAD_S", default_value = "6", value_parser = args::parse_speed_limits)]
-    pub max_joint_speed_rad_s: [f32; 3],
+    /// Joint speed limit, rad/s: one value for all joints or ABDUCTION,HIP,KNEE [default: the
+    /// device's joint-speed limiter, 3 rad/s: a motion faster than it is slowed on the device].
+    #[arg(long, value_name = "RAD_S", value_parser = args::parse_speed_limits)]
+    pub max_joint_speed_rad_s: Option<[f32; 3]>,
     /// Also print the report as one JSON object on the last line.
     #[arg(long)]
     pub json: bool,
@@ -84,7 +87,9 @@ pub fn run(args: &Args) -> ExitCode {
         params: args.law_args.params(),
         duration_s: args.duration_s,
         rate_hz: args.rate_hz,
-        max_joint_speed_rad_s: args.max_joint_speed_rad_s,
+        max_joint_speed_rad_s: args
+            .max_joint_speed_rad_s
+            .unwrap_or([defaults::joint_speed_limit_rad_s(&args.law_args.robot.robot); 3]),
     };
     let mut bar = Bar::new("check");
     match check::run(&request, &mut |p| bar.update(p)) {

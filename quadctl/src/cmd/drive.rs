@@ -61,8 +61,9 @@ pub struct Args {
     /// Walk (one leg at a time) instead of trot.
     #[arg(long)]
     pub walk: bool,
-    /// Body height to walk at, m; default: the device's stance height.
-    #[arg(long, value_name = "M", value_parser = args::parse_positive_m)]
+    /// Stance height (the body's height above the feet) to walk at, m; default: the device's.
+    /// `--body-height-m` is the same option (its former name).
+    #[arg(long = "stance-height-m", alias = "body-height-m", value_name = "M", value_parser = args::parse_positive_m)]
     pub body_height_m: Option<f32>,
     /// A key script instead of the keyboard.
     #[arg(long, value_name = "FILE")]

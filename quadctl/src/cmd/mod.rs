@@ -17,6 +17,7 @@ pub mod motion;
 pub mod onboard;
 pub mod play;
 pub mod plot;
+pub mod port;
 pub mod pose;
 pub mod serve;
 pub mod sim;

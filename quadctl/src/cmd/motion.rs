@@ -56,7 +56,7 @@ Fig. 4-6):
               half-wave sine lift (ω_z = 0.085 rad/s, T1 = 6 s, h_K = 0.3 m)
   rect-path   seed 000 §3.2 Fig. 8: each foot runs a closed path under a held body (rectangle:
               stride 0.1 m, lift 0.05 m at stance height 0.2 m, 3 s per loop)
-  trot, walk  gait driven by --forward-m-s, --lateral-m-s, --yaw-rad-s (stance feet fixed in
+  trot, walk  gait driven by --forward-m-s, --lateral-m-s, --yaw-rate-rad-s (stance feet fixed in
               the world, Bezier swing by default)
 
 Frames and units: world frame = body frame of the nominal pose (x forward, y left, z up, origin

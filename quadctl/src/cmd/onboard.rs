@@ -82,7 +82,7 @@ Parameters (units in the names; every one optional, the defaults are the device'
              --step-period-s (6) --lift-height-m (0.3) --duration-s (one step period)
   foot-path  --path (rectangle) --leg (all) --stride-m (0.1) --step-height-m (0.05)
              --duty-factor (1/3) --cycle-s (3) --duration-s (one cycle)
-  trot, walk --body-height-m (the device's stance height) --step-height-m (0.15 x height)
+  trot, walk --stance-height-m (the device's) --step-height-m (0.15 x height)
              --cycle-s (0.8) --velocity-timeout-ms (500) and the velocity --forward-m-s,
              --lateral-m-s, --yaw-rate-rad-s (0) held for --duration-s (5), then a stop (the
              strides finish, the feet park on the stance).
@@ -152,8 +152,14 @@ pub struct RunArgs {
     /// foot-path, trot, walk: one loop or gait cycle, s.
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub cycle_s: Option<f32>,
-    /// trot, walk: body height, m.
-    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    /// trot, walk: stance height (the body's height above the feet), m, as `motion`'s
+    /// --stance-height-m; `--body-height-m` is the same option (its former name).
+    #[arg(
+        long = "stance-height-m",
+        alias = "body-height-m",
+        value_name = "M",
+        allow_negative_numbers = true
+    )]
     pub body_height_m: Option<f32>,
     /// trot, walk: timeout of the velocity command, ms.
     #[arg(long, value_name = "MS")]
@@ -203,7 +209,7 @@ impl RunArgs {
             ("--step-height-m", self.step_height_m.is_some()),
             ("--duty-factor", self.duty_factor.is_some()),
             ("--cycle-s", self.cycle_s.is_some()),
-            ("--body-height-m", self.body_height_m.is_some()),
+            ("--stance-height-m", self.body_height_m.is_some()),
             ("--velocity-timeout-ms", self.velocity_timeout_ms.is_some()),
             ("--forward-m-s", self.forward_m_s.is_some()),
             ("--lateral-m-s", self.lateral_m_s.is_some()),

@@ -25,15 +25,19 @@ What is sent: joint angles as SetJoints, else feet as SetFeet (moved into the bo
 the row's pose when the file has one), else the pose as SetBodyPose; --send picks a kind.
 
 Pacing: row i is due at start + (t_i - t_0) / --speed on the link's clock: simulated time with
---sim and --emulator (nothing sleeps), wall time with --port. A row is sent at its due time;
-when the next row is already due before a row could be sent, the row is skipped (never the
-last). Each answer is checked as `quadctl stream` checks it (angles against the host's
+--sim and --emulator (nothing sleeps), wall time with --port. A row is sent at its due time,
+with up to two requests in flight (--one-at-a-time: each answer before the next row); when the
+next row is already due before a row could be sent, the row is skipped (never the last). Each answer is checked as `quadctl stream` checks it (angles against the host's
 kin-core and joint limits, pulses against the calibration's mapping; the pins with
 --emulator). Nacked, lost and mismatching rows are reported on stderr as <file>:<line>: ...
 
+The device's joint-speed limiter (3 rad/s) slows a row that asks a joint to move faster from
+the row before: such rows are counted in slowed_rows, the first named on stderr
+(<file>:<line>: <joint> at <speed> rad/s > the limit ...); `quadctl check` finds them first.
+
 Output: the last line of stdout is one JSON object: kind, rows, late_mean_ms, late_max_ms
 (sending after the due time), skipped, answer_mean_ms, answer_max_ms (sending to answer),
-motion_s, then the fields of `quadctl stream`'s summary (sent, acked, nacked, retries, lost,
+motion_s, slowed_rows, then the fields of `quadctl stream`'s summary (sent, acked, nacked, retries, lost,
 readback_mismatches, ...) and with --emulator pulses_checked and pulse_width_errors.
 
 Exit status: 0 every row sent was acked, every check passed (skipped rows do not count); 2
@@ -79,6 +83,7 @@ pub fn main(args: &Args) -> ExitCode {
         speed: args.speed,
         send: args.send,
         input: args.file.clone(),
+        window: args.session.window(),
     };
     let summary = match play::run(&request, &mut io::stderr().lock()) {
         Ok(s) => s,

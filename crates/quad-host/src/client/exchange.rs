@@ -67,6 +67,29 @@ enum Wait {
     Timeout,
 }
 
+/// What [`Client::wait_any`] saw first.
+pub(super) enum Waited {
+    /// The answer to one of the sequence numbers waited for.
+    Answer(u16, DeviceToHost),
+    /// A nack without a sequence number, or an unreadable frame.
+    LinkNack,
+    /// The deadline passed.
+    Timeout,
+}
+
+/// A request framed under its sequence number: the same bytes on every attempt.
+#[derive(Debug, Clone)]
+pub(super) struct Framed {
+    /// Its sequence number.
+    pub seq: u16,
+    /// The frame on the wire.
+    pub bytes: Vec<u8>,
+    /// How long an attempt waits for the answer ([`Client::attempt_timeout`]).
+    pub timeout: Duration,
+    /// The frame's time on the wire.
+    pub on_wire: Duration,
+}
+
 /// Requests over a [`Link`] (see the module docs).
 pub struct Client<L> {
     link: L,
@@ -202,6 +225,67 @@ impl<L: Link> Client<L> {
         deadline: Duration,
         nack_from: Duration,
     ) -> Result<Wait, link::Error> {
+        Ok(match self.wait_any(&[seq], deadline, nack_from)? {
+            Waited::Answer(_, answer) => Wait::Answer(answer),
+            Waited::LinkNack => Wait::LinkNack,
+            Waited::Timeout => Wait::Timeout,
+        })
+    }
+
+    /// Frames `request` under the next sequence number, for [`Client::send_framed`] (the
+    /// requests of a window in flight, [`super::PoseStream`]).
+    pub(super) fn frame_next(&mut self, request: Request) -> Framed {
+        self.seq = self.seq.wrapping_add(1);
+        let seq = self.seq;
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let bytes = encode_frame(&HostToDevice { seq, request }, &mut buf)
+            .map(<[u8]>::to_vec)
+            .unwrap_or_default();
+        let timeout = self.attempt_timeout(bytes.len(), &request);
+        let on_wire = byte_time(self.link.baud()) * bytes.len() as u32;
+        Framed {
+            seq,
+            bytes,
+            timeout,
+            on_wire,
+        }
+    }
+
+    /// Sends `framed` (a first attempt, or a resend with `retry`); returns the link's time
+    /// when it was handed to the line.
+    ///
+    /// # Errors
+    /// Link failures.
+    pub(super) fn send_framed(
+        &mut self,
+        framed: &Framed,
+        retry: bool,
+    ) -> Result<Duration, link::Error> {
+        let sent_at = self.link.now();
+        self.link.send(&framed.bytes)?;
+        self.counters.frames_sent += 1;
+        if retry {
+            self.counters.retries += 1;
+        }
+        Ok(sent_at)
+    }
+
+    /// The counters, to count what a caller of [`Client::wait_any`] decides.
+    pub(super) fn counters_mut(&mut self) -> &mut Counters {
+        &mut self.counters
+    }
+
+    /// Waits until `deadline` for an answer to one of `seqs`; a nack without a sequence number
+    /// counts only from `nack_from` on. Answers to other sequence numbers are dropped as stale.
+    ///
+    /// # Errors
+    /// Link failures.
+    pub(super) fn wait_any(
+        &mut self,
+        seqs: &[u16],
+        deadline: Duration,
+        nack_from: Duration,
+    ) -> Result<Waited, link::Error> {
         let mut buf = [0u8; 256];
         loop {
             let input = std::mem::take(&mut self.pending);
@@ -211,13 +295,13 @@ impl<L: Link> Client<L> {
                     Feed::NeedMore => break,
                     Feed::Frame { msg, remaining } => {
                         rest = remaining;
-                        if msg.seq() == Some(seq) {
+                        if let Some(seq) = msg.seq().filter(|s| seqs.contains(s)) {
                             self.pending = rest.to_vec();
-                            return Ok(Wait::Answer(msg));
+                            return Ok(Waited::Answer(seq, msg));
                         }
                         if msg.seq().is_none() && self.link.now() >= nack_from {
                             self.pending = rest.to_vec();
-                            return Ok(Wait::LinkNack);
+                            return Ok(Waited::LinkNack);
                         }
                         self.counters.stale += 1;
                     }
@@ -228,14 +312,14 @@ impl<L: Link> Client<L> {
                         // at the timeout.
                         if self.link.now() >= nack_from {
                             self.pending = rest.to_vec();
-                            return Ok(Wait::LinkNack);
+                            return Ok(Waited::LinkNack);
                         }
                     }
                 }
             }
             let now = self.link.now();
             if now >= deadline {
-                return Ok(Wait::Timeout);
+                return Ok(Waited::Timeout);
             }
             let n = self.link.recv(&mut buf, deadline - now)?;
             self.pending.extend_from_slice(&buf[..n]);

@@ -16,6 +16,15 @@
 //! dropped. The device answers an exact repeat of the request it answered last with the same
 //! answer, without acting again (docs/protocol.md, link rules), so a resend is always safe.
 //!
+//! ## A window in flight
+//! [`PoseStream::submit`] keeps up to [`MAX_WINDOW`] (two) setpoints in flight, as the device
+//! allows (docs/protocol.md, link rules): the next request leaves as soon as the oldest is
+//! answered, so the device solves it while the previous answer is on the wire. Each setpoint
+//! gets the checks and retries above under its own sequence number; an attempt's timeout runs
+//! from its sending or from the answer to the one before it, whichever is later (the device
+//! answers in order). A resend after a later setpoint was answered leaves the device holding
+//! the older one, so [`PoseStream::flush`] then sends the newest once more.
+//!
 //! The answer timeout of an attempt ([`AnswerWait`]) is, for the ATmega2560 (a real port or
 //! the emulated chip), the firmware's measured answer time of that kind of request at the
 //! link's line rate with a margin ([`quad_protocol::timing`]); for the simulated device, the
@@ -50,7 +59,9 @@ pub use checks::{
     check_readback, expected, judge, AngleCheck, Expected, Mismatch, AVR_ANGLE_TOLERANCE_RAD,
 };
 pub use exchange::{Client, Counters, Exchange, Outcome, Verdict};
-pub use stream::{PoseResult, PoseStream, Setpoint, StreamSetup, StreamStats};
+pub use stream::{
+    PoseResult, PoseStream, Setpoint, Settled, StreamSetup, StreamStats, DEFAULT_WINDOW, MAX_WINDOW,
+};
 
 use crate::link;
 use quad_protocol::{DeviceToHost, NackReason, Request, RobotPreset, PROTOCOL_VERSION};
@@ -189,6 +200,15 @@ pub enum Error {
     Version {
         /// The device's version.
         device: u16,
+    },
+    /// A window of requests in flight the device does not take.
+    #[error(
+        "{window} requests in flight: the device takes 1 to {}",
+        stream::MAX_WINDOW
+    )]
+    Window {
+        /// The window asked for.
+        window: usize,
     },
     /// The device runs another robot than the host was asked for.
     #[error(

@@ -2,7 +2,8 @@
 //! kin-core (see the module docs of [`crate::client`]).
 
 use super::checks::{check_readback, expected, expected_angles, judge};
-use super::{AngleCheck, Client, Error, Exchange, Expected, Mismatch, Outcome};
+use super::exchange::{Framed, Waited};
+use super::{AngleCheck, Client, Error, Exchange, Expected, Mismatch, Outcome, Verdict};
 use crate::link::Link;
 use kin_core::body::{self, Pose};
 use kin_core::{ReachPolicy, Robot, RotationOrder, Vec3};
@@ -12,7 +13,16 @@ use quad_protocol::{
     ServoId,
 };
 use serde::Serialize;
+use std::collections::VecDeque;
 use std::time::Duration;
+
+/// Requests [`PoseStream::submit`] keeps in flight by default: the device solves the next
+/// while the answer to the previous one is on the wire (docs/protocol.md, link rules).
+pub const DEFAULT_WINDOW: usize = 2;
+
+/// The most requests the device takes in flight: one being solved, one waiting in its receive
+/// buffer (docs/protocol.md, link rules).
+pub const MAX_WINDOW: usize = 2;
 
 /// What the host asks of a pose stream.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,6 +121,44 @@ pub struct PoseStream<L> {
     stats: StreamStats,
     started: Option<Duration>,
     finished: Duration,
+    window: usize,
+    in_flight: VecDeque<InFlight>,
+    /// The setpoint of the request the device answered last, and whether it is the newest
+    /// one submitted: a resend after a later request leaves the device holding an older one.
+    held_newest: bool,
+    /// When the last setpoint taken out of the window was answered (or given up).
+    settled_at: Duration,
+}
+
+/// How a setpoint of [`PoseStream::submit`] ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settled {
+    /// The tag it was submitted with.
+    pub tag: u64,
+    /// Its result.
+    pub result: PoseResult,
+    /// The link's time of its first attempt.
+    pub sent_at: Duration,
+    /// The link's time its answer was taken (or it was given up).
+    pub answered_at: Duration,
+}
+
+/// A setpoint of [`PoseStream::submit`] on its way: its request framed once, its attempts.
+struct InFlight {
+    tag: u64,
+    first_sent_at: Duration,
+    answered_at: Duration,
+    setpoint: Setpoint,
+    expected: Expected,
+    framed: Framed,
+    sent_at: Duration,
+    attempts: u32,
+    /// The last answer the check refused.
+    rejected: Option<DeviceToHost>,
+    /// Answers the check refused.
+    rejections: u64,
+    /// How it ended, once it has.
+    done: Option<Outcome>,
 }
 
 impl<L: Link> PoseStream<L> {
@@ -143,6 +191,10 @@ impl<L: Link> PoseStream<L> {
             stats: StreamStats::default(),
             started: None,
             finished: Duration::ZERO,
+            window: DEFAULT_WINDOW,
+            in_flight: VecDeque::new(),
+            held_newest: true,
+            settled_at: Duration::ZERO,
         };
         s.setup()?;
         Ok(s)
@@ -314,8 +366,13 @@ impl<L: Link> PoseStream<L> {
             exchange = self.exchange_pose(setpoint, expected)?;
         }
         self.stats.retries += u64::from(exchange.attempts - 1);
+        self.conclude(exchange.outcome, expected)
+    }
+
+    /// The result of a setpoint whose exchange ended with `outcome`, counted in the statistics.
+    fn conclude(&mut self, outcome: Outcome, expected: Expected) -> Result<PoseResult, Error> {
         self.finished = self.client.link().now();
-        let result = match (exchange.outcome, expected) {
+        let result = match (outcome, expected) {
             // The check accepts an ack only when the host expects angles.
             (Outcome::Accepted(DeviceToHost::Ack { readback, .. }), Expected::Angles(want)) => {
                 self.count_out_of_range(&readback);
@@ -351,6 +408,241 @@ impl<L: Link> PoseStream<L> {
             }
         };
         Ok(result)
+    }
+
+    /// The requests [`PoseStream::submit`] keeps in flight.
+    pub fn window(&self) -> usize {
+        self.window
+    }
+
+    /// Sets how many requests [`PoseStream::submit`] keeps in flight: 1 is one at a time (as
+    /// [`PoseStream::send_setpoint`]), at most [`MAX_WINDOW`]. Setpoints still in flight are
+    /// finished first and their results returned.
+    ///
+    /// # Errors
+    /// [`Error::Window`] for 0 or more than [`MAX_WINDOW`]; the errors of [`PoseStream::flush`].
+    pub fn set_window(&mut self, window: usize) -> Result<Vec<Settled>, Error> {
+        if !(1..=MAX_WINDOW).contains(&window) {
+            return Err(Error::Window { window });
+        }
+        let done = self.flush()?;
+        self.window = window;
+        Ok(done)
+    }
+
+    /// Sends `setpoint` with up to [`PoseStream::window`] requests in flight: it leaves as soon
+    /// as an earlier one has been answered, and each answer gets the checks and retries of
+    /// [`PoseStream::send_setpoint`] (a resend keeps its sequence number; the others stay in
+    /// flight meanwhile). Returns the setpoints that ended meanwhile, in the order they were
+    /// submitted, each with the `tag` it was submitted with.
+    ///
+    /// # Errors
+    /// Link failures, and the errors of a new handshake after a device reset.
+    pub fn submit(&mut self, setpoint: &Setpoint, tag: u64) -> Result<Vec<Settled>, Error> {
+        let mut done = Vec::new();
+        while self.in_flight.len() >= self.window {
+            self.settle_oldest(&mut done)?;
+        }
+        let expected = self.expected_for(setpoint);
+        if self.started.is_none() {
+            self.started = Some(self.client.link().now());
+        }
+        self.stats.sent += 1;
+        let framed = self.client.frame_next(setpoint.request());
+        let sent_at = self.client.send_framed(&framed, false)?;
+        self.held_newest = false;
+        self.in_flight.push_back(InFlight {
+            tag,
+            first_sent_at: sent_at,
+            answered_at: sent_at,
+            setpoint: *setpoint,
+            expected,
+            framed,
+            sent_at,
+            attempts: 1,
+            rejected: None,
+            rejections: 0,
+            done: None,
+        });
+        Ok(done)
+    }
+
+    /// Waits for every setpoint still in flight and returns their results in submission order
+    /// (see [`PoseStream::submit`]). When a resend left the device holding an older setpoint
+    /// than the newest one, the newest is sent once more (one at a time, counted as a retry):
+    /// the device ends holding the last setpoint, as one request at a time would leave it.
+    ///
+    /// # Errors
+    /// As [`PoseStream::submit`].
+    pub fn flush(&mut self) -> Result<Vec<Settled>, Error> {
+        let mut done = Vec::new();
+        let newest = self.in_flight.back().map(|f| (f.setpoint, f.expected));
+        while !self.in_flight.is_empty() {
+            self.settle_oldest(&mut done)?;
+        }
+        if let (false, Some((setpoint, expected))) = (self.held_newest, newest) {
+            let exchange = self.exchange_pose(&setpoint, expected)?;
+            self.stats.retries += u64::from(exchange.attempts);
+            self.held_newest = true;
+        }
+        Ok(done)
+    }
+
+    /// Waits until the oldest setpoint in flight has ended, handling every answer, nack and
+    /// timeout of the window meanwhile; moves the ended setpoints at the front to `done`.
+    fn settle_oldest(&mut self, done: &mut Vec<Settled>) -> Result<(), Error> {
+        while self.in_flight.front().is_some_and(|f| f.done.is_none()) {
+            self.step(None)?;
+        }
+        while let Some(front) = self.in_flight.front() {
+            let Some(outcome) = front.done else { break };
+            let Some(f) = self.in_flight.pop_front() else {
+                break;
+            };
+            if matches!(outcome, Outcome::Accepted(_)) {
+                self.stats.transient_mismatches += f.rejections;
+            }
+            self.settled_at = f.answered_at;
+            self.stats.retries += u64::from(f.attempts - 1);
+            let result = self.conclude(outcome, f.expected)?;
+            done.push(Settled {
+                tag: f.tag,
+                result,
+                sent_at: f.first_sent_at,
+                answered_at: f.answered_at,
+            });
+        }
+        Ok(())
+    }
+
+    /// Lets the link's time run until `until` while the setpoints in flight are answered,
+    /// resent or given up; returns those that ended, as [`PoseStream::submit`] does.
+    ///
+    /// # Errors
+    /// As [`PoseStream::submit`].
+    pub fn idle_until(&mut self, until: Duration) -> Result<Vec<Settled>, Error> {
+        let mut done = Vec::new();
+        while self.client.link().now() < until {
+            if self.in_flight.iter().all(|f| f.done.is_some()) {
+                self.client.idle_until(until)?;
+                break;
+            }
+            self.step(Some(until))?;
+        }
+        if self.in_flight.front().is_some_and(|f| f.done.is_some()) {
+            self.settle_oldest(&mut done)?;
+        }
+        Ok(done)
+    }
+
+    /// One event of the window: an answer, a nack of an unreadable frame, or the earliest
+    /// deadline passing (or `until`, which ends the step without a resend).
+    fn step(&mut self, until: Option<Duration>) -> Result<(), Error> {
+        let open: Vec<usize> = (0..self.in_flight.len())
+            .filter(|&i| self.in_flight[i].done.is_none())
+            .collect();
+        let Some(&first) = open.first() else {
+            return Ok(());
+        };
+        let seqs: Vec<u16> = open.iter().map(|&i| self.in_flight[i].framed.seq).collect();
+        let (latest, deadline) = self
+            .deadlines()
+            .into_iter()
+            .min_by_key(|&(_, d)| d)
+            .unwrap_or((first, Duration::ZERO));
+        let nack_from = self.in_flight[first].sent_at + self.in_flight[first].framed.on_wire;
+        let wait_until = until.map_or(deadline, |u| u.min(deadline));
+        match self.client.wait_any(&seqs, wait_until, nack_from)? {
+            Waited::Answer(seq, answer) => {
+                let Some(i) = open
+                    .iter()
+                    .copied()
+                    .find(|&i| self.in_flight[i].framed.seq == seq)
+                else {
+                    return Ok(());
+                };
+                self.held_newest = i + 1 == self.in_flight.len();
+                if let DeviceToHost::Nack {
+                    reason: NackReason::HelloRequired,
+                    ..
+                } = answer
+                {
+                    // The device was reset: set the session up again and send every setpoint
+                    // without an answer once more.
+                    self.setup()?;
+                    for i in open {
+                        self.resend(i)?;
+                    }
+                    return Ok(());
+                }
+                self.in_flight[i].answered_at = self.client.link().now();
+                let f = &self.in_flight[i];
+                match judge(self.setup.check, &self.calibration, &answer, &f.expected) {
+                    Verdict::Accept => self.in_flight[i].done = Some(Outcome::Accepted(answer)),
+                    Verdict::Reject => {
+                        self.client.counters_mut().rejected += 1;
+                        let f = &mut self.in_flight[i];
+                        f.rejections += 1;
+                        f.rejected = Some(answer);
+                        self.retry(i)?;
+                    }
+                }
+            }
+            Waited::LinkNack => {
+                // Most likely the oldest request or its answer, damaged on the line.
+                self.client.counters_mut().link_nacks += 1;
+                self.retry(first)?;
+            }
+            Waited::Timeout if wait_until < deadline => {}
+            Waited::Timeout => {
+                self.client.counters_mut().timeouts += 1;
+                self.retry(latest)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The answer deadline of each setpoint in flight without an answer: its timeout from its
+    /// last attempt, or from when the one before it was answered (or timed out) when that is
+    /// later: the device answers in order, so a request waits for the one before it.
+    fn deadlines(&self) -> Vec<(usize, Duration)> {
+        let mut out = Vec::new();
+        let mut before = self.settled_at;
+        for (i, f) in self.in_flight.iter().enumerate() {
+            let start = f.sent_at.max(before);
+            let deadline = start + f.framed.timeout;
+            if f.done.is_none() {
+                out.push((i, deadline));
+                before = deadline;
+            } else {
+                before = f.answered_at;
+            }
+        }
+        out
+    }
+
+    /// Resends the `i`-th setpoint in flight, or ends it (rejected or lost) when it has had
+    /// every attempt.
+    fn retry(&mut self, i: usize) -> Result<(), Error> {
+        let retries = self.client.config().retries;
+        let now = self.client.link().now();
+        let f = &mut self.in_flight[i];
+        if f.attempts > retries {
+            f.answered_at = now;
+            f.done = Some(f.rejected.map_or(Outcome::Lost, Outcome::Rejected));
+            return Ok(());
+        }
+        self.resend(i)
+    }
+
+    /// Sends the `i`-th setpoint in flight again, the same bytes under the same sequence
+    /// number.
+    fn resend(&mut self, i: usize) -> Result<(), Error> {
+        let sent_at = self.client.send_framed(&self.in_flight[i].framed, true)?;
+        let f = &mut self.in_flight[i];
+        f.sent_at = sent_at;
+        f.attempts += 1;
+        Ok(())
     }
 
     fn exchange_pose(

@@ -8,11 +8,15 @@
 //! - [`emulator::EmulatorLink`]: the real firmware ELF in simavr in-process, behind its USART0,
 //!   on the emulated MCU's clock, with the same fault injection and a check of the pulses on
 //!   the twelve servo pins against the readbacks.
+//! - [`pty::VirtualPort`] (Unix): either of the two above served on a pseudo-terminal, for
+//!   programs that open a serial port.
 //!
 //! A link moves bytes and tells the time; framing, sequence numbers and retries are the
 //! [`crate::client`]'s. [`open`] is the one way to open a link from a [`Target`].
 
 pub mod emulator;
+#[cfg(unix)]
+pub mod pty;
 pub mod serial;
 pub mod sim;
 

@@ -5,6 +5,7 @@ pub mod accuracy;
 pub mod batch;
 pub mod calibrate;
 pub mod check;
+pub mod defaults;
 pub mod demo;
 pub mod demo_motions;
 pub mod drive;

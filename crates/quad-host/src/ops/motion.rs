@@ -3,6 +3,7 @@
 //! validation, and [`run`], the operation behind `quadctl motion`.
 
 use crate::csv::motion::{header, push_num, Output};
+use crate::ops::defaults;
 use crate::plot::{self, JointSeries};
 use crate::{csv, robot_file};
 use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
@@ -127,6 +128,10 @@ pub struct Params {
     pub yaw_rad_s: Option<f32>,
 }
 
+/// Stance heights closer than this are the same stance, m (seed 001's initial pose through
+/// forward kinematics against the device's rounded 0.9294 m).
+const SAME_STANCE_M: f32 = 1e-4;
+
 /// Errors of the motion operations (`motion`, `check`, `plot`, `accuracy`).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -189,7 +194,7 @@ pub enum Error {
 pub fn option_of(parameter: &str) -> String {
     match parameter {
         "feet_in_world" | "stance_feet" => "--stance-height-m".to_owned(),
-        "velocity" => "--forward-m-s/--lateral-m-s/--yaw-rad-s".to_owned(),
+        "velocity" => "--forward-m-s/--lateral-m-s/--yaw-rate-rad-s".to_owned(),
         "path" => "--path/--stride-m/--step-height-m/--duty-factor".to_owned(),
         "max_joint_speed_rad_s" => "--max-joint-speed-rad-s".to_owned(),
         other => format!("--{}", other.replace('_', "-")),
@@ -247,7 +252,7 @@ impl Params {
             (
                 "--yaw-rate-rad-s",
                 self.yaw_rate_rad_s.is_some(),
-                law == Law::YawTurn,
+                law == Law::YawTurn || gait,
             ),
             (
                 "--step-period-s",
@@ -308,7 +313,19 @@ impl Params {
                 }
                 Ok(robot.stance_feet(h))
             }
-            None => Ok(laws::seed001_stance(robot)),
+            None => Ok(self.device_stance(robot)),
+        }
+    }
+
+    /// The device's stance for a preset ([`defaults::stance_height_m`]: feet straight below
+    /// the hips), seed 001's initial stance for a robot file. Where the device's stance is
+    /// seed 001's initial pose (fernando2025's 0.9294 m), that pose's own feet (forward
+    /// kinematics of eq. 5), which lie there within float rounding.
+    fn device_stance(&self, robot: &Robot) -> [Vec3; 4] {
+        let seed001 = laws::seed001_stance(robot);
+        match defaults::stance_height_m(&self.robot) {
+            Some(h) if (seed001[0].z + h).abs() > SAME_STANCE_M => robot.stance_feet(h),
+            _ => seed001,
         }
     }
 
@@ -402,7 +419,7 @@ impl Params {
                 p.velocity = Velocity {
                     forward_m_s: self.forward_m_s.unwrap_or(0.0),
                     lateral_m_s: self.lateral_m_s.unwrap_or(0.0),
-                    yaw_rad_s: self.yaw_rad_s.unwrap_or(0.0),
+                    yaw_rad_s: self.yaw_rad_s.or(self.yaw_rate_rad_s).unwrap_or(0.0),
                 };
                 AnyMotion::Gait(Gait::new(p).map_err(param_err)?)
             }

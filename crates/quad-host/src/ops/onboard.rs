@@ -151,14 +151,14 @@ pub fn option(param: MotionParam) -> &'static str {
         MotionParam::DutyFactor => "--duty-factor",
         MotionParam::CycleS => "--cycle-s",
         MotionParam::Path => "--path (with --stride-m, --step-height-m)",
-        MotionParam::BodyHeightM => "--body-height-m",
+        MotionParam::BodyHeightM => "--stance-height-m",
         MotionParam::VelocityTimeoutMs => "--velocity-timeout-ms",
         MotionParam::ForwardMS => "--forward-m-s",
         MotionParam::LateralMS => "--lateral-m-s",
         MotionParam::Velocity => "the velocity (--forward-m-s, --lateral-m-s, --yaw-rate-rad-s)",
         MotionParam::JointSpeedLimitRadS => "--joint-speed-limit-rad-s",
         MotionParam::Stance => "the device's stance height",
-        MotionParam::ReachRadiusM => "--body-height-m (it sets the stride's reach)",
+        MotionParam::ReachRadiusM => "--stance-height-m (it sets the stride's reach)",
         _ => "a parameter",
     }
 }

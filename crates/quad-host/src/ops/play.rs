@@ -5,8 +5,9 @@
 //! ## Pacing
 //! Row `i` is due at `start + (t_i − t_0) / speed` on the link's clock: the virtual clock of
 //! the simulated and the emulated device (nothing sleeps), the wall clock of a port. The host
-//! waits for the due time, sends the row and waits for its answer (retried as every request
-//! is, [`crate::client`]). A row is **late** by the time between its due time and its
+//! waits for the due time and sends the row, with up to [`Request::window`] requests in
+//! flight ([`PoseStream::submit`]: each answer checked and retried as every request is,
+//! [`crate::client`]). A row is **late** by the time between its due time and its
 //! sending; when the next row is already due before a row could be sent, the row is
 //! **skipped** (the device holds the latest setpoint; a backlog would only grow), except the
 //! last one. Both are in the summary.
@@ -18,14 +19,18 @@
 //! (feet at the device's stance). With several kinds, joint angles come first, then feet,
 //! then the pose, unless [`Request::send`] names one.
 
-use crate::client::{self, PoseStream, Setpoint, StreamStats};
+use crate::client::{self, Expected, PoseStream, Setpoint, Settled, StreamStats};
 use crate::csv;
 use crate::csv::play::{self as play_csv, ColumnKind, PlayFile};
 use crate::link::Link;
+use crate::names;
+use crate::ops::defaults;
 use crate::ops::session::{self, Pins, Session};
 use kin_core::body;
 use kin_core::{BodyConfig, LegId, Robot, RotationOrder, Vec3};
+use quad_protocol::ServoId;
 use serde::Serialize;
+use std::fmt;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -42,6 +47,9 @@ pub struct Request {
     pub send: Option<ColumnKind>,
     /// The file (`-`: stdin).
     pub input: PathBuf,
+    /// Requests kept in flight (1: one at a time; [`client::DEFAULT_WINDOW`] by default, at
+    /// most [`client::MAX_WINDOW`]).
+    pub window: usize,
 }
 
 /// Why nothing or not everything could be played.
@@ -93,6 +101,10 @@ pub struct Timing {
     pub answer_max_ms: f64,
     /// The file's span divided by the speed, s.
     pub motion_s: f64,
+    /// Rows that ask a joint to move faster than the device's joint-speed limit (its power-on
+    /// limit, 3 rad/s: [`defaults::joint_speed_limit_rad_s`]) from the row before: the device slows
+    /// them, and its outputs lag the file ([`slowed`]).
+    pub slowed_rows: u64,
 }
 
 /// `quadctl play`'s JSON summary.
@@ -187,6 +199,7 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Summary, Error> {
     let file = play_csv::read(&args.input)?;
     let kind = kind_to_send(&file, args.send)?;
     let mut stream = args.session.connect(checked, file.rotation_order)?;
+    stream.set_window(args.window)?;
     let timing = play(&mut stream, &file, kind, args.speed, diag)?;
     let pins = Pins::after(&mut stream, &file.name, diag)
         .map_err(|source| csv::Error::Write { path: None, source })?;
@@ -212,6 +225,8 @@ pub fn play<L: Link>(
 ) -> Result<Timing, Error> {
     let robot = stream.stream_setup().robot;
     let order = stream.pose_config().order;
+    let limit_rad_s =
+        defaults::joint_speed_limit_rad_s(names::robot_preset_name(stream.stream_setup().preset));
     let frames = &file.frames;
     let t_first = frames.first().map_or(0.0, |f| f.t_s);
     let start = stream.client().link().now();
@@ -220,7 +235,9 @@ pub fn play<L: Link>(
         motion_s: frames.last().map_or(0.0, |f| f.t_s - t_first) / speed,
         ..Timing::default()
     };
-    let (mut late_sum, mut answer_sum, mut sent) = (0.0, 0.0, 0u64);
+    let mut sums = Sums::default();
+    // The angles and time of the last row sent, for the limiter's count.
+    let mut last: Option<([f32; 12], f64)> = None;
     for (i, frame) in frames.iter().enumerate() {
         let at = due(frame.t_s);
         let now = stream.client().link().now();
@@ -228,30 +245,124 @@ pub fn play<L: Link>(
             timing.skipped += 1;
             continue;
         }
-        stream
-            .client_mut()
-            .idle_until(at)
-            .map_err(client::Error::from)?;
-        let sent_at = stream.client().link().now();
-        let result = stream.send_setpoint(&setpoint(&robot, order, frame, kind))?;
-        let answered = stream.client().link().now();
-        let late_ms = ms(sent_at.saturating_sub(at));
-        let answer_ms = ms(answered.saturating_sub(sent_at));
-        late_sum += late_ms;
-        answer_sum += answer_ms;
-        sent += 1;
-        timing.late_max_ms = timing.late_max_ms.max(late_ms);
-        timing.answer_max_ms = timing.answer_max_ms.max(answer_ms);
-        if let Some(r) = session::report(&result) {
-            writeln!(diag, "{}:{}: {r}", file.name, frame.line)
-                .map_err(|source| csv::Error::Write { path: None, source })?;
+        let settled = stream.idle_until(at)?;
+        sums.take(&settled, file, &due, &mut timing, diag)?;
+        let sp = setpoint(&robot, order, frame, kind);
+        if let Expected::Angles(angles) = stream.expected_for(&sp) {
+            let t_s = frame.t_s / speed;
+            if let Some((before, t_before)) = last {
+                if let Some(slowed) = slowed(&before, &angles, t_s - t_before, limit_rad_s) {
+                    if timing.slowed_rows == 0 {
+                        writeln!(
+                            diag,
+                            "{}:{}: {slowed}; the device's joint-speed limiter slows this row \
+                             (and every row counted in slowed_rows)",
+                            file.name, frame.line
+                        )
+                        .map_err(|source| csv::Error::Write { path: None, source })?;
+                    }
+                    timing.slowed_rows += 1;
+                }
+            }
+            last = Some((angles, t_s));
         }
+        let settled = stream.submit(&sp, i as u64)?;
+        sums.take(&settled, file, &due, &mut timing, diag)?;
     }
-    if sent > 0 {
-        timing.late_mean_ms = late_sum / sent as f64;
-        timing.answer_mean_ms = answer_sum / sent as f64;
+    let settled = stream.flush()?;
+    sums.take(&settled, file, &due, &mut timing, diag)?;
+    if sums.sent > 0 {
+        timing.late_mean_ms = sums.late / sums.sent as f64;
+        timing.answer_mean_ms = sums.answer / sums.sent as f64;
     }
     Ok(timing)
+}
+
+/// Why a row is slowed by the device's joint-speed limiter: a joint whose change from the
+/// previous row (`dt_s` earlier) asks more than `limit_rad_s` of it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slowed {
+    /// The joint, canonical index.
+    pub servo: ServoId,
+    /// The speed the row asks of it, rad/s.
+    pub speed_rad_s: f32,
+    /// The limit, rad/s.
+    pub limit_rad_s: f32,
+}
+
+impl fmt::Display for Slowed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} at {:.3} rad/s > the limit {} rad/s",
+            self.servo, self.speed_rad_s, self.limit_rad_s
+        )
+    }
+}
+
+/// The fastest joint between two rows of angles `dt_s` apart when it moves faster than
+/// `limit_rad_s` (the device then takes longer than the rows allow: the outputs lag the file).
+/// Rows at the same time (or out of order) compare their change with one servo frame.
+pub fn slowed(
+    before: &[f32; 12],
+    after: &[f32; 12],
+    dt_s: f64,
+    limit_rad_s: f32,
+) -> Option<Slowed> {
+    let dt_s = dt_s.max(f64::from(quad_device::engine::FRAME_MS) * 1e-3) as f32;
+    ServoId::ALL
+        .into_iter()
+        .map(|s| (s, (after[s.index()] - before[s.index()]).abs() / dt_s))
+        .filter(|&(_, v)| v > limit_rad_s * (1.0 + SLOWED_MARGIN))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(servo, speed_rad_s)| Slowed {
+            servo,
+            speed_rad_s,
+            limit_rad_s,
+        })
+}
+
+/// Relative margin above the limit before a row counts as slowed: the rows' times and angles
+/// are rounded in the file.
+pub const SLOWED_MARGIN: f32 = 1e-3;
+
+/// Lateness and answer-time sums of the rows sent.
+#[derive(Default)]
+struct Sums {
+    late: f64,
+    answer: f64,
+    sent: u64,
+}
+
+impl Sums {
+    /// Counts the rows in `settled` (tagged with their index in `file`) and reports those
+    /// nacked, lost or mismatched on `diag`.
+    fn take(
+        &mut self,
+        settled: &[Settled],
+        file: &PlayFile,
+        due: &dyn Fn(f64) -> Duration,
+        timing: &mut Timing,
+        diag: &mut dyn Write,
+    ) -> Result<(), Error> {
+        for s in settled {
+            let Some(frame) = file.frames.get(s.tag as usize) else {
+                continue;
+            };
+            let late_ms = ms(s.sent_at.saturating_sub(due(frame.t_s)));
+            let answer_ms = ms(s.answered_at.saturating_sub(s.sent_at));
+            self.late += late_ms;
+            self.answer += answer_ms;
+            self.sent += 1;
+            timing.late_max_ms = timing.late_max_ms.max(late_ms);
+            timing.answer_max_ms = timing.answer_max_ms.max(answer_ms);
+            if let Some(r) = session::report(&s.result) {
+                writeln!(diag, "{}:{}: {r}", file.name, frame.line)
+                    .map_err(|source| csv::Error::Write { path: None, source })?;
+            }
+        }
+        Ok(())
+    }
 }
 
 fn ms(d: Duration) -> f64 {

@@ -1,12 +1,13 @@
 //! Body poses from a CSV to the device, every answer checked against the host's own kin-core:
 //! the operation behind `quadctl stream`. Its summary is one JSON object ([`Summary`]).
 
-use crate::client::{self, StreamStats};
+use crate::client::{self, Setpoint, Settled, StreamStats};
 use crate::csv::{self, AnswerError, FirstColumn, Input, Schema};
 use crate::ops::session::{self, Pins, Session};
 use kin_core::body::Pose;
 use serde::Serialize;
 use std::cell::RefCell;
+use std::collections::VecDeque;
 use std::io::{self, Write};
 use std::path::PathBuf;
 
@@ -23,6 +24,9 @@ pub struct Request {
     pub session: Session,
     /// The poses, CSV (`-`: stdin).
     pub input: PathBuf,
+    /// Requests kept in flight (1: one at a time; [`client::DEFAULT_WINDOW`] by default, at
+    /// most [`client::MAX_WINDOW`]).
+    pub window: usize,
 }
 
 /// Why nothing or not everything could be streamed.
@@ -80,7 +84,10 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
     let checked = args.session.check()?;
     let input = Input::open(&args.input)?;
     let mut stream = args.session.connect(checked, None)?;
+    stream.set_window(args.window)?;
     let name = input.name.clone();
+    // The poses in flight: their line and rotation angles, for the reports of their results.
+    let mut in_flight: VecDeque<(u64, [f32; 3])> = VecDeque::new();
     let mut failure: Option<client::Error> = None;
     // Malformed records (reported by `for_each_row`) and pose reports share `diag`, in order.
     let diag = RefCell::new(diag);
@@ -95,18 +102,13 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
             for (i, slot) in v.iter_mut().enumerate() {
                 *slot = row.number(i)?;
             }
-            let result = match stream.send(&Pose::from_array(v)) {
-                Ok(r) => r,
+            let line = row.line as u64;
+            in_flight.push_back((line, [v[0], v[1], v[2]]));
+            match stream.submit(&Setpoint::Pose(Pose::from_array(v)), line) {
+                Ok(settled) => report(&name, &settled, &mut in_flight, &diag)?,
                 Err(e) => {
                     failure = Some(e);
                     return Err(AnswerError::Io(io::Error::other("link failed")));
-                }
-            };
-            if let Some(r) = session::report(&result) {
-                let angles = [("roll_rad", v[0]), ("pitch_rad", v[1]), ("yaw_rad", v[2])];
-                match session::degrees_hint(&angles) {
-                    Some(hint) => writeln!(diag.borrow_mut(), "{name}:{}: {r}; {hint}", row.line)?,
-                    None => writeln!(diag.borrow_mut(), "{name}:{}: {r}", row.line)?,
                 }
             }
             Ok(())
@@ -116,6 +118,9 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
         return Err(e.into());
     }
     let rows = rows?;
+    let settled = stream.flush()?;
+    report(&name, &settled, &mut in_flight, &diag)
+        .map_err(|source| csv::Error::Write { path: None, source })?;
     let pins = Pins::after(&mut stream, &name, &mut Shared(&diag))
         .map_err(|source| csv::Error::Write { path: None, source })?;
     Ok(Outcome {
@@ -125,6 +130,37 @@ pub fn run(args: &Request, diag: &mut dyn Write) -> Result<Outcome, Error> {
         },
         malformed: rows.malformed,
     })
+}
+
+/// Reports every pose of `settled` that was nacked, lost or mismatched as `<input>:<line>: …`
+/// (with a hint when its angles look like degrees), taking them out of `in_flight`.
+fn report(
+    name: &str,
+    settled: &[Settled],
+    in_flight: &mut VecDeque<(u64, [f32; 3])>,
+    diag: &RefCell<&mut dyn Write>,
+) -> io::Result<()> {
+    for s in settled {
+        let mut angles = [0.0f32; 3];
+        while let Some((line, a)) = in_flight.pop_front() {
+            if line == s.tag {
+                angles = a;
+                break;
+            }
+        }
+        if let Some(r) = session::report(&s.result) {
+            let named = [
+                ("roll_rad", angles[0]),
+                ("pitch_rad", angles[1]),
+                ("yaw_rad", angles[2]),
+            ];
+            match session::degrees_hint(&named) {
+                Some(hint) => writeln!(diag.borrow_mut(), "{name}:{}: {r}; {hint}", s.tag)?,
+                None => writeln!(diag.borrow_mut(), "{name}:{}: {r}", s.tag)?,
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A `Write` through a shared `RefCell`.
