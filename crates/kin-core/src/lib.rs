@@ -39,6 +39,7 @@
 //!   [`Robot::fernando2025`].
 //! - [`leg`]: FK (closed form and DH form), IK, reachability, [`ReachPolicy`].
 //! - [`rotation`], [`body`]: body rotation in six orders, full-body IK/FK.
+//! - [`attitude`]: roll and pitch from a six-axis inertial sensor (Mahony's filter).
 //! - [`jacobian`]: velocity kinematics and the singularity measure.
 //! - [`paper`]: seed 000 (θ1, θ2, θ3) and seed 001 (β, α, φ) angle adapters.
 //! - [`math`]: the [`Math`] backend trait (`libm`, fast polynomials, the soft-float choices of
@@ -61,6 +62,7 @@
 // `link_section`), which only the `Math` backend's reads can reach.
 #![deny(unsafe_code)]
 
+pub mod attitude;
 pub mod body;
 pub mod jacobian;
 pub mod leg;
