@@ -51,9 +51,9 @@
 use crate::imu::{ImuFault, ImuReading, ImuSample};
 use kin_core::attitude::{Attitude, Estimator, Gains, G_M_S2};
 use kin_core::Math;
-use quad_protocol::{BalanceConfig, FallKind, ImuFaultKind, ImuHealth, ImuReport, NackReason};
 #[cfg(doc)]
 use quad_protocol::SafeState;
+use quad_protocol::{BalanceConfig, FallKind, ImuFaultKind, ImuHealth, ImuReport, NackReason};
 
 /// How long the robot must stay still from its first sample while the gyro bias is measured,
 /// ms.

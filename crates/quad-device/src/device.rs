@@ -1,11 +1,11 @@
 //! The controller: bytes in → requests → IK, joint limits, servo calibration → outputs →
 //! answer bytes out.
 
+use crate::balance::{Balance, Event};
 use crate::config::{
     validate_pose_config, write_default_calibration, Config, ConfigError, ValidConfig,
     UNBOOTED_CALIBRATION,
 };
-use crate::balance::{Balance, Event};
 use crate::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS, FRAME_S, LEVEL_SHARES};
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::imu::{ImuReading, ImuState};
@@ -15,13 +15,13 @@ use kin_core::motion::gait::Velocity;
 use kin_core::{BodyConfig, DefaultMath, Math, ReachPolicy, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{Calibration, PulseMap};
-use quad_protocol::{BalanceConfig, FaultAction, ImuReport, SafeState};
 use quad_protocol::{
     check_request_in, encode_frame_in_pieces, is_compatible, negotiated_minor, Accumulator,
     DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout,
     MotionCommand, MotionKind, MotionStatus, NackReason, PoseConfig, Ranges, Readback, Request,
     ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
+use quad_protocol::{BalanceConfig, FaultAction, ImuReport, SafeState};
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
 pub const RX_LEN: usize = MAX_DECODED_LEN;
@@ -457,7 +457,9 @@ where
     fn hold_angles(&mut self, angles_rad: &[f32; 12]) -> Result<(), ()> {
         let mut pulses_half_us = [0u16; 12];
         for (i, p) in pulses_half_us.iter_mut().enumerate() {
-            *p = self.pulse_maps[i].pulse_half_us(angles_rad[i]).map_err(|_| ())?;
+            *p = self.pulse_maps[i]
+                .pulse_half_us(angles_rad[i])
+                .map_err(|_| ())?;
         }
         self.held = Some(Held {
             angles_rad: *angles_rad,
