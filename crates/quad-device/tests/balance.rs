@@ -231,6 +231,13 @@ fn leveling_corrects_a_ten_degree_slope() {
             let (r, p) = attitude_of(up_on_slope(&dev, slope_roll, slope_pitch));
             worst = worst.max(r.abs()).max(p.abs());
         }
+        println!(
+            "slope roll {:.1}° pitch {:.1}°: body tilt with leveling, worst over 2 s after 2 s: \
+             {:.3}°",
+            slope_roll.to_degrees(),
+            slope_pitch.to_degrees(),
+            worst.to_degrees()
+        );
         assert!(
             worst.to_degrees() <= LEVEL_TOLERANCE_DEG,
             "slope ({slope_roll}, {slope_pitch}): body tilt {}°",
