@@ -179,8 +179,8 @@ impl Kind {
             Kind::GetMotion => [16_600, 4_800],
             Kind::SetVelocity => [23_100, 17_100],
             Kind::SetJointSpeedLimit => [9_200, 1_700],
-            Kind::SetBalance => [9_000, 1_700],
-            Kind::GetImu => [7_500, 1_400],
+            Kind::SetBalance => [9_200, 2_200],
+            Kind::GetImu => [5_500, 1_100],
         }
     }
 
