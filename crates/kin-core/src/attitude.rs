@@ -151,7 +151,7 @@ impl<M: Math> Estimator<M> {
     /// positive, changes nothing; an accelerometer reading outside the gate (module docs) does
     /// not correct. Returns true when the accelerometer corrected the estimate.
     pub fn update(&mut self, gyro_rad_s: [f32; 3], accel_m_s2: [f32; 3], dt_s: f32) -> bool {
-        if !finite3(gyro_rad_s) || !(dt_s > 0.0 && dt_s.is_finite()) {
+        if !(finite3(gyro_rad_s) && dt_s > 0.0 && dt_s.is_finite()) {
             return false;
         }
         let Gains {

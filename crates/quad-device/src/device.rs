@@ -385,7 +385,7 @@ where
         let now = self.clock.now_ms();
         match self.balance.push(reading, now, self.outputs_enabled) {
             Event::None => {}
-            Event::Fall(_) => self.to_safe_state(),
+            Event::Fall(_) => self.enter_safe_state(),
             Event::Fault => {
                 if self.balance.config().on_fault == FaultAction::Stop {
                     self.engine.stop();
@@ -409,7 +409,7 @@ where
     }
 
     /// A fall: the motion ends and the outputs go to the safe state.
-    fn to_safe_state(&mut self) {
+    fn enter_safe_state(&mut self) {
         self.engine.cancel();
         self.base_pose = None;
         if self.balance.config().safe_state == SafeState::Rest {

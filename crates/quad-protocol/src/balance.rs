@@ -113,7 +113,7 @@ impl BalanceConfig {
         level_ki_per_s: 4.0,
         max_correction_rad: 0.26,
         fall_detection: true,
-        fall_angle_rad: 1.047_197_6,
+        fall_angle_rad: core::f32::consts::FRAC_PI_3,
         safe_state: SafeState::Rest,
         on_fault: FaultAction::OpenLoop,
     };
