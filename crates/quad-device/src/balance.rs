@@ -9,7 +9,7 @@
 //! restarts that second. The mean rate is the bias, the mean accelerometer reading the first
 //! attitude ([`kin_core::attitude::Estimator::reset`]); the estimator's integral term then
 //! follows the bias as it drifts. Meanwhile the health is
-//! [`ImuHealth::Starting`](quad_protocol::ImuHealth::Starting): leveling and the tilt's fall
+//! [`ImuHealth::Starting`]: leveling and the tilt's fall
 //! detection wait (a leveling switched on meanwhile starts when the second is over), the open
 //! loop motions run as without a sensor, and the start check reads the accelerometer alone.
 //!
