@@ -119,3 +119,6 @@ pub const DEVICE_TO_HOST_MAX_LEN: usize = if CONFIGURED_MAX_LEN > MOTION_ACK_MAX
 
 const _: () = assert!(HOST_TO_DEVICE_MAX_LEN <= MAX_DECODED_LEN);
 const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);
+// The `Imu` answer (variant, seq, report, CRC) is shorter than the largest answer.
+const _: () =
+    assert!(1 + 3 + balance::IMU_REPORT_MAX_LEN + frame::CRC_LEN <= DEVICE_TO_HOST_MAX_LEN);
