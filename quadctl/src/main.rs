@@ -50,6 +50,12 @@ enum Command {
     /// Run one of the device's own motions: sways, yaw turn, foot paths, trot, walk.
     Run(cmd::onboard::RunArgs),
     Drive(cmd::drive::Args),
+    /// The device's state with its inertial sensor: health, attitude, leveling, fall.
+    Status(cmd::balance::StatusArgs),
+    /// The device's state with its inertial sensor, live.
+    Watch(cmd::balance::WatchArgs),
+    /// The balance switch: leveling, fall detection, safe state, action on a sensor fault.
+    Balance(cmd::balance::BalanceArgs),
 }
 
 fn main() -> ExitCode {
@@ -80,5 +86,8 @@ fn main() -> ExitCode {
         Command::Rest(args) => cmd::onboard::posture(&args, Rest),
         Command::Run(args) => cmd::onboard::run(&args),
         Command::Drive(args) => cmd::drive::main(&args),
+        Command::Status(args) => cmd::balance::status(&args),
+        Command::Watch(args) => cmd::balance::watch(&args),
+        Command::Balance(args) => cmd::balance::balance(&args),
     }
 }

@@ -12,8 +12,8 @@ use kin_core::{LegId, Pose, ReachPolicy, RotationOrder};
 use quad_host::link::emulator::EmulatorLink;
 use quad_host::link::Link;
 use quad_protocol::{
-    timing, DeviceToHost, LegSet, LinkLossAction, LinkTimeout, MotionCommand, PoseConfig, Request,
-    ServoId, PROTOCOL_VERSION,
+    timing, BalanceConfig, DeviceToHost, LegSet, LinkLossAction, LinkTimeout, MotionCommand,
+    PoseConfig, Request, SafeState, ServoId, PROTOCOL_VERSION,
 };
 use std::time::Duration;
 
@@ -138,6 +138,17 @@ fn workload() -> Vec<Step> {
     steps.push(Send(Request::SetJointSpeedLimit {
         joint_speed_limit_rad_s: 6.0,
     }));
+    // The balance requests (2.3): the firmware without a sensor takes every setting but
+    // leveling.
+    let balance = |safe_state| {
+        Request::SetBalance(BalanceConfig {
+            safe_state,
+            ..BalanceConfig::DEFAULT
+        })
+    };
+    steps.push(Send(Request::GetImu));
+    steps.push(Send(balance(SafeState::Off)));
+    steps.push(Send(balance(SafeState::Rest)));
     steps.push(Send(Request::GetCalibration { servo }));
     // The calibration sent back is the one read (see `measure`).
     steps.push(Send(Request::GetCalibration { servo }));
@@ -146,6 +157,11 @@ fn workload() -> Vec<Step> {
     steps.push(WaitIdle);
     for axis in [Axis::Roll, Axis::Pitch, Axis::Yaw] {
         steps.push(Send(sway(axis)));
+        // The balance requests while the motion's frames run.
+        for request in [Request::GetImu, balance(SafeState::Rest)] {
+            steps.push(Pause);
+            steps.push(Send(request));
+        }
         stop(&mut steps);
     }
     steps.push(Send(Request::StartMotion(MotionCommand::YawTurn {

@@ -550,7 +550,7 @@ pub fn measure_motions(fw: &mut BenchFirmware) -> Vec<MotionFigures> {
 }
 
 /// Names of the primitives of `bench.elf` and `bench-libm.elf`, by op id.
-pub const PRIMITIVES: [&str; 25] = [
+pub const PRIMITIVES: [&str; 27] = [
     "add",
     "mul",
     "div",
@@ -576,6 +576,8 @@ pub const PRIMITIVES: [&str; 25] = [
     "avr-libc sub",
     "avr-libc mul",
     "avr-libc sqrt",
+    "attitude update",
+    "attitude update + roll, pitch",
 ];
 
 /// The op id of a primitive of `bench.elf`, by its name in [`PRIMITIVES`].

@@ -41,6 +41,7 @@
 //! - [`rotation`], [`body`]: body rotation in six orders, full-body IK/FK.
 //! - [`batch`]: leg IK/FK and body IK over many targets, in fixed-width chunks of lanes that
 //!   the compiler vectorises; each result the scalar solve's, bit for bit.
+//! - [`attitude`]: roll and pitch from a six-axis inertial sensor (Mahony's filter).
 //! - [`jacobian`]: velocity kinematics and the singularity measure.
 //! - [`paper`]: seed 000 (θ1, θ2, θ3) and seed 001 (β, α, φ) angle adapters.
 //! - [`math`]: the [`Math`] backend trait (`libm`, fast polynomials, the soft-float choices of
@@ -65,6 +66,7 @@
 // `batch::avx2` (unsafe to call: the CPU must have AVX2).
 #![deny(unsafe_code)]
 
+pub mod attitude;
 pub mod batch;
 pub mod body;
 pub mod jacobian;

@@ -1,25 +1,27 @@
 //! The controller: bytes in → requests → IK, joint limits, servo calibration → outputs →
 //! answer bytes out.
 
+use crate::balance::{Balance, Event};
 use crate::config::{
     validate_pose_config, write_default_calibration, Config, ConfigError, ValidConfig,
     UNBOOTED_CALIBRATION,
 };
-use crate::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS};
+use crate::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS, FRAME_S, LEVEL_SHARES};
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::imu::{ImuReading, ImuState};
 use crate::store::{Store, Table};
 use kin_core::body::{self, BodySolution, Pose};
 use kin_core::motion::gait::Velocity;
-use kin_core::{BodyConfig, DefaultMath, Math, Vec3};
+use kin_core::{BodyConfig, DefaultMath, Math, ReachPolicy, Vec3};
 use quad_protocol::frame::encoded_len_max;
 use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
     check_request_in, encode_frame_in_pieces, is_compatible, negotiated_minor, Accumulator,
     DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout,
-    MotionCommand, MotionStatus, NackReason, PoseConfig, Ranges, Readback, Request, ServoId,
-    Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    MotionCommand, MotionKind, MotionStatus, NackReason, PoseConfig, Ranges, Readback, Request,
+    ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
+use quad_protocol::{BalanceConfig, FaultAction, ImuReport, SafeState};
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
 pub const RX_LEN: usize = MAX_DECODED_LEN;
@@ -91,6 +93,13 @@ struct Held {
 /// - The motion engine ([`Device::start_motion`]) runs stand-up, sit, rest, the sways, the yaw
 ///   turn, the foot paths and the walk; a direct setpoint request or stopping the outputs
 ///   cancels a running motion, a link loss with [`LinkLossAction::Hold`] stops it cleanly.
+/// - The inertial sensor's readings ([`Device::on_imu`]) drive the [`balance`](crate::balance)
+///   functions: the gyro bias measured in the first still second, the attitude, body leveling
+///   while a pose is held or a sway runs (through the body IK and the limiter), fall detection
+///   (the outputs to their safe state at the sample that detects it, latched until an explicit
+///   motion request), the start check (a motion refused while the body is not upright), and the
+///   sensor's faults (leveling off). A host of minor < 3 is sent nothing of 2.3: the start
+///   check's refusal reaches it as [`NackReason::Busy`] and [`Flags::FALL_DETECTED`] is not set.
 pub struct Device<O, C, S, M: Math = DefaultMath> {
     outputs: O,
     clock: C,
@@ -137,6 +146,11 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     enabling_frame: bool,
     /// The inertial sensor's readings ([`Device::on_imu`]).
     imu: ImuState,
+    /// The balance functions on those readings.
+    balance: Balance<M>,
+    /// The body pose held while no motion runs (the leveling's base): `None` after joint or
+    /// feet setpoints and at the rest pose.
+    base_pose: Option<Pose>,
 }
 
 // The dispatcher and the handlers that solve the body IK are `#[inline(never)]` on purpose:
@@ -220,6 +234,8 @@ where
             next_frame: now,
             enabling_frame: false,
             imu: ImuState::default(),
+            balance: Balance::new(),
+            base_pose: None,
         }
     }
 
@@ -361,9 +377,95 @@ where
     }
 
     /// Takes one reading of the inertial sensor (or the fault that kept the driver from reading
-    /// one), pushed by the target's driver; see [`crate::imu`].
+    /// one), pushed by the target's driver at its rate (the device clock times it); see
+    /// [`crate::imu`] and [`crate::balance`]. A fall detected here stops the motion and puts
+    /// the outputs in their safe state at once.
     pub fn on_imu(&mut self, reading: ImuReading) {
         self.imu.push(reading);
+        let now = self.clock.now_ms();
+        match self.balance.push(reading, now, self.outputs_enabled) {
+            Event::None => {}
+            Event::Fall(_) => self.enter_safe_state(),
+            Event::Fault => {
+                if self.balance.config().on_fault == FaultAction::Stop {
+                    self.engine.stop();
+                }
+            }
+        }
+    }
+
+    /// The balance functions' report (what `GetImu` answers).
+    pub fn imu_report(&self) -> ImuReport {
+        self.balance.report()
+    }
+
+    /// Configures the balance functions (`SetBalance`).
+    ///
+    /// # Errors
+    /// [`NackReason::ImuAbsent`] or [`NackReason::ImuFault`] for leveling without a working
+    /// sensor.
+    pub fn set_balance(&mut self, config: BalanceConfig) -> Result<(), NackReason> {
+        self.balance.configure(config)
+    }
+
+    /// A fall: the motion ends and the outputs go to the safe state.
+    fn enter_safe_state(&mut self) {
+        self.engine.cancel();
+        self.base_pose = None;
+        if self.balance.config().safe_state == SafeState::Rest {
+            let rest = engine::rest_angles(&self.config.robot);
+            if let Ok(()) = rest.and_then(|r| self.hold_motion_target(r)) {
+                return;
+            }
+        }
+        self.stop_outputs();
+    }
+
+    /// Holds `pose` with the leveling correction `c` (roll, pitch) added, or the largest of
+    /// [`LEVEL_SHARES`] of it within reach: the set point, the correction applied and whether
+    /// it was limited; `None` when not even the pose itself maps.
+    // Out of line: the body solve's locals stay out of the frame tick's stack frame.
+    #[inline(never)]
+    fn level_pose(&mut self, pose: &Pose, c: [f32; 2]) -> Option<([f32; 2], [f32; 2], bool)> {
+        let pc = self.config.pose_config;
+        let intended = [pose.roll_rad, pose.pitch_rad];
+        for share in LEVEL_SHARES {
+            let applied = [c[0] * share, c[1] * share];
+            let leveled = Pose {
+                roll_rad: pose.roll_rad + applied[0],
+                pitch_rad: pose.pitch_rad + applied[1],
+                ..*pose
+            };
+            let mut solution = BodySolution::default();
+            let solved = self.solver.inverse_at_stance_into(
+                &leveled,
+                &BodyConfig::about_centre(pc.order),
+                pc.stance_height_m,
+                ReachPolicy::Reject,
+                &mut solution,
+            );
+            if solved.is_ok() && self.hold_angles(&solution.angles_rad).is_ok() {
+                let limited = share < 1.0 && (c[0] != 0.0 || c[1] != 0.0);
+                return Some((intended, applied, limited));
+            }
+        }
+        None
+    }
+
+    /// Makes `angles_rad` the held target when all twelve map through the calibration, the
+    /// flags and the engine untouched (the leveling's re-solve of the held pose).
+    fn hold_angles(&mut self, angles_rad: &[f32; 12]) -> Result<(), ()> {
+        let mut pulses_half_us = [0u16; 12];
+        for (i, p) in pulses_half_us.iter_mut().enumerate() {
+            *p = self.pulse_maps[i]
+                .pulse_half_us(angles_rad[i])
+                .map_err(|_| ())?;
+        }
+        self.held = Some(Held {
+            angles_rad: *angles_rad,
+            pulses_half_us,
+        });
+        Ok(())
     }
 
     /// What the controller knows of its inertial sensor.
@@ -428,15 +530,44 @@ where
         };
         self.enabling_frame = false;
         let mut disable = false;
+        // The leveling: its correction for this frame, taken by a sway or by the held pose.
+        let had_correction = self.balance.correction_rad() != [0.0; 2];
+        let correction = self.balance.level(frames as f32 * FRAME_S);
+        let mut applied = None;
         if self.engine.is_active() {
-            let tick = self.engine.tick(frames, now, &self.out_rad, &self.solver);
+            let kind = self.engine.status().kind;
+            let levels = correction.filter(|_| self.engine.levels());
+            let tick = self
+                .engine
+                .tick(frames, now, &self.out_rad, &self.solver, levels);
+            if let Some(l) = tick.leveled {
+                applied = Some((l.intended_rad, l.applied_rad, l.limited));
+            }
             if let Some(q) = tick.target {
                 if let Err(e) = self.hold_motion_target(q) {
                     self.engine.fail(e, &self.out_rad);
                 }
             }
             disable = tick.disable_outputs;
+            if !self.engine.is_active() {
+                // Ended: at the stance, or at the rest pose after sit and rest.
+                self.base_pose = match kind {
+                    Some(MotionKind::Sit | MotionKind::Rest) => None,
+                    _ => Some(Pose::default()),
+                };
+            }
+        } else if let Some(pose) = self.base_pose {
+            match correction {
+                Some(c) => applied = self.level_pose(&pose, c),
+                // Leveling just ended: the pose without its correction, once.
+                None if had_correction => {
+                    self.level_pose(&pose, [0.0; 2]);
+                }
+                None => {}
+            }
         }
+        self.balance
+            .applied(applied, correction.unwrap_or([0.0; 2]));
         if let Some(held) = &self.held {
             if self
                 .engine
@@ -476,6 +607,7 @@ where
     /// # Errors
     /// [`engine::Error`].
     pub fn start_motion(&mut self, request: &MotionCommand) -> Result<(), engine::Error> {
+        self.balance.start_check(self.imu.last.as_ref())?;
         let setup = Setup {
             robot: &self.config.robot,
             solver: &self.solver,
@@ -500,6 +632,7 @@ where
                 return Err(e);
             }
         }
+        self.balance.clear_fall();
         Ok(())
     }
 
@@ -645,6 +778,21 @@ where
                 return self.motion_answer(seq, Ok(()));
             }
             Request::GetMotion => return self.motion_answer(seq, Ok(())),
+            Request::SetBalance(config) => {
+                return match self.set_balance(config) {
+                    Ok(()) => DeviceToHost::Imu {
+                        seq,
+                        report: self.balance.report(),
+                    },
+                    Err(reason) => nack(Some(seq), reason),
+                };
+            }
+            Request::GetImu => {
+                return DeviceToHost::Imu {
+                    seq,
+                    report: self.balance.report(),
+                };
+            }
             Request::SetVelocity {
                 forward_m_s,
                 lateral_m_s,
@@ -685,7 +833,7 @@ where
                 status: MotionStatus::from(self.engine.status()).for_minor(self.peer_minor),
                 readback: self.readback(),
             },
-            Err(e) => nack(Some(seq), e.into()),
+            Err(e) => nack(Some(seq), NackReason::from(e).for_minor(self.peer_minor)),
         }
     }
 
@@ -714,6 +862,10 @@ where
             .with(
                 Flags::WATCHDOG_RESET,
                 self.watchdog_reset && self.peer_minor >= 2,
+            )
+            .with(
+                Flags::FALL_DETECTED,
+                self.balance.fall().is_some() && self.peer_minor >= 3,
             );
         let (frames_ok, frames_bad) = (self.acc.frames_ok(), self.acc.frames_bad());
         // One arm per case, so that each array is written once, in place (zeroed first and
@@ -794,7 +946,9 @@ where
             c.policy,
             &mut solution,
         )?;
-        self.apply_solution(&solution)
+        self.apply_solution(&solution)?;
+        self.base_pose = Some(*pose);
+        Ok(())
     }
 
     /// `SetFeet`: the feet in the body frame at the zero pose.
@@ -813,7 +967,9 @@ where
             pc.policy,
             &mut solution,
         )?;
-        self.apply_solution(&solution)
+        self.apply_solution(&solution)?;
+        self.base_pose = None;
+        Ok(())
     }
 
     /// Applies a body solve's angles, read where the solve left them (no copy).
@@ -840,7 +996,9 @@ where
                 });
             }
         }
-        self.apply(angles, false, false)
+        self.apply(angles, false, false)?;
+        self.base_pose = None;
+        Ok(())
     }
 
     /// Maps all twelve angles through the calibration; commits and drives only when all map.
@@ -882,8 +1040,10 @@ where
         }
         self.clamped = clamped;
         self.limited = limited;
-        // A direct setpoint takes over from a running motion.
+        // A direct setpoint takes over from a running motion (and is an explicit request after
+        // a fall).
         self.engine.cancel();
+        self.balance.clear_fall();
         if self.outputs_enabled && self.in_enabling_frame() {
             self.out_rad = *angles_rad;
             self.write_out();
@@ -961,6 +1121,7 @@ where
             self.outputs.set_enabled(true);
             self.outputs_enabled = true;
         }
+        self.balance.clear_fall();
         Ok(())
     }
 

@@ -14,6 +14,8 @@
 //!   link-loss failsafe and the 50 Hz servo frames, [`Device::handle`] at message level,
 //!   [`Device::start_motion`] and its siblings for the motion engine). Its documentation lists
 //!   the behaviour and invariants.
+//! - [`balance`]: the inertial sensor's readings → attitude, body leveling, fall detection,
+//!   the start check ([`Device::on_imu`]).
 //! - [`engine`]: the motion engine (stand-up, sit, the papers' motions, the walk) and the one
 //!   joint-speed limiter every output passes.
 //! - [`hal`]: the traits a target implements — [`ServoOutputs`] (twelve pulse widths in 0.5 µs
@@ -57,6 +59,7 @@
 #[cfg(feature = "sim")]
 extern crate alloc;
 
+pub mod balance;
 pub mod config;
 pub mod device;
 pub mod engine;

@@ -24,6 +24,7 @@ use quad_protocol::{
     MotionStatus, NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback,
     Request, RobotPreset, ServoId, Setting, MAX_DECODED_LEN, MAX_FRAME_LEN,
 };
+use quad_protocol::{BalanceConfig, FallKind, ImuFaultKind, ImuHealth, ImuReport, SafeState};
 
 // ---- The expected index of every variant (written here, independently of the declarations).
 
@@ -45,6 +46,8 @@ fn request_index(r: &Request) -> u8 {
         Request::GetMotion => 13,
         Request::SetVelocity { .. } => 14,
         Request::SetJointSpeedLimit { .. } => 15,
+        Request::SetBalance(_) => 16,
+        Request::GetImu => 17,
     }
 }
 
@@ -56,6 +59,7 @@ fn answer_index(a: &DeviceToHost) -> u8 {
         DeviceToHost::Calibration { .. } => 3,
         DeviceToHost::Configured { .. } => 4,
         DeviceToHost::MotionAck { .. } => 5,
+        DeviceToHost::Imu { .. } => 6,
     }
 }
 
@@ -133,6 +137,12 @@ fn requests() -> Vec<Request> {
         Request::SetJointSpeedLimit {
             joint_speed_limit_rad_s: 2.5,
         },
+        Request::SetBalance(BalanceConfig {
+            leveling: true,
+            safe_state: SafeState::Off,
+            ..BalanceConfig::DEFAULT
+        }),
+        Request::GetImu,
     ]
 }
 
@@ -178,6 +188,9 @@ fn nack_reasons() -> Vec<NackReason> {
         },
         NackReason::MotionRunning,
         NackReason::NotWalking,
+        NackReason::ImuAbsent,
+        NackReason::ImuFault(ImuFaultKind::Stuck),
+        NackReason::NotUpright,
     ]
 }
 
@@ -257,6 +270,21 @@ fn answers() -> Vec<DeviceToHost> {
                 flags: Flags(Flags::OUTPUTS_ENABLED),
                 frames_ok: 70_000,
                 frames_bad: 1,
+            },
+        },
+        DeviceToHost::Imu {
+            seq: 12,
+            report: ImuReport {
+                health: ImuHealth::Fault(ImuFaultKind::BusHeld),
+                roll_rad: 0.1,
+                pitch_rad: -0.2,
+                correction_roll_rad: -0.1,
+                correction_pitch_rad: 0.2,
+                leveling_active: true,
+                correction_limited: true,
+                fall: Some(FallKind::FreeFall),
+                samples: 123_456,
+                config: BalanceConfig::DEFAULT,
             },
         },
     ]

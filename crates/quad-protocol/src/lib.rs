@@ -11,6 +11,7 @@
 //! - [`crc`]: CRC-16/GENIBUS (CCITT-FALSE with a final XOR), a byte at a time, no table.
 //! - [`range`]: the admissible range of every request field, one check for host and device.
 //! - [`servo`]: per-joint [`servo::Calibration`] and the angle ↔ pulse mapping.
+//! - [`balance`]: the inertial sensor's report and the balance functions' settings (2.3).
 //! - [`wire`]: the explicit wire index of every enum variant, and the tables of the kin-core
 //!   types the messages carry.
 //!
@@ -29,6 +30,7 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod balance;
 pub mod crc;
 pub mod frame;
 pub mod msg;
@@ -38,6 +40,9 @@ pub mod servo;
 pub mod timing;
 pub mod wire;
 
+pub use balance::{
+    BalanceConfig, FallKind, FaultAction, ImuFaultKind, ImuHealth, ImuReport, SafeState,
+};
 pub use frame::{
     decode_payload, encode_frame, encode_frame_in_pieces, Accumulator, Feed, DELIMITER,
     MAX_DECODED_LEN, MAX_FRAME_LEN,
@@ -51,8 +56,9 @@ pub use msg::{
 pub use range::{check_request, check_request_in, Ranges};
 
 /// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions; 2.2: the idle
-/// motion stage and the watchdog-reset flag).
-pub const PROTOCOL_VERSION: u16 = 0x0202;
+/// motion stage and the watchdog-reset flag; 2.3: the inertial sensor and the balance
+/// functions, [`balance`]).
+pub const PROTOCOL_VERSION: u16 = 0x0203;
 
 /// Major part of a protocol version.
 #[inline]
@@ -113,3 +119,6 @@ pub const DEVICE_TO_HOST_MAX_LEN: usize = if CONFIGURED_MAX_LEN > MOTION_ACK_MAX
 
 const _: () = assert!(HOST_TO_DEVICE_MAX_LEN <= MAX_DECODED_LEN);
 const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);
+// The `Imu` answer (variant, seq, report, CRC) is shorter than the largest answer.
+const _: () =
+    assert!(1 + 3 + balance::IMU_REPORT_MAX_LEN + frame::CRC_LEN <= DEVICE_TO_HOST_MAX_LEN);

@@ -14,6 +14,7 @@
 //! `[FL_abduction, FL_hip, FL_knee, FR_…, RL_…, RR_…]`; arrays of four feet in leg order
 //! FL, FR, RL, RR.
 
+use crate::balance::{BalanceConfig, ImuFaultKind, ImuReport};
 use crate::servo;
 use crate::wire::{self, wire_enum};
 use core::fmt;
@@ -121,6 +122,16 @@ wire_enum! {
             /// The limit, rad/s.
             joint_speed_limit_rad_s: f32,
         },
+        /// Configure the balance functions: leveling, fall detection, the safe state, the
+        /// action on a sensor fault (since 2.3). Its numbers are checked against their ranges
+        /// ([`crate::range`]) first. → [`DeviceToHost::Imu`] with the settings as applied, or
+        /// [`NackReason::InvalidParameter`] naming the field, [`NackReason::ImuAbsent`] or
+        /// [`NackReason::ImuFault`] when leveling is asked of a device without a working
+        /// sensor (nothing changes then).
+        16 => SetBalance(BalanceConfig),
+        /// Report the sensor, the attitude and the balance functions (since 2.3).
+        /// → [`DeviceToHost::Imu`].
+        17 => GetImu,
     }
 }
 
@@ -390,6 +401,14 @@ wire_enum! {
         18 => ReachRadiusM,
         /// A parameter this protocol version has no code for.
         19 => Other,
+        /// The leveling's proportional gain ([`BalanceConfig::level_kp`]; since 2.3).
+        20 => LevelKp,
+        /// The leveling's integral gain ([`BalanceConfig::level_ki_per_s`]; since 2.3).
+        21 => LevelKiPerS,
+        /// The leveling's bound ([`BalanceConfig::max_correction_rad`]; since 2.3).
+        22 => MaxCorrectionRad,
+        /// The fall angle ([`BalanceConfig::fall_angle_rad`]; since 2.3).
+        23 => FallAngleRad,
     }
 }
 
@@ -616,6 +635,9 @@ impl Flags {
     /// The device's last reset was the watchdog's (since 2.2): set from boot, latched until an
     /// answer carrying the flags has reported it to a host of minor 2 or later.
     pub const WATCHDOG_RESET: u8 = 1 << 6;
+    /// A fall was detected and the outputs went to their safe state (since 2.3): latched until
+    /// an explicit motion request, sent only to a host of minor 3 or later.
+    pub const FALL_DETECTED: u8 = 1 << 7;
 
     /// No bit set.
     pub const EMPTY: Flags = Flags(0);
@@ -716,6 +738,13 @@ wire_enum! {
             /// The state after the request, as [`DeviceToHost::Ack`] reports it.
             readback: Readback,
         },
+        /// Answer to [`Request::SetBalance`] and [`Request::GetImu`] (since 2.3).
+        6 => Imu {
+            /// The request's sequence number.
+            seq: u16,
+            /// The sensor, the attitude and the balance functions after the request.
+            report: ImuReport,
+        },
     }
 }
 
@@ -760,7 +789,8 @@ impl DeviceToHost {
             | DeviceToHost::Ack { seq, .. }
             | DeviceToHost::Calibration { seq, .. }
             | DeviceToHost::Configured { seq, .. }
-            | DeviceToHost::MotionAck { seq, .. } => Some(*seq),
+            | DeviceToHost::MotionAck { seq, .. }
+            | DeviceToHost::Imu { seq, .. } => Some(*seq),
         }
     }
 
@@ -772,7 +802,8 @@ impl DeviceToHost {
             | DeviceToHost::MotionAck { readback, .. } => Some(readback),
             DeviceToHost::Nack { .. }
             | DeviceToHost::HelloAck { .. }
-            | DeviceToHost::Calibration { .. } => None,
+            | DeviceToHost::Calibration { .. }
+            | DeviceToHost::Imu { .. } => None,
         }
     }
 }
@@ -869,6 +900,32 @@ wire_enum! {
         17 => MotionRunning,
         /// A velocity command arrived while no walk runs (since 2.1).
         18 => NotWalking,
+        /// Leveling was asked of a device without a sensor (since 2.3).
+        19 => ImuAbsent,
+        /// Leveling was asked while the sensor fails (since 2.3).
+        20 => ImuFault(ImuFaultKind),
+        /// A motion was refused because the body is not upright (since 2.3; to a host of
+        /// minor < 3 the device sends [`NackReason::Busy`] instead,
+        /// [`NackReason::for_minor`]).
+        21 => NotUpright,
+    }
+}
+
+impl NackReason {
+    /// This reason as a peer of protocol minor `minor` may receive it: unchanged for minor 3
+    /// or later; the reasons of 2.3 that a request of an older minor can meet
+    /// ([`NackReason::NotUpright`]) become [`NackReason::Busy`] ("cannot take it now") for an
+    /// older peer.
+    #[must_use]
+    pub const fn for_minor(self, minor: u8) -> NackReason {
+        match self {
+            NackReason::NotUpright | NackReason::ImuAbsent | NackReason::ImuFault(_)
+                if minor < 3 =>
+            {
+                NackReason::Busy
+            }
+            other => other,
+        }
     }
 }
 
@@ -974,6 +1031,9 @@ impl fmt::Display for NackReason {
             NackReason::Preflight { leg, fault } => write!(f, "preflight: {leg} {fault:?}"),
             NackReason::MotionRunning => f.write_str("a motion is running (stop it first)"),
             NackReason::NotWalking => f.write_str("no walk is running"),
+            NackReason::ImuAbsent => f.write_str("no inertial sensor"),
+            NackReason::ImuFault(kind) => write!(f, "inertial sensor fault: {kind:?}"),
+            NackReason::NotUpright => f.write_str("the body is not upright"),
         }
     }
 }

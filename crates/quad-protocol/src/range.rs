@@ -27,8 +27,8 @@
 //!
 //! ## Motion fields
 //!
-//! Every number of [`Request::StartMotion`], [`Request::SetVelocity`] and
-//! [`Request::SetJointSpeedLimit`] has a [`ParamRange`] too, checked here before any maths and
+//! Every number of [`Request::StartMotion`], [`Request::SetVelocity`],
+//! [`Request::SetJointSpeedLimit`] and [`Request::SetBalance`] has a [`ParamRange`] too, checked here before any maths and
 //! refused as [`NackReason::InvalidParameter`] naming the [`MotionParam`] and its
 //! [`ParamProblem`]:
 //!
@@ -44,6 +44,10 @@
 //! | `duty_factor` | [`DUTY_FACTOR`]: `[0.05, 0.95]` | stance and swing each at least a twentieth of the loop |
 //! | `velocity_timeout_ms` | `[1, 65535]` ms | 0 would stop a walk at once |
 //! | `joint_speed_limit_rad_s` | [`JOINT_SPEED_LIMIT_RAD_S`]: `[0.1, π/0.02]` rad/s | a servo's whole travel (π rad) in half a minute at the least; beyond its whole travel in one 20 ms servo frame a limit limits nothing |
+//! | balance `level_kp` (2.3) | [`LEVEL_KP`]: `[0, 0.9]` | the body follows the correction within a frame: a gain of 1 or more overshoots every frame |
+//! | balance `level_ki_per_s` (2.3) | [`LEVEL_KI_PER_S`]: `[0, 20]` 1/s | a time constant of 2.5 servo frames at the fastest |
+//! | balance `max_correction_rad` (2.3) | [`MAX_CORRECTION_RAD`]: `[0, π/4]` rad | as the sway's amplitude; the reach bounds it further at run time |
+//! | balance `fall_angle_rad` (2.3) | [`FALL_ANGLE_RAD`]: `[0.17, π]` rad | below 10° a slope or a sway would be a fall; π is upside down |
 //!
 //! What a value outside gets ([`ParamRange::check`]): NaN or ±∞ is [`ParamProblem::NonFinite`];
 //! zero or a negative value (−0 too) of a field that must be positive (periods, durations, the
@@ -191,7 +195,18 @@ pub fn check_request_in(request: &Request, ranges: &Ranges) -> Result<(), NackRe
             JOINT_SPEED_LIMIT_RAD_S,
             *joint_speed_limit_rad_s,
         )]),
+        Request::SetBalance(b) => first_invalid(&[
+            (MotionParam::LevelKp, LEVEL_KP, b.level_kp),
+            (MotionParam::LevelKiPerS, LEVEL_KI_PER_S, b.level_ki_per_s),
+            (
+                MotionParam::MaxCorrectionRad,
+                MAX_CORRECTION_RAD,
+                b.max_correction_rad,
+            ),
+            (MotionParam::FallAngleRad, FALL_ANGLE_RAD, b.fall_angle_rad),
+        ]),
         Request::Hello { .. }
+        | Request::GetImu
         | Request::GetState
         | Request::SetOutputs { .. }
         | Request::SetLinkTimeout(_)
@@ -438,6 +453,26 @@ const SERVO_FRAME_S: f32 = 0.02;
 /// nothing, and none is needed (the fastest hobby servos turn 20–30 rad/s unloaded).
 pub const JOINT_SPEED_LIMIT_RAD_S: ParamRange = ParamRange::positive(0.1, PI / SERVO_FRAME_S);
 
+/// The leveling's proportional gain (`BalanceConfig::level_kp`), rad per rad: `[0, 0.9]`. The
+/// body follows a correction within a servo frame or two, so the loop's plant is nearly a unit
+/// gain with a delay: a proportional gain of 1 or more would overshoot every frame.
+pub const LEVEL_KP: ParamRange = ParamRange::non_negative(0.9);
+
+/// The leveling's integral gain (`BalanceConfig::level_ki_per_s`), 1/s: `[0, 20]`, a time
+/// constant of 50 ms (2.5 servo frames) at the fastest; faster would oscillate against the
+/// joint-speed limiter and the estimator's own lag.
+pub const LEVEL_KI_PER_S: ParamRange = ParamRange::non_negative(20.0);
+
+/// The largest leveling correction (`BalanceConfig::max_correction_rad`), rad: `[0, π/4]`. A
+/// quarter turn of the body with its feet on the ground is beyond any leg (as the sway's
+/// amplitude); the robot's reach bounds the correction further at run time (reported).
+pub const MAX_CORRECTION_RAD: ParamRange = ParamRange::non_negative(core::f32::consts::FRAC_PI_4);
+
+/// The fall angle (`BalanceConfig::fall_angle_rad`), rad: `[0.17, π]` (10° to upside down).
+/// Below 10° a slope or a sway would count as a fall; at π only an upside-down roll reaches it
+/// (free fall is detected by the acceleration).
+pub const FALL_ANGLE_RAD: ParamRange = ParamRange::positive(0.17, PI);
+
 /// The admissible range of `param` for a robot of `ranges` (see the module docs); `None` for
 /// the parameters that are no single number (the path, the velocity as a whole, the stance)
 /// and for the walk's `velocity_timeout_ms`, an integer (`[1, 65535]` ms).
@@ -453,6 +488,10 @@ pub fn param_range(param: MotionParam, ranges: &Ranges) -> Option<ParamRange> {
         P::BodyHeightM => ranges.body_height_m(),
         P::ForwardMS | P::LateralMS => SPEED_M_S,
         P::JointSpeedLimitRadS => JOINT_SPEED_LIMIT_RAD_S,
+        P::LevelKp => LEVEL_KP,
+        P::LevelKiPerS => LEVEL_KI_PER_S,
+        P::MaxCorrectionRad => MAX_CORRECTION_RAD,
+        P::FallAngleRad => FALL_ANGLE_RAD,
         _ => return None,
     })
 }

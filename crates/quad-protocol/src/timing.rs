@@ -55,11 +55,13 @@ pub enum Kind {
     GetMotion,
     SetVelocity,
     SetJointSpeedLimit,
+    SetBalance,
+    GetImu,
 }
 
 impl Kind {
     /// Every row, in the order of the table.
-    pub const ALL: [Kind; 22] = [
+    pub const ALL: [Kind; 24] = [
         Kind::Hello,
         Kind::GetState,
         Kind::SetBodyPose,
@@ -82,6 +84,8 @@ impl Kind {
         Kind::GetMotion,
         Kind::SetVelocity,
         Kind::SetJointSpeedLimit,
+        Kind::SetBalance,
+        Kind::GetImu,
     ];
 
     /// The row of `request`.
@@ -111,6 +115,8 @@ impl Kind {
             Request::GetMotion => Kind::GetMotion,
             Request::SetVelocity { .. } => Kind::SetVelocity,
             Request::SetJointSpeedLimit { .. } => Kind::SetJointSpeedLimit,
+            Request::SetBalance(_) => Kind::SetBalance,
+            Request::GetImu => Kind::GetImu,
         }
     }
 
@@ -139,6 +145,8 @@ impl Kind {
             Kind::GetMotion => "GetMotion",
             Kind::SetVelocity => "SetVelocity",
             Kind::SetJointSpeedLimit => "SetJointSpeedLimit",
+            Kind::SetBalance => "SetBalance",
+            Kind::GetImu => "GetImu",
         }
     }
 
@@ -171,6 +179,8 @@ impl Kind {
             Kind::GetMotion => [16_600, 4_800],
             Kind::SetVelocity => [23_100, 17_100],
             Kind::SetJointSpeedLimit => [9_200, 1_700],
+            Kind::SetBalance => [9_200, 2_200],
+            Kind::GetImu => [5_500, 1_100],
         }
     }
 

@@ -678,6 +678,9 @@ mod tests {
             NackReason::Preflight { .. } => 16,
             NackReason::MotionRunning => 17,
             NackReason::NotWalking => 18,
+            NackReason::ImuAbsent => 19,
+            NackReason::ImuFault(_) => 20,
+            NackReason::NotUpright => 21,
         }
     }
 
@@ -766,6 +769,10 @@ mod tests {
             MotionParam::Stance => 17,
             MotionParam::ReachRadiusM => 18,
             MotionParam::Other => 19,
+            MotionParam::LevelKp => 20,
+            MotionParam::LevelKiPerS => 21,
+            MotionParam::MaxCorrectionRad => 22,
+            MotionParam::FallAngleRad => 23,
         }
     }
 
@@ -969,6 +976,9 @@ mod tests {
             },
             NackReason::MotionRunning,
             NackReason::NotWalking,
+            NackReason::ImuAbsent,
+            NackReason::ImuFault(crate::ImuFaultKind::Nak),
+            NackReason::NotUpright,
         ]
         .into();
         // Nack | seq None (00) | reason ...
@@ -1268,6 +1278,10 @@ mod tests {
             MotionParam::Stance,
             MotionParam::ReachRadiusM,
             MotionParam::Other,
+            MotionParam::LevelKp,
+            MotionParam::LevelKiPerS,
+            MotionParam::MaxCorrectionRad,
+            MotionParam::FallAngleRad,
         ];
         // Nack (00) | None (00) | InvalidParameter (0f) | param | problem
         for (i, p) in params.iter().enumerate() {
@@ -1316,5 +1330,76 @@ mod tests {
         assert_eq!(sway_axis::from_index(3), None);
         assert_eq!(path_kind::from_index(5), None);
         assert_eq!(gait_pattern::from_index(2), None);
+    }
+
+    #[test]
+    fn every_balance_variant_has_its_index_and_round_trips() {
+        use crate::balance::{
+            BalanceConfig, FallKind, FaultAction, ImuFaultKind, ImuHealth, ImuReport, SafeState,
+        };
+        let kinds = [
+            ImuFaultKind::WrongId,
+            ImuFaultKind::Nak,
+            ImuFaultKind::Stuck,
+            ImuFaultKind::BusHeld,
+        ];
+        // Nack (00) | None (00) | ImuFault (14) | kind
+        for (i, k) in kinds.iter().enumerate() {
+            check(nack(NackReason::ImuFault(*k)), 3, i as u8, 4);
+        }
+        let report = |health, fall, safe_state, on_fault| DeviceToHost::Imu {
+            seq: 1,
+            report: ImuReport {
+                health,
+                roll_rad: 0.0,
+                pitch_rad: 0.0,
+                correction_roll_rad: 0.0,
+                correction_pitch_rad: 0.0,
+                leveling_active: false,
+                correction_limited: false,
+                fall,
+                samples: 0,
+                config: BalanceConfig {
+                    safe_state,
+                    on_fault,
+                    ..BalanceConfig::DEFAULT
+                },
+            },
+        };
+        let (rest, open) = (SafeState::Rest, FaultAction::OpenLoop);
+        // Imu (06) | seq (01) | health ...
+        let healths = [
+            ImuHealth::Absent,
+            ImuHealth::Starting,
+            ImuHealth::Ok,
+            ImuHealth::Fault(ImuFaultKind::Stuck),
+        ];
+        for (i, h) in healths.iter().enumerate() {
+            check(report(*h, None, rest, open), 2, i as u8, 4);
+        }
+        // … health (02) | 4 × f32 | 2 bools | fall (01) | kind
+        for (i, f) in [FallKind::Tilt, FallKind::FreeFall].iter().enumerate() {
+            check(report(ImuHealth::Ok, Some(*f), rest, open), 22, i as u8, 2);
+        }
+        // … fall (00) | samples (00) | leveling, kp, ki, bound, detection, angle | safe state
+        for (i, v) in [SafeState::Rest, SafeState::Off].iter().enumerate() {
+            check(report(ImuHealth::Ok, None, *v, open), 41, i as u8, 2);
+        }
+        for (i, a) in [FaultAction::OpenLoop, FaultAction::Stop]
+            .iter()
+            .enumerate()
+        {
+            check(report(ImuHealth::Ok, None, rest, *a), 42, i as u8, 2);
+        }
+        let set = HostToDevice {
+            seq: 2,
+            request: Request::SetBalance(BalanceConfig::DEFAULT),
+        };
+        check(set, 1, 16, 18);
+        let get = HostToDevice {
+            seq: 2,
+            request: Request::GetImu,
+        };
+        check(get, 1, 17, 18);
     }
 }

@@ -73,10 +73,12 @@ fn every_request_has_its_golden_bytes() {
             | Request::StopMotion
             | Request::GetMotion
             | Request::SetVelocity { .. }
-            | Request::SetJointSpeedLimit { .. } => {}
+            | Request::SetJointSpeedLimit { .. }
+            | Request::SetBalance(_)
+            | Request::GetImu => {}
         }
     }
-    assert_eq!(cases.len(), 20);
+    assert_eq!(cases.len(), 22);
     for (name, msg, golden) in cases {
         check(name, &msg, golden);
     }
@@ -93,6 +95,7 @@ fn every_answer_has_its_golden_bytes() {
         "Configured",
         "Nack OutOfRange",
         "MotionAck",
+        "Imu",
     ];
     for v in variants {
         assert!(cases.iter().any(|(n, _, _)| *n == v), "{v} has no golden");
@@ -130,12 +133,13 @@ fn hand_written_frames() {
 }
 
 #[test]
-fn version_is_two_two() {
+fn version_is_two_three() {
     // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0; 2.2 appended
-    // the idle motion stage and the watchdog-reset flag.
-    assert_eq!(PROTOCOL_VERSION, 0x0202);
+    // the idle motion stage and the watchdog-reset flag; 2.3 the inertial sensor's requests,
+    // answer, nack reasons, parameters and the fall flag.
+    assert_eq!(PROTOCOL_VERSION, 0x0203);
     assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
-    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 2);
+    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 3);
     assert!(quad_protocol::is_compatible(0x0207));
     assert!(!quad_protocol::is_compatible(0x0100));
     assert!(!quad_protocol::is_compatible(0x0300));

@@ -18,6 +18,7 @@ use avr_libc_math::{AvrFast, AvrLibm};
 avr_libc_math::link_avr_libc!();
 use firmware_avr::bench::{self, Backend, PerCall, Prepared};
 use firmware_avr::usart::{self, Baud, Usart0};
+use kin_core::attitude::{Estimator, Gains};
 use kin_core::math::{poly, Fast, Libm};
 use kin_core::{BodyConfig, Math, Pose, RotationOrder};
 
@@ -33,8 +34,11 @@ use kin_core::{BodyConfig, Math, Pose, RotationOrder};
 /// sine for `b = +0`, else the cosine), for the bit-for-bit comparison; 20 sub; avr-libc's
 /// own path for the float primitives (`avr_libc_math::float` puts a fast path in front of
 /// it), for the bit-for-bit comparison: 21 add, 22 sub, 23 mul; 24 avr-libc's own `sqrt`
-/// (`avr_libc_math::sqrt` replaces it; 3 is the firmware's), for the same comparison.
-static PRIMS: [bench::PrimFn; 25] = [
+/// (`avr_libc_math::sqrt` replaces it; 3 is the firmware's), for the same comparison; the
+/// attitude estimator on `AvrFast` (`kin_core::attitude`), one 10 ms sample of a gyro rate
+/// `(a, b, 0.01)` rad/s and a tilted specific force: 25 the update, 26 the update and the roll
+/// and pitch.
+static PRIMS: [bench::PrimFn; 27] = [
     |a, b| a + b,
     |a, b| a * b,
     |a, b| a / b,
@@ -99,6 +103,16 @@ static PRIMS: [bench::PrimFn; 25] = [
     |a, b| unsafe { libc_mulsf3(a, b) },
     // SAFETY: a C function of one `double` (32-bit on the AVR), no preconditions.
     |a, _| unsafe { avr_libc_sqrt(a) },
+    |a, b| {
+        let mut e = core::hint::black_box(Estimator::<AvrFast>::new(Gains::DEFAULT));
+        e.update([a, b, 0.01], [0.8, -0.6, 9.7], 0.01);
+        core::hint::black_box(e).up()[0]
+    },
+    |a, b| {
+        let mut e = core::hint::black_box(Estimator::<AvrFast>::new(Gains::DEFAULT));
+        e.update([a, b, 0.01], [0.8, -0.6, 9.7], 0.01);
+        core::hint::black_box(e).attitude().roll_rad
+    },
 ];
 
 // avr-libc's own float primitives and `sqrt` (`libc_addsf3`, …, `avr_libc_sqrt`): the

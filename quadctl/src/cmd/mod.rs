@@ -6,6 +6,7 @@
 //! `quad_twin::command`), and one variant in `main.rs`.
 
 pub mod accuracy;
+pub mod balance;
 pub mod calibrate;
 pub mod check;
 pub mod demo;

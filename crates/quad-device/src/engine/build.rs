@@ -355,6 +355,52 @@ impl<M: Math> Engine<M> {
         solve_frame(solver, law.motion.order(), &frame)
     }
 
+    /// The law's joint setpoint at `t_s` with `correction` (roll, pitch, rad) added to its body
+    /// pose, or the largest of [`LEVEL_SHARES`](super::LEVEL_SHARES) of it within reach; what
+    /// was applied (`None` when even the frame without correction fails: its error).
+    pub(super) fn law_setpoint_leveled(
+        law: &Law,
+        t_s: f32,
+        solver: &body::Solver<M>,
+        correction: [f32; 2],
+    ) -> (Result<[f32; 12], IkError>, Option<super::Leveled>) {
+        let mut frame = Frame::ZERO;
+        if Self::law_frame(law, t_s, &mut frame).is_err() {
+            let e = IkError {
+                leg: LegId::FL,
+                kind: kin_core::Unreachable::NonFinite,
+            };
+            return (Err(e), None);
+        }
+        let intended_rad = [frame.pose.roll_rad, frame.pose.pitch_rad];
+        let order = law.motion.order();
+        let mut last = None;
+        for share in super::LEVEL_SHARES {
+            let applied_rad = [correction[0] * share, correction[1] * share];
+            frame.pose.roll_rad = intended_rad[0] + applied_rad[0];
+            frame.pose.pitch_rad = intended_rad[1] + applied_rad[1];
+            match solve_frame(solver, order, &frame) {
+                Ok(q) => {
+                    let leveled = super::Leveled {
+                        intended_rad,
+                        applied_rad,
+                        limited: share < 1.0 && (correction[0] != 0.0 || correction[1] != 0.0),
+                    };
+                    return (Ok(q), Some(leveled));
+                }
+                Err(e) => last = Some(e),
+            }
+        }
+        // `LEVEL_SHARES` is not empty: `last` holds the failure of the uncorrected frame.
+        (
+            Err(last.unwrap_or(IkError {
+                leg: LegId::FL,
+                kind: kin_core::Unreachable::NonFinite,
+            })),
+            None,
+        )
+    }
+
     /// The walk's joint setpoint with its feet at `feet` (body frame, the body at the zero pose;
     /// the contacts do not enter the IK), through `solver`.
     pub(super) fn walk_setpoint(

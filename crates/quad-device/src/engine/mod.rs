@@ -139,6 +139,9 @@ pub enum Error {
     NotWalking,
     /// A run-time IK failed (the motion was stopped).
     Ik(IkError),
+    /// The inertial sensor finds the body tipped beyond the start limit
+    /// ([`crate::balance::START_TILT_MAX_RAD`]): the robot is not on its feet.
+    NotUpright,
 }
 
 impl fmt::Display for Error {
@@ -153,6 +156,7 @@ impl fmt::Display for Error {
             Error::Busy => f.write_str("a motion is running (stop it first)"),
             Error::NotWalking => f.write_str("no walk is running"),
             Error::Ik(e) => write!(f, "unreachable setpoint: {e}"),
+            Error::NotUpright => f.write_str("the body is not upright"),
         }
     }
 }
@@ -212,7 +216,27 @@ pub struct Tick {
     pub target: Option<[f32; 12]>,
     /// Stop the outputs after this frame ([`MotionCommand::Rest`] ended).
     pub disable_outputs: bool,
+    /// The leveling correction this frame took, when the tick was given one and the motion
+    /// takes it (a sway running).
+    pub leveled: Option<Leveled>,
 }
+
+/// A body-leveling correction as a frame took it ([`Engine::tick`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Leveled {
+    /// The roll and pitch the motion itself commands this frame (the level the correction
+    /// holds), rad.
+    pub intended_rad: [f32; 2],
+    /// The correction of roll and pitch applied, rad: the one asked, or the largest share of
+    /// it within reach ([`LEVEL_SHARES`]).
+    pub applied_rad: [f32; 2],
+    /// Less than the correction asked was applied (the robot's reach).
+    pub limited: bool,
+}
+
+/// The shares of a leveling correction tried in turn through the body IK until one is within
+/// reach: the whole, a half, a quarter, none (the motion's own frame, start-checked).
+pub const LEVEL_SHARES: [f32; 4] = [1.0, 0.5, 0.25, 0.0];
 
 /// A law's kin-core motion, without the robot (the device's solver holds it).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -478,19 +502,38 @@ impl<M: Math> Engine<M> {
         }
     }
 
+    /// True while the running motion takes a leveling correction: a sway, running or
+    /// stopping at the end of its period (not its ramps).
+    pub fn levels(&self) -> bool {
+        matches!(
+            (&self.program, self.stage),
+            (
+                Program::Law(Law {
+                    motion: LawMotion::Sway(_),
+                    ..
+                }),
+                MotionStage::Run | MotionStage::Stopping
+            )
+        )
+    }
+
     /// One tick after `frames` (≥ 1) frame boundaries, at `now_ms`, with the outputs at `out`,
     /// the motion's frames solved by `solver` (the [`Setup::solver`] it started with): the new
-    /// target, if any.
+    /// target, if any. `correction` (roll, pitch, rad) is added to a sway's body pose
+    /// ([`Engine::levels`]) before its IK, or the largest share of it that is within reach
+    /// ([`LEVEL_SHARES`]); [`Tick::leveled`] tells what was applied.
     pub fn tick(
         &mut self,
         frames: u32,
         now_ms: u32,
         out: &[f32; 12],
         solver: &body::Solver<M>,
+        correction: Option<[f32; 2]>,
     ) -> Tick {
         let mut tick = Tick {
             target: None,
             disable_outputs: false,
+            leveled: None,
         };
         match self.stage {
             MotionStage::Idle => tick,
@@ -534,7 +577,15 @@ impl<M: Math> Engine<M> {
                             frame = e;
                         }
                         self.frame = frame;
-                        let q = Self::law_setpoint(law, frame as f32 * FRAME_S, solver);
+                        let t_s = frame as f32 * FRAME_S;
+                        let q = match (&law.motion, correction) {
+                            (LawMotion::Sway(_), Some(c)) => {
+                                let (q, leveled) = Self::law_setpoint_leveled(law, t_s, solver, c);
+                                tick.leveled = leveled;
+                                q
+                            }
+                            _ => Self::law_setpoint(law, t_s, solver),
+                        };
                         (q, end.is_some())
                     }
                     Program::Walk {

@@ -103,6 +103,7 @@ impl From<Error> for NackReason {
             Error::Busy => NackReason::MotionRunning,
             Error::NotWalking => NackReason::NotWalking,
             Error::Ik(e) => e.into(),
+            Error::NotUpright => NackReason::NotUpright,
         }
     }
 }

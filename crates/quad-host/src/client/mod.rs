@@ -233,6 +233,7 @@ pub fn answer_name(a: &DeviceToHost) -> &'static str {
         DeviceToHost::Calibration { .. } => "Calibration",
         DeviceToHost::Configured { .. } => "Configured",
         DeviceToHost::MotionAck { .. } => "MotionAck",
+        DeviceToHost::Imu { .. } => "Imu",
     }
 }
 
@@ -255,5 +256,7 @@ pub fn request_name(r: &Request) -> &'static str {
         Request::GetMotion => "GetMotion",
         Request::SetVelocity { .. } => "SetVelocity",
         Request::SetJointSpeedLimit { .. } => "SetJointSpeedLimit",
+        Request::SetBalance(_) => "SetBalance",
+        Request::GetImu => "GetImu",
     }
 }

@@ -23,6 +23,9 @@
 //! - [`Device::poll`] (the link-loss failsafe, the servo frames of the motion engine) runs
 //!   before every byte and whenever the host's clock advances, at every millisecond boundary
 //!   in between. The device's millisecond clock is the virtual clock.
+//! - **Inertial sensor**: before those polls, every [`IMU_PERIOD_NS`] (100 Hz, the firmware
+//!   driver's rate), the device gets a level-and-still reading ([`LEVEL_AND_STILL`],
+//!   `Device::on_imu`): its sensor reports ok once the start-up second has passed.
 //!
 //! ## Faults
 //! [`Faults`] apply to both directions, drawn from one seeded generator (the same seed, the
@@ -33,7 +36,7 @@
 use super::{byte_time, Error, Faults, LineStats, Link};
 use kin_core::DefaultMath;
 use quad_device::sim::{EepromError, Outputs, RamEeprom, VirtualClock, EEPROM_LEN};
-use quad_device::{Config, ConfigError, Device, Storage};
+use quad_device::{Config, ConfigError, Device, ImuReading, ImuSample, Storage};
 use std::collections::VecDeque;
 use std::fmt;
 use std::path::PathBuf;
@@ -207,7 +210,19 @@ pub struct SimLink {
     clock: VirtualClock,
     device: Simulated,
     stats: LineStats,
+    /// When the device's inertial sensor gives its next reading, ns.
+    next_imu_ns: u64,
 }
+
+/// The simulated device's inertial sensor reads every 10 ms (100 Hz, as the firmware's driver).
+pub const IMU_PERIOD_NS: u64 = 10_000_000;
+
+/// The simulated sensor's reading: level and still (the robot on flat ground; the shared
+/// sensor sources replace it).
+pub const LEVEL_AND_STILL: ImuSample = ImuSample {
+    accel_m_s2: [0.0, 0.0, kin_core::attitude::G_M_S2],
+    gyro_rad_s: [0.0; 3],
+};
 
 impl SimLink {
     /// A line to a freshly powered-on device built with `device_config` on `storage`, at
@@ -235,6 +250,7 @@ impl SimLink {
             clock,
             device,
             stats: LineStats::default(),
+            next_imu_ns: 0,
         })
     }
 
@@ -322,11 +338,23 @@ impl SimLink {
         let mut t = (self.clock.now_ns() / MS_NS + 1) * MS_NS;
         while t < t_ns {
             self.clock.set_ns(t);
+            self.imu_tick();
             self.device.poll();
             t += MS_NS;
         }
         self.set_device_time(t_ns);
+        self.imu_tick();
         self.device.poll();
+    }
+
+    /// Pushes the sensor's reading when its period has come ([`IMU_PERIOD_NS`]), as a
+    /// driver does from the main loop.
+    fn imu_tick(&mut self) {
+        let now = self.clock.now_ns();
+        if now >= self.next_imu_ns {
+            self.device.on_imu(ImuReading::Sample(LEVEL_AND_STILL));
+            self.next_imu_ns = now - now % IMU_PERIOD_NS + IMU_PERIOD_NS;
+        }
     }
 
     fn set_device_time(&mut self, t_ns: u64) {

@@ -15,8 +15,9 @@ use crate::link::{self, Link, Target};
 use quad_protocol::range::{self, ParamRange, Ranges};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    DeviceInfo, DeviceToHost, Flags, MotionCommand, MotionKind, MotionParam, MotionStage,
-    MotionStatus, NackReason, ParamProblem, PreflightFault, Readback, Request, RobotPreset,
+    DeviceInfo, DeviceToHost, Flags, ImuReport, MotionCommand, MotionKind, MotionParam,
+    MotionStage, MotionStatus, NackReason, ParamProblem, PreflightFault, Readback, Request,
+    RobotPreset,
 };
 use serde::Serialize;
 use std::time::Duration;
@@ -76,6 +77,20 @@ pub enum Error {
     /// The motion did not end within the time allowed.
     #[error("the motion did not end within {0:?}")]
     NoEnd(Duration),
+    /// The device speaks an older minor version than the request needs.
+    #[error(
+        "{request} needs protocol 2.{minor_needed}; the device speaks {}.{}",
+        quad_protocol::version_major(*.device_version),
+        quad_protocol::version_minor(*.device_version)
+    )]
+    TooOld {
+        /// The request.
+        request: &'static str,
+        /// The minor version it needs.
+        minor_needed: u8,
+        /// The device's version.
+        device_version: u16,
+    },
     /// A command-line value the device cannot take in this form.
     #[error("--{option} {value}: {problem}")]
     Value {
@@ -113,6 +128,8 @@ fn unit(param: MotionParam) -> &'static str {
         | MotionParam::StepHeightM
         | MotionParam::BodyHeightM => "m",
         MotionParam::ForwardMS | MotionParam::LateralMS => "m/s",
+        MotionParam::MaxCorrectionRad | MotionParam::FallAngleRad => "rad",
+        MotionParam::LevelKiPerS => "1/s",
         _ => "",
     }
 }
@@ -159,6 +176,10 @@ pub fn option(param: MotionParam) -> &'static str {
         MotionParam::JointSpeedLimitRadS => "--joint-speed-limit-rad-s",
         MotionParam::Stance => "the device's stance height",
         MotionParam::ReachRadiusM => "--stance-height-m (it sets the stride's reach)",
+        MotionParam::LevelKp => "--kp",
+        MotionParam::LevelKiPerS => "--ki-per-s",
+        MotionParam::MaxCorrectionRad => "--max-correction-rad",
+        MotionParam::FallAngleRad => "--fall-angle-rad",
         _ => "a parameter",
     }
 }
@@ -254,6 +275,11 @@ pub fn words_in(reason: &NackReason, naming: &Naming) -> String {
         }
         NackReason::NotWalking => format!("no walk is running ({} first)", naming.start_walk),
         NackReason::OutputsDisabled => format!("the outputs are off ({} first)", naming.stand),
+        NackReason::NotUpright => {
+            "the inertial sensor finds the body tipped (set the robot on its feet); nothing moved"
+                .to_owned()
+        }
+        NackReason::ImuAbsent => "the device has no inertial sensor: leveling is off".to_owned(),
         other => other.to_string(),
     }
 }
@@ -371,6 +397,65 @@ impl<L: Link> Session<L> {
                 reason,
                 shaped_by: shaping_params(&request),
             }),
+            Outcome::Accepted(other) | Outcome::Rejected(other) => Err(client::Error::Unexpected {
+                request: name,
+                answer: Box::new(other),
+            }
+            .into()),
+            Outcome::Lost => Err(client::Error::NoAnswer { request: name }.into()),
+        }
+    }
+
+    /// A request of the inertial sensor and the balance functions (`SetBalance`, `GetImu`;
+    /// protocol 2.3), sent once the host's range check passes it.
+    ///
+    /// # Errors
+    /// [`Error::TooOld`] for a device of an older minor (nothing sent), [`Error::NotSent`],
+    /// [`Error::Refused`] with the device's reason, or the link's errors.
+    pub fn imu(&mut self, request: Request) -> Result<ImuReport, Error> {
+        let name = client::request_name(&request);
+        if quad_protocol::version_minor(self.info.version) < 3 {
+            return Err(Error::TooOld {
+                request: name,
+                minor_needed: 3,
+                device_version: self.info.version,
+            });
+        }
+        self.check(&request)?;
+        let retries = self.client.config().retries;
+        let exchange = self
+            .client
+            .exchange_with(request, retries, |_| Verdict::Accept)
+            .map_err(client::Error::from)?;
+        match exchange.outcome {
+            Outcome::Accepted(DeviceToHost::Imu { report, .. }) => Ok(report),
+            Outcome::Accepted(DeviceToHost::Nack { reason, .. }) => Err(Error::Refused {
+                request: name,
+                reason,
+                shaped_by: &[],
+            }),
+            Outcome::Accepted(other) | Outcome::Rejected(other) => Err(client::Error::Unexpected {
+                request: name,
+                answer: Box::new(other),
+            }
+            .into()),
+            Outcome::Lost => Err(client::Error::NoAnswer { request: name }.into()),
+        }
+    }
+
+    /// The state (`GetState`): the readback.
+    ///
+    /// # Errors
+    /// The link's errors, or an unexpected answer.
+    pub fn state(&mut self) -> Result<Readback, Error> {
+        let name = "GetState";
+        let retries = self.client.config().retries;
+        let exchange = self
+            .client
+            .exchange_with(Request::GetState, retries, |_| Verdict::Accept)
+            .map_err(client::Error::from)?;
+        match exchange.outcome {
+            Outcome::Accepted(DeviceToHost::Ack { readback, .. }) => Ok(readback),
             Outcome::Accepted(other) | Outcome::Rejected(other) => Err(client::Error::Unexpected {
                 request: name,
                 answer: Box::new(other),

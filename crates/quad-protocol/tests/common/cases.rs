@@ -9,10 +9,11 @@ use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
 use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
 use quad_protocol::{
-    servo, DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet,
-    LinkLossAction, LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus,
-    NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request,
-    RobotPreset, ServoId, Setting,
+    servo, BalanceConfig, DeviceInfo, DeviceToHost, FallKind, FaultAction, Field, FirmwareVersion,
+    Flags, HostToDevice, ImuFaultKind, ImuHealth, ImuReport, LegSet, LinkLossAction, LinkTimeout,
+    MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason, ParamProblem,
+    PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset, SafeState, ServoId,
+    Setting,
 };
 
 pub fn h2d(seq: u16, request: Request) -> HostToDevice {
@@ -269,8 +270,33 @@ pub fn requests() -> Vec<(&'static str, HostToDevice, &'static str)> {
             ),
             "13 0f 00 00 20 40",
         ),
+        (
+            "SetBalance",
+            // seq 20 | variant 16 | leveling 1 | kp 0.25 | ki 4 | bound 0.25 | detection 1 |
+            // angle 1 | Off = 1 | Stop = 1
+            h2d(20, Request::SetBalance(BALANCE)),
+            "14 10 01 00 00 80 3e 00 00 80 40 00 00 80 3e 01 00 00 80 3f 01 01",
+        ),
+        (
+            "GetImu",
+            // seq 21 | variant 17
+            h2d(21, Request::GetImu),
+            "15 11",
+        ),
     ]
 }
+
+/// Balance settings with exactly representable values.
+pub const BALANCE: BalanceConfig = BalanceConfig {
+    leveling: true,
+    level_kp: 0.25,
+    level_ki_per_s: 4.0,
+    max_correction_rad: 0.25,
+    fall_detection: true,
+    fall_angle_rad: 1.0,
+    safe_state: SafeState::Off,
+    on_fault: FaultAction::Stop,
+};
 
 /// Every answer (and the nack layouts with fields) with its postcard bytes.
 pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
@@ -504,6 +530,38 @@ pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
              00 00 00 3f 00 00 00 3f 00 00 00 3f 00 00 00 3f \
              b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 b8 17 \
              04 05 00",
+        ),
+        (
+            "Imu",
+            // variant 6 | seq 5 | Fault = 3, Nak = 1 | roll 0.25 | pitch -0.5 | corrections
+            // -0.25, 0.5 | active 1 | limited 0 | Some = 1, Tilt = 0 | samples 300 = ac 02 |
+            // the settings of `BALANCE`
+            DeviceToHost::Imu {
+                seq: 5,
+                report: ImuReport {
+                    health: ImuHealth::Fault(ImuFaultKind::Nak),
+                    roll_rad: 0.25,
+                    pitch_rad: -0.5,
+                    correction_roll_rad: -0.25,
+                    correction_pitch_rad: 0.5,
+                    leveling_active: true,
+                    correction_limited: false,
+                    fall: Some(FallKind::Tilt),
+                    samples: 300,
+                    config: BALANCE,
+                },
+            },
+            "06 05 03 01 00 00 80 3e 00 00 00 bf 00 00 80 be 00 00 00 3f 01 00 01 00 ac 02 \
+             01 00 00 80 3e 00 00 80 40 00 00 80 3e 01 00 00 80 3f 01 01",
+        ),
+        (
+            "Nack NotUpright",
+            // variant 0 | Some, seq 18 | reason 21
+            DeviceToHost::Nack {
+                seq: Some(18),
+                reason: NackReason::NotUpright,
+            },
+            "00 01 12 15",
         ),
     ]
 }
