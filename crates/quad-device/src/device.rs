@@ -17,8 +17,8 @@ use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
     check_request_in, encode_frame_in_pieces, is_compatible, negotiated_minor, Accumulator,
     DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout,
-    MotionCommand, MotionStatus, NackReason, PoseConfig, Ranges, Readback, Request, ServoId,
-    Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    MotionCommand, MotionFrames, MotionStatus, NackReason, PoseConfig, Ranges, Readback, Request,
+    ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 
 /// Receive buffer of the accumulator (decoded bytes), the protocol's `MAX_DECODED_LEN`.
@@ -680,11 +680,16 @@ where
     /// or the nack of `result`'s error.
     fn motion_answer(&self, seq: u16, result: Result<(), engine::Error>) -> DeviceToHost {
         match result {
-            Ok(()) => DeviceToHost::MotionAck {
-                seq,
-                status: MotionStatus::from(self.engine.status()).for_minor(self.peer_minor),
-                readback: self.readback(),
-            },
+            Ok(()) => {
+                let status = self.engine.status();
+                DeviceToHost::MotionAck {
+                    seq,
+                    status: MotionStatus::from(status).for_minor(self.peer_minor),
+                    readback: self.readback(),
+                    // Since 2.3: to an older host, no byte of it.
+                    frames: (self.peer_minor >= 3).then(|| MotionFrames::from(status)),
+                }
+            }
             Err(e) => nack(Some(seq), e.into()),
         }
     }
