@@ -14,4 +14,5 @@ pub mod link;
 pub mod names;
 pub mod ops;
 pub mod plot;
+pub mod replay;
 pub mod robot_file;

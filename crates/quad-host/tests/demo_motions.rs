@@ -42,3 +42,36 @@ fn the_tour_runs_and_every_check_passes_on_the_simulated_device() {
         assert_eq!(leg.max_angle_err_rad, 0.0, "{leg:?}");
     }
 }
+
+#[test]
+fn the_full_tour_replays_every_frame_of_stand_up_the_walks_and_sit_exactly() {
+    let link = SimLink::new(
+        SimConfig::default(),
+        Config::shahriar2023(),
+        EepromImage::erased(),
+    )
+    .unwrap();
+    let client = Client::new(link, ClientConfig::sim(Duration::ZERO));
+    let mut session = Session::connect(client, RobotPreset::Shahriar2023).unwrap();
+    let legs = demo_motions::run_tour(
+        &mut session,
+        &Robot::shahriar2023(),
+        AngleCheck::Exact,
+        demo_motions::full_tour,
+        |_| {},
+    )
+    .unwrap();
+    assert_eq!(legs.len(), 7);
+    for leg in &legs {
+        assert_eq!(leg.errors, 0, "{leg:?}");
+    }
+    // Stand-up, the trot, the walk and sit: every answer of the motion is a replayed frame.
+    for i in [0, 4, 5, 6] {
+        assert!(legs[i].frames_checked >= 3, "{:?}", legs[i]);
+        assert!(legs[i].angles_checked > 0, "{:?}", legs[i]);
+    }
+    for i in [4, 5] {
+        assert!(legs[i].angles_checked >= 20, "{:?}", legs[i]);
+        assert_eq!(legs[i].max_angle_err_rad, 0.0, "{:?}", legs[i]);
+    }
+}
