@@ -51,6 +51,14 @@
 //! running. A direct setpoint request cancels a running motion at once (the host takes over; the
 //! limiter still bounds every step), as does stopping the outputs.
 //!
+//! ## Frame numbers
+//! [`Status`] reports the frame of the current stage ([`Status::frame`]: the ramp's steps, or
+//! the run's frame, `t_s` in frames), the run frame from which the last velocity command
+//! applies and the run frame at which a stop took effect (a stop, the walk's velocity timeout
+//! or the failsafe's stop; the first of them). With the request they fix every frame of a
+//! motion: the host replays them with this engine (protocol 2.3's `MotionFrames`, quad-host's
+//! `replay`).
+//!
 //! ## Start check
 //! A request from the wire has passed the protocol's range check already
 //! ([`quad_protocol::range`]: every number within its field's range, the same check the host
