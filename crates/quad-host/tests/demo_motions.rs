@@ -75,3 +75,48 @@ fn the_full_tour_replays_every_frame_of_stand_up_the_walks_and_sit_exactly() {
         assert_eq!(legs[i].max_angle_err_rad, 0.0, "{:?}", legs[i]);
     }
 }
+
+#[test]
+fn a_perturbed_replay_fails_the_trot_naming_the_frame_and_the_joint() {
+    // The host's robot a millimetre off the device's: its replay of the trot is not what the
+    // device runs, and the check says where first.
+    let link = SimLink::new(
+        SimConfig::default(),
+        Config::shahriar2023(),
+        EepromImage::erased(),
+    )
+    .unwrap();
+    let client = Client::new(link, ClientConfig::sim(Duration::ZERO));
+    let mut session = Session::connect(client, RobotPreset::Shahriar2023).unwrap();
+    let mut robot = Robot::shahriar2023();
+    robot.leg.tibia_m += 1e-3;
+    let legs = demo_motions::run_tour(
+        &mut session,
+        &robot,
+        AngleCheck::Within(1e-5),
+        |h| {
+            demo_motions::tour(h)
+                .into_iter()
+                .filter(|(name, ..)| name.starts_with("trot"))
+                .collect()
+        },
+        |_| {},
+    )
+    .unwrap();
+    assert_eq!(legs.len(), 1);
+    let trot = &legs[0];
+    assert!(trot.errors > 0, "{trot:?}");
+    // "trot: …: readback 1: Run frame 4: FR Knee is -1.5394 on the device, -1.5431 in the
+    // replay".
+    let first = trot.first_error.as_deref().unwrap();
+    assert!(
+        first.contains("readback") && first.contains("Run frame"),
+        "{first}"
+    );
+    assert!(
+        ["Abduction", "Hip", "Knee"]
+            .iter()
+            .any(|j| first.contains(j)),
+        "{first}"
+    );
+}
