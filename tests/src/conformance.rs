@@ -51,6 +51,9 @@ pub const PULSE_TOLERANCE_HALF_US: f64 = 1.0;
 pub const MOTION_TIME_TOLERANCE_S: f64 = 0.02;
 /// The phase's tolerance: one 20 ms frame of the shortest cycle recorded (1 s).
 pub const PHASE_TOLERANCE: f64 = 0.02;
+/// Absolute tolerance of a motion's frame numbers (`MotionFrames`, since 2.3): one frame, as
+/// its time.
+pub const FRAME_NUMBER_TOLERANCE: f64 = 1.0;
 
 /// One recorded exchange: a line of the kit (docs/conformance.md explains every field).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -454,7 +457,8 @@ fn check_named(name: &str, answer: &DeviceToHost, previous: Option<&Exchange>) {
 }
 
 /// The tolerances of `answer`'s fields: the joint angles and pulses of a readback, a motion's
-/// time and phase; the frame counters and the inertial sensor's sample count are ignored.
+/// time, phase and frame numbers; the frame counters and the inertial sensor's sample count are
+/// ignored.
 fn tolerances(answer: &DeviceToHost) -> (BTreeMap<String, f64>, Vec<String>) {
     let mut tolerance = BTreeMap::new();
     let mut ignore = Vec::new();
@@ -471,6 +475,9 @@ fn tolerances(answer: &DeviceToHost) -> (BTreeMap<String, f64>, Vec<String>) {
     if matches!(answer, DeviceToHost::MotionAck { .. }) {
         tolerance.insert("t_s".to_owned(), MOTION_TIME_TOLERANCE_S);
         tolerance.insert("phase".to_owned(), PHASE_TOLERANCE);
+        // Since 2.3: the frame numbers, one servo frame as the time.
+        tolerance.insert("frame".to_owned(), FRAME_NUMBER_TOLERANCE);
+        tolerance.insert("stop_frame".to_owned(), FRAME_NUMBER_TOLERANCE);
     }
     if matches!(answer, DeviceToHost::Imu { .. }) {
         // The sensor's sample count depends on when the request came.

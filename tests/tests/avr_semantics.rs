@@ -2,7 +2,8 @@
 //! the version a `HelloAck` reports, what may start while the outputs are off, the rest pose,
 //! the joint-speed limiter (per joint for a direct setpoint, one synchronised ramp for a
 //! motion's start), seen on the pins, which frame a readback describes, the idle motion status
-//! (2.2 and older hosts) and a watchdog reset mid-trot. Simulated time.
+//! (2.2 and older hosts), the frame numbers of 2.3 (to a 2.3 host only) and a watchdog reset
+//! mid-trot. Simulated time.
 
 use integration_tests::wire;
 use quad_host::emu::build;
@@ -528,4 +529,72 @@ fn a_readback_reports_the_target_which_the_pins_show_from_the_next_periods() {
         pins_show(&later[0], &r.pulses_half_us),
         "the pins reach the target"
     );
+}
+
+/// `GetMotion`'s status and frame numbers.
+fn motion_frames(
+    link: &mut EmulatorLink,
+    seq: u16,
+    request: Request,
+) -> (
+    quad_protocol::MotionStatus,
+    Option<quad_protocol::MotionFrames>,
+) {
+    match ask(link, seq, request) {
+        DeviceToHost::MotionAck { status, frames, .. } => (status, frames),
+        other => panic!("{request:?}: {other:?}"),
+    }
+}
+
+#[test]
+fn the_frame_numbers_end_the_motion_acks_to_a_two_three_host_only() {
+    let mut link = boot();
+    hello(&mut link);
+    let mut seq = 1;
+    ask(&mut link, seq, Request::StartMotion(MotionCommand::StandUp));
+    wait_idle(&mut link, &mut seq);
+    let info = hello(&mut link);
+    let walk = MotionCommand::walk(
+        kin_core::motion::gait::Pattern::Trot,
+        info.pose_config.stance_height_m,
+    );
+    seq += 1;
+    ask(&mut link, seq, Request::StartMotion(walk));
+    let velocity = Request::SetVelocity {
+        forward_m_s: 0.03,
+        lateral_m_s: 0.0,
+        yaw_rate_rad_s: 0.0,
+    };
+    // In the run: a velocity's answer names the run frame it applies from, its time.
+    let mut in_run = 0;
+    for _ in 0..20 {
+        link.idle(Duration::from_millis(60)).expect("runs");
+        seq += 1;
+        let (status, frames) = motion_frames(&mut link, seq, velocity);
+        let frames = frames.expect("frame numbers to a 2.3 host");
+        if status.stage == quad_protocol::MotionStage::Run {
+            assert_eq!(
+                u32::from(frames.frame),
+                (status.t_s / 0.02).round() as u32,
+                "{status:?} {frames:?}"
+            );
+            assert_eq!(frames.stop_frame, None);
+            in_run += 1;
+        }
+    }
+    assert!(in_run > 10, "{in_run}");
+    // A 2.2 host gets the answer of 2.2: nothing after the readback.
+    seq += 1;
+    ask(&mut link, seq, Request::Hello { version: 0x0202 });
+    seq += 1;
+    let (status, frames) = motion_frames(&mut link, seq, velocity);
+    assert_eq!(status.stage, quad_protocol::MotionStage::Run);
+    assert_eq!(frames, None);
+    // Back to 2.3: the stop's answer names its frame.
+    hello(&mut link);
+    seq += 1;
+    let (status, frames) = motion_frames(&mut link, seq, Request::StopMotion);
+    let stop = frames.and_then(|f| f.stop_frame).expect("the stop frame");
+    assert_eq!(u32::from(stop), (status.t_s / 0.02).round() as u32);
+    wait_idle(&mut link, &mut seq);
 }

@@ -18,8 +18,8 @@ use quad_protocol::servo::{Calibration, PulseMap};
 use quad_protocol::{
     check_request_in, encode_frame_in_pieces, is_compatible, negotiated_minor, Accumulator,
     DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout,
-    MotionCommand, MotionKind, MotionStatus, NackReason, PoseConfig, Ranges, Readback, Request,
-    ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    MotionCommand, MotionFrames, MotionKind, MotionStatus, NackReason, PoseConfig, Ranges,
+    Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
 };
 use quad_protocol::{BalanceConfig, FaultAction, ImuReport, SafeState};
 
@@ -828,11 +828,16 @@ where
     /// or the nack of `result`'s error.
     fn motion_answer(&self, seq: u16, result: Result<(), engine::Error>) -> DeviceToHost {
         match result {
-            Ok(()) => DeviceToHost::MotionAck {
-                seq,
-                status: MotionStatus::from(self.engine.status()).for_minor(self.peer_minor),
-                readback: self.readback(),
-            },
+            Ok(()) => {
+                let status = self.engine.status();
+                DeviceToHost::MotionAck {
+                    seq,
+                    status: MotionStatus::from(status).for_minor(self.peer_minor),
+                    readback: self.readback(),
+                    // Since 2.3: to an older host, no byte of it.
+                    frames: (self.peer_minor >= 3).then(|| MotionFrames::from(status)),
+                }
+            }
             Err(e) => nack(Some(seq), NackReason::from(e).for_minor(self.peer_minor)),
         }
     }

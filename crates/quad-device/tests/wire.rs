@@ -271,6 +271,7 @@ fn answers() -> Vec<DeviceToHost> {
                 frames_ok: 70_000,
                 frames_bad: 1,
             },
+            frames: None,
         },
         DeviceToHost::Imu {
             seq: 12,

@@ -12,8 +12,8 @@ use kin_core::{Pose, ReachPolicy, RotationOrder};
 use quad_protocol::schema::{self, ENUMS};
 use quad_protocol::wire::FieldsSchema;
 use quad_protocol::{
-    servo, DeviceInfo, FirmwareVersion, Flags, HostToDevice, LinkTimeout, MotionKind, MotionStage,
-    MotionStatus, NackReason, PoseConfig, Readback, Request, RobotPreset, ServoId,
+    servo, DeviceInfo, FirmwareVersion, Flags, HostToDevice, LinkTimeout, MotionFrames, MotionKind,
+    MotionStage, MotionStatus, NackReason, PoseConfig, Readback, Request, RobotPreset, ServoId,
 };
 use schema_shape::Shape;
 use serde_json::{json, Map, Value};
@@ -75,6 +75,10 @@ fn structs() -> Vec<Value> {
             t_s: 0.0,
             phase: 0.0,
             fault: Some(NackReason::Busy),
+        }),
+        schema_shape::shape(&MotionFrames {
+            frame: 0,
+            stop_frame: Some(0),
         }),
     ];
     let mut out: Vec<Value> = shapes

@@ -49,15 +49,15 @@ pub use frame::{
 };
 pub use msg::{
     DeviceInfo, DeviceToHost, Field, FirmwareVersion, Flags, HostToDevice, LegSet, LinkLossAction,
-    LinkTimeout, MotionCommand, MotionKind, MotionParam, MotionStage, MotionStatus, NackReason,
-    ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request, RobotPreset, ServoId,
-    Setting, DEFAULT_VELOCITY_TIMEOUT_MS,
+    LinkTimeout, MotionCommand, MotionFrames, MotionKind, MotionParam, MotionStage, MotionStatus,
+    NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request,
+    RobotPreset, ServoId, Setting, DEFAULT_VELOCITY_TIMEOUT_MS,
 };
 pub use range::{check_request, check_request_in, Ranges};
 
 /// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions; 2.2: the idle
 /// motion stage and the watchdog-reset flag; 2.3: the inertial sensor and the balance
-/// functions, [`balance`]).
+/// functions, [`balance`], and the motion's frame numbers, [`MotionFrames`]).
 pub const PROTOCOL_VERSION: u16 = 0x0203;
 
 /// Major part of a protocol version.
@@ -105,8 +105,10 @@ const CONFIGURED_MAX_LEN: usize = 1 + 3 + (1 + 2 + 18) + READBACK_MAX_LEN + fram
 
 /// Largest [`DeviceToHost::MotionAck`] frame (postcard bytes + CRC), bytes: variant (1) + seq
 /// (≤ 3) + [`MotionStatus`] (kind ≤ 2, stage 1, time and phase 2 × 4, fault ≤ 1 + 4) +
-/// [`READBACK_MAX_LEN`] + CRC (2).
-const MOTION_ACK_MAX_LEN: usize = 1 + 3 + (2 + 1 + 2 * 4 + 5) + READBACK_MAX_LEN + frame::CRC_LEN;
+/// [`READBACK_MAX_LEN`] + [`MotionFrames`] (since 2.3: two frame numbers below 2^14, ≤ 2 each,
+/// one of them an option, + 1) + CRC (2).
+const MOTION_ACK_MAX_LEN: usize =
+    1 + 3 + (2 + 1 + 2 * 4 + 5) + READBACK_MAX_LEN + (2 + 1 + 2) + frame::CRC_LEN;
 
 /// Largest decoded [`DeviceToHost`] frame of this version (postcard bytes + CRC), bytes: the
 /// larger of a [`DeviceToHost::Configured`] echoing a calibration and a
@@ -122,3 +124,5 @@ const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);
 // The `Imu` answer (variant, seq, report, CRC) is shorter than the largest answer.
 const _: () =
     assert!(1 + 3 + balance::IMU_REPORT_MAX_LEN + frame::CRC_LEN <= DEVICE_TO_HOST_MAX_LEN);
+// The frame numbers of 2.3 keep the motion ack within 2.2's largest answer.
+const _: () = assert!(MOTION_ACK_MAX_LEN <= CONFIGURED_MAX_LEN);

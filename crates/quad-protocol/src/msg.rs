@@ -357,6 +357,41 @@ impl MotionStatus {
     }
 }
 
+/// The frame numbers of a motion (since 2.3, at the end of [`DeviceToHost::MotionAck`] to a
+/// peer of minor 3 or later): with the request and the [`MotionStatus`], what a host needs to
+/// recompute every frame of the motion (docs/motion.md, "Replaying a motion").
+///
+/// A frame is one 20 ms servo frame. The run's frames are counted from 0 at the start of stage
+/// [`MotionStage::Run`] (frame `n` is the setpoint at motion time `n · 20 ms`; `t_s` reports
+/// the same count in seconds); a ramp's frames are its steps. Each number is sent modulo
+/// [`MotionFrames::MODULUS`] (16,384 frames, 5 min 27.68 s), so that it takes at most two
+/// bytes and the answer stays within the largest answer of 2.2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MotionFrames {
+    /// Frames of the current stage when the answer was made: the steps taken along the ramp
+    /// in [`MotionStage::Approach`] and [`MotionStage::Leave`], the run frame in
+    /// [`MotionStage::Run`] and [`MotionStage::Stopping`]; 0 when idle. In the answer to a
+    /// [`Request::SetVelocity`] in stage `Run` this is the run frame from which the velocity
+    /// applies (the walker's step from this frame to the next is the first with it); one
+    /// answered in stage `Approach` applies from run frame 0.
+    pub frame: u16,
+    /// The run frame at which the stop took effect ([`Request::StopMotion`], the walk's
+    /// velocity timeout or the link-loss failsafe; the first of them): the run's step from this
+    /// frame on is the first of the stopping motion. `None` while no stop took effect in the
+    /// run (a stop asked for in the approach turns the ramp back at once, without a run).
+    pub stop_frame: Option<u16>,
+}
+
+impl MotionFrames {
+    /// The frame numbers are sent modulo this (2^14: a varint of at most two bytes).
+    pub const MODULUS: u32 = 1 << 14;
+
+    /// `frame` modulo [`MotionFrames::MODULUS`], as sent.
+    pub const fn wrap(frame: u32) -> u16 {
+        (frame % Self::MODULUS) as u16
+    }
+}
+
 wire_enum! {
     /// A parameter of a motion request ([`NackReason::InvalidParameter`]).
     #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -737,6 +772,10 @@ wire_enum! {
             status: MotionStatus,
             /// The state after the request, as [`DeviceToHost::Ack`] reports it.
             readback: Readback,
+            /// When the motion's frames ran and its commands took effect (since 2.3): present
+            /// exactly when the negotiated minor is 3 or later, absent (no byte) otherwise
+            /// ([`wire::trailing`]).
+            frames: Option<MotionFrames> as wire::trailing,
         },
         /// Answer to [`Request::SetBalance`] and [`Request::GetImu`] (since 2.3).
         6 => Imu {

@@ -529,6 +529,42 @@ pub mod shared {
     }
 }
 
+/// A field at the end of an answer that only a peer of a later minor receives (serde's `with`
+/// and `wire_enum!`'s `as`; [`crate::DeviceToHost::MotionAck`]'s `frames` since 2.3): `None`
+/// writes no byte at all — the answer is byte for byte the older one — and `Some(value)` writes
+/// `value` (no option tag). Reading, the field is `None` when the message ends before it.
+///
+/// A device sends the field exactly when the negotiated minor has it, so a decoder that knows
+/// the minor knows whether the bytes are there; this one does not need to. Only the last field
+/// of a message may be trailing.
+pub mod trailing {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Writes nothing for `None`, the value itself for `Some` (serde's `with`).
+    ///
+    /// # Errors
+    /// The serializer's.
+    pub fn serialize<S: Serializer, T: Serialize>(
+        value: &Option<T>,
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        match value {
+            Some(v) => v.serialize(s),
+            None => s.serialize_unit(),
+        }
+    }
+
+    /// Reads the value when the message goes on, `None` when it has ended (serde's `with`).
+    ///
+    /// # Errors
+    /// None from postcard: a message that ends early reads as `None`.
+    pub fn deserialize<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<Option<T>, D::Error> {
+        Ok(T::deserialize(d).ok())
+    }
+}
+
 /// Arrays on the wire, for serde's `with` and `wire_enum!`'s `as`: a tuple of `N` elements,
 /// the data model of serde's own `[T; N]` implementations (postcard: the elements one after
 /// the other, no length), so the bytes are the same. serde reads an array with one unrolled
@@ -1230,6 +1266,7 @@ mod tests {
                 fault: None,
             },
             readback,
+            frames: None,
         };
         let kinds = [
             MotionKind::StandUp,

@@ -477,6 +477,7 @@ fn encoded_answers_carry_postcards_own_bytes() {
                     fault: None,
                 },
                 readback,
+                frames: None,
             },
             _ => DeviceToHost::Nack {
                 seq: Some(seq),
@@ -552,6 +553,7 @@ fn largest_messages_fit_the_declared_bounds() {
             DeviceToHost::Ack { readback, .. } => readback,
             _ => unreachable!(),
         },
+        frames: None,
     };
     let mut buf = [0u8; MAX_DECODED_LEN];
     let ack_len = postcard::to_slice(&ack, &mut buf).unwrap().len() + 2;

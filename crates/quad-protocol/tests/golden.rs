@@ -136,7 +136,7 @@ fn hand_written_frames() {
 fn version_is_two_three() {
     // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0; 2.2 appended
     // the idle motion stage and the watchdog-reset flag; 2.3 the inertial sensor's requests,
-    // answer, nack reasons, parameters and the fall flag.
+    // answer, nack reasons, parameters and the fall flag, and the motion ack's frame numbers.
     assert_eq!(PROTOCOL_VERSION, 0x0203);
     assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
     assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 3);
@@ -189,6 +189,7 @@ fn the_appendices_of_two_two_have_their_golden_bytes() {
             frames_ok: 2,
             frames_bad: 0,
         },
+        frames: None,
     };
     check(
         "MotionAck Idle WATCHDOG_RESET",
@@ -224,4 +225,46 @@ fn the_appendices_of_two_two_have_their_golden_bytes() {
     assert_eq!(running.for_minor(1), running);
     // kind None = 0 | stage Idle = 4.
     assert_eq!(postcard_bytes(&status)[..2], [0x00, 0x04]);
+}
+
+#[test]
+fn the_appendix_of_two_three_has_its_golden_bytes() {
+    use quad_protocol::{Flags, MotionFrames, MotionKind, MotionStage, MotionStatus, Readback};
+    let ack = |frames| DeviceToHost::MotionAck {
+        seq: 9,
+        status: MotionStatus {
+            kind: Some(MotionKind::Walk),
+            stage: MotionStage::Stopping,
+            t_s: 0.0,
+            phase: 0.0,
+            fault: None,
+        },
+        readback: Readback {
+            angles_rad: [0.0; 12],
+            pulses_half_us: [0; 12],
+            flags: Flags(0),
+            frames_ok: 2,
+            frames_bad: 0,
+        },
+        frames,
+    };
+    let old = postcard_bytes(&ack(None));
+    // To a 2.3 host the same bytes, then frame 300 = AC 02 | stop_frame Some = 01, 200 = C8 01.
+    let new = postcard_bytes(&ack(Some(MotionFrames {
+        frame: 300,
+        stop_frame: Some(200),
+    })));
+    assert_eq!(new[..old.len()], old[..]);
+    assert_eq!(new[old.len()..], [0xAC, 0x02, 0x01, 0xC8, 0x01]);
+    // Both read back; the older answer as `frames: None`.
+    for bytes in [&old, &new] {
+        let back: DeviceToHost = postcard::from_bytes(bytes).unwrap();
+        let DeviceToHost::MotionAck { frames, .. } = back else {
+            unreachable!()
+        };
+        assert_eq!(frames.is_some(), bytes.len() > old.len());
+    }
+    // The numbers wrap at 2^14: at most two bytes each.
+    assert_eq!(MotionFrames::wrap(16_384 + 5), 5);
+    assert_eq!(MotionFrames::wrap(16_383), 16_383);
 }

@@ -27,7 +27,7 @@ Motion: seed 000's pose sweeps on its robot (shahriar2023) at the stance height 
 order zyx — roll +-28 deg, then pitch +-21 deg, then yaw +-21 deg, one sine period each, sampled
 at --poses-per-sweep poses and streamed as fast as the link allows. Then the device's own
 motions (--sweeps-only leaves them out): stand-up, seed 001's roll and pitch sways and yaw turn
-(counter-clockwise), a trot whose velocity command changes, sit.
+(counter-clockwise), a trot and a walk whose velocity commands change, sit.
 
 Checks: every pose is acked with the 12 angles of the host's own kin-core (within 2e-5 rad: the
 AVR's math differs) and the 12 pulses of the device calibration's mapping of those angles; on the
@@ -35,8 +35,10 @@ emulator every pulse measured on the 12 servo pins (Timer1/3/4/5, port L include
 the readback in force within one 0.5 us timer tick (or lie on the joint-speed limiter's way to
 it). The onboard motions: every answer's pulses and (sways, yaw turn) angles against the host's
 kin-core law at the device's motion time, the stance and rest poses at the ends, and on the
-emulator the pins against the host's calibration mapping. Times are simulated time on the
-emulator.
+emulator the pins against the host's calibration mapping; stand-up, the trot, the walk and sit
+replayed frame by frame by the host (the device's engine on the host's kin-core, fed with the
+frames at which the device reports each velocity command and the stop took effect): every
+answer's angles and every PWM period on the pins. Times are simulated time on the emulator.
 
 Exit status: 0 every check passed; 2 the firmware could not be built or the link failed; 3 a
 check failed.";
@@ -117,12 +119,13 @@ pub fn main(args: &Args) -> ExitCode {
         for l in legs {
             let line = format!(
                 "  onboard {}: {} answers, {} angle checks (largest |device − host| {:.1e} rad), \
-                 {} pins, {} errors, {:.1} s of motion",
+                 {} pins, {} frames replayed, {} errors, {:.1} s of motion",
                 l.motion,
                 l.answers,
                 l.angles_checked,
                 l.max_angle_err_rad,
                 l.pins_checked,
+                l.frames_checked,
                 l.errors,
                 l.motion_s
             );

@@ -162,6 +162,11 @@ impl Ramp {
         p
     }
 
+    /// Steps taken so far ([`Ramp::advance`] calls that moved; 0 after a restart).
+    pub const fn steps_done(&self) -> u32 {
+        self.done
+    }
+
     /// True once the end is reached.
     pub fn finished(&self) -> bool {
         self.done >= self.frames

@@ -51,6 +51,14 @@
 //! running. A direct setpoint request cancels a running motion at once (the host takes over; the
 //! limiter still bounds every step), as does stopping the outputs.
 //!
+//! ## Frame numbers
+//! [`Status`] reports the frame of the current stage ([`Status::frame`]: the ramp's steps, or
+//! the run's frame, `t_s` in frames), the run frame from which the last velocity command
+//! applies and the run frame at which a stop took effect (a stop, the walk's velocity timeout
+//! or the failsafe's stop; the first of them). With the request they fix every frame of a
+//! motion: the host replays them with this engine (protocol 2.3's `MotionFrames`, quad-host's
+//! `replay`).
+//!
 //! ## Start check
 //! A request from the wire has passed the protocol's range check already
 //! ([`quad_protocol::range`]: every number within its field's range, the same check the host
@@ -182,6 +190,16 @@ pub struct Status {
     pub phase: f32,
     /// Why the last motion stopped early, if it did.
     pub fault: Option<Error>,
+    /// Frames of the current stage so far: the ramp's steps in [`MotionStage::Approach`] and
+    /// [`MotionStage::Leave`], the run's frame (`t_s` in frames) in [`MotionStage::Run`] and
+    /// [`MotionStage::Stopping`]; 0 when idle.
+    pub frame: u32,
+    /// The run frame from which the last velocity command applies ([`Engine::set_velocity`]);
+    /// `None` before the first, and outside a walk.
+    pub velocity_frame: Option<u32>,
+    /// The run frame at which the stop took effect ([`Engine::stop`], or the walk's velocity
+    /// timeout; the first of them); `None` while none did in the run.
+    pub stop_frame: Option<u32>,
 }
 
 /// Twelve servo calibrations as their pulse maps, canonical order (the device's calibration
@@ -309,6 +327,10 @@ pub struct Engine<M> {
     limiter: Limiter,
     /// Why the last motion stopped early.
     fault: Option<Error>,
+    /// The run frame from which the last velocity command applies.
+    velocity_frame: Option<u32>,
+    /// The run frame at which the stop took effect.
+    stop_frame: Option<u32>,
     _math: PhantomData<fn() -> M>,
 }
 
@@ -334,6 +356,8 @@ impl<M: Math> Engine<M> {
             home: [0.0; 12],
             frame: 0,
             fault: None,
+            velocity_frame: None,
+            stop_frame: None,
             limiter,
             _math: PhantomData,
         }
@@ -416,6 +440,8 @@ impl<M: Math> Engine<M> {
         self.home = home;
         self.frame = 0;
         self.fault = None;
+        self.velocity_frame = None;
+        self.stop_frame = None;
         Ok(start)
     }
 
@@ -433,6 +459,8 @@ impl<M: Math> Engine<M> {
             } if !walker.is_stopping() && self.stage != MotionStage::Leave => {
                 walker.set_velocity::<M>(v)?;
                 *last_command_ms = now_ms;
+                // The next tick's first step is the first with `v` (frame 0 before the run).
+                self.velocity_frame = Some(self.frame);
                 Ok(())
             }
             _ => Err(Error::NotWalking),
@@ -453,6 +481,9 @@ impl<M: Math> Engine<M> {
             }
             Program::Walk { walker, .. } => walker.stop(),
             _ => return,
+        }
+        if self.stage == MotionStage::Run {
+            self.stop_frame = Some(self.frame);
         }
         // One tail for both programs: one ramp call site, not two.
         if self.stage == MotionStage::Approach {
@@ -487,11 +518,18 @@ impl<M: Math> Engine<M> {
                     t_s: 0.0,
                     phase: 0.0,
                     fault: self.fault,
+                    frame: 0,
+                    velocity_frame: None,
+                    stop_frame: None,
                 };
             }
             Program::Pose { kind } => (Some(*kind), 0.0),
             Program::Law(law) => (Some(law.motion_kind()), motion_phase(t_s, law.period_s)),
             Program::Walk { walker, .. } => (Some(MotionKind::Walk), walker.phase()),
+        };
+        let frame = match self.stage {
+            MotionStage::Approach | MotionStage::Leave => self.ramp.steps_done(),
+            _ => self.frame,
         };
         Status {
             kind,
@@ -499,6 +537,9 @@ impl<M: Math> Engine<M> {
             t_s,
             phase,
             fault: self.fault,
+            frame,
+            velocity_frame: self.velocity_frame,
+            stop_frame: self.stop_frame,
         }
     }
 
@@ -595,6 +636,9 @@ impl<M: Math> Engine<M> {
                     } => {
                         if now_ms.wrapping_sub(*last_command_ms) > u32::from(*timeout_ms) {
                             walker.stop();
+                            if self.stage == MotionStage::Run {
+                                self.stop_frame = Some(self.frame);
+                            }
                             self.stage = MotionStage::Stopping;
                         }
                         for _ in 0..frames.min(MAX_CATCH_UP_FRAMES) {

@@ -6,7 +6,7 @@ use kin_core::motion;
 use kin_core::preflight::FailureKind;
 use kin_core::Unreachable;
 use quad_protocol::{
-    MotionParam, MotionStatus, NackReason, ParamProblem, PreflightFault, ReachFault,
+    MotionFrames, MotionParam, MotionStatus, NackReason, ParamProblem, PreflightFault, ReachFault,
 };
 
 impl From<Status> for MotionStatus {
@@ -17,6 +17,16 @@ impl From<Status> for MotionStatus {
             t_s: s.t_s,
             phase: s.phase,
             fault: s.fault.map(NackReason::from),
+        }
+    }
+}
+
+impl From<Status> for MotionFrames {
+    /// The frame numbers of `s`, each modulo [`MotionFrames::MODULUS`] (the wire's).
+    fn from(s: Status) -> MotionFrames {
+        MotionFrames {
+            frame: MotionFrames::wrap(s.frame),
+            stop_frame: s.stop_frame.map(MotionFrames::wrap),
         }
     }
 }

@@ -296,10 +296,11 @@ pub fn run(args: &Request, log: &mut dyn Write) -> Result<Demo, Error> {
         writeln!(log, "quadctl demo: the device's own motions")?;
         let mut session =
             crate::ops::onboard::Session::connect(stream.into_client(), RobotPreset::Shahriar2023)?;
-        let legs = crate::ops::demo_motions::run(
+        let legs = crate::ops::demo_motions::run_tour(
             &mut session,
             &Robot::shahriar2023(),
             AngleCheck::Within(AVR_ANGLE_TOLERANCE_RAD),
+            crate::ops::demo_motions::full_tour,
             |_| {},
         )?;
         motions = Some(legs);

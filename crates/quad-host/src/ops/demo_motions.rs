@@ -18,20 +18,29 @@
 //!   latched to the PWM periods; these motions move slower than the joint-speed limit, so the
 //!   limiter never holds them back), within one 0.5 µs timer tick.
 //!
-//! The walk's footholds depend on when each velocity command arrived, so the trot is checked
-//! by its readbacks' pulses and, on the pins, by the travel of every pulse.
+//! Stand-up, the trot, the walk and sit are replayed ([`crate::replay`]): the device reports
+//! the run frame from which each velocity command applies and at which the stop took effect
+//! (protocol 2.3), and the host recomputes every frame with the device's own engine on its
+//! kin-core; every answer's readback is that replay's frame of the answer's stage and frame
+//! number (within the angle tolerance) and, on the emulator, every PWM period the pins showed
+//! between the answers is a replayed frame, in order (within one 0.5 µs timer tick). The walk's
+//! and the trot's readbacks while they run count as angle checks; stand-up and sit count their
+//! end pose (the host's stance, the rest pose) as before, and their ramps' frames among the
+//! frames replayed.
 
 use crate::client::{self, AngleCheck};
 use crate::emu::CYCLES_PER_TICK;
 use crate::link::Link;
 use crate::ops::onboard::{self, MotionAnswer, Session, VelocityStep, POLL_PERIOD};
+use crate::replay::{self, Commands};
 use kin_core::body::{BodyConfig, Pose, Solver};
+use kin_core::motion::gait::{Pattern, Velocity};
 use kin_core::motion::laws::{self, Axis};
 use kin_core::motion::Motion as _;
 use kin_core::{ReachPolicy, Robot};
 use quad_device::engine;
 use quad_protocol::servo::Calibration;
-use quad_protocol::{Flags, MotionCommand, MotionKind, MotionStage, Readback};
+use quad_protocol::{Flags, MotionCommand, MotionKind, MotionStage, Readback, Request};
 use serde::Serialize;
 use std::time::Duration;
 
@@ -75,6 +84,24 @@ pub fn tour(stance_height_m: f32) -> Vec<(&'static str, MotionCommand, Vec<Veloc
     ]
 }
 
+/// [`tour`] with a walk (the four-beat gait) before the sit: what `quadctl demo` runs.
+pub fn full_tour(stance_height_m: f32) -> Vec<(&'static str, MotionCommand, Vec<VelocityStep>)> {
+    let mut legs = tour(stance_height_m);
+    let step = |forward_m_s, yaw_rate_rad_s, duration_s| VelocityStep {
+        forward_m_s,
+        lateral_m_s: 0.0,
+        yaw_rate_rad_s,
+        duration_s,
+    };
+    let walk = (
+        "walk: 2 cm/s, then 3 cm/s turning right, then stop",
+        MotionCommand::walk(Pattern::Walk, stance_height_m),
+        vec![step(0.02, 0.0, 2.0), step(0.03, -0.1, 2.0)],
+    );
+    legs.insert(legs.len() - 1, walk);
+    legs
+}
+
 /// The checks of one motion of the tour.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Leg {
@@ -88,6 +115,9 @@ pub struct Leg {
     pub max_angle_err_rad: f32,
     /// Pin pulses compared with the host's mapping.
     pub pins_checked: u64,
+    /// Frames compared with the host's replay of the motion: answers' readbacks and PWM periods
+    /// of the pins (stand-up, the walks and sit).
+    pub frames_checked: u64,
     /// Disagreements (readback pulses, angles, pins).
     pub errors: u64,
     /// The first disagreement, described.
@@ -219,6 +249,20 @@ pub fn run<L: Link>(
     session: &mut Session<L>,
     robot: &Robot,
     check: AngleCheck,
+    progress: impl FnMut(&str),
+) -> Result<Vec<Leg>, onboard::Error> {
+    run_tour(session, robot, check, tour, progress)
+}
+
+/// Runs the motions `tour` gives for the device's stance height, as [`run`] does.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_tour<L: Link>(
+    session: &mut Session<L>,
+    robot: &Robot,
+    check: AngleCheck,
+    tour: impl FnOnce(f32) -> Vec<(&'static str, MotionCommand, Vec<VelocityStep>)>,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<Leg>, onboard::Error> {
     let tolerance_rad = match check {
@@ -238,6 +282,7 @@ pub fn run<L: Link>(
                 angles_checked: 0,
                 max_angle_err_rad: 0.0,
                 pins_checked: 0,
+                frames_checked: 0,
                 errors: 0,
                 first_error: None,
                 motion_s: 0.0,
@@ -252,32 +297,7 @@ pub fn run<L: Link>(
         if is_law {
             c.leg.motion_s = law_run(session, &mut c, robot, &request, h, order)?;
         } else {
-            let mut answers: Vec<MotionAnswer> = Vec::new();
-            let summary = onboard::run(session, &request, &walk, WAIT, |a| answers.push(*a))?;
-            c.leg.motion_s = summary.motion_s;
-            for a in &answers {
-                c.readback(&a.readback);
-            }
-            if let Some(emu) = session.client_mut().link_mut().emulator() {
-                // The trot's pins: each within its servo's travel.
-                let pins = emu
-                    .next_pulses()
-                    .map_err(|e| onboard::Error::Client(e.into()))?;
-                for (i, p) in pins.iter().enumerate() {
-                    c.leg.pins_checked += 1;
-                    let cal = &calibration[i];
-                    let (lo, hi) = (
-                        u64::from(cal.min_half_us()) * CYCLES_PER_TICK,
-                        u64::from(cal.max_half_us()) * CYCLES_PER_TICK,
-                    );
-                    let inside = p.is_some_and(|p| {
-                        p.high_cycles + PIN_TOLERANCE >= lo && p.high_cycles <= hi + PIN_TOLERANCE
-                    });
-                    if !inside && last_enabled(session)? {
-                        c.error(format!("channel {i}: pulse outside its travel"));
-                    }
-                }
-            }
+            c.leg.motion_s = replayed_run(session, &mut c, robot, &request, &walk)?;
         }
         let last = session.get()?;
         c.readback(&last.readback);
@@ -313,12 +333,182 @@ const WAIT: Duration = Duration::from_secs(120);
 /// A pin's pulse may differ from the host's by one timer tick.
 const PIN_TOLERANCE: u64 = CYCLES_PER_TICK;
 
-fn last_enabled<L: Link>(session: &mut Session<L>) -> Result<bool, onboard::Error> {
-    Ok(session
-        .get()?
-        .readback
-        .flags
-        .contains(Flags::OUTPUTS_ENABLED))
+/// The pins of every PWM period until `deadline` on the emulator (appended to `pins`); on
+/// another link, the time passes.
+fn capture<L: Link>(
+    session: &mut Session<L>,
+    pins: &mut Vec<[Option<crate::emu::Pulse>; 12]>,
+    deadline: Duration,
+) -> Result<(), onboard::Error> {
+    if let Some(emu) = session.client_mut().link_mut().emulator() {
+        while emu.now() < deadline {
+            pins.push(
+                emu.next_pulses()
+                    .map_err(|e| onboard::Error::Client(e.into()))?,
+            );
+        }
+        return Ok(());
+    }
+    session
+        .client_mut()
+        .idle_until(deadline)
+        .map_err(|e| onboard::Error::Client(e.into()))
+}
+
+/// The run frame an answer reports (its time in frames), in `Run` and `Stopping`.
+fn run_frame(a: &MotionAnswer) -> Option<u32> {
+    matches!(a.status.stage, MotionStage::Run | MotionStage::Stopping)
+        .then(|| (a.status.t_s / FRAME_S).round() as u32)
+}
+
+/// Runs stand-up, sit or a walk (with its velocity `walk` steps at [`POLL_PERIOD`], then a
+/// stop) to its end, recording every answer and, on the emulator, the pins of every period
+/// between them; then replays the motion from what the device reported and checks every
+/// readback and pin period against it (module docs). Returns the last motion time.
+fn replayed_run<L: Link>(
+    session: &mut Session<L>,
+    c: &mut Checker<'_>,
+    robot: &Robot,
+    request: &MotionCommand,
+    walk: &[VelocityStep],
+) -> Result<f32, onboard::Error> {
+    session.check(&Request::StartMotion(*request))?;
+    for step in walk {
+        session.check(&onboard::velocity_request(step))?;
+    }
+    let is_walk = matches!(request, MotionCommand::Walk { .. });
+    if is_walk {
+        session.stand_if_off(WAIT)?;
+    }
+    let before = session.get()?;
+    c.readback(&before.readback);
+    let on = before.readback.flags.contains(Flags::OUTPUTS_ENABLED);
+    if !on && !matches!(request, MotionCommand::StandUp) {
+        // A sit with the outputs off has nothing to do.
+        return Ok(0.0);
+    }
+    let mut answers: Vec<MotionAnswer> = Vec::new();
+    let mut velocities: Vec<(u32, Velocity)> = Vec::new();
+    let mut pins = Vec::new();
+    let first = session.start(request)?;
+    answers.push(first);
+    for step in walk {
+        let until = session.now() + Duration::from_secs_f32(step.duration_s);
+        loop {
+            let now = session.now();
+            capture(session, &mut pins, (now + POLL_PERIOD).min(until))?;
+            let a = session.motion(onboard::velocity_request(step))?;
+            // In the approach a velocity applies from the run's first step.
+            velocities.push((
+                run_frame(&a).unwrap_or(0),
+                Velocity {
+                    forward_m_s: step.forward_m_s,
+                    lateral_m_s: step.lateral_m_s,
+                    yaw_rad_s: step.yaw_rate_rad_s,
+                },
+            ));
+            answers.push(a);
+            if session.now() >= until {
+                break;
+            }
+        }
+    }
+    if is_walk {
+        answers.push(session.motion(Request::StopMotion)?);
+    }
+    let until = session.now() + WAIT;
+    loop {
+        let now = session.now();
+        capture(session, &mut pins, now + POLL_PERIOD)?;
+        let a = session.get()?;
+        answers.push(a);
+        if a.status.kind.is_none() {
+            if let Some(fault) = a.status.fault {
+                return Err(onboard::Error::Fault(fault));
+            }
+            break;
+        }
+        if session.now() >= until {
+            return Err(onboard::Error::NoEnd(WAIT));
+        }
+    }
+    let mut motion_s = 0.0f32;
+    for a in &answers {
+        c.readback(&a.readback);
+        motion_s = motion_s.max(a.status.t_s);
+    }
+    // The stop frame, from the first answer that reports it (unwrapped at its run frame).
+    let stop_frame = answers.iter().find_map(|a| {
+        let stop = a.frames?.stop_frame?;
+        Some(run_frame(a).map_or(u32::from(stop), |now| replay::unwrap_frame(stop, now)))
+    });
+    let info = *session.info();
+    let config = replay::Config {
+        robot: *robot,
+        calibration: *c.calibration,
+        stance_height_m: info.pose_config.stance_height_m,
+        order: info.pose_config.order,
+        joint_speed_limit_rad_s: engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S,
+    };
+    let commands = Commands {
+        request: *request,
+        outputs_rad: on.then_some(before.readback.angles_rad),
+        velocities,
+        stop_frame,
+    };
+    let replayed = match replay::replay(&config, &commands) {
+        Ok(r) => r,
+        Err(e) => {
+            c.error(format!("{}: {e}", c.leg.motion));
+            return Ok(motion_s);
+        }
+    };
+    check_against_replay(c, &replayed, &answers, &pins, is_walk);
+    Ok(motion_s)
+}
+
+/// Every answer's readback (those of the motion: with frame numbers, not idle) and every pin
+/// period against `replayed`.
+fn check_against_replay(
+    c: &mut Checker<'_>,
+    replayed: &replay::Replay,
+    answers: &[MotionAnswer],
+    pins: &[[Option<crate::emu::Pulse>; 12]],
+    is_walk: bool,
+) {
+    for (i, a) in answers.iter().enumerate() {
+        if a.status.kind.is_none() {
+            continue;
+        }
+        let Some(frames) = a.frames else {
+            c.error(format!(
+                "{}: the device reports no frame numbers (protocol 2.3)",
+                c.leg.motion
+            ));
+            return;
+        };
+        let label = replay::label(&a.status, &frames);
+        match replayed.check_readback(i, label, &a.readback, c.tolerance_rad) {
+            Ok(err) => {
+                c.leg.frames_checked += 1;
+                if is_walk && run_frame(a).is_some() {
+                    c.leg.angles_checked += 1;
+                    c.leg.max_angle_err_rad = c.leg.max_angle_err_rad.max(err);
+                }
+            }
+            Err(m) => c.error(format!("{}: {m}", c.leg.motion)),
+        }
+    }
+    if pins.is_empty() {
+        return;
+    }
+    match replayed.check_pins(pins, PIN_TOLERANCE) {
+        Ok(_) => {
+            c.leg.pins_checked += 12 * pins.len() as u64;
+            c.leg.frames_checked += pins.len() as u64;
+        }
+        Err(m) => c.error(format!("{}: {m}", c.leg.motion)),
+    }
 }
 
 /// Runs a sway or the yaw turn, asking for the state every [`POLL_PERIOD`]: each answer's

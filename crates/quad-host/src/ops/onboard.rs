@@ -15,9 +15,9 @@ use crate::link::{self, Link, Target};
 use quad_protocol::range::{self, ParamRange, Ranges};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    DeviceInfo, DeviceToHost, Flags, ImuReport, MotionCommand, MotionKind, MotionParam,
-    MotionStage, MotionStatus, NackReason, ParamProblem, PreflightFault, Readback, Request,
-    RobotPreset,
+    DeviceInfo, DeviceToHost, Flags, ImuReport, MotionCommand, MotionFrames, MotionKind,
+    MotionParam, MotionStage, MotionStatus, NackReason, ParamProblem, PreflightFault, Readback,
+    Request, RobotPreset,
 };
 use serde::Serialize;
 use std::time::Duration;
@@ -291,6 +291,8 @@ pub struct MotionAnswer {
     pub status: MotionStatus,
     /// The readback after it.
     pub readback: Readback,
+    /// The motion's frame numbers (from a device of protocol 2.3 or later).
+    pub frames: Option<MotionFrames>,
 }
 
 /// A session with the device for onboard motions: handshake, robot check, calibration.
@@ -383,8 +385,15 @@ impl<L: Link> Session<L> {
             .map_err(client::Error::from)?;
         match exchange.outcome {
             Outcome::Accepted(DeviceToHost::MotionAck {
-                status, readback, ..
-            }) => Ok(MotionAnswer { status, readback }),
+                status,
+                readback,
+                frames,
+                ..
+            }) => Ok(MotionAnswer {
+                status,
+                readback,
+                frames,
+            }),
             // A start whose first answer was lost: its retry finds it running.
             Outcome::Accepted(DeviceToHost::Nack {
                 reason: NackReason::MotionRunning,
@@ -586,7 +595,7 @@ pub struct VelocityStep {
 }
 
 /// The velocity command of `step`.
-fn velocity_request(step: &VelocityStep) -> Request {
+pub fn velocity_request(step: &VelocityStep) -> Request {
     Request::SetVelocity {
         forward_m_s: step.forward_m_s,
         lateral_m_s: step.lateral_m_s,

@@ -523,6 +523,7 @@ pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
                     frames_ok: 5,
                     frames_bad: 0,
                 },
+                frames: None,
             },
             "05 04 01 06 02 00 00 48 41 00 00 80 3e 00 \
              00 00 00 3f 00 00 00 3f 00 00 00 3f 00 00 00 3f \
