@@ -844,12 +844,16 @@ pub struct StableTurnParams {
 impl StableTurnParams {
     /// Default yaw of one cycle, rad (11.5°).
     pub const DEFAULT_YAW_PER_CYCLE_RAD: f32 = 0.2;
-    /// Default cycle, s: each leg has 2 s, 1 s to shift the body and 1 s to swing.
-    pub const DEFAULT_CYCLE_S: f32 = 8.0;
+    /// Default cycle, s: each leg has 5 s, 2.5 s to shift the body and 2.5 s to swing. Slow
+    /// enough for seed 001's 22 kg robot in the physics twin, which falls at 12 s
+    /// (`docs/twin.md`).
+    pub const DEFAULT_CYCLE_S: f32 = 20.0;
     /// Default swing apex, as a fraction of the stance height.
     pub const DEFAULT_LIFT_FRACTION: f32 = 0.15;
-    /// Default shift: onto the centroid of the support triangle.
-    pub const DEFAULT_SHIFT_FRACTION: f32 = 1.0;
+    /// Default shift: 0.8 of the way to the centroid of the support triangle. The physics
+    /// twin's seed 001 robot, whose stance legs sag under load, falls with 0.6, 0.7 and 0.9
+    /// (`docs/twin.md`).
+    pub const DEFAULT_SHIFT_FRACTION: f32 = 0.8;
 
     /// The defaults above for `robot` at the stance of height `stance_height_m`
     /// ([`Robot::stance_feet`]), order `zyx`.
