@@ -335,6 +335,14 @@ pub struct LawArgs {
     /// trot, walk: yaw rate (counter-clockwise positive), rad/s [default: 0].
     #[arg(long, value_name = "RAD_S")]
     pub yaw_rad_s: Option<f32>,
+    /// stable-turn: yaw of one cycle (each leg steps once), rad, counter-clockwise positive,
+    /// |Δψ| ≤ π/2 [default: 0.2].
+    #[arg(long, value_name = "RAD", value_parser = parse_angle_rad, allow_hyphen_values = true)]
+    pub yaw_per_cycle_rad: Option<f32>,
+    /// stable-turn: how far the body moves towards the centroid of the three feet that stay
+    /// down, in (0, 1] [default: 0.8].
+    #[arg(long, value_name = "F")]
+    pub shift_fraction: Option<f32>,
 }
 
 impl LawArgs {
@@ -356,6 +364,8 @@ impl LawArgs {
             forward_m_s: self.forward_m_s,
             lateral_m_s: self.lateral_m_s,
             yaw_rad_s: self.yaw_rad_s,
+            yaw_per_cycle_rad: self.yaw_per_cycle_rad,
+            shift_fraction: self.shift_fraction,
             rotation_order: self.rotation_order,
         }
     }
