@@ -71,7 +71,7 @@ fn seed_001s_crossed_pair_turn_has_no_support_polygon() {
 fn the_stable_turn_turns_by_its_yaw_per_cycle_with_its_stance_feet_fixed() {
     for (name, h) in PRESETS {
         let (t, _) = turn(name, h);
-        let p = *t.params();
+        let p = t.params();
         let cycle = p.cycle_s;
         for k in 1..=3u8 {
             let f = t.frame::<DefaultMath>(f32::from(k) * cycle).unwrap();

@@ -58,7 +58,7 @@ fn a_motion_gone_by(dev: &mut Dev, clock: &VirtualClock) {
 
 #[test]
 fn an_idle_device_reports_the_idle_stage_to_a_two_two_host() {
-    let (mut dev, clock) = rig(PROTOCOL_VERSION);
+    let (mut dev, clock) = rig(0x0202);
     assert_eq!(dev.peer_minor(), 2);
     let idle = MotionStatus {
         kind: None,

@@ -51,8 +51,8 @@ pub use msg::{
 pub use range::{check_request, check_request_in, Ranges};
 
 /// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions; 2.2: the idle
-/// motion stage and the watchdog-reset flag).
-pub const PROTOCOL_VERSION: u16 = 0x0202;
+/// motion stage and the watchdog-reset flag; 2.3: the statically stable yaw turn).
+pub const PROTOCOL_VERSION: u16 = 0x0203;
 
 /// Major part of a protocol version.
 #[inline]

@@ -51,6 +51,7 @@ pub enum Kind {
     StartYawTurn,
     StartFootPath,
     StartWalk,
+    StartStableTurn,
     StopMotion,
     GetMotion,
     SetVelocity,
@@ -59,7 +60,7 @@ pub enum Kind {
 
 impl Kind {
     /// Every row, in the order of the table.
-    pub const ALL: [Kind; 22] = [
+    pub const ALL: [Kind; 23] = [
         Kind::Hello,
         Kind::GetState,
         Kind::SetBodyPose,
@@ -78,6 +79,7 @@ impl Kind {
         Kind::StartYawTurn,
         Kind::StartFootPath,
         Kind::StartWalk,
+        Kind::StartStableTurn,
         Kind::StopMotion,
         Kind::GetMotion,
         Kind::SetVelocity,
@@ -106,6 +108,7 @@ impl Kind {
                 MotionCommand::YawTurn { .. } => Kind::StartYawTurn,
                 MotionCommand::FootPath { .. } => Kind::StartFootPath,
                 MotionCommand::Walk { .. } => Kind::StartWalk,
+                MotionCommand::StableTurn { .. } => Kind::StartStableTurn,
             },
             Request::StopMotion => Kind::StopMotion,
             Request::GetMotion => Kind::GetMotion,
@@ -135,6 +138,7 @@ impl Kind {
             Kind::StartYawTurn => "StartMotion YawTurn",
             Kind::StartFootPath => "StartMotion FootPath",
             Kind::StartWalk => "StartMotion Walk",
+            Kind::StartStableTurn => "StartMotion StableTurn",
             Kind::StopMotion => "StopMotion",
             Kind::GetMotion => "GetMotion",
             Kind::SetVelocity => "SetVelocity",
@@ -167,6 +171,7 @@ impl Kind {
             Kind::StartYawTurn => [44_300, 34_800],
             Kind::StartFootPath => [45_800, 35_700],
             Kind::StartWalk => [67_200, 57_500],
+            Kind::StartStableTurn => [44_300, 34_800],
             Kind::StopMotion => [13_300, 2_100],
             Kind::GetMotion => [16_600, 4_800],
             Kind::SetVelocity => [23_100, 17_100],

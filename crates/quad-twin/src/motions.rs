@@ -401,6 +401,16 @@ impl Plan {
                     duration_s,
                 }
             }
+            Script::Law(AnyMotion::StableTurn(m)) => {
+                let p = m.params();
+                MotionCommand::StableTurn {
+                    yaw_per_cycle_rad: p.yaw_per_cycle_rad,
+                    cycle_s: p.cycle_s,
+                    lift_height_m: p.lift_height_m,
+                    shift_fraction: p.shift_fraction,
+                    duration_s,
+                }
+            }
             Script::Law(AnyMotion::Gait(g)) => {
                 let p = g.params();
                 // The catalogue's gaits are trots (`Plan::gait`).

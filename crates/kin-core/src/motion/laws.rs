@@ -870,6 +870,38 @@ impl StableTurnParams {
     }
 }
 
+impl StableTurnParams {
+    /// These parameters but the robot.
+    pub const fn law_params(&self) -> StableTurnLawParams {
+        StableTurnLawParams {
+            yaw_per_cycle_rad: self.yaw_per_cycle_rad,
+            cycle_s: self.cycle_s,
+            lift_height_m: self.lift_height_m,
+            shift_fraction: self.shift_fraction,
+            order: self.order,
+            stance_feet: self.stance_feet,
+        }
+    }
+}
+
+/// [`StableTurnParams`] but the robot: a [`StableTurnLaw`]'s input.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableTurnLawParams {
+    /// Yaw of one cycle `Δψ`, rad, counter-clockwise positive; `|Δψ| ≤ π/2`.
+    pub yaw_per_cycle_rad: f32,
+    /// Duration of one cycle `T`, s.
+    pub cycle_s: f32,
+    /// Swing apex above the ground, m.
+    pub lift_height_m: f32,
+    /// How far the body centre moves towards the centroid of the three feet that stay down,
+    /// in (0, 1].
+    pub shift_fraction: f32,
+    /// Rotation order of the pose.
+    pub order: RotationOrder,
+    /// The feet at `t = 0` relative to the body, m.
+    pub stance_feet: [Vec3; 4],
+}
+
 /// A statically stable yaw turn on the spot: one leg lifted at a time, in
 /// [`STABLE_TURN_ORDER`], the body first shifted towards the centroid of the other three feet,
 /// so that the centre of mass stays inside the support triangle while the leg is in the air
@@ -890,11 +922,21 @@ impl StableTurnParams {
 ///   stance's centre), and holds `g_j` while the leg swings.
 ///
 /// From the end of the first shift on, the joint angles repeat with period `T`.
+///
+/// This is the law without its robot ([`StableTurn`] is the law on a robot), for a caller that
+/// holds the robot itself (a device's solver).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StableTurn {
-    p: StableTurnParams,
+pub struct StableTurnLaw {
+    p: StableTurnLawParams,
     rho_m: [f32; 4],
     alpha_rad: [f32; 4],
+}
+
+/// [`StableTurnLaw`] on a robot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableTurn {
+    robot: Robot,
+    law: StableTurnLaw,
 }
 
 /// `v − sin(2πv)/2π`: 0 → 1 on `[0, 1]` with zero slope at both ends.
@@ -936,8 +978,44 @@ impl StableTurn {
     }
 
     /// [`StableTurn::new`]'s parameter checks without its reach checks and without validating
-    /// `p.robot`, with the foot radii and angles on backend `M`.
+    /// `p.robot` ([`StableTurnLaw::without_reach_check`]).
     pub fn without_reach_check<M: Math>(p: StableTurnParams) -> Result<StableTurn, Error> {
+        Ok(StableTurn {
+            robot: p.robot,
+            law: StableTurnLaw::without_reach_check::<M>(p.law_params())?,
+        })
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> StableTurnParams {
+        let l = &self.law.p;
+        StableTurnParams {
+            robot: self.robot,
+            yaw_per_cycle_rad: l.yaw_per_cycle_rad,
+            cycle_s: l.cycle_s,
+            lift_height_m: l.lift_height_m,
+            shift_fraction: l.shift_fraction,
+            order: l.order,
+            stance_feet: l.stance_feet,
+        }
+    }
+
+    /// The robot-free law.
+    pub const fn law(&self) -> &StableTurnLaw {
+        &self.law
+    }
+
+    /// [`Motion::frame`] written into `frame` ([`StableTurnLaw::frame_into`]).
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        self.law.frame_into::<M>(t_s, frame)
+    }
+}
+
+impl StableTurnLaw {
+    /// [`StableTurn::new`]'s parameter checks without its reach checks, with the foot radii
+    /// and angles on backend `M`, for a caller that checks the reach itself by running the
+    /// law's frames through its own IK (a device's start check).
+    pub fn without_reach_check<M: Math>(p: StableTurnLawParams) -> Result<StableTurnLaw, Error> {
         if !(finite(p.yaw_per_cycle_rad, Param::YawPerCycleRad)?.abs() <= 0.5 * PI) {
             return Err(Error::OutOfRange {
                 parameter: Param::YawPerCycleRad,
@@ -962,7 +1040,7 @@ impl StableTurn {
                 });
             }
         }
-        Ok(StableTurn {
+        Ok(StableTurnLaw {
             p,
             rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
             alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
@@ -970,7 +1048,7 @@ impl StableTurn {
     }
 
     /// The parameters.
-    pub const fn params(&self) -> &StableTurnParams {
+    pub const fn params(&self) -> &StableTurnLawParams {
         &self.p
     }
 
@@ -1091,11 +1169,11 @@ impl StableTurn {
 
 impl Motion for StableTurn {
     fn robot(&self) -> &Robot {
-        &self.p.robot
+        &self.robot
     }
 
     fn body_config(&self) -> BodyConfig {
-        BodyConfig::about_centre(self.p.order)
+        BodyConfig::about_centre(self.law.p.order)
     }
 
     fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
@@ -1105,6 +1183,6 @@ impl Motion for StableTurn {
     }
 
     fn period_s(&self) -> Option<f32> {
-        Some(self.p.cycle_s)
+        Some(self.law.p.cycle_s)
     }
 }

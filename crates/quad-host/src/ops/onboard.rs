@@ -102,7 +102,7 @@ impl Error {
 /// The unit of a motion parameter, as its name ends.
 fn unit(param: MotionParam) -> &'static str {
     match param {
-        MotionParam::AmplitudeRad => "rad",
+        MotionParam::AmplitudeRad | MotionParam::YawPerCycleRad => "rad",
         MotionParam::PeriodS
         | MotionParam::DurationS
         | MotionParam::StepPeriodS
@@ -159,6 +159,8 @@ pub fn option(param: MotionParam) -> &'static str {
         MotionParam::JointSpeedLimitRadS => "--joint-speed-limit-rad-s",
         MotionParam::Stance => "the device's stance height",
         MotionParam::ReachRadiusM => "--body-height-m (it sets the stride's reach)",
+        MotionParam::YawPerCycleRad => "--yaw-per-cycle-rad",
+        MotionParam::ShiftFraction => "--shift-fraction",
         _ => "a parameter",
     }
 }
@@ -174,6 +176,9 @@ pub fn shaping_params(request: &Request) -> &'static [MotionParam] {
         }
         Request::StartMotion(MotionCommand::FootPath { .. }) => &[P::StrideM, P::StepHeightM],
         Request::StartMotion(MotionCommand::Walk { .. }) => &[P::BodyHeightM, P::StepHeightM],
+        Request::StartMotion(MotionCommand::StableTurn { .. }) => {
+            &[P::YawPerCycleRad, P::ShiftFraction, P::LiftHeightM]
+        }
         _ => &[],
     }
 }
@@ -484,6 +489,7 @@ pub fn kind_name(kind: MotionKind) -> &'static str {
         MotionKind::YawTurn => "yaw_turn",
         MotionKind::FootPath => "foot_path",
         MotionKind::Walk => "walk",
+        MotionKind::StableTurn => "stable_turn",
     }
 }
 
