@@ -130,12 +130,12 @@ fn hand_written_frames() {
 }
 
 #[test]
-fn version_is_two_two() {
+fn version_is_two_three() {
     // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0; 2.2 appended
-    // the idle motion stage and the watchdog-reset flag.
-    assert_eq!(PROTOCOL_VERSION, 0x0202);
+    // the idle motion stage and the watchdog-reset flag; 2.3 the statically stable yaw turn.
+    assert_eq!(PROTOCOL_VERSION, 0x0203);
     assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
-    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 2);
+    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 3);
     assert!(quad_protocol::is_compatible(0x0207));
     assert!(!quad_protocol::is_compatible(0x0100));
     assert!(!quad_protocol::is_compatible(0x0300));
