@@ -171,7 +171,7 @@ impl Kind {
             Kind::StartYawTurn => [44_300, 34_800],
             Kind::StartFootPath => [45_800, 35_700],
             Kind::StartWalk => [67_200, 57_500],
-            Kind::StartStableTurn => [44_300, 34_800],
+            Kind::StartStableTurn => [47_200, 37_400],
             Kind::StopMotion => [13_300, 2_100],
             Kind::GetMotion => [16_600, 4_800],
             Kind::SetVelocity => [23_100, 17_100],
