@@ -85,9 +85,9 @@ fn the_stable_turn_turns_by_its_yaw_per_cycle_with_its_stance_feet_fixed() {
             let f = t.frame::<DefaultMath>(i as f32 * dt).unwrap();
             let lifted = f.contact.iter().filter(|c| **c == Contact::Swing).count();
             assert!(lifted <= 1, "{name}: one leg at a time");
-            for leg in 0..4 {
+            for (leg, swung) in swings.iter_mut().enumerate() {
                 if f.contact[leg] == Contact::Swing {
-                    swings[leg] += 1;
+                    *swung += 1;
                 } else if prev.contact[leg] == Contact::Stance {
                     let d = (f.feet_in_world[leg] - prev.feet_in_world[leg]).norm();
                     assert!(d < STANCE_DRIFT_M, "{name}: leg {leg} drifts {d} m");
