@@ -348,6 +348,14 @@ pub struct LawArgs {
     /// trot, walk: lateral speed (left positive), m/s [default: 0].
     #[arg(long, value_name = "M_S")]
     pub lateral_m_s: Option<f32>,
+    /// stable-turn: yaw of one cycle (each leg steps once), rad, counter-clockwise positive,
+    /// |Δψ| ≤ π/2 [default: 0.2].
+    #[arg(long, value_name = "RAD", value_parser = parse_angle_rad, allow_hyphen_values = true)]
+    pub yaw_per_cycle_rad: Option<f32>,
+    /// stable-turn: how far the body moves towards the centroid of the three feet that stay
+    /// down, in (0, 1] [default: 0.8].
+    #[arg(long, value_name = "F")]
+    pub shift_fraction: Option<f32>,
 }
 
 impl LawArgs {
@@ -369,6 +377,8 @@ impl LawArgs {
             forward_m_s: self.forward_m_s,
             lateral_m_s: self.lateral_m_s,
             yaw_rad_s: None,
+            yaw_per_cycle_rad: self.yaw_per_cycle_rad,
+            shift_fraction: self.shift_fraction,
             rotation_order: self.rotation_order,
         }
     }

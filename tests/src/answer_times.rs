@@ -171,6 +171,14 @@ fn workload() -> Vec<Step> {
         duration_s: None,
     })));
     stop(&mut steps);
+    steps.push(Send(Request::StartMotion(MotionCommand::StableTurn {
+        yaw_per_cycle_rad: 0.2,
+        cycle_s: 2.0,
+        lift_height_m: 0.03,
+        shift_fraction: 0.8,
+        duration_s: None,
+    })));
+    stop(&mut steps);
     for path in PathKind::ALL {
         for legs in [LegSet::All, LegSet::One(LegId::FL)] {
             steps.push(Send(foot_path(path, legs)));

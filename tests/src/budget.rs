@@ -208,8 +208,8 @@ pub fn measure(elf_path: &Path, poses: &[Pose]) -> Figures {
 }
 
 /// Every onboard motion once, each run for a second of emulated time and then stopped cleanly:
-/// stand-up, seed 001's sways and yaw turn, seed 000's rectangle, a trot with velocity
-/// commands, sit.
+/// stand-up, seed 001's sways and yaw turn, the statically stable turn, seed 000's rectangle, a
+/// trot with velocity commands, sit.
 fn run_motions(client: &mut Client<EmulatorLink>) {
     let h = crate::avr_bench::STANCE_HEIGHT_M;
     let motions = [
@@ -224,6 +224,13 @@ fn run_motions(client: &mut Client<EmulatorLink>) {
             yaw_rate_rad_s: 0.085,
             step_period_s: 2.0,
             lift_height_m: 0.03,
+            duration_s: None,
+        },
+        MotionCommand::StableTurn {
+            yaw_per_cycle_rad: 0.2,
+            cycle_s: 2.0,
+            lift_height_m: 0.03,
+            shift_fraction: 0.8,
             duration_s: None,
         },
         MotionCommand::FootPath {

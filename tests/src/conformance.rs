@@ -289,6 +289,19 @@ fn workload() -> Vec<Step> {
         Send("stop_motion yaw_turn", Request::StopMotion),
         Pause(4000),
         Send(
+            "start_motion stable_turn",
+            Request::StartMotion(MotionCommand::StableTurn {
+                yaw_per_cycle_rad: 0.2,
+                cycle_s: 2.0,
+                lift_height_m: 0.03,
+                shift_fraction: 0.8,
+                duration_s: None,
+            }),
+        ),
+        Pause(500),
+        Send("stop_motion stable_turn", Request::StopMotion),
+        Pause(4000),
+        Send(
             "start_motion foot_path",
             Request::StartMotion(MotionCommand::FootPath {
                 path: PathKind::Bezier,

@@ -221,6 +221,39 @@ fn onboard_stand_up_sways_yaw_turn_and_sit_keep_every_frame_and_the_speed_bound(
 }
 
 #[test]
+fn onboard_stable_turn_keeps_every_frame_and_the_speed_bound() {
+    let mut rig = Rig::boot();
+    rig.start(MotionCommand::StandUp);
+    rig.until_idle(10.0);
+    let h = rig.stance_height_m();
+    let MotionCommand::StableTurn {
+        yaw_per_cycle_rad,
+        lift_height_m,
+        shift_fraction,
+        ..
+    } = MotionCommand::stable_turn(h, None)
+    else {
+        unreachable!("stable_turn is a stable turn")
+    };
+    // One 4 s cycle: every leg shifts and swings once, a second each.
+    rig.start(MotionCommand::StableTurn {
+        yaw_per_cycle_rad,
+        cycle_s: 4.0,
+        lift_height_m,
+        shift_fraction,
+        duration_s: Some(4.0),
+    });
+    assert_eq!(rig.running(), Some(MotionKind::StableTurn));
+    rig.until_idle(20.0);
+    eprintln!(
+        "stable turn: {} frames watched, {} late, max joint step {:.4} rad",
+        rig.frames, rig.late, rig.max_step_rad
+    );
+    assert_eq!(rig.late, 0, "late or missed servo frames");
+    assert!(rig.frames > 200);
+}
+
+#[test]
 fn onboard_trot_with_a_changing_velocity_keeps_every_frame_and_the_speed_bound() {
     let wall = Instant::now();
     let trot_s: f32 = std::env::var("QUAD_TROT_S")

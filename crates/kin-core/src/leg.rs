@@ -177,8 +177,13 @@ pub fn forward(g: &LegGeometry, leg: LegId, q: JointAngles) -> Vec3 {
 
 /// Every joint position of the leg in its hip frame.
 pub fn joint_points(g: &LegGeometry, leg: LegId, q: JointAngles) -> LegPoints {
-    let (ku, kw, u, w) = planar::<DefaultMath>(g, q.hip_rad, q.knee_rad);
-    let (sa, ca) = DefaultMath::sin_cos(q.abduction_rad);
+    joint_points_on::<DefaultMath>(g, leg, q)
+}
+
+/// Every joint position of the leg in its hip frame, on backend `M` ([`joint_points`]).
+pub fn joint_points_on<M: Math>(g: &LegGeometry, leg: LegId, q: JointAngles) -> LegPoints {
+    let (ku, kw, u, w) = planar::<M>(g, q.hip_rad, q.knee_rad);
+    let (sa, ca) = M::sin_cos(q.abduction_rad);
     let y = leg.side() * g.d_lat_m;
     LegPoints {
         hip_mount: Vec3::ZERO,

@@ -48,6 +48,7 @@
 //!   CPUs without floating-point hardware, or a firmware's own).
 //! - [`motion`]: foot paths, seed 001's body-motion laws, trot / walk gaits.
 //! - [`preflight`]: sweep a motion and report reach, margins, singularity, joint speeds.
+//! - [`stability`]: the centre of mass against the support polygon (static stability margin).
 //!
 //! ## Why not nalgebra inside
 //! On the ATmega2560, a program that builds the zyx body rotation and rotates four vectors
@@ -77,6 +78,7 @@ pub mod paper;
 pub mod preflight;
 pub mod robot;
 pub mod rotation;
+pub mod stability;
 pub mod vec;
 
 pub use body::{BodyConfig, BodySolution, Pose};

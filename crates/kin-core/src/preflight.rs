@@ -14,6 +14,11 @@
 //! - **joint speed** (rad/s): finite differences between consecutive samples, against a per-joint
 //!   limit.
 //!
+//! Overall, when the checker has the robot's masses ([`Checker::with_mass`], [`check_with_mass`]):
+//! - **static stability margin** (m): [`stability::frame_margin`] of every frame whose four legs
+//!   solve, its minimum and when it happens (≤ 0: the centre of mass is not inside the support
+//!   polygon of the feet in stance; reported, not counted as a failure).
+//!
 //! No allocation: the [`Report`] has fixed arrays. [`check`] sweeps a [`Motion`]; a [`Checker`]
 //! takes samples one at a time (frames or joint angles) for callers that stream them.
 
@@ -23,6 +28,7 @@ use crate::leg::{self, Unreachable};
 use crate::math::wrap_pi;
 use crate::motion::{finite, positive, Error, Expected, Frame, Motion, Param};
 use crate::robot::{Joint, JointAngles, JointLimits, LegId, Robot};
+use crate::stability::{self, MassModel};
 use crate::vec::Vec3;
 use crate::ReachPolicy;
 
@@ -278,6 +284,9 @@ pub struct Report {
     pub max_joint_speed_limit_rad_s: [f32; 3],
     /// The singularity threshold used ([`SINGULARITY_THRESHOLD`]).
     pub singularity_threshold: f32,
+    /// Minimum static stability margin (m) and its time, over the frames whose four legs
+    /// solve ([`stability::frame_margin`]); `None` without a mass model or such a frame.
+    pub static_margin_m: Option<Extremum>,
 }
 
 /// Smallest (or largest) of the legs' extrema, with its leg.
@@ -340,6 +349,7 @@ pub struct Checker {
     robot: Robot,
     geometric: Robot,
     config: BodyConfig,
+    mass: Option<MassModel>,
     max_speed: [f32; 3],
     prev: [Option<(f32, JointAngles)>; 4],
     report: Report,
@@ -363,6 +373,7 @@ impl Checker {
             robot: *robot,
             geometric,
             config,
+            mass: None,
             max_speed: max_joint_speed_rad_s,
             prev: [None; 4],
             report: Report {
@@ -372,8 +383,17 @@ impl Checker {
                 legs: LegId::ALL.map(LegReport::empty),
                 max_joint_speed_limit_rad_s: max_joint_speed_rad_s,
                 singularity_threshold: SINGULARITY_THRESHOLD,
+                static_margin_m: None,
             },
         })
+    }
+
+    /// The same checker reporting the static stability margin of every frame with the masses
+    /// `mass` ([`Report::static_margin_m`]).
+    pub fn with_mass(mut self, mass: &MassModel) -> Result<Checker, Error> {
+        mass.validate(&self.robot)?;
+        self.mass = Some(*mass);
+        Ok(self)
     }
 
     /// Checks one frame (body pose + feet in the world) at `t_s`: solves each leg and records
@@ -423,6 +443,16 @@ impl Checker {
             if let Some(kind) = failure {
                 self.record(sample, t_s, leg, kind);
             }
+        }
+        if let (Some(mass), [Ok(a), Ok(b), Ok(c), Ok(d)]) = (&self.mass, out) {
+            let margin = stability::frame_margin::<crate::DefaultMath>(
+                &self.robot,
+                mass,
+                &self.config,
+                frame,
+                &[a, b, c, d],
+            );
+            update(&mut self.report.static_margin_m, margin, t_s, true);
         }
         out
     }
@@ -538,6 +568,24 @@ impl Checker {
     pub const fn finish(self) -> Report {
         self.report
     }
+}
+
+/// [`check`] with the static stability margin of every frame, for the masses `mass`
+/// ([`Report::static_margin_m`]).
+pub fn check_with_mass<T: Motion>(
+    motion: &T,
+    sweep: &Sweep,
+    max_joint_speed_rad_s: [f32; 3],
+    mass: &MassModel,
+) -> Result<Report, Error> {
+    let mut c = Checker::new(motion.robot(), motion.body_config(), max_joint_speed_rad_s)?
+        .with_mass(mass)?;
+    for k in 0..sweep.samples() {
+        let t = sweep.time_s(k);
+        let frame = motion.frame::<crate::DefaultMath>(t)?;
+        let _ = c.push_frame(t, &frame);
+    }
+    Ok(c.finish())
 }
 
 /// Sweeps `motion` over `sweep` with per-joint speed limits `max_joint_speed_rad_s`.

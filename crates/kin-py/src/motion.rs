@@ -91,6 +91,8 @@ pub fn sample_motion<'py>(
         forward_m_s,
         lateral_m_s,
         yaw_rad_s,
+        yaw_per_cycle_rad: None,
+        shift_fraction: None,
     };
     let m = params.build(law_id).map_err(motion_err)?;
     let sweep = motion::sweep(duration_s, rate_hz).map_err(motion_err)?;

@@ -76,6 +76,7 @@ def test_laws_and_bad_parameters():
         "rect-path",
         "trot",
         "walk",
+        "stable-turn",
     ]
     with pytest.raises(ValueError, match="law"):
         quadkin.sample_motion("moonwalk")

@@ -283,6 +283,25 @@ fn seed001_sways_and_yaw_turn_run_for_their_duration_as_kin_core_computes_them()
 }
 
 #[test]
+fn the_stable_turn_runs_on_both_presets_as_kin_core_computes_it() {
+    for config in [Config::shahriar2023(), Config::fernando2025()] {
+        let h = config.pose_config.stance_height_m;
+        let mut p = laws::StableTurnParams::new(config.robot, h);
+        p.order = config.pose_config.order;
+        let turn = laws::StableTurn::new(p).unwrap();
+        let request = Request::stable_turn(h, Some(p.cycle_s));
+        let rig = run_law(config, request, |t| {
+            motion::solve::<DefaultMath>(&turn, t, ReachPolicy::Reject)
+                .unwrap()
+                .1
+                .flat()
+        });
+        // One cycle of 1000 frames, the approach and the leave (from the shifted body) short.
+        assert!(rig.frames >= 1000 && rig.frames < 1200, "{}", rig.frames);
+    }
+}
+
+#[test]
 fn seed000_foot_paths_run_on_one_leg_or_all_four() {
     let config = Config::shahriar2023();
     let stance_feet = config.robot.stance_feet(config.pose_config.stance_height_m);

@@ -108,6 +108,20 @@ impl Physical {
         Ok(self)
     }
 
+    /// Where the mass sits, for kin-core's centre of mass and static stability margin: the
+    /// abduction link at the hip joint, the femur and tibia at their middles, the knee servo
+    /// (the servo preset's mass) `knee_servo_offset_m` down the femur.
+    pub const fn mass_model(&self) -> kin_core::stability::MassModel {
+        kin_core::stability::MassModel {
+            body_kg: self.body_mass_kg,
+            abduction_link_kg: self.abduction_link_mass_kg,
+            femur_kg: self.femur_mass_kg,
+            knee_servo_kg: self.servo.mass_kg,
+            knee_servo_offset_m: self.knee_servo_offset_m,
+            tibia_kg: self.tibia_mass_kg,
+        }
+    }
+
     /// Total mass of the robot, kg.
     pub fn total_mass_kg(&self) -> f32 {
         self.body_mass_kg
@@ -347,6 +361,23 @@ mod tests {
         assert!((s.physical().total_mass_kg() - 2.84).abs() < 1e-4);
         let f = Model::preset("fernando2025").unwrap();
         assert!((f.physical().total_mass_kg() - 22.02).abs() < 1e-3);
+    }
+
+    #[test]
+    fn kin_cores_mass_presets_are_the_twins() {
+        use kin_core::stability::MassModel;
+        assert_eq!(
+            Physical::shahriar2023().mass_model(),
+            MassModel::shahriar2023()
+        );
+        assert_eq!(
+            Physical::fernando2025().mass_model(),
+            MassModel::fernando2025()
+        );
+        for name in Physical::PRESETS {
+            let p = Physical::preset(name).unwrap();
+            assert!((p.mass_model().total_kg() - p.total_mass_kg()).abs() < 1e-4);
+        }
     }
 
     #[test]

@@ -57,7 +57,8 @@ pub use range::{check_request, check_request_in, Ranges};
 
 /// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions; 2.2: the idle
 /// motion stage and the watchdog-reset flag; 2.3: the inertial sensor and the balance
-/// functions, [`balance`], and the motion's frame numbers, [`MotionFrames`]).
+/// functions, [`balance`], the motion's frame numbers, [`MotionFrames`], and the statically
+/// stable yaw turn).
 pub const PROTOCOL_VERSION: u16 = 0x0203;
 
 /// Major part of a protocol version.

@@ -199,6 +199,21 @@ wire_enum! {
             /// stops the walk as [`Request::StopMotion`] does.
             velocity_timeout_ms: u16 as wire::shared,
         },
+        /// A statically stable yaw turn on the spot about the body centre (kin-core's
+        /// `StableTurn`): one leg at a time, the body first shifted towards the centroid of
+        /// the other three feet (since 2.3).
+        7 => StableTurn {
+            /// Yaw of one cycle (each leg steps once), rad, counter-clockwise positive (REP 103).
+            yaw_per_cycle_rad: f32,
+            /// One cycle, s.
+            cycle_s: f32,
+            /// Swing apex above the ground, m.
+            lift_height_m: f32,
+            /// How far the body moves towards the centroid of its support triangle, in (0, 1].
+            shift_fraction: f32,
+            /// Duration, s; `None`: until stopped.
+            duration_s: Option<f32>,
+        },
     }
 }
 
@@ -245,6 +260,19 @@ impl MotionCommand {
         }
     }
 
+    /// kin-core's statically stable yaw turn with its defaults (0.2 rad per 20 s cycle, a
+    /// shift of 0.8) and a lift of 0.15 × `body_height_m`, for `duration_s`.
+    pub fn stable_turn(body_height_m: f32, duration_s: Option<f32>) -> MotionCommand {
+        use kin_core::motion::laws::StableTurnParams as P;
+        MotionCommand::StableTurn {
+            yaw_per_cycle_rad: P::DEFAULT_YAW_PER_CYCLE_RAD,
+            cycle_s: P::DEFAULT_CYCLE_S,
+            lift_height_m: P::DEFAULT_LIFT_FRACTION * body_height_m,
+            shift_fraction: P::DEFAULT_SHIFT_FRACTION,
+            duration_s,
+        }
+    }
+
     /// A walk with `gait` at `body_height_m` with kin-core's default cycle and step height
     /// ([`kin_core::motion::gait::GaitParams::new`]) and [`DEFAULT_VELOCITY_TIMEOUT_MS`].
     pub fn walk(gait: Pattern, body_height_m: f32) -> MotionCommand {
@@ -268,6 +296,7 @@ impl MotionCommand {
             MotionCommand::YawTurn { .. } => MotionKind::YawTurn,
             MotionCommand::FootPath { .. } => MotionKind::FootPath,
             MotionCommand::Walk { .. } => MotionKind::Walk,
+            MotionCommand::StableTurn { .. } => MotionKind::StableTurn,
         }
     }
 }
@@ -301,6 +330,8 @@ wire_enum! {
         5 => FootPath,
         /// [`MotionCommand::Walk`].
         6 => Walk,
+        /// [`MotionCommand::StableTurn`] (since 2.3).
+        7 => StableTurn,
     }
 }
 
@@ -344,15 +375,26 @@ impl MotionStatus {
     /// or later; for minor 0 or 1, which do not know [`MotionStage::Idle`], an idle status is
     /// reported as stage [`MotionStage::Run`] (what 2.1 devices sent) with `t_s` and `phase` 0.
     #[must_use]
+    ///
+    /// A host of minor 0 to 2 does not know [`MotionKind::StableTurn`] (2.3): a stable turn
+    /// that another host started is reported to it as [`MotionKind::YawTurn`], the turn on the
+    /// spot it knows.
     pub const fn for_minor(self, minor: u8) -> MotionStatus {
-        match self.stage {
+        let status = match self.kind {
+            Some(MotionKind::StableTurn) if minor < 3 => MotionStatus {
+                kind: Some(MotionKind::YawTurn),
+                ..self
+            },
+            _ => self,
+        };
+        match status.stage {
             MotionStage::Idle if minor < 2 => MotionStatus {
                 stage: MotionStage::Run,
                 t_s: 0.0,
                 phase: 0.0,
-                ..self
+                ..status
             },
-            _ => self,
+            _ => status,
         }
     }
 }
@@ -444,6 +486,10 @@ wire_enum! {
         22 => MaxCorrectionRad,
         /// The fall angle ([`BalanceConfig::fall_angle_rad`]; since 2.3).
         23 => FallAngleRad,
+        /// A stable turn's yaw per cycle (since 2.3).
+        24 => YawPerCycleRad,
+        /// A stable turn's shift fraction (since 2.3).
+        25 => ShiftFraction,
     }
 }
 

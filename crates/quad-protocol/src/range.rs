@@ -42,6 +42,8 @@
 //! | `lift_height_m`, `stride_m`, `step_height_m` | `[0,` [`reach_limit_m`]`]` | no foot moves farther than the reach |
 //! | walk `body_height_m` | `[`[`MIN_STANCE_HEIGHT_M`]`, reach_limit_m]` | as the stance height |
 //! | `duty_factor` | [`DUTY_FACTOR`]: `[0.05, 0.95]` | stance and swing each at least a twentieth of the loop |
+//! | stable turn `yaw_per_cycle_rad` | [`YAW_PER_CYCLE_RAD`]: `[−π/2, π/2]` rad | a quarter turn per cycle (kin-core's bound); the reach is the start check's |
+//! | stable turn `shift_fraction` | [`SHIFT_FRACTION`]: `[0.05, 1]` | less keeps the centre of mass on the diagonal the lifted leg leaves; more goes past the centroid of the support triangle |
 //! | `velocity_timeout_ms` | `[1, 65535]` ms | 0 would stop a walk at once |
 //! | `joint_speed_limit_rad_s` | [`JOINT_SPEED_LIMIT_RAD_S`]: `[0.1, π/0.02]` rad/s | a servo's whole travel (π rad) in half a minute at the least; beyond its whole travel in one 20 ms servo frame a limit limits nothing |
 //! | balance `level_kp` (2.3) | [`LEVEL_KP`]: `[0, 0.9]` | the body follows the correction within a frame: a gain of 1 or more overshoots every frame |
@@ -431,6 +433,14 @@ pub const DURATION_S: ParamRange = ParamRange::positive(0.02, 3600.0);
 /// `[−π, π]`, half a turn per second, beyond what a servo-driven quadruped turns.
 pub const YAW_RATE_RAD_S: ParamRange = ParamRange::symmetric(PI);
 
+/// A stable turn's yaw per cycle, rad, counter-clockwise positive: `[−π/2, π/2]`, a quarter
+/// turn per cycle (kin-core's own bound).
+pub const YAW_PER_CYCLE_RAD: ParamRange = ParamRange::symmetric(FRAC_PI_2);
+
+/// A stable turn's shift towards the centroid of its support triangle: `[0.05, 1]`; less keeps
+/// the centre of mass on the diagonal the lifted leg leaves, more goes past the centroid.
+pub const SHIFT_FRACTION: ParamRange = ParamRange::positive(0.05, 1.0);
+
 /// A velocity command's forward or lateral speed, m/s: `[−10, 10]` (36 km/h, many times what
 /// a servo-driven quadruped walks). What a robot's gait can take is narrower and the device's
 /// walker checks it after this check (the footholds within its stride disc).
@@ -492,6 +502,8 @@ pub fn param_range(param: MotionParam, ranges: &Ranges) -> Option<ParamRange> {
         P::LevelKiPerS => LEVEL_KI_PER_S,
         P::MaxCorrectionRad => MAX_CORRECTION_RAD,
         P::FallAngleRad => FALL_ANGLE_RAD,
+        P::YawPerCycleRad => YAW_PER_CYCLE_RAD,
+        P::ShiftFraction => SHIFT_FRACTION,
         _ => return None,
     })
 }
@@ -589,6 +601,21 @@ fn motion_in(m: &MotionCommand, ranges: &Ranges) -> Result<(), NackReason> {
                 });
             }
             Ok(())
+        }
+        MotionCommand::StableTurn {
+            yaw_per_cycle_rad,
+            cycle_s,
+            lift_height_m,
+            shift_fraction,
+            duration_s,
+        } => {
+            first_invalid(&[
+                (P::YawPerCycleRad, YAW_PER_CYCLE_RAD, yaw_per_cycle_rad),
+                (P::CycleS, PERIOD_S, cycle_s),
+                (P::LiftHeightM, length, lift_height_m),
+                (P::ShiftFraction, SHIFT_FRACTION, shift_fraction),
+            ])?;
+            duration(duration_s)
         }
     }
 }

@@ -51,6 +51,7 @@ pub enum Kind {
     StartYawTurn,
     StartFootPath,
     StartWalk,
+    StartStableTurn,
     StopMotion,
     GetMotion,
     SetVelocity,
@@ -61,7 +62,7 @@ pub enum Kind {
 
 impl Kind {
     /// Every row, in the order of the table.
-    pub const ALL: [Kind; 24] = [
+    pub const ALL: [Kind; 25] = [
         Kind::Hello,
         Kind::GetState,
         Kind::SetBodyPose,
@@ -80,6 +81,7 @@ impl Kind {
         Kind::StartYawTurn,
         Kind::StartFootPath,
         Kind::StartWalk,
+        Kind::StartStableTurn,
         Kind::StopMotion,
         Kind::GetMotion,
         Kind::SetVelocity,
@@ -110,6 +112,7 @@ impl Kind {
                 MotionCommand::YawTurn { .. } => Kind::StartYawTurn,
                 MotionCommand::FootPath { .. } => Kind::StartFootPath,
                 MotionCommand::Walk { .. } => Kind::StartWalk,
+                MotionCommand::StableTurn { .. } => Kind::StartStableTurn,
             },
             Request::StopMotion => Kind::StopMotion,
             Request::GetMotion => Kind::GetMotion,
@@ -141,6 +144,7 @@ impl Kind {
             Kind::StartYawTurn => "StartMotion YawTurn",
             Kind::StartFootPath => "StartMotion FootPath",
             Kind::StartWalk => "StartMotion Walk",
+            Kind::StartStableTurn => "StartMotion StableTurn",
             Kind::StopMotion => "StopMotion",
             Kind::GetMotion => "GetMotion",
             Kind::SetVelocity => "SetVelocity",
@@ -175,6 +179,7 @@ impl Kind {
             Kind::StartYawTurn => [44_500, 34_800],
             Kind::StartFootPath => [46_000, 35_800],
             Kind::StartWalk => [67_500, 57_600],
+            Kind::StartStableTurn => [47_200, 37_400],
             Kind::StopMotion => [13_300, 2_100],
             Kind::GetMotion => [16_600, 4_800],
             Kind::SetVelocity => [25_900, 17_100],

@@ -751,6 +751,7 @@ mod tests {
             MotionCommand::YawTurn { .. } => 4,
             MotionCommand::FootPath { .. } => 5,
             MotionCommand::Walk { .. } => 6,
+            MotionCommand::StableTurn { .. } => 7,
         }
     }
 
@@ -770,6 +771,7 @@ mod tests {
             MotionKind::YawTurn => 4,
             MotionKind::FootPath => 5,
             MotionKind::Walk => 6,
+            MotionKind::StableTurn => 7,
         }
     }
 
@@ -809,6 +811,8 @@ mod tests {
             MotionParam::LevelKiPerS => 21,
             MotionParam::MaxCorrectionRad => 22,
             MotionParam::FallAngleRad => 23,
+            MotionParam::YawPerCycleRad => 24,
+            MotionParam::ShiftFraction => 25,
         }
     }
 
@@ -1220,6 +1224,13 @@ mod tests {
             },
             path(PathKind::Rectangle, LegSet::All),
             walk(Pattern::Trot),
+            MotionCommand::StableTurn {
+                yaw_per_cycle_rad: 0.2,
+                cycle_s: 20.0,
+                lift_height_m: 0.06,
+                shift_fraction: 0.8,
+                duration_s: Some(60.0),
+            },
         ];
         // seq (05) | StartMotion (0b) | command | fields
         for (i, m) in commands.iter().enumerate() {
@@ -1276,11 +1287,12 @@ mod tests {
             MotionKind::YawTurn,
             MotionKind::FootPath,
             MotionKind::Walk,
+            MotionKind::StableTurn,
         ];
         // MotionAck (05) | seq (09) | Some (01) | kind | stage ...
         for (i, k) in kinds.iter().enumerate() {
             assert_eq!(usize::from(motion_kind_index(k)), i);
-            check(ack(Some(*k), MotionStage::Run), 3, i as u8, 7);
+            check(ack(Some(*k), MotionStage::Run), 3, i as u8, 8);
         }
         let stages = [
             MotionStage::Approach,
@@ -1319,6 +1331,8 @@ mod tests {
             MotionParam::LevelKiPerS,
             MotionParam::MaxCorrectionRad,
             MotionParam::FallAngleRad,
+            MotionParam::YawPerCycleRad,
+            MotionParam::ShiftFraction,
         ];
         // Nack (00) | None (00) | InvalidParameter (0f) | param | problem
         for (i, p) in params.iter().enumerate() {

@@ -136,7 +136,8 @@ fn hand_written_frames() {
 fn version_is_two_three() {
     // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0; 2.2 appended
     // the idle motion stage and the watchdog-reset flag; 2.3 the inertial sensor's requests,
-    // answer, nack reasons, parameters and the fall flag, and the motion ack's frame numbers.
+    // answer, nack reasons, parameters and the fall flag, the motion ack's frame numbers and the
+    // statically stable yaw turn.
     assert_eq!(PROTOCOL_VERSION, 0x0203);
     assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
     assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 3);

@@ -366,6 +366,10 @@ pub struct Run {
     pub wall_s: f64,
     /// Simulated seconds per wall second of the whole loop.
     pub sim_per_wall: f64,
+    /// The commanded motion's minimum static stability margin (m) and its time after the
+    /// settling, with the physical model's masses ([`Plan::min_static_margin`] at the servo
+    /// frame rate); `None` when no frame's legs all solve.
+    pub static_margin: Option<kin_core::preflight::Extremum>,
 }
 
 impl fmt::Display for Run {
@@ -379,6 +383,13 @@ impl fmt::Display for Run {
         )?;
         if let Some(reason) = &s.fall_reason {
             writeln!(f, "  fall: {reason}")?;
+        }
+        if let Some(m) = &self.static_margin {
+            writeln!(
+                f,
+                "  static stability margin (commanded): min {:.4} m at {:.2} s",
+                m.value, m.t_s
+            )?;
         }
         if let Some(y) = &s.yaw {
             writeln!(
@@ -533,6 +544,9 @@ pub fn run_plan(
         Some(d) => plan.lasting_at_least(d),
         None => *plan,
     };
+    let static_margin = plan
+        .min_static_margin(&physical.mass_model(), source::FRAME_S)
+        .map_err(Error::Motion)?;
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {
             let device = device::InProcess::start(*config)
@@ -574,6 +588,7 @@ pub fn run_plan(
         options.render || options.picture.is_some(),
         &options.scenario,
     )?;
+    run.static_margin = static_margin;
     if let (Some(picture), Some(dir)) = (&options.picture, out_dir) {
         let strip = picture
             .extension()
@@ -684,5 +699,7 @@ pub fn run_source_in(
         sim_per_wall: simulated / loop_s,
         wall_s: loop_s,
         summary,
+        // The caller that knows the masses fills it in (`run_plan`).
+        static_margin: None,
     })
 }

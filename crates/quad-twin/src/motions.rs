@@ -9,9 +9,13 @@
 
 use core::fmt;
 use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
-use kin_core::motion::laws::{Axis, Sway, SwayParams, YawTurn, YawTurnParams};
-use kin_core::motion::{AnyMotion, Contact, Motion};
-use kin_core::{rotation, Pose, Robot, RotationOrder};
+use kin_core::motion::laws::{
+    Axis, StableTurn, StableTurnParams, Sway, SwayParams, YawTurn, YawTurnParams,
+};
+use kin_core::motion::{AnyMotion, Contact, Frame, Motion};
+use kin_core::preflight::{Checker, Extremum, Sweep, DEFAULT_MAX_JOINT_SPEED_RAD_S};
+use kin_core::stability::MassModel;
+use kin_core::{rotation, BodyConfig, Pose, Robot, RotationOrder};
 use quad_device::engine::DEFAULT_VELOCITY_TIMEOUT_MS;
 use quad_device::Config;
 use quad_protocol::MotionCommand;
@@ -45,6 +49,9 @@ pub const YAW_TURN_PERIODS: f32 = 2.0;
 pub const FAST_YAW_TURN_PERIOD_S: f32 = 0.8;
 /// Step height of the fast yaw turn as a fraction of the stance height (the gait's default).
 pub const FAST_YAW_TURN_LIFT_FRACTION: f32 = 0.15;
+
+/// Duration of the statically stable turn, in cycles of [`StableTurnParams::DEFAULT_CYCLE_S`].
+pub const STABLE_TURN_CYCLES: f32 = 3.0;
 
 /// The shape of the twin's trot: kin-core's gait parameters that a parameter study varies,
 /// relative to the stance height `H` where they scale with the robot.
@@ -116,11 +123,15 @@ pub enum MotionKind {
     /// A turn on the spot with the trot of [`TrotShape::default`] at seed 001's yaw rate
     /// (ω = 0.085 rad/s, clockwise) over the yaw turn's 12 s.
     TrotTurn,
+    /// The statically stable yaw turn (kin-core's `StableTurn`, its defaults: one leg at a
+    /// time, the body shifted into the support triangle first, 0.2 rad per 20 s cycle),
+    /// [`STABLE_TURN_CYCLES`] cycles.
+    StableTurn,
 }
 
 impl MotionKind {
     /// Every motion.
-    pub const ALL: [MotionKind; 10] = [
+    pub const ALL: [MotionKind; 11] = [
         MotionKind::Stand,
         MotionKind::Roll,
         MotionKind::Pitch,
@@ -131,6 +142,7 @@ impl MotionKind {
         MotionKind::YawTurnFast,
         MotionKind::Trot,
         MotionKind::TrotTurn,
+        MotionKind::StableTurn,
     ];
 
     /// Command-line name.
@@ -146,6 +158,7 @@ impl MotionKind {
             MotionKind::YawTurnFast => "yaw-turn-fast",
             MotionKind::Trot => "trot",
             MotionKind::TrotTurn => "trot-turn",
+            MotionKind::StableTurn => "stable-turn",
         }
     }
 
@@ -162,6 +175,9 @@ impl MotionKind {
             MotionKind::YawTurnFast => "The yaw turn with a trot's step period, same turn rate",
             MotionKind::Trot => "A trot forward, 10 s",
             MotionKind::TrotTurn => "A turn on the spot with the trot, seed 001's turn rate",
+            MotionKind::StableTurn => {
+                "A statically stable yaw turn: one leg at a time, the body shifted first"
+            }
         }
     }
 
@@ -266,6 +282,16 @@ impl Plan {
                 (
                     Script::Law(AnyMotion::YawTurn(YawTurn::new(p)?)),
                     YAW_TURN_PERIODS * base.step_period_s,
+                )
+            }
+            MotionKind::StableTurn => {
+                let p = StableTurnParams {
+                    order,
+                    ..StableTurnParams::new(robot, h)
+                };
+                (
+                    Script::Law(AnyMotion::StableTurn(StableTurn::new(p)?)),
+                    STABLE_TURN_CYCLES * p.cycle_s,
                 )
             }
             MotionKind::Trot => return Plan::trot(config, TrotShape::default()),
@@ -375,6 +401,16 @@ impl Plan {
                     duration_s,
                 }
             }
+            Script::Law(AnyMotion::StableTurn(m)) => {
+                let p = m.params();
+                MotionCommand::StableTurn {
+                    yaw_per_cycle_rad: p.yaw_per_cycle_rad,
+                    cycle_s: p.cycle_s,
+                    lift_height_m: p.lift_height_m,
+                    shift_fraction: p.shift_fraction,
+                    duration_s,
+                }
+            }
             Script::Law(AnyMotion::Gait(g)) => {
                 let p = g.params();
                 // The catalogue's gaits are trots (`Plan::gait`).
@@ -421,6 +457,52 @@ impl Plan {
     /// # Errors
     /// kin-core's error for a non-finite time.
     pub fn target(&self, t_s: f32) -> Result<Target, kin_core::motion::Error> {
+        let Frame {
+            pose,
+            feet_in_world,
+            contact,
+        } = self.frame(t_s)?;
+        let r = rotation::matrix::<kin_core::DefaultMath>(
+            self.order,
+            pose.roll_rad,
+            pose.pitch_rad,
+            pose.yaw_rad,
+        );
+        let t = pose.translation();
+        Ok(Target {
+            pose,
+            feet_in_body_m: feet_in_world.map(|p| r.transpose_mul_vec(p - t).to_array()),
+            stance: contact.map(|c| c == Contact::Stance),
+        })
+    }
+
+    /// The minimum static stability margin of the commanded motion (m, and the plan's time of
+    /// it), sampled every `frame_s` over the plan with the masses `mass`
+    /// ([`kin_core::stability`]); `None` when no sample's four legs solve.
+    ///
+    /// # Errors
+    /// kin-core's error for invalid masses or a non-finite time step.
+    pub fn min_static_margin(
+        &self,
+        mass: &MassModel,
+        frame_s: f32,
+    ) -> Result<Option<Extremum>, kin_core::motion::Error> {
+        let sweep = Sweep::new(0.0, self.duration_s, 1.0 / frame_s)?;
+        let mut checker = Checker::new(
+            &self.robot,
+            BodyConfig::about_centre(self.order),
+            [DEFAULT_MAX_JOINT_SPEED_RAD_S; 3],
+        )?
+        .with_mass(mass)?;
+        for k in 0..sweep.samples() {
+            let t = sweep.time_s(k);
+            let _ = checker.push_frame(t, &self.frame(t)?);
+        }
+        Ok(checker.finish().static_margin_m)
+    }
+
+    /// The commanded body pose, feet in the world and contacts at `t_s`.
+    fn frame(&self, t_s: f32) -> Result<Frame, kin_core::motion::Error> {
         let (pose, feet_in_world, contact) = match self.script {
             Script::StandUp { rest_m, stance_m } => {
                 let u = (t_s / STAND_RAMP_S).clamp(0.0, 1.0);
@@ -439,17 +521,10 @@ impl Plan {
                 (f.pose, f.feet_in_world, f.contact)
             }
         };
-        let r = rotation::matrix::<kin_core::DefaultMath>(
-            self.order,
-            pose.roll_rad,
-            pose.pitch_rad,
-            pose.yaw_rad,
-        );
-        let t = pose.translation();
-        Ok(Target {
+        Ok(Frame {
             pose,
-            feet_in_body_m: feet_in_world.map(|p| r.transpose_mul_vec(p - t).to_array()),
-            stance: contact.map(|c| c == Contact::Stance),
+            feet_in_world,
+            contact,
         })
     }
 }

@@ -13,6 +13,9 @@ const SWAY_SLIP_LIMIT_M: f64 = 0.02;
 const AMPLITUDE_BAND: (f64, f64) = (0.8, 1.25);
 /// The yaw turn must reach this fraction of its commanded yaw.
 const YAW_RATIO_MIN: f64 = 0.8;
+/// The statically stable yaw turn's commanded minimum static stability margin must exceed
+/// this, m.
+const STABLE_TURN_MARGIN_MIN_M: f32 = 0.0;
 /// The trot must cover this fraction of its commanded distance.
 const TRAVEL_RATIO_MIN: f64 = 0.5;
 /// Each stance foot of the trot must sweep at least this fraction of its commanded stride
@@ -125,6 +128,29 @@ fn the_trot_turns_both_presets_on_the_spot() {
         assert_steps(name, &s);
         let yaw = s.yaw.expect("a turning motion");
         assert!(yaw.ratio >= YAW_RATIO_MIN, "{name}: {yaw:?}");
+    }
+}
+
+#[test]
+fn the_statically_stable_turn_turns_both_presets_without_a_fall() {
+    for (name, config, physical) in presets() {
+        let r = run(
+            &config,
+            &physical,
+            MotionKind::StableTurn,
+            &RunOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        println!("{r}");
+        let s = &r.summary;
+        assert!(!s.fell, "{name}: fell: {:?}", s.fall_reason);
+        let yaw = s.yaw.expect("a turning motion");
+        assert!(yaw.ratio >= YAW_RATIO_MIN, "{name}: {yaw:?}");
+        let margin = r.static_margin.expect("every frame solves");
+        assert!(
+            margin.value > STABLE_TURN_MARGIN_MIN_M,
+            "{name}: {margin:?}"
+        );
     }
 }
 

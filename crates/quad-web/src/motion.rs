@@ -95,6 +95,8 @@ pub fn field(param: MotionParam) -> &'static str {
         MotionParam::JointSpeedLimitRadS => "joint_speed_limit_rad_s",
         MotionParam::Stance => "the device's stance height",
         MotionParam::ReachRadiusM => "body_height_m (it sets the stride's reach)",
+        MotionParam::YawPerCycleRad => "yaw_per_cycle_rad",
+        MotionParam::ShiftFraction => "shift_fraction",
         _ => "a parameter",
     }
 }

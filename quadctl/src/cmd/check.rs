@@ -20,7 +20,10 @@ Preflight report of a motion: sweeps it and reports, per leg and overall,
     (1 = isotropic, 0 = singular), failing below 0.05;
   - maximum joint speed (rad/s), finite differences between samples, against
     --max-joint-speed-rad-s (default: the device's joint-speed limiter, 3 rad/s, which slows
-    every output that would move faster).
+    every output that would move faster);
+  - with --motion, the minimum static stability margin (m): the centre of mass (the robot's
+    masses) against the support polygon of the feet in stance, positive inside, ≤ 0 outside or
+    with two feet down (reported, not a failure; a motion file has no stance column).
 
 Source: a CSV written by `quadctl motion` (FILE, `-` for stdin; rows with feet and pose are
 solved again, rows with angles only are checked as they are; the rotation order is read from the

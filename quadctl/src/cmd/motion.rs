@@ -40,6 +40,11 @@ pub struct Args {
     /// Also draw the joint angles over time (.svg or .png).
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Also print the motion's minimum static stability margin (m) and when it happens, on
+    /// stderr: the centre of mass (the robot's masses) against the support polygon of the feet
+    /// in stance; ≤ 0 when it leaves it.
+    #[arg(long)]
+    pub stability: bool,
 }
 
 const LONG_ABOUT: &str = "\
@@ -84,7 +89,18 @@ pub fn run(args: &Args) -> ExitCode {
         plot: args.plot.clone(),
     };
     let mut bar = Bar::new(args.law.name());
-    match motion::run(&request, &mut |p| bar.update(p)) {
+    let result = motion::run(&request, &mut |p| bar.update(p));
+    if args.stability && result.is_ok() {
+        match motion::static_margin(&request.params, args.law, args.duration_s, args.rate_hz) {
+            Ok(Some(m)) => eprintln!(
+                "quadctl: static stability margin (min) {:.4} m at t = {:.3} s",
+                m.value, m.t_s
+            ),
+            Ok(None) => eprintln!("quadctl: static stability margin: no sample solves"),
+            Err(e) => return args::fail("quadctl", &e),
+        }
+    }
+    match result {
         Ok(w) if w.unreachable == 0 => ExitCode::from(EXIT_OK),
         Ok(w) => {
             if let Some((t, e)) = w.first_unreachable {

@@ -70,6 +70,9 @@ pub enum Motion {
     Trot,
     /// Walk: one leg at a time, from a velocity command.
     Walk,
+    /// A statically stable yaw turn: one leg at a time, the body shifted into the support
+    /// triangle first.
+    StableTurn,
 }
 
 const RUN_ABOUT: &str = "\
@@ -86,6 +89,9 @@ Parameters (units in the names; every one optional, the defaults are the device'
              --cycle-s (0.8) --velocity-timeout-ms (500) and the velocity --forward-m-s,
              --lateral-m-s, --yaw-rate-rad-s (0) held for --duration-s (5), then a stop (the
              strides finish, the feet park on the stance).
+  stable-turn --yaw-per-cycle-rad (0.2; counter-clockwise positive) --cycle-s (20)
+             --lift-height-m (0.15 x the device's stance height) --shift-fraction (0.8)
+             --duration-s (one cycle)
 Durations are rounded up to whole periods by the device.
 
 Bad values are refused before anything moves, the option named: a value outside its range
@@ -149,7 +155,14 @@ pub struct RunArgs {
     /// foot-path: stance fraction of the loop, in (0, 1).
     #[arg(long, value_name = "D", allow_negative_numbers = true)]
     pub duty_factor: Option<f32>,
-    /// foot-path, trot, walk: one loop or gait cycle, s.
+    /// stable-turn: yaw of one cycle, rad, counter-clockwise positive.
+    #[arg(long, value_name = "RAD", allow_negative_numbers = true, value_parser = crate::args::parse_angle_rad)]
+    pub yaw_per_cycle_rad: Option<f32>,
+    /// stable-turn: how far the body moves towards the centroid of its support triangle, in
+    /// (0, 1].
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    pub shift_fraction: Option<f32>,
+    /// foot-path, trot, walk, stable-turn: one loop or gait cycle, s.
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub cycle_s: Option<f32>,
     /// trot, walk: stance height (the body's height above the feet), m, as `motion`'s
@@ -180,9 +193,12 @@ fn applies(motion: Motion, option: &str) -> bool {
         "--amplitude-rad" | "--period-s" => sway,
         "--duration-s" => true,
         "--yaw-rate-rad-s" => motion == Motion::YawTurn || gait,
-        "--step-period-s" | "--lift-height-m" => motion == Motion::YawTurn,
+        "--step-period-s" => motion == Motion::YawTurn,
+        "--lift-height-m" => matches!(motion, Motion::YawTurn | Motion::StableTurn),
+        "--yaw-per-cycle-rad" | "--shift-fraction" => motion == Motion::StableTurn,
         "--path" | "--leg" | "--stride-m" | "--duty-factor" => motion == Motion::FootPath,
-        "--step-height-m" | "--cycle-s" => motion == Motion::FootPath || gait,
+        "--step-height-m" => motion == Motion::FootPath || gait,
+        "--cycle-s" => matches!(motion, Motion::FootPath | Motion::StableTurn) || gait,
         _ => gait,
     }
 }
@@ -213,6 +229,8 @@ impl RunArgs {
             ("--velocity-timeout-ms", self.velocity_timeout_ms.is_some()),
             ("--forward-m-s", self.forward_m_s.is_some()),
             ("--lateral-m-s", self.lateral_m_s.is_some()),
+            ("--yaw-per-cycle-rad", self.yaw_per_cycle_rad.is_some()),
+            ("--shift-fraction", self.shift_fraction.is_some()),
         ]
         .into_iter()
         .filter_map(|(o, g)| g.then_some(o))
@@ -286,6 +304,26 @@ impl RunArgs {
                     step_height_m: self.step_height_m.unwrap_or(step_height_m),
                     duty_factor: self.duty_factor.unwrap_or(duty_factor),
                     cycle_s,
+                    duration_s: Some(d.unwrap_or(one(cycle_s))),
+                }
+            }
+            Motion::StableTurn => {
+                let MotionCommand::StableTurn {
+                    yaw_per_cycle_rad,
+                    cycle_s,
+                    lift_height_m,
+                    shift_fraction,
+                    ..
+                } = MotionCommand::stable_turn(stance_height_m, None)
+                else {
+                    unreachable!("stable_turn is a stable turn")
+                };
+                let cycle_s = self.cycle_s.unwrap_or(cycle_s);
+                MotionCommand::StableTurn {
+                    yaw_per_cycle_rad: self.yaw_per_cycle_rad.unwrap_or(yaw_per_cycle_rad),
+                    cycle_s,
+                    lift_height_m: self.lift_height_m.unwrap_or(lift_height_m),
+                    shift_fraction: self.shift_fraction.unwrap_or(shift_fraction),
                     duration_s: Some(d.unwrap_or(one(cycle_s))),
                 }
             }

@@ -808,3 +808,381 @@ impl Motion for LegPaths {
         Some(self.law.cycle_s)
     }
 }
+
+/// The order in which a [`StableTurn`] lifts its legs: around the body, so that the body's
+/// shift from one support triangle to the next runs along a side of the feet's rectangle,
+/// never across its diagonal.
+pub const STABLE_TURN_ORDER: [LegId; 4] = [LegId::FL, LegId::FR, LegId::RR, LegId::RL];
+
+/// Share of each leg's quarter of a [`StableTurn`] cycle in which the body shifts with all four
+/// feet down; the leg swings in the rest.
+pub const STABLE_TURN_SHIFT_SHARE: f32 = 0.5;
+
+/// Parameters of a [`StableTurn`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableTurnParams {
+    /// The robot.
+    pub robot: Robot,
+    /// Yaw of one cycle `Δψ` (each leg steps once), rad; positive turns counter-clockwise seen
+    /// from above. `|Δψ| ≤ π/2`.
+    pub yaw_per_cycle_rad: f32,
+    /// Duration of one cycle `T`, s.
+    pub cycle_s: f32,
+    /// Swing apex above the ground, m.
+    pub lift_height_m: f32,
+    /// How far the body centre moves towards the centroid of the three feet that stay down,
+    /// in (0, 1] (1: onto the centroid).
+    pub shift_fraction: f32,
+    /// Rotation order of the pose.
+    pub order: RotationOrder,
+    /// The feet at `t = 0` relative to the body, world frame of the nominal pose, m. The world
+    /// origin (the body centre of the stance) should be the centre of the four feet, as in
+    /// [`Robot::stance_feet`].
+    pub stance_feet: [Vec3; 4],
+}
+
+impl StableTurnParams {
+    /// Default yaw of one cycle, rad (11.5°).
+    pub const DEFAULT_YAW_PER_CYCLE_RAD: f32 = 0.2;
+    /// Default cycle, s: each leg has 5 s, 2.5 s to shift the body and 2.5 s to swing. Slow
+    /// enough for seed 001's 22 kg robot in the physics twin, which falls at 12 s
+    /// (`docs/twin.md`).
+    pub const DEFAULT_CYCLE_S: f32 = 20.0;
+    /// Default swing apex, as a fraction of the stance height.
+    pub const DEFAULT_LIFT_FRACTION: f32 = 0.15;
+    /// Default shift: 0.8 of the way to the centroid of the support triangle. The physics
+    /// twin's seed 001 robot, whose stance legs sag under load, falls with 0.6, 0.7 and 0.9
+    /// (`docs/twin.md`).
+    pub const DEFAULT_SHIFT_FRACTION: f32 = 0.8;
+
+    /// The defaults above for `robot` at the stance of height `stance_height_m`
+    /// ([`Robot::stance_feet`]), order `zyx`.
+    pub fn new(robot: Robot, stance_height_m: f32) -> StableTurnParams {
+        StableTurnParams {
+            robot,
+            yaw_per_cycle_rad: Self::DEFAULT_YAW_PER_CYCLE_RAD,
+            cycle_s: Self::DEFAULT_CYCLE_S,
+            lift_height_m: Self::DEFAULT_LIFT_FRACTION * stance_height_m,
+            shift_fraction: Self::DEFAULT_SHIFT_FRACTION,
+            order: RotationOrder::Zyx,
+            stance_feet: robot.stance_feet(stance_height_m),
+        }
+    }
+}
+
+impl StableTurnParams {
+    /// These parameters but the robot.
+    pub const fn law_params(&self) -> StableTurnLawParams {
+        StableTurnLawParams {
+            yaw_per_cycle_rad: self.yaw_per_cycle_rad,
+            cycle_s: self.cycle_s,
+            lift_height_m: self.lift_height_m,
+            shift_fraction: self.shift_fraction,
+            order: self.order,
+            stance_feet: self.stance_feet,
+        }
+    }
+}
+
+/// [`StableTurnParams`] but the robot: a [`StableTurnLaw`]'s input.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableTurnLawParams {
+    /// Yaw of one cycle `Δψ`, rad, counter-clockwise positive; `|Δψ| ≤ π/2`.
+    pub yaw_per_cycle_rad: f32,
+    /// Duration of one cycle `T`, s.
+    pub cycle_s: f32,
+    /// Swing apex above the ground, m.
+    pub lift_height_m: f32,
+    /// How far the body centre moves towards the centroid of the three feet that stay down,
+    /// in (0, 1].
+    pub shift_fraction: f32,
+    /// Rotation order of the pose.
+    pub order: RotationOrder,
+    /// The feet at `t = 0` relative to the body, m.
+    pub stance_feet: [Vec3; 4],
+}
+
+/// A statically stable yaw turn on the spot: one leg lifted at a time, in
+/// [`STABLE_TURN_ORDER`], the body first shifted towards the centroid of the other three feet,
+/// so that the centre of mass stays inside the support triangle while the leg is in the air
+/// (unlike seed 001's crossed-pair [`YawTurn`], which holds the body on a diagonal pair).
+///
+/// With `k = ⌊t/T⌋`, `τ = t − kT`, the cycle is four slots of `T/4`, slot `j` for leg
+/// `STABLE_TURN_ORDER[j]`, each with a local phase `u ∈ [0, 1)`:
+/// - body yaw `ψ(t) = Δψ·t/T` (about the body centre), no roll or pitch, at the stance height;
+/// - foot `i` at `ρ_i·(cos(α_i + a_i), sin(α_i + a_i))` with `ρ_i`, `α_i` of its stance
+///   position and `a_i = kΔψ` before its step in cycle `k`, `(k + 1)Δψ` after it; during its
+///   step (`u ≥ s`, `s` = [`STABLE_TURN_SHIFT_SHARE`], `v = (u − s)/(1 − s)`)
+///   `a_i = kΔψ + Δψ·b(v)` and the foot is `h·(1 − cos 2πv)/2` above the ground, with
+///   `b(v) = v − sin(2πv)/2π` (zero speed at lift-off and touch-down);
+/// - body translation: in slot `j`, the target `g_j` is `shift_fraction` times the centroid
+///   (ground plane, world frame) of the three feet other than leg `j`'s, which stand still
+///   through the slot; for `u < s` the body moves from the previous slot's target to `g_j`
+///   along `b(u/s)` with four feet down (in the first slot of cycle 0 it starts from the
+///   stance's centre), and holds `g_j` while the leg swings.
+///
+/// From the end of the first shift on, the joint angles repeat with period `T`.
+///
+/// This is the law without its robot ([`StableTurn`] is the law on a robot), for a caller that
+/// holds the robot itself (a device's solver).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableTurnLaw {
+    p: StableTurnLawParams,
+    rho_m: [f32; 4],
+    alpha_rad: [f32; 4],
+}
+
+/// [`StableTurnLaw`] on a robot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableTurn {
+    robot: Robot,
+    law: StableTurnLaw,
+}
+
+/// `v − sin(2πv)/2π`: 0 → 1 on `[0, 1]` with zero slope at both ends.
+fn cycloid_blend<M: Math>(v: f32) -> f32 {
+    v - M::sin_cos(2.0 * PI * v).0 / (2.0 * PI)
+}
+
+impl StableTurn {
+    /// Validates the parameters: the robot, finite values, `|Δψ| ≤ π/2`, `T > 0`, the lift
+    /// `≥ 0` and below the hips, `shift_fraction ∈ (0, 1]`, and the feet reachable at 64
+    /// samples of each of the first two cycles (a quick check; [`crate::preflight`] sweeps
+    /// the whole motion, with its static stability margin). The checks run on the
+    /// [`DefaultMath`] backend.
+    pub fn new(p: StableTurnParams) -> Result<StableTurn, Error> {
+        p.robot.validate()?;
+        let turn = Self::without_reach_check::<DefaultMath>(p)?;
+        let cfg = turn.body_config();
+        let f0 = turn.frame::<DefaultMath>(0.0)?;
+        check_reach(
+            &p.robot,
+            &f0.pose,
+            &cfg,
+            &f0.feet_in_world,
+            Param::StanceFeet,
+        )?;
+        const SAMPLES: u16 = 128;
+        for i in 1..SAMPLES {
+            let t = 2.0 * p.cycle_s * f32::from(i) / f32::from(SAMPLES);
+            let f = turn.frame::<DefaultMath>(t)?;
+            let any_swing = f.contact.contains(&Contact::Swing);
+            let name = if any_swing {
+                Param::YawPerCycleRad
+            } else {
+                Param::ShiftFraction
+            };
+            check_reach(&p.robot, &f.pose, &cfg, &f.feet_in_world, name)?;
+        }
+        Ok(turn)
+    }
+
+    /// [`StableTurn::new`]'s parameter checks without its reach checks and without validating
+    /// `p.robot` ([`StableTurnLaw::without_reach_check`]).
+    pub fn without_reach_check<M: Math>(p: StableTurnParams) -> Result<StableTurn, Error> {
+        Ok(StableTurn {
+            robot: p.robot,
+            law: StableTurnLaw::without_reach_check::<M>(p.law_params())?,
+        })
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> StableTurnParams {
+        let l = &self.law.p;
+        StableTurnParams {
+            robot: self.robot,
+            yaw_per_cycle_rad: l.yaw_per_cycle_rad,
+            cycle_s: l.cycle_s,
+            lift_height_m: l.lift_height_m,
+            shift_fraction: l.shift_fraction,
+            order: l.order,
+            stance_feet: l.stance_feet,
+        }
+    }
+
+    /// The robot-free law.
+    pub const fn law(&self) -> &StableTurnLaw {
+        &self.law
+    }
+
+    /// [`Motion::frame`] written into `frame` ([`StableTurnLaw::frame_into`]).
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        self.law.frame_into::<M>(t_s, frame)
+    }
+}
+
+impl StableTurnLaw {
+    /// [`StableTurn::new`]'s parameter checks without its reach checks, with the foot radii
+    /// and angles on backend `M`, for a caller that checks the reach itself by running the
+    /// law's frames through its own IK (a device's start check).
+    pub fn without_reach_check<M: Math>(p: StableTurnLawParams) -> Result<StableTurnLaw, Error> {
+        if !(finite(p.yaw_per_cycle_rad, Param::YawPerCycleRad)?.abs() <= 0.5 * PI) {
+            return Err(Error::OutOfRange {
+                parameter: Param::YawPerCycleRad,
+                expected: Expected::QuarterTurnPerCycle,
+            });
+        }
+        positive(p.cycle_s, Param::CycleS)?;
+        non_negative(p.lift_height_m, Param::LiftHeightM)?;
+        let shift = finite(p.shift_fraction, Param::ShiftFraction)?;
+        if !(shift > 0.0 && shift <= 1.0) {
+            return Err(Error::OutOfRange {
+                parameter: Param::ShiftFraction,
+                expected: Expected::UnitIntervalOpenBelow,
+            });
+        }
+        finite_feet(&p.stance_feet, Param::StanceFeet)?;
+        for f in &p.stance_feet {
+            if !(f.z + p.lift_height_m < 0.0) {
+                return Err(Error::OutOfRange {
+                    parameter: Param::LiftHeightM,
+                    expected: Expected::BelowStanceHeight,
+                });
+            }
+        }
+        Ok(StableTurnLaw {
+            p,
+            rho_m: p.stance_feet.map(|f| M::sqrt(f.x * f.x + f.y * f.y)),
+            alpha_rad: p.stance_feet.map(|f| M::atan2(f.y, f.x)),
+        })
+    }
+
+    /// The parameters.
+    pub const fn params(&self) -> &StableTurnLawParams {
+        &self.p
+    }
+
+    /// The slot (index in [`STABLE_TURN_ORDER`]) of `leg`.
+    pub fn slot(leg: LegId) -> usize {
+        match leg {
+            LegId::FL => 0,
+            LegId::FR => 1,
+            LegId::RR => 2,
+            LegId::RL => 3,
+        }
+    }
+
+    /// `(k, τ)` with `t = kT + τ`, `τ ∈ [0, T)`.
+    fn split(&self, t_s: f32) -> (f32, f32) {
+        let t1 = self.p.cycle_s;
+        let mut k = crate::math::floor(t_s / t1);
+        let mut tau = t_s - k * t1;
+        if tau < 0.0 {
+            k -= 1.0;
+            tau += t1;
+        }
+        if tau >= t1 {
+            k += 1.0;
+            tau -= t1;
+        }
+        if !(tau >= 0.0 && tau < t1) {
+            tau = 0.0;
+        }
+        (k, tau)
+    }
+
+    /// Foot `i` on its circle at angle `α_i + a`, in the ground plane (z of its stance).
+    fn foot_at<M: Math>(&self, i: usize, a: f32) -> Vec3 {
+        let (s, c) = M::sin_cos(self.alpha_rad[i] + a);
+        Vec3::new(
+            self.rho_m[i] * c,
+            self.rho_m[i] * s,
+            self.p.stance_feet[i].z,
+        )
+    }
+
+    /// The body's target `(x, y)` in slot `j` of the cycle whose start yaw is `base`.
+    fn target<M: Math>(&self, j: usize, base: f32) -> (f32, f32) {
+        let (mut x, mut y) = (0.0, 0.0);
+        for leg in LegId::ALL {
+            let slot = Self::slot(leg);
+            if slot == j {
+                continue;
+            }
+            let a = if slot < j {
+                base + self.p.yaw_per_cycle_rad
+            } else {
+                base
+            };
+            let f = self.foot_at::<M>(leg.index(), a);
+            x += f.x;
+            y += f.y;
+        }
+        let w = self.p.shift_fraction / 3.0;
+        (w * x, w * y)
+    }
+
+    /// [`Motion::frame`] written into `frame` (unchanged when `t_s` is not finite).
+    pub fn frame_into<M: Math>(&self, t_s: f32, frame: &mut Frame) -> Result<(), Error> {
+        finite(t_s, Param::TS)?;
+        let p = &self.p;
+        let (k, tau) = self.split(t_s);
+        let d = p.yaw_per_cycle_rad;
+        // Yaw at the start of this cycle, wrapped once so that body and feet share it.
+        let base = wrap_pi(d * k);
+        let yaw = wrap_pi(base + d * (tau / p.cycle_s));
+        let quarter = 4.0 * tau / p.cycle_s;
+        let mut j = crate::math::floor(quarter) as usize;
+        if j > 3 {
+            j = 3;
+        }
+        let u = fract01(quarter - j as f32);
+        let s = STABLE_TURN_SHIFT_SHARE;
+        for leg in LegId::ALL {
+            let i = leg.index();
+            let slot = Self::slot(leg);
+            let (a, lift, contact) = if slot < j {
+                (base + d, 0.0, Contact::Stance)
+            } else if slot > j || u < s {
+                (base, 0.0, Contact::Stance)
+            } else {
+                let v = (u - s) / (1.0 - s);
+                let lift = 0.5 * (1.0 - M::sin_cos(2.0 * PI * v).1);
+                (base + d * cycloid_blend::<M>(v), lift, Contact::Swing)
+            };
+            let mut f = self.foot_at::<M>(i, a);
+            f.z += p.lift_height_m * lift;
+            frame.feet_in_world[i] = f;
+            frame.contact[i] = contact;
+        }
+        let (x, y) = if u < s {
+            let to = self.target::<M>(j, base);
+            let from = if j > 0 {
+                self.target::<M>(j - 1, base)
+            } else if k == 0.0 {
+                (0.0, 0.0)
+            } else {
+                self.target::<M>(3, wrap_pi(base - d))
+            };
+            let w = cycloid_blend::<M>(u / s);
+            (from.0 + (to.0 - from.0) * w, from.1 + (to.1 - from.1) * w)
+        } else {
+            self.target::<M>(j, base)
+        };
+        let mut pose = Pose::rotation(0.0, 0.0, yaw);
+        pose.x_m = x;
+        pose.y_m = y;
+        frame.pose = pose;
+        Ok(())
+    }
+}
+
+impl Motion for StableTurn {
+    fn robot(&self) -> &Robot {
+        &self.robot
+    }
+
+    fn body_config(&self) -> BodyConfig {
+        BodyConfig::about_centre(self.law.p.order)
+    }
+
+    fn frame<M: Math>(&self, t_s: f32) -> Result<Frame, Error> {
+        let mut frame = Frame::ZERO;
+        self.frame_into::<M>(t_s, &mut frame)?;
+        Ok(frame)
+    }
+
+    fn period_s(&self) -> Option<f32> {
+        Some(self.law.p.cycle_s)
+    }
+}

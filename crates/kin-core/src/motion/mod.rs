@@ -9,7 +9,8 @@
 //!   seed 000's rectangle, semicircle, ellipse, cycloid, Bézier swing.
 //! - [`laws`]: seed 001's body-motion laws — roll and pitch sways (eq. 6–8) and the yaw turn
 //!   with the crossed-pair leg transfer (eq. 9–11, corrected; see `docs/papers.md`) — plus the
-//!   feet following a path under a fixed body (seed 000 §3.2).
+//!   feet following a path under a fixed body (seed 000 §3.2) and a statically stable yaw turn
+//!   (one leg at a time, the body shifted into the support triangle first).
 //! - [`gait`]: trot / walk generator driven by a body velocity command.
 //! - [`walker`]: the same gaits as a stateful stepper, for a velocity command that changes
 //!   while walking (footholds planned at lift-off, a stop that ends at the stance).
@@ -107,6 +108,12 @@ pub enum Param {
     VelocityTimeoutMs,
     /// `joint_speed_limit_rad_s`: A joint-speed limit, rad/s.
     JointSpeedLimitRadS,
+    /// `yaw_per_cycle_rad`: The yaw of one cycle of a statically stable turn, rad
+    /// (counter-clockwise positive).
+    YawPerCycleRad,
+    /// `shift_fraction`: How far a statically stable turn moves the body towards the centroid
+    /// of its support triangle.
+    ShiftFraction,
 }
 
 impl Param {
@@ -145,6 +152,8 @@ impl Param {
             Param::YawRateRadS => "yaw_rate_rad_s",
             Param::VelocityTimeoutMs => "velocity_timeout_ms",
             Param::JointSpeedLimitRadS => "joint_speed_limit_rad_s",
+            Param::YawPerCycleRad => "yaw_per_cycle_rad",
+            Param::ShiftFraction => "shift_fraction",
         }
     }
 }
@@ -169,6 +178,10 @@ pub enum Expected {
     WithinGaitReach,
     /// At most 2^24 samples (`duration_s × rate_hz`).
     SweepSamples,
+    /// In the half-open interval (0, 1].
+    UnitIntervalOpenBelow,
+    /// At most a quarter turn per cycle (`|Δψ| ≤ π/2`).
+    QuarterTurnPerCycle,
 }
 
 impl fmt::Display for Expected {
@@ -183,6 +196,8 @@ impl fmt::Display for Expected {
                 "within the gait's reach (footholds inside the stride disc)"
             }
             Expected::SweepSamples => "at most 2^24 samples (duration_s × rate_hz)",
+            Expected::UnitIntervalOpenBelow => "in (0, 1]",
+            Expected::QuarterTurnPerCycle => "at most a quarter turn per cycle (|Δψ| ≤ π/2)",
         })
     }
 }
@@ -217,6 +232,8 @@ pub enum Error {
     Robot(RobotError),
     /// A sample of the motion cannot be reached (inverse kinematics refused it).
     Ik(IkError),
+    /// The mass model is invalid.
+    Mass(crate::stability::MassError),
 }
 
 impl fmt::Display for Error {
@@ -236,11 +253,18 @@ impl fmt::Display for Error {
             } => write!(f, "`{parameter}` puts the {leg} foot out of reach ({kind})"),
             Error::Robot(e) => write!(f, "robot: {e}"),
             Error::Ik(e) => write!(f, "unreachable sample: {e}"),
+            Error::Mass(e) => write!(f, "masses: {e}"),
         }
     }
 }
 
 impl core::error::Error for Error {}
+
+impl From<crate::stability::MassError> for Error {
+    fn from(e: crate::stability::MassError) -> Self {
+        Error::Mass(e)
+    }
+}
 
 impl From<RobotError> for Error {
     fn from(e: RobotError) -> Self {
@@ -425,6 +449,8 @@ pub enum AnyMotion {
     LegPaths(laws::LegPaths),
     /// A trot / walk gait.
     Gait(gait::Gait),
+    /// A statically stable yaw turn: one leg at a time, the body shifted first.
+    StableTurn(laws::StableTurn),
 }
 
 impl Motion for AnyMotion {
@@ -434,6 +460,7 @@ impl Motion for AnyMotion {
             AnyMotion::YawTurn(m) => m.robot(),
             AnyMotion::LegPaths(m) => m.robot(),
             AnyMotion::Gait(m) => m.robot(),
+            AnyMotion::StableTurn(m) => m.robot(),
         }
     }
 
@@ -443,6 +470,7 @@ impl Motion for AnyMotion {
             AnyMotion::YawTurn(m) => m.body_config(),
             AnyMotion::LegPaths(m) => m.body_config(),
             AnyMotion::Gait(m) => m.body_config(),
+            AnyMotion::StableTurn(m) => m.body_config(),
         }
     }
 
@@ -452,6 +480,7 @@ impl Motion for AnyMotion {
             AnyMotion::YawTurn(m) => m.frame::<M>(t_s),
             AnyMotion::LegPaths(m) => m.frame::<M>(t_s),
             AnyMotion::Gait(m) => m.frame::<M>(t_s),
+            AnyMotion::StableTurn(m) => m.frame::<M>(t_s),
         }
     }
 
@@ -461,6 +490,7 @@ impl Motion for AnyMotion {
             AnyMotion::YawTurn(m) => m.period_s(),
             AnyMotion::LegPaths(m) => m.period_s(),
             AnyMotion::Gait(m) => m.period_s(),
+            AnyMotion::StableTurn(m) => m.period_s(),
         }
     }
 }

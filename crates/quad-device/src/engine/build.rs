@@ -169,6 +169,22 @@ fn law_motion<M: Math>(request: &MotionCommand, s: &Setup<'_, M>) -> Result<LawM
             order: s.order,
             stance_feet,
         })?)),
+        MotionCommand::StableTurn {
+            yaw_per_cycle_rad,
+            cycle_s,
+            lift_height_m,
+            shift_fraction,
+            ..
+        } => Ok(LawMotion::StableTurn(
+            laws::StableTurnLaw::without_reach_check::<M>(laws::StableTurnLawParams {
+                yaw_per_cycle_rad,
+                cycle_s,
+                lift_height_m,
+                shift_fraction,
+                order: s.order,
+                stance_feet,
+            })?,
+        )),
         MotionCommand::FootPath {
             path,
             stride_m,
@@ -216,9 +232,9 @@ impl<M: Math> Engine<M> {
 
     fn build_law(request: &MotionCommand, s: &Setup<'_, M>) -> Result<Law, Error> {
         let (legs, duration_s) = match *request {
-            MotionCommand::Sway { duration_s, .. } | MotionCommand::YawTurn { duration_s, .. } => {
-                ([true; 4], duration_s)
-            }
+            MotionCommand::Sway { duration_s, .. }
+            | MotionCommand::YawTurn { duration_s, .. }
+            | MotionCommand::StableTurn { duration_s, .. } => ([true; 4], duration_s),
             MotionCommand::FootPath {
                 legs, duration_s, ..
             } => (
@@ -327,6 +343,7 @@ impl<M: Math> Engine<M> {
         match &law.motion {
             LawMotion::Sway(m) => m.frame_into::<M>(t_s, frame),
             LawMotion::YawTurn(m) => m.frame_into::<M>(t_s, frame),
+            LawMotion::StableTurn(m) => m.frame_into::<M>(t_s, frame),
             LawMotion::LegPaths(m) => {
                 m.frame_into::<M>(t_s, frame)?;
                 let stance = &m.stance_feet;

@@ -39,7 +39,10 @@
 //! - [`MotionCommand::Sway`]: seed 001's roll or pitch sway (eq. 6–8), [`MotionCommand::YawTurn`]: its yaw
 //!   turn with the crossed pairs (eq. 9–11 as corrected in `docs/papers.md`), with the yaw rate
 //!   counter-clockwise positive (REP 103, as in kin-core and the walk's velocity command),
-//!   [`MotionCommand::FootPath`]: a seed 000 foot path on one leg or all four under a held body. They
+//!   [`MotionCommand::FootPath`]: a seed 000 foot path on one leg or all four under a held body,
+//!   [`MotionCommand::StableTurn`]: kin-core's statically stable yaw turn (one leg at a time, the
+//!   body shifted into the support triangle first; its cycles end with the body shifted, and
+//!   the ramp to the stance brings it back). They
 //!   run for their duration rounded up to whole periods, or until [`Engine::stop`]: a stop or
 //!   the end takes effect at the next period boundary, where the joints are back at their start.
 //! - [`MotionCommand::Walk`]: trot or walk from a velocity command ([`crate::Device::set_velocity`],
@@ -262,6 +265,7 @@ enum LawMotion {
     Sway(laws::SwayLaw),
     YawTurn(laws::YawTurnLaw),
     LegPaths(laws::LegPathsLaw),
+    StableTurn(laws::StableTurnLaw),
 }
 
 impl LawMotion {
@@ -271,6 +275,7 @@ impl LawMotion {
             LawMotion::Sway(m) => m.order,
             LawMotion::YawTurn(m) => m.params().order,
             LawMotion::LegPaths(_) => BodyConfig::default().order,
+            LawMotion::StableTurn(m) => m.params().order,
         }
     }
 
@@ -280,6 +285,7 @@ impl LawMotion {
             LawMotion::Sway(m) => m.period_s,
             LawMotion::YawTurn(m) => m.params().step_period_s,
             LawMotion::LegPaths(m) => m.cycle_s,
+            LawMotion::StableTurn(m) => m.params().cycle_s,
         }
     }
 }
@@ -683,6 +689,7 @@ impl Law {
             LawMotion::Sway(_) => MotionKind::Sway,
             LawMotion::YawTurn(_) => MotionKind::YawTurn,
             LawMotion::LegPaths(_) => MotionKind::FootPath,
+            LawMotion::StableTurn(_) => MotionKind::StableTurn,
         }
     }
 }

@@ -57,6 +57,8 @@ pub fn motion_param(param: motion::Param) -> MotionParam {
         // The feet a law starts from: the device's stance.
         P::FeetInWorld | P::StanceFeet => MotionParam::Stance,
         P::ReachRadiusM => MotionParam::ReachRadiusM,
+        P::YawPerCycleRad => MotionParam::YawPerCycleRad,
+        P::ShiftFraction => MotionParam::ShiftFraction,
         _ => MotionParam::Other,
     }
 }

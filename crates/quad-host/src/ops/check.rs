@@ -159,7 +159,14 @@ fn check_law(
         .unwrap_or_else(|| m.period_s().unwrap_or(10.0));
     let rate = args.rate_hz.unwrap_or(100.0);
     let sweep = motion::sweep(duration, rate)?;
-    let mut c = Checker::new(m.robot(), m.body_config(), limits).map_err(param_err)?;
+    // The static stability margin with the robot's masses: a preset's physical preset, a
+    // robot file's `[physical]` table.
+    let mass = robot_file::resolve_description(&args.params.robot)?
+        .physical
+        .mass_model();
+    let mut c = Checker::new(m.robot(), m.body_config(), limits)
+        .and_then(|c| c.with_mass(&mass))
+        .map_err(param_err)?;
     progress(Progress::Start(u64::from(sweep.samples())));
     for k in 0..sweep.samples() {
         let t = sweep.time_s(k);
@@ -348,6 +355,20 @@ pub fn table(checked: &Checked) -> String {
         overall("min joint margin", r.min_joint_margin(), "rad"),
         overall("min inverse condition", r.min_inverse_condition(), "")
     );
+    // A motion file has no contact column: the margin needs the law's stance and swing.
+    if let Some(m) = r.static_margin_m {
+        let _ = writeln!(
+            out,
+            "static stability margin (min): {:.4} m @ {:.3} s{}",
+            m.value,
+            m.t_s,
+            if m.value > 0.0 {
+                ""
+            } else {
+                " (the centre of mass leaves the support polygon)"
+            }
+        );
+    }
     match r.first_failure {
         None => {
             let _ = writeln!(out, "result: PASS (all {} samples)", r.samples);

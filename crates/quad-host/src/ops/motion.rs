@@ -8,7 +8,8 @@ use crate::plot::{self, JointSeries};
 use crate::{csv, robot_file};
 use kin_core::motion::gait::{Gait, GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::{
-    self, Axis, LegPaths, LegPathsParams, Sway, SwayParams, YawTurn, YawTurnParams,
+    self, Axis, LegPaths, LegPathsParams, StableTurn, StableTurnParams, Sway, SwayParams, YawTurn,
+    YawTurnParams,
 };
 use kin_core::motion::path::{AnyPath, PathKind, Rectangle, Stride};
 use kin_core::motion::{self, AnyMotion, Motion};
@@ -34,11 +35,14 @@ pub enum Law {
     Trot,
     /// Walk: one leg at a time (RL, FL, RR, FR), duty 0.75.
     Walk,
+    /// A statically stable yaw turn: one leg at a time, the body shifted towards its support
+    /// triangle first (kin-core's `StableTurn`).
+    StableTurn,
 }
 
 impl Law {
     /// Every law, in the order of the command line's help.
-    pub const ALL: [Law; 7] = [
+    pub const ALL: [Law; 8] = [
         Law::RollSway,
         Law::PitchSway,
         Law::YawSway,
@@ -46,6 +50,7 @@ impl Law {
         Law::RectPath,
         Law::Trot,
         Law::Walk,
+        Law::StableTurn,
     ];
 
     /// The name on the command line.
@@ -58,6 +63,7 @@ impl Law {
             Law::RectPath => "rect-path",
             Law::Trot => "trot",
             Law::Walk => "walk",
+            Law::StableTurn => "stable-turn",
         }
     }
 
@@ -81,6 +87,10 @@ impl Law {
                 "Trot: diagonal pairs in antiphase, duty 0.75, driven by a velocity command"
             }
             Law::Walk => "Walk: one leg at a time (RL, FL, RR, FR), duty 0.75",
+            Law::StableTurn => {
+                "Statically stable yaw turn: one leg at a time (FL, FR, RR, RL), the body shifted \
+                 towards its support triangle first, Δψ per cycle"
+            }
         }
     }
 
@@ -126,6 +136,11 @@ pub struct Params {
     pub lateral_m_s: Option<f32>,
     /// trot, walk: yaw rate (counter-clockwise positive), rad/s.
     pub yaw_rad_s: Option<f32>,
+    /// stable-turn: yaw of one cycle (counter-clockwise positive), rad.
+    pub yaw_per_cycle_rad: Option<f32>,
+    /// stable-turn: how far the body moves towards the centroid of its support triangle, in
+    /// (0, 1].
+    pub shift_fraction: Option<f32>,
 }
 
 /// Stance heights closer than this are the same stance, m (seed 001's initial pose through
@@ -235,6 +250,8 @@ impl Params {
             ("--forward-m-s", self.forward_m_s.is_some()),
             ("--lateral-m-s", self.lateral_m_s.is_some()),
             ("--yaw-rad-s", self.yaw_rad_s.is_some()),
+            ("--yaw-per-cycle-rad", self.yaw_per_cycle_rad.is_some()),
+            ("--shift-fraction", self.shift_fraction.is_some()),
         ]
         .into_iter()
         .find(|(_, given)| *given)
@@ -246,7 +263,8 @@ impl Params {
         let sway = matches!(law, Law::RollSway | Law::PitchSway | Law::YawSway);
         let gait = matches!(law, Law::Trot | Law::Walk);
         let rect = law == Law::RectPath;
-        let given: [(&'static str, bool, bool); 13] = [
+        let stable = law == Law::StableTurn;
+        let given: [(&'static str, bool, bool); 15] = [
             ("--amplitude-rad", self.amplitude_rad.is_some(), sway),
             ("--period-s", self.period_s.is_some(), sway),
             (
@@ -262,7 +280,7 @@ impl Params {
             (
                 "--lift-height-m",
                 self.lift_height_m.is_some(),
-                law == Law::YawTurn,
+                law == Law::YawTurn || stable,
             ),
             ("--path", self.path.is_some(), rect || gait),
             ("--stride-m", self.stride_m.is_some(), rect),
@@ -272,10 +290,16 @@ impl Params {
                 rect || gait,
             ),
             ("--duty-factor", self.duty_factor.is_some(), rect || gait),
-            ("--cycle-s", self.cycle_s.is_some(), rect || gait),
+            ("--cycle-s", self.cycle_s.is_some(), rect || gait || stable),
             ("--forward-m-s", self.forward_m_s.is_some(), gait),
             ("--lateral-m-s", self.lateral_m_s.is_some(), gait),
             ("--yaw-rad-s", self.yaw_rad_s.is_some(), gait),
+            (
+                "--yaw-per-cycle-rad",
+                self.yaw_per_cycle_rad.is_some(),
+                stable,
+            ),
+            ("--shift-fraction", self.shift_fraction.is_some(), stable),
         ];
         for (option, present, applies) in given {
             if present && !applies {
@@ -423,6 +447,29 @@ impl Params {
                 };
                 AnyMotion::Gait(Gait::new(p).map_err(param_err)?)
             }
+            Law::StableTurn => {
+                // A preset's default stance is the device's (the twin's); a robot file's, seed
+                // 001's initial pose.
+                let device_h = self.device_pose_config().map(|c| c.stance_height_m);
+                let stance = self.stance(&robot, device_h)?;
+                let h = -stance[0].z;
+                let mut p = StableTurnParams::new(robot, h);
+                p.stance_feet = stance;
+                p.order = order(RotationOrder::Zyx);
+                if let Some(v) = self.yaw_per_cycle_rad {
+                    p.yaw_per_cycle_rad = v;
+                }
+                if let Some(v) = self.cycle_s {
+                    p.cycle_s = v;
+                }
+                if let Some(v) = self.lift_height_m {
+                    p.lift_height_m = v;
+                }
+                if let Some(v) = self.shift_fraction {
+                    p.shift_fraction = v;
+                }
+                AnyMotion::StableTurn(StableTurn::new(p).map_err(param_err)?)
+            }
         })
     }
 }
@@ -569,6 +616,33 @@ pub fn write_motion<T: Motion>(
     }
     progress(u64::from(n));
     Ok(w)
+}
+
+/// The minimum static stability margin of `law` over `duration_s` at `rate_hz` (m, and when),
+/// with the robot's masses (a preset's physical preset, a robot file's `[physical]` table);
+/// `None` when no sample's four legs solve. See `kin_core::stability`.
+///
+/// # Errors
+/// Bad parameters, the robot, a bad sweep.
+pub fn static_margin(
+    params: &Params,
+    law: Law,
+    duration_s: f32,
+    rate_hz: f32,
+) -> Result<Option<kin_core::preflight::Extremum>, Error> {
+    let m = params.build(law)?;
+    let sw = sweep(duration_s, rate_hz)?;
+    let mass = robot_file::resolve_description(&params.robot)?
+        .physical
+        .mass_model();
+    let report = kin_core::preflight::check_with_mass(
+        &m,
+        &sw,
+        [kin_core::preflight::DEFAULT_MAX_JOINT_SPEED_RAD_S; 3],
+        &mass,
+    )
+    .map_err(param_err)?;
+    Ok(report.static_margin_m)
 }
 
 /// What [`run`] is asked to write.

@@ -117,7 +117,7 @@ impl Error {
 /// The unit of a motion parameter, as its name ends.
 fn unit(param: MotionParam) -> &'static str {
     match param {
-        MotionParam::AmplitudeRad => "rad",
+        MotionParam::AmplitudeRad | MotionParam::YawPerCycleRad => "rad",
         MotionParam::PeriodS
         | MotionParam::DurationS
         | MotionParam::StepPeriodS
@@ -180,6 +180,8 @@ pub fn option(param: MotionParam) -> &'static str {
         MotionParam::LevelKiPerS => "--ki-per-s",
         MotionParam::MaxCorrectionRad => "--max-correction-rad",
         MotionParam::FallAngleRad => "--fall-angle-rad",
+        MotionParam::YawPerCycleRad => "--yaw-per-cycle-rad",
+        MotionParam::ShiftFraction => "--shift-fraction",
         _ => "a parameter",
     }
 }
@@ -195,6 +197,9 @@ pub fn shaping_params(request: &Request) -> &'static [MotionParam] {
         }
         Request::StartMotion(MotionCommand::FootPath { .. }) => &[P::StrideM, P::StepHeightM],
         Request::StartMotion(MotionCommand::Walk { .. }) => &[P::BodyHeightM, P::StepHeightM],
+        Request::StartMotion(MotionCommand::StableTurn { .. }) => {
+            &[P::YawPerCycleRad, P::ShiftFraction, P::LiftHeightM]
+        }
         _ => &[],
     }
 }
@@ -578,6 +583,7 @@ pub fn kind_name(kind: MotionKind) -> &'static str {
         MotionKind::YawTurn => "yaw_turn",
         MotionKind::FootPath => "foot_path",
         MotionKind::Walk => "walk",
+        MotionKind::StableTurn => "stable_turn",
     }
 }
 
