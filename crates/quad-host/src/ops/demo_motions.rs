@@ -355,6 +355,38 @@ fn capture<L: Link>(
         .map_err(|e| onboard::Error::Client(e.into()))
 }
 
+/// The longest the joint-speed limiter takes to bring an output onto its target: half a turn
+/// at the device's default limit (3 rad/s), with a frame to spare.
+const SETTLE_BOUND: Duration = Duration::from_millis(1_070);
+
+/// Waits until the outputs show `pulses_half_us` (the held target): on the emulator until one
+/// PWM period shows them on all twelve pins (or [`SETTLE_BOUND`] passed: an error), elsewhere
+/// for [`SETTLE_BOUND`] (the outputs cannot be seen).
+fn settle<L: Link>(
+    session: &mut Session<L>,
+    pulses_half_us: &[u16; 12],
+) -> Result<(), onboard::Error> {
+    let until = session.now() + SETTLE_BOUND;
+    if let Some(emu) = session.client_mut().link_mut().emulator() {
+        while emu.now() < until {
+            let period = emu
+                .next_pulses()
+                .map_err(|e| onboard::Error::Client(e.into()))?;
+            let settled = period.iter().zip(pulses_half_us).all(|(p, &w)| {
+                p.is_some_and(|p| p.width_could_be(u64::from(w) * CYCLES_PER_TICK, PIN_TOLERANCE))
+            });
+            if settled {
+                return Ok(());
+            }
+        }
+        return Err(onboard::Error::NoEnd(SETTLE_BOUND));
+    }
+    session
+        .client_mut()
+        .idle_until(until)
+        .map_err(|e| onboard::Error::Client(e.into()))
+}
+
 /// The run frame an answer reports (its time in frames), in `Run` and `Stopping`.
 fn run_frame(a: &MotionAnswer) -> Option<u32> {
     matches!(a.status.stage, MotionStage::Run | MotionStage::Stopping)
@@ -380,9 +412,15 @@ fn replayed_run<L: Link>(
     if is_walk {
         session.stand_if_off(WAIT)?;
     }
-    let before = session.get()?;
-    c.readback(&before.readback);
+    let mut before = session.get()?;
     let on = before.readback.flags.contains(Flags::OUTPUTS_ENABLED);
+    if on {
+        // The replay starts from the held target; the outputs may still be on their way
+        // there under the limiter (a stream of poses outruns it).
+        settle(session, &before.readback.pulses_half_us)?;
+        before = session.get()?;
+    }
+    c.readback(&before.readback);
     if !on && !matches!(request, MotionCommand::StandUp) {
         // A sit with the outputs off has nothing to do.
         return Ok(0.0);
