@@ -1,7 +1,8 @@
 //! Millisecond clock on Timer2 (8-bit, CTC mode, prescaler 64, OCR2A = 249: 1 kHz).
 //!
 //! The binary forwards the `TIMER2_COMPA` interrupt to [`on_tick_interrupt`], which also gives
-//! the servo outputs their chance to apply a staged state ([`crate::servo::on_tick`]).
+//! the servo outputs their chance to apply a staged state ([`crate::servo::on_tick`]) and the
+//! sensor its periodic burst ([`crate::imu::on_tick`]).
 
 use crate::pac;
 use avr_device::interrupt::{self, Mutex};
@@ -59,6 +60,8 @@ pub fn on_tick_interrupt() {
         let c = MILLIS.borrow(cs);
         c.set(c.get().wrapping_add(1));
     });
+    // A few instructions: starts the sensor's periodic burst when due.
+    crate::imu::on_tick();
     // SAFETY: the clock's state is updated; the servo code guards itself (`BUSY`) and touches
     // nothing the other handlers use.
     unsafe { interrupt::enable() };
