@@ -95,9 +95,7 @@ pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
     }
     loop {
         watchdog.feed();
-        let start = pass_stamp();
         serve(&mut device, &mut usart, &mut imu, &portd, hold_cycles);
-        crate::imu::note_pass_us(pass_us(start, pass_stamp()));
     }
 }
 
@@ -124,7 +122,7 @@ fn pass_stamp() -> (u32, u16) {
 }
 
 /// Microseconds between two [`pass_stamp`]s (saturating at 65,535 µs).
-fn pass_us(a: (u32, u16), b: (u32, u16)) -> u16 {
+fn elapsed_us(a: (u32, u16), b: (u32, u16)) -> u16 {
     let ms = b.0.wrapping_sub(a.0);
     if ms >= 20 {
         return u16::try_from(ms.saturating_mul(1000)).unwrap_or(u16::MAX);
@@ -166,8 +164,13 @@ fn serve(
             device.receive(&chunk[..n], |frame| usart.send(frame));
         }
     }
+    // Timed: the frame's work (at a frame boundary: the motion engine, the IK, the limiter)
+    // and the sensor's step, without the request handled above (its time is the request's
+    // answer time).
+    let start = pass_stamp();
     device.poll();
     imu.poll(device, portd, crate::clock::now_ms());
+    crate::imu::note_frame_us(elapsed_us(start, pass_stamp()));
 }
 
 /// Defines the interrupt handlers of a binary that calls [`run`] (handlers must live in the

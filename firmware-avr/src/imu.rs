@@ -52,8 +52,9 @@ pub struct Window {
     pub who_am_i: u8,
     /// Bus recoveries (SCL clocked) since boot.
     pub recoveries: u16,
-    /// The longest pass of the main loop since boot (receive, answer, frame, sensor), µs.
-    pub longest_pass_us: u16,
+    /// The longest `Device::poll` (at a frame boundary: the motion engine, the IK, the
+    /// limiter) together with the sensor's step, since boot, µs: the worst frame.
+    pub longest_frame_us: u16,
     /// Reads the tick skipped because the last burst was not taken yet.
     pub bursts_skipped: u16,
 }
@@ -72,7 +73,7 @@ pub static IMU_WINDOW: WindowCell = WindowCell(UnsafeCell::new(Window {
     fault: 0,
     who_am_i: 0,
     recoveries: 0,
-    longest_pass_us: 0,
+    longest_frame_us: 0,
     bursts_skipped: 0,
 }));
 
@@ -80,13 +81,13 @@ fn window() -> *mut Window {
     IMU_WINDOW.0.get()
 }
 
-/// Notes the length of one main-loop pass, µs.
-pub fn note_pass_us(us: u16) {
+/// Notes the length of one frame's work (see [`Window::longest_frame_us`]), µs.
+pub fn note_frame_us(us: u16) {
     // SAFETY: the main loop is this field's only writer.
     unsafe {
         let w = window();
-        if us > (*w).longest_pass_us {
-            (*w).longest_pass_us = us;
+        if us > (*w).longest_frame_us {
+            (*w).longest_frame_us = us;
         }
     }
 }
