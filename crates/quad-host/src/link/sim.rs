@@ -24,6 +24,12 @@
 //!   before every byte and whenever the host's clock advances, at every millisecond boundary
 //!   in between. The device's millisecond clock is the virtual clock.
 //!
+//! - **Inertial sensor** ([`SimLink::attach_imu`]): the device gets the source's reading every
+//!   [`READ_PERIOD_MS`] ms of virtual time, at the millisecond boundary, before that
+//!   millisecond's poll, as the firmware's driver reads its MPU-6050 (the same sources as the
+//!   emulator's virtual sensor, `quad_device::sim::imu`; a fault reading is pushed as the
+//!   fault). Without a source nothing is pushed.
+//!
 //! ## Faults
 //! [`Faults`] apply to both directions, drawn from one seeded generator (the same seed, the
 //! same run): per frame a stall (the line idles `stall_ms` first), a cut (the frame ends after a
@@ -31,7 +37,9 @@
 //! (its line time passes, nothing arrives) and a bit flip.
 
 use super::{byte_time, Error, Faults, LineStats, Link};
+use crate::emu::SharedImuSource;
 use kin_core::DefaultMath;
+use quad_device::imu::mpu6050::READ_PERIOD_MS;
 use quad_device::sim::{EepromError, Outputs, RamEeprom, VirtualClock, EEPROM_LEN};
 use quad_device::{Config, ConfigError, Device, Storage};
 use std::collections::VecDeque;
@@ -207,6 +215,8 @@ pub struct SimLink {
     clock: VirtualClock,
     device: Simulated,
     stats: LineStats,
+    /// The inertial sensor's source, when attached.
+    imu: Option<SharedImuSource>,
 }
 
 impl SimLink {
@@ -235,7 +245,14 @@ impl SimLink {
             clock,
             device,
             stats: LineStats::default(),
+            imu: None,
         })
+    }
+
+    /// Gives the device an inertial sensor fed by `source` (see the module docs); replaces an
+    /// earlier one. It stays attached across [`SimLink::reset_device`].
+    pub fn attach_imu(&mut self, source: SharedImuSource) {
+        self.imu = Some(source);
     }
 
     /// The simulated device, for inspection.
@@ -322,6 +339,11 @@ impl SimLink {
         let mut t = (self.clock.now_ns() / MS_NS + 1) * MS_NS;
         while t < t_ns {
             self.clock.set_ns(t);
+            if let Some(imu) = &self.imu {
+                if (t / MS_NS) % u64::from(READ_PERIOD_MS) == 0 {
+                    self.device.on_imu(imu.read(t as f64 * 1e-9));
+                }
+            }
             self.device.poll();
             t += MS_NS;
         }
@@ -419,6 +441,30 @@ mod tests {
         encode_frame(&HostToDevice { seq, request }, &mut buf)
             .unwrap()
             .to_vec()
+    }
+
+    #[test]
+    fn an_attached_sensor_is_read_at_the_firmware_s_rate_and_its_faults_reach_the_device() {
+        use quad_device::imu::{ImuFault, ImuReading};
+        use quad_device::sim::imu::{Feed, LevelStill};
+        let mut link = SimLink::new(
+            SimConfig::default(),
+            Config::fernando2025(),
+            EepromImage::erased(),
+        )
+        .unwrap();
+        link.attach_imu(SharedImuSource::new(LevelStill));
+        let mut buf = [0u8; 16];
+        assert_eq!(link.recv(&mut buf, Duration::from_secs(1)).unwrap(), 0);
+        let imu = *link.device().imu();
+        // Reads at 8, 16, …, 992 ms: 124 in the first second.
+        assert_eq!(imu.samples, 1000 / u32::from(READ_PERIOD_MS) - 1);
+        assert_eq!(imu.fault, None);
+        link.attach_imu(SharedImuSource::new(Feed(|_t: f64| {
+            ImuReading::Fault(ImuFault::Nak)
+        })));
+        link.recv(&mut buf, Duration::from_millis(20)).unwrap();
+        assert_eq!(link.device().imu().fault, Some(ImuFault::Nak));
     }
 
     #[test]
