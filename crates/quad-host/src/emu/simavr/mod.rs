@@ -594,7 +594,7 @@ impl Mega2560 {
 
     /// What the virtual MPU-6050 saw on the bus (`None`: no sensor attached).
     pub fn imu_bus(&self) -> Option<&ImuBus> {
-        self.imu.as_deref().map(|imu| &imu.bus)
+        self.imu.as_deref().map(twi::VirtualMpu::bus)
     }
 
     /// Fault injection: moves the program counter to `byte_addr`, as a corrupted return

@@ -101,12 +101,9 @@ fn msg(conditions: u32, addr: u8, data: u8) -> u32 {
     (conditions << 8) | (u32::from(addr) << 16) | (u32::from(data) << 24)
 }
 
-/// The virtual chip (module docs); reached by simavr's hook through a raw pointer.
-pub(super) struct VirtualMpu {
-    avr: *mut ffi::avr_t,
-    twi_in: *mut ffi::avr_irq_t,
-    sda: *mut ffi::avr_irq_t,
-    pub(super) source: SharedImuSource,
+/// The chip's logic, apart from simavr: the register file, the bus protocol, the source's
+/// readings applied.
+struct Chip {
     regs: [u8; 128],
     /// Acknowledges its address.
     present: bool,
@@ -118,78 +115,21 @@ pub(super) struct VirtualMpu {
     /// Bytes written in this transfer.
     written: u32,
     pointer: u8,
-    next_refresh_cycle: u64,
-    /// The cycle of the instruction being run (for the hook's time stamps).
-    pub(super) now_cycle: u64,
-    pub(super) bus: ImuBus,
+    bus: ImuBus,
 }
 
-impl VirtualMpu {
-    /// A powered-on sensor on `avr`'s TWI fed by `source`, its hook registered; boxed for its
-    /// address.
-    ///
-    /// # Safety
-    /// `avr` is a live, initialised ATmega2560; the box must outlive the simulator's use of
-    /// the hook (drop it only after `avr_terminate`).
-    pub(super) unsafe fn attach(avr: *mut ffi::avr_t, source: SharedImuSource) -> Box<VirtualMpu> {
-        // SAFETY (this block): `avr` is live (caller); the IRQs exist on the ATmega2560
-        // (TWI and port D are part of its core description).
-        unsafe {
-            let out = ffi::avr_io_getirq(avr, IOCTL_TWI_GETIRQ, ffi::TWI_IRQ_OUTPUT as i32);
-            let twi_in = ffi::avr_io_getirq(avr, IOCTL_TWI_GETIRQ, ffi::TWI_IRQ_INPUT as i32);
-            let sda = ffi::avr_io_getirq(avr, IOCTL_IOPORT_GETIRQ_D, ffi::IOPORT_IRQ_PIN1 as i32);
-            let scl = ffi::avr_io_getirq(avr, IOCTL_IOPORT_GETIRQ_D, ffi::IOPORT_IRQ_PIN0 as i32);
-            let mut chip = Box::new(VirtualMpu {
-                avr,
-                twi_in,
-                sda,
-                source,
-                regs: power_on_registers(),
-                present: true,
-                sda_low: false,
-                who_am_i: WHO_AM_I_VALUE,
-                selected: None,
-                written: 0,
-                pointer: 0,
-                next_refresh_cycle: 0,
-                now_cycle: 0,
-                bus: ImuBus::default(),
-            });
-            chip.set_pull_ups();
-            ffi::avr_raise_irq(scl, 1);
-            ffi::avr_raise_irq(sda, 1);
-            let param: *mut c_void = (&mut *chip as *mut VirtualMpu).cast();
-            ffi::avr_irq_register_notify(out, Some(on_twi_output), param);
-            chip.refresh(0);
-            chip
+impl Chip {
+    fn new() -> Chip {
+        Chip {
+            regs: power_on_registers(),
+            present: true,
+            sda_low: false,
+            who_am_i: WHO_AM_I_VALUE,
+            selected: None,
+            written: 0,
+            pointer: 0,
+            bus: ImuBus::default(),
         }
-    }
-
-    /// simavr's external pull-ups on the bus pins: both high, or SDA held low.
-    fn set_pull_ups(&mut self) {
-        let value = if self.sda_low { 0b01 } else { BUS_PINS_MASK };
-        // `avr_ioport_external_t`: name (7 bits), mask (8), value (8), in an unsigned long.
-        let mut external: std::ffi::c_ulong = (std::ffi::c_ulong::from(b'D'))
-            | (std::ffi::c_ulong::from(BUS_PINS_MASK) << 7)
-            | (std::ffi::c_ulong::from(value) << 15);
-        // SAFETY: the ioctl reads an `avr_ioport_external_t` from the pointer; `avr` is live.
-        unsafe {
-            ffi::avr_ioctl(
-                self.avr,
-                IOCTL_IOPORT_SET_EXTERNAL_D,
-                (&mut external as *mut std::ffi::c_ulong).cast(),
-            );
-        }
-    }
-
-    fn hold_sda(&mut self, low: bool) {
-        if low == self.sda_low {
-            return;
-        }
-        self.sda_low = low;
-        self.set_pull_ups();
-        // SAFETY: a port D pin IRQ of a live simulator.
-        unsafe { ffi::avr_raise_irq(self.sda, u32::from(!low)) };
     }
 
     /// The sample period as configured, cycles.
@@ -199,19 +139,13 @@ impl VirtualMpu {
         u64::from(super::F_CPU_HZ) / u64::from(rate.max(1))
     }
 
-    /// Takes the source's reading when a sample instant has come (after each instruction).
-    pub(super) fn tick(&mut self, cycle: u64) {
-        if cycle < self.next_refresh_cycle || self.selected.is_some_and(|a| a & 1 == 1) {
-            return;
-        }
-        self.refresh(cycle);
+    /// True while a read addressed to it is in progress (the data must not change).
+    fn reading(&self) -> bool {
+        self.selected.is_some_and(|a| a & 1 == 1)
     }
 
-    fn refresh(&mut self, cycle: u64) {
-        let period = self.period_cycles();
-        self.next_refresh_cycle = (self.next_refresh_cycle + period).max(cycle + 1);
-        let t_s = cycle as f64 / f64::from(super::F_CPU_HZ);
-        let reading = self.source.read(t_s);
+    /// Takes a reading of the source (module docs): the data registers, presence, SDA.
+    fn apply(&mut self, reading: ImuReading) {
         let (present, sda_low) = match reading {
             ImuReading::Sample(s) => {
                 self.who_am_i = WHO_AM_I_VALUE;
@@ -237,12 +171,7 @@ impl VirtualMpu {
             ImuReading::Fault(ImuFault::BusHeld) => (false, true),
         };
         self.present = present;
-        self.hold_sda(sda_low);
-    }
-
-    fn answer(&self, value: u32) {
-        // SAFETY: the TWI input IRQ of a live simulator; simavr takes the answer synchronously.
-        unsafe { ffi::avr_raise_irq(self.twi_in, value) };
+        self.sda_low = sda_low;
     }
 
     fn read_register(&mut self) -> u8 {
@@ -268,7 +197,8 @@ impl VirtualMpu {
         }
     }
 
-    fn on_message(&mut self, value: u32) {
+    /// One message of simavr's TWI master at `cycle`; `answer` takes the chip's replies.
+    fn on_message(&mut self, value: u32, cycle: u64, mut answer: impl FnMut(u32)) {
         let conditions = (value >> 8) & 0xFF;
         let addr = (value >> 16) as u8;
         let data = (value >> 24) as u8;
@@ -282,9 +212,9 @@ impl VirtualMpu {
                     self.selected = Some(addr);
                     self.written = 0;
                     if addr & 1 == 1 && self.pointer == reg::ACCEL_XOUT_H {
-                        self.bus.burst_cycles.push(self.now_cycle);
+                        self.bus.burst_cycles.push(cycle);
                     }
-                    self.answer(msg(ffi::TWI_COND_ACK, addr, 1));
+                    answer(msg(ffi::TWI_COND_ACK, addr, 1));
                 } else {
                     self.bus.unanswered += 1;
                 }
@@ -292,7 +222,7 @@ impl VirtualMpu {
         }
         let Some(sel) = self.selected else { return };
         if conditions & ffi::TWI_COND_WRITE != 0 {
-            self.answer(msg(ffi::TWI_COND_ACK, sel, 1));
+            answer(msg(ffi::TWI_COND_ACK, sel, 1));
             if self.written == 0 {
                 self.pointer = data;
             } else {
@@ -302,8 +232,117 @@ impl VirtualMpu {
         }
         if conditions & ffi::TWI_COND_READ != 0 {
             let byte = self.read_register();
-            self.answer(msg(ffi::TWI_COND_READ, sel, byte));
+            answer(msg(ffi::TWI_COND_READ, sel, byte));
         }
+    }
+}
+
+/// The virtual chip on simavr (module docs); reached by simavr's hook through a raw pointer.
+pub(super) struct VirtualMpu {
+    avr: *mut ffi::avr_t,
+    twi_in: *mut ffi::avr_irq_t,
+    sda: *mut ffi::avr_irq_t,
+    pub(super) source: SharedImuSource,
+    chip: Chip,
+    /// SDA as last driven on the port.
+    sda_low: bool,
+    next_refresh_cycle: u64,
+    /// The cycle of the instruction being run (for the hook's time stamps).
+    pub(super) now_cycle: u64,
+}
+
+impl VirtualMpu {
+    /// A powered-on sensor on `avr`'s TWI fed by `source`, its hook registered; boxed for its
+    /// address.
+    ///
+    /// # Safety
+    /// `avr` is a live, initialised ATmega2560; the box must outlive the simulator's use of
+    /// the hook (drop it only after `avr_terminate`).
+    pub(super) unsafe fn attach(avr: *mut ffi::avr_t, source: SharedImuSource) -> Box<VirtualMpu> {
+        // SAFETY (this block): `avr` is live (caller); the IRQs exist on the ATmega2560
+        // (TWI and port D are part of its core description).
+        unsafe {
+            let out = ffi::avr_io_getirq(avr, IOCTL_TWI_GETIRQ, ffi::TWI_IRQ_OUTPUT as i32);
+            let twi_in = ffi::avr_io_getirq(avr, IOCTL_TWI_GETIRQ, ffi::TWI_IRQ_INPUT as i32);
+            let sda = ffi::avr_io_getirq(avr, IOCTL_IOPORT_GETIRQ_D, ffi::IOPORT_IRQ_PIN1 as i32);
+            let scl = ffi::avr_io_getirq(avr, IOCTL_IOPORT_GETIRQ_D, ffi::IOPORT_IRQ_PIN0 as i32);
+            let mut mpu = Box::new(VirtualMpu {
+                avr,
+                twi_in,
+                sda,
+                source,
+                chip: Chip::new(),
+                sda_low: false,
+                next_refresh_cycle: 0,
+                now_cycle: 0,
+            });
+            mpu.set_pull_ups();
+            ffi::avr_raise_irq(scl, 1);
+            ffi::avr_raise_irq(sda, 1);
+            let param: *mut c_void = (&mut *mpu as *mut VirtualMpu).cast();
+            ffi::avr_irq_register_notify(out, Some(on_twi_output), param);
+            mpu.refresh(0);
+            mpu
+        }
+    }
+
+    /// What it saw on the bus.
+    pub(super) fn bus(&self) -> &ImuBus {
+        &self.chip.bus
+    }
+
+    /// simavr's external pull-ups on the bus pins: both high, or SDA held low.
+    fn set_pull_ups(&mut self) {
+        let value = if self.sda_low { 0b01 } else { BUS_PINS_MASK };
+        // `avr_ioport_external_t`: name (7 bits), mask (8), value (8), in an unsigned long.
+        let mut external: std::ffi::c_ulong = (std::ffi::c_ulong::from(b'D'))
+            | (std::ffi::c_ulong::from(BUS_PINS_MASK) << 7)
+            | (std::ffi::c_ulong::from(value) << 15);
+        // SAFETY: the ioctl reads an `avr_ioport_external_t` from the pointer; `avr` is live.
+        unsafe {
+            ffi::avr_ioctl(
+                self.avr,
+                IOCTL_IOPORT_SET_EXTERNAL_D,
+                (&mut external as *mut std::ffi::c_ulong).cast(),
+            );
+        }
+    }
+
+    /// Drives SDA as the chip wants it (after a reading was applied).
+    fn drive_sda(&mut self) {
+        let low = self.chip.sda_low;
+        if low == self.sda_low {
+            return;
+        }
+        self.sda_low = low;
+        self.set_pull_ups();
+        // SAFETY: a port D pin IRQ of a live simulator.
+        unsafe { ffi::avr_raise_irq(self.sda, u32::from(!low)) };
+    }
+
+    /// Takes the source's reading when a sample instant has come (after each instruction).
+    pub(super) fn tick(&mut self, cycle: u64) {
+        if cycle < self.next_refresh_cycle || self.chip.reading() {
+            return;
+        }
+        self.refresh(cycle);
+    }
+
+    fn refresh(&mut self, cycle: u64) {
+        let period = self.chip.period_cycles();
+        self.next_refresh_cycle = (self.next_refresh_cycle + period).max(cycle + 1);
+        let t_s = cycle as f64 / f64::from(super::F_CPU_HZ);
+        self.chip.apply(self.source.read(t_s));
+        self.drive_sda();
+    }
+
+    fn on_message(&mut self, value: u32) {
+        let twi_in = self.twi_in;
+        self.chip.on_message(value, self.now_cycle, |answer| {
+            // SAFETY: the TWI input IRQ of a live simulator; simavr takes the answer
+            // synchronously.
+            unsafe { ffi::avr_raise_irq(twi_in, answer) };
+        });
     }
 }
 
@@ -322,4 +361,136 @@ unsafe extern "C" fn on_twi_output(_: *mut ffi::avr_irq_t, value: u32, param: *m
     // Rust reference to the box is used.
     let chip = unsafe { &mut *param.cast::<VirtualMpu>() };
     chip.on_message(value);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quad_device::imu::mpu6050::{CONFIG_SEQUENCE, STANDARD_GRAVITY_M_S2};
+    use quad_device::sim::imu::at_attitude;
+
+    const W: u8 = ADDRESS << 1;
+    const R: u8 = W | 1;
+
+    /// A host that drives the chip as simavr's master does; returns the chip's answers.
+    struct Master(Chip);
+
+    impl Master {
+        fn send(&mut self, conditions: u32, addr: u8, data: u8) -> Vec<u32> {
+            let mut out = Vec::new();
+            self.0
+                .on_message(msg(conditions, addr, data), 0, |a| out.push(a));
+            out
+        }
+
+        fn write(&mut self, bytes: &[u8]) -> bool {
+            let acked = !self.send(ffi::TWI_COND_START, W, 0).is_empty();
+            for &b in bytes {
+                self.send(ffi::TWI_COND_WRITE, W, b);
+            }
+            self.send(ffi::TWI_COND_STOP, W, 0);
+            acked
+        }
+
+        fn read(&mut self, register: u8, n: usize) -> Option<Vec<u8>> {
+            self.send(ffi::TWI_COND_START, W, 0);
+            self.send(ffi::TWI_COND_WRITE, W, register);
+            if self.send(ffi::TWI_COND_START, R, 0).is_empty() {
+                return None;
+            }
+            let bytes = (0..n)
+                .map(|_| (self.send(ffi::TWI_COND_READ, R, 0)[0] >> 24) as u8)
+                .collect();
+            self.send(ffi::TWI_COND_STOP, R, 0);
+            Some(bytes)
+        }
+    }
+
+    fn tilted() -> ImuReading {
+        ImuReading::Sample(at_attitude(0.0, 0.2, [0.1, 0.0, -0.3]))
+    }
+
+    #[test]
+    fn asleep_after_power_on_the_data_stays_zero_and_wakes_with_the_configuration() {
+        let mut m = Master(Chip::new());
+        assert_eq!(m.read(reg::WHO_AM_I, 1), Some(vec![0x68]));
+        assert_eq!(m.read(reg::PWR_MGMT_1, 1), Some(vec![0x40]));
+        m.0.apply(tilted());
+        assert_eq!(
+            m.read(reg::ACCEL_XOUT_H, BURST_LEN),
+            Some(vec![0; BURST_LEN])
+        );
+        // 8 kHz with the DLPF off at power-on: 2,000 cycles.
+        assert_eq!(m.0.period_cycles(), 2_000);
+        for (r, v) in CONFIG_SEQUENCE {
+            assert!(m.write(&[r, v]));
+        }
+        assert_eq!(m.0.bus.writes, CONFIG_SEQUENCE.to_vec());
+        assert_eq!(m.0.period_cycles(), 16_000_000 / 250);
+        m.0.apply(tilted());
+        let burst: [u8; BURST_LEN] = m
+            .read(reg::ACCEL_XOUT_H, BURST_LEN)
+            .unwrap()
+            .try_into()
+            .unwrap();
+        let s = mpu6050::decode(&burst);
+        let g = STANDARD_GRAVITY_M_S2;
+        assert!((s.accel_m_s2[0] + g * 0.2f32.sin()).abs() < 0.005, "{s:?}");
+        assert!((s.gyro_rad_s[2] + 0.3).abs() < 0.001, "{s:?}");
+        assert_eq!(m.0.bus.burst_cycles.len(), 2);
+        // Back to sleep: the data keeps its values.
+        assert!(m.write(&[reg::PWR_MGMT_1, SLEEP]));
+        m.0.apply(ImuReading::Sample(at_attitude(0.0, 0.0, [0.0; 3])));
+        assert_eq!(
+            m.read(reg::ACCEL_XOUT_H, BURST_LEN).unwrap(),
+            burst.to_vec()
+        );
+        // DEVICE_RESET: the power-on registers.
+        assert!(m.write(&[reg::PWR_MGMT_1, 0x80]));
+        assert_eq!(m.read(reg::PWR_MGMT_1, 1), Some(vec![0x40]));
+    }
+
+    #[test]
+    fn the_ranges_written_are_the_ranges_encoded() {
+        let mut m = Master(Chip::new());
+        m.write(&[reg::PWR_MGMT_1, 0x01]);
+        m.write(&[reg::ACCEL_CONFIG, AccelRange::G2.register()]);
+        m.0.apply(ImuReading::Sample(at_attitude(0.0, 0.0, [0.0; 3])));
+        let b = m.read(reg::ACCEL_XOUT_H + 4, 2).unwrap();
+        assert_eq!(i16::from_be_bytes([b[0], b[1]]), 16_384, "1 g at ±2 g");
+        m.write(&[reg::ACCEL_CONFIG, AccelRange::G16.register()]);
+        m.0.apply(ImuReading::Sample(at_attitude(0.0, 0.0, [0.0; 3])));
+        let b = m.read(reg::ACCEL_XOUT_H + 4, 2).unwrap();
+        assert_eq!(i16::from_be_bytes([b[0], b[1]]), 2_048, "1 g at ±16 g");
+    }
+
+    #[test]
+    fn faults_act_on_the_bus() {
+        let mut m = Master(Chip::new());
+        m.0.apply(ImuReading::Fault(ImuFault::Nak));
+        assert_eq!(m.read(reg::WHO_AM_I, 1), None);
+        assert!(!m.0.sda_low);
+        m.0.apply(ImuReading::Fault(ImuFault::BusHeld));
+        assert_eq!(m.read(reg::WHO_AM_I, 1), None);
+        assert!(m.0.sda_low);
+        m.0.apply(ImuReading::Fault(ImuFault::WrongId { who_am_i: 0x70 }));
+        assert_eq!(m.read(reg::WHO_AM_I, 1), Some(vec![0x70]));
+        assert!(!m.0.sda_low);
+        m.write(&[reg::PWR_MGMT_1, 0x01]);
+        m.0.apply(tilted());
+        let before = m.read(reg::ACCEL_XOUT_H, BURST_LEN);
+        m.0.apply(ImuReading::Fault(ImuFault::Stuck));
+        assert_eq!(
+            m.read(reg::ACCEL_XOUT_H, BURST_LEN),
+            before,
+            "frozen while stuck"
+        );
+        m.0.apply(ImuReading::Sample(at_attitude(0.0, 0.0, [0.0; 3])));
+        assert_ne!(
+            m.read(reg::ACCEL_XOUT_H, BURST_LEN),
+            before,
+            "fresh data after"
+        );
+        assert!(m.0.bus.unanswered >= 2);
+    }
 }
