@@ -121,15 +121,21 @@ fn pass_stamp() -> (u32, u16) {
     })
 }
 
-/// Microseconds between two [`pass_stamp`]s (saturating at 65,535 µs).
+/// Microseconds between two [`pass_stamp`]s (saturating at 65,535 µs). No division: this runs
+/// on every pass of the main loop.
 fn elapsed_us(a: (u32, u16), b: (u32, u16)) -> u16 {
     let ms = b.0.wrapping_sub(a.0);
     if ms >= 20 {
-        return u16::try_from(ms.saturating_mul(1000)).unwrap_or(u16::MAX);
+        return if ms >= 65 { u16::MAX } else { ms as u16 * 1000 };
     }
     let period = crate::servo::PERIOD_TICKS;
-    let ticks = (u32::from(b.1) + u32::from(period) - u32::from(a.1)) % u32::from(period);
-    (ticks / 2) as u16
+    // Both counts are below `period`: no overflow.
+    let ticks = if b.1 >= a.1 {
+        b.1 - a.1
+    } else {
+        b.1 + (period - a.1)
+    };
+    ticks / 2
 }
 
 /// One pass of the main loop: received bytes to the controller, answers out, failsafe check,
@@ -164,14 +170,26 @@ fn serve(
             device.receive(&chunk[..n], |frame| usart.send(frame));
         }
     }
-    // Timed: the frame's work (at a frame boundary: the motion engine, the IK, the limiter)
-    // and the sensor's step, without the request handled above (its time is the request's
-    // answer time).
+    // Timed when a servo frame is due (a PWM period began since the last timed pass): the
+    // frame's work (the motion engine, the IK, the limiter) and the sensor's step, without
+    // the request handled above (its time is the request's answer time). The other passes
+    // pay one comparison. (A period that begins in the few instructions between this look
+    // and the device's own lets that one frame go untimed.)
+    let period = crate::servo::periods_mod_256();
+    if period == FRAME_TIMED.load() {
+        device.poll();
+        imu.poll(device, portd, crate::clock::now_ms());
+        return;
+    }
+    FRAME_TIMED.store(period);
     let start = pass_stamp();
     device.poll();
     imu.poll(device, portd, crate::clock::now_ms());
     crate::imu::note_frame_us(elapsed_us(start, pass_stamp()));
 }
+
+/// [`crate::servo::periods_mod_256`] at the last timed pass (main loop only).
+static FRAME_TIMED: crate::usart::SharedU8 = crate::usart::SharedU8::new(0);
 
 /// Defines the interrupt handlers of a binary that calls [`run`] (handlers must live in the
 /// binary crate to be linked): `USART0_RX`, `USART0_UDRE`, `TIMER2_COMPA`, `TWI` and
