@@ -11,6 +11,7 @@
 //!       main loop: finished burst ─▶ stuck check ─▶ decode ─▶ Device::on_imu(Sample)
 //! fault mid-run: NAK ─▶ Nak │ STUCK_REPEATS identical bursts ─▶ Stuck │ SDA low or no end ─▶ BusHeld
 //!       (SCL clocked, STOP); after RETRY_MS the probe and configuration again, then run
+//!       (after Stuck too: a sensor that lost its power is asleep with frozen data)
 //! ```
 //!
 //! The periodic burst is started by the clock's 1 kHz tick ([`on_tick`], in its interrupt),
@@ -153,7 +154,7 @@ pub struct Imu {
     /// A transfer of the boot or retry sequence was started.
     started: bool,
     stuck: StuckDetector,
-    /// Stuck was pushed for the current run of identical bursts.
+    /// Stuck was pushed and no fresh sample came since.
     stuck_pushed: bool,
 }
 
@@ -228,8 +229,8 @@ impl Imu {
                         if usize::from(next) < CONFIG_SEQUENCE.len() {
                             self.phase = Phase::Configure(next);
                         } else {
-                            self.stuck.reset();
-                            self.stuck_pushed = false;
+                            // The stuck detector keeps its count: data still frozen after
+                            // the configuration is stuck from the first burst on.
                             self.phase = Phase::Run;
                             compiler_fence(Ordering::SeqCst);
                             RUN.store(1);
@@ -293,6 +294,10 @@ impl Imu {
                         self.stuck_pushed = true;
                         self.push(device, ImuReading::Fault(ImuFault::Stuck));
                     }
+                    // A sensor that lost its power and came back is asleep with frozen data:
+                    // probe and configure it again (the fault stays until a fresh sample).
+                    self.stop_bursts();
+                    self.phase = retry(now_ms);
                 } else {
                     self.stuck_pushed = false;
                     self.push(device, ImuReading::Sample(mpu6050::decode(&burst)));

@@ -392,7 +392,19 @@ fn fault_then_recovery(fault: ImuFault) -> Window {
         Some(name_of(fault)),
         "{fault:?}: during: {during:?}"
     );
-    board.idle_s(1.6);
+    // Still there near the window's end: no sample got through meanwhile.
+    board.idle_s(0.5);
+    let late = board.window();
+    assert_eq!(
+        late.fault(),
+        Some(name_of(fault)),
+        "{fault:?}: late: {late:?}"
+    );
+    assert_eq!(
+        late.samples, during.samples,
+        "{fault:?}: no sample while it lasts"
+    );
+    board.idle_s(1.1);
     let after = board.window();
     assert_eq!(after.fault(), None, "{fault:?}: after: {after:?}");
     assert!(
