@@ -47,8 +47,9 @@ pub fn now_ms() -> u32 {
     interrupt::free(|cs| MILLIS.borrow(cs).get())
 }
 
-/// Advances the clock by one millisecond, then (with interrupts enabled again) lets the servo
-/// outputs apply a staged state; call from the `TIMER2_COMPA` interrupt.
+/// Advances the clock by one millisecond, then (with interrupts enabled again) starts the
+/// sensor's burst when due and lets the servo outputs apply a staged state; call from the
+/// `TIMER2_COMPA` interrupt.
 ///
 /// Interrupts are re-enabled for the servo part because writing the twelve compare registers
 /// takes longer than one byte time at 1 Mbaud: the receive interrupt must be able to come in
@@ -60,10 +61,10 @@ pub fn on_tick_interrupt() {
         let c = MILLIS.borrow(cs);
         c.set(c.get().wrapping_add(1));
     });
-    // A few instructions: starts the sensor's periodic burst when due.
-    crate::imu::on_tick();
     // SAFETY: the clock's state is updated; the servo code guards itself (`BUSY`) and touches
-    // nothing the other handlers use.
+    // nothing the other handlers use; the sensor's tick starts a transfer only into an idle
+    // slot, which the TWI handler does not touch (`crate::twi`).
     unsafe { interrupt::enable() };
+    crate::imu::on_tick();
     crate::servo::on_tick();
 }

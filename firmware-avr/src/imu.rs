@@ -106,7 +106,8 @@ static BUSY_TICKS: SharedU8 = SharedU8::new(0);
 /// The burst's register address, written before the read.
 const BURST_START: [u8; 1] = [reg::ACCEL_XOUT_H];
 
-/// Starts the periodic burst when it is due; call from the 1 kHz tick with interrupts off.
+/// Starts the periodic burst when it is due; call from the 1 kHz tick (interrupts may be on:
+/// the TWI handler only ends a transfer, and a slot it has not released yet makes this skip).
 #[inline(always)]
 pub fn on_tick() {
     if twi::is_busy() {
