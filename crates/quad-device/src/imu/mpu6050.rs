@@ -25,8 +25,8 @@
 //! ## Stuck data
 //! A live sensor's 14 bytes never repeat exactly for long: the accelerometer's noise alone is
 //! about ten LSB at ±8 g with the 44 Hz filter (400 µg/√Hz, product specification §6.2), and
-//! the temperature word moves too. [`StuckDetector`] calls the data stuck after
-//! [`STUCK_REPEATS`] identical bursts in a row. (So a noiseless simulated source reads as stuck
+//! the temperature word moves too. [`StuckDetector`] calls the data stuck when a burst has
+//! repeated unchanged [`STUCK_REPEATS`] times in a row. (So a noiseless simulated source reads as stuck
 //! too: give it noise, as the real chip has.)
 
 use super::ImuSample;
@@ -333,7 +333,7 @@ pub fn encode(
     out
 }
 
-/// Identical bursts in a row after which the data counts as stuck (80 ms at the read rate).
+/// Unchanged repeats of a burst after which the data counts as stuck (80 ms at the read rate).
 pub const STUCK_REPEATS: u8 = 10;
 
 /// Watches bursts for stuck data (see the module docs).
