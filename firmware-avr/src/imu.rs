@@ -60,6 +60,11 @@ pub struct Window {
     pub bursts_skipped: u16,
 }
 
+// The emulator tests read the window by these offsets: samples 0, fault 4, who_am_i 5,
+// recoveries 6, longest_frame_us 8, bursts_skipped 10 (`tests/tests/avr_imu.rs`).
+const _: () = assert!(core::mem::size_of::<Window>() == 12);
+const _: () = assert!(core::mem::offset_of!(Window, longest_frame_us) == 8);
+
 /// [`Window`] in a static cell.
 pub struct WindowCell(UnsafeCell<Window>);
 
