@@ -8,7 +8,9 @@
 //!   Timer1/3/4/5 compare outputs ◀─ staged state ◀─ ServoOutputs        Clock ◀─ Timer2 (1 kHz)
 //!                    ▲ written between pulses, by the main loop or the Timer2 tick
 //!                                                   Storage ◀─ EEPROM (EE_READY interrupt)
-//! main loop: feed the watchdog, hand received bytes to the controller, Device::poll (failsafe)
+//!   MPU-6050 ─ TWI interrupt ─▶ burst (started by the Timer2 tick) ─▶ imu::Imu ─▶ Device::on_imu
+//! main loop: feed the watchdog, hand received bytes to the controller, Device::poll (failsafe),
+//!            take the sensor's finished burst
 //! ```
 //!
 //! The main loop never waits for the line or for a servo window: answers leave by interrupt
@@ -31,6 +33,7 @@
 
 use crate::clock::Clock;
 use crate::eeprom::Eeprom;
+use crate::imu::Imu;
 use crate::servo::Servos;
 use crate::usart::{Baud, Usart0};
 use crate::watchdog::{self, Timeout, Watchdog};
@@ -76,6 +79,8 @@ pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
     let clock = Clock::new(dp.TC2);
     let mut usart = Usart0::new(dp.USART0, baud);
     let eeprom = Eeprom::new(dp.EEPROM);
+    let portd = dp.PORTD;
+    let mut imu = Imu::new(dp.TWI, &portd);
     // SAFETY: the binaries define the handlers (`forward_interrupts!`); each touches only its
     // own module's state.
     unsafe { avr_device::interrupt::enable() };
@@ -90,7 +95,7 @@ pub fn run_with_receive_hold(baud: Baud, hold_cycles: u32) -> ! {
     }
     loop {
         watchdog.feed();
-        serve(&mut device, &mut usart, hold_cycles);
+        serve(&mut device, &mut usart, &mut imu, &portd, hold_cycles);
     }
 }
 
@@ -105,13 +110,48 @@ fn new_device(servos: Servos, clock: Clock, eeprom: Eeprom) -> BoardDevice {
     BoardDevice::stopped_valid(DEVICE_CONFIG, servos, clock, eeprom)
 }
 
-/// One pass of the main loop: received bytes to the controller, answers out, failsafe check.
+/// The millisecond clock and Timer1's count (0.5 µs ticks, wrapping every 20 ms), read
+/// together with interrupts off (a 16-bit count is read through the timer's shared TEMP
+/// register, which a tick's compare writes would clobber between the two bytes).
+fn pass_stamp() -> (u32, u16) {
+    avr_device::interrupt::free(|_| {
+        // SAFETY: TCNT1 is only read here; the servo code owns Timer1's configuration.
+        let tc1 = unsafe { crate::pac::TC1::steal() };
+        (crate::clock::now_ms(), tc1.tcnt1().read().bits())
+    })
+}
+
+/// Microseconds between two [`pass_stamp`]s (saturating at 65,535 µs). No division: this runs
+/// on every pass of the main loop.
+fn elapsed_us(a: (u32, u16), b: (u32, u16)) -> u16 {
+    let ms = b.0.wrapping_sub(a.0);
+    if ms >= 20 {
+        return if ms >= 65 { u16::MAX } else { ms as u16 * 1000 };
+    }
+    let period = crate::servo::PERIOD_TICKS;
+    // Both counts are below `period`: no overflow.
+    let ticks = if b.1 >= a.1 {
+        b.1 - a.1
+    } else {
+        b.1 + (period - a.1)
+    };
+    ticks / 2
+}
+
+/// One pass of the main loop: received bytes to the controller, answers out, failsafe check,
+/// the sensor's finished transfer.
 ///
 /// Kept out of line: inlined into [`run`], whose stack frame holds the whole controller, every
 /// access to a local would need a frame pointer beyond the AVR's 63-byte displacement (about
 /// 8 instructions per access) — it doubled the firmware's flash.
 #[inline(never)]
-fn serve(device: &mut BoardDevice, usart: &mut Usart0, hold_cycles: u32) {
+fn serve(
+    device: &mut BoardDevice,
+    usart: &mut Usart0,
+    imu: &mut Imu,
+    portd: &crate::pac::PORTD,
+    hold_cycles: u32,
+) {
     if hold_cycles == 0 {
         // The bytes are read where they lie in the receive ring: no copy.
         Usart0::with_received(CHUNK, |bytes| {
@@ -130,11 +170,30 @@ fn serve(device: &mut BoardDevice, usart: &mut Usart0, hold_cycles: u32) {
             device.receive(&chunk[..n], |frame| usart.send(frame));
         }
     }
+    // Timed when a servo frame is due (a PWM period began since the last timed pass): the
+    // frame's work (the motion engine, the IK, the limiter) and the sensor's step, without
+    // the request handled above (its time is the request's answer time). The other passes
+    // pay one comparison. (A period that begins in the few instructions between this look
+    // and the device's own lets that one frame go untimed.)
+    let period = crate::servo::periods_mod_256();
+    if period == FRAME_TIMED.load() {
+        device.poll();
+        imu.poll(device, portd, crate::clock::now_ms());
+        return;
+    }
+    FRAME_TIMED.store(period);
+    let start = pass_stamp();
     device.poll();
+    imu.poll(device, portd, crate::clock::now_ms());
+    crate::imu::note_frame_us(elapsed_us(start, pass_stamp()));
 }
 
+/// [`crate::servo::periods_mod_256`] at the last timed pass (main loop only).
+static FRAME_TIMED: crate::usart::SharedU8 = crate::usart::SharedU8::new(0);
+
 /// Defines the interrupt handlers of a binary that calls [`run`] (handlers must live in the
-/// binary crate to be linked): `USART0_RX`, `USART0_UDRE`, `TIMER2_COMPA` and `EE_READY`.
+/// binary crate to be linked): `USART0_RX`, `USART0_UDRE`, `TIMER2_COMPA`, `TWI` and
+/// `EE_READY`.
 /// The binary needs `#![feature(abi_avr_interrupt)]`.
 #[macro_export]
 macro_rules! forward_interrupts {
@@ -152,6 +211,11 @@ macro_rules! forward_interrupts {
         #[avr_device::interrupt(atmega2560)]
         fn TIMER2_COMPA() {
             $crate::clock::on_tick_interrupt();
+        }
+
+        #[avr_device::interrupt(atmega2560)]
+        fn TWI() {
+            $crate::twi::on_interrupt();
         }
 
         #[avr_device::interrupt(atmega2560)]

@@ -38,8 +38,8 @@ use kin_core::motion::gait::{GaitParams, Pattern, Velocity};
 use kin_core::motion::laws::Axis;
 use kin_core::{body, BodyConfig, IkError, LegId, Math, Pose, ReachPolicy, Robot, Vec3};
 use quad_device::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS};
-use quad_protocol::{LegSet, MotionCommand as Request, MotionStage};
 use quad_device::{default_calibration, Config};
+use quad_protocol::{LegSet, MotionCommand as Request, MotionStage};
 
 /// Stance height of the body-pose benchmark: seed 000 Table 4 body height, m.
 pub const STANCE_HEIGHT_M: f32 = 0.277;

@@ -1,7 +1,8 @@
 //! Millisecond clock on Timer2 (8-bit, CTC mode, prescaler 64, OCR2A = 249: 1 kHz).
 //!
 //! The binary forwards the `TIMER2_COMPA` interrupt to [`on_tick_interrupt`], which also gives
-//! the servo outputs their chance to apply a staged state ([`crate::servo::on_tick`]).
+//! the servo outputs their chance to apply a staged state ([`crate::servo::on_tick`]) and the
+//! sensor its periodic burst ([`crate::imu::on_tick`]).
 
 use crate::pac;
 use avr_device::interrupt::{self, Mutex};
@@ -46,8 +47,9 @@ pub fn now_ms() -> u32 {
     interrupt::free(|cs| MILLIS.borrow(cs).get())
 }
 
-/// Advances the clock by one millisecond, then (with interrupts enabled again) lets the servo
-/// outputs apply a staged state; call from the `TIMER2_COMPA` interrupt.
+/// Advances the clock by one millisecond, then (with interrupts enabled again) starts the
+/// sensor's burst when due and lets the servo outputs apply a staged state; call from the
+/// `TIMER2_COMPA` interrupt.
 ///
 /// Interrupts are re-enabled for the servo part because writing the twelve compare registers
 /// takes longer than one byte time at 1 Mbaud: the receive interrupt must be able to come in
@@ -60,7 +62,9 @@ pub fn on_tick_interrupt() {
         c.set(c.get().wrapping_add(1));
     });
     // SAFETY: the clock's state is updated; the servo code guards itself (`BUSY`) and touches
-    // nothing the other handlers use.
+    // nothing the other handlers use; the sensor's tick starts a transfer only into an idle
+    // slot, which the TWI handler does not touch (`crate::twi`).
     unsafe { interrupt::enable() };
+    crate::imu::on_tick();
     crate::servo::on_tick();
 }

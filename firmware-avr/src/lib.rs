@@ -11,6 +11,8 @@
 //! | [`eeprom`] | the EEPROM as calibration storage (`quad_device::Storage`) |
 //! | [`mem`] | `memcpy` and `memset`, four bytes per loop step |
 //! | [`usart`] | USART0: receive and transmit by interrupt through lock-free rings |
+//! | [`twi`] | the TWI (I²C) master at 400 kHz by interrupt, bus recovery |
+//! | [`imu`] | the MPU-6050 driver: probe, configuration, periodic bursts into `Device::on_imu`, typed faults |
 //! | [`watchdog`] | watchdog enable/feed and the reset cause |
 //! | [`stack`] | SRAM painting at boot and the high-water mark of the stack |
 //! | [`mod@bench`] | the cycle benchmark's request loop (used by the `bench` binaries only) |
@@ -23,8 +25,8 @@
 //! Interrupt handlers must be defined in the binary crate (a handler in a library is not
 //! pulled in by the linker): each binary forwards `USART0_RX` to [`usart::on_rx_interrupt`],
 //! `USART0_UDRE` to [`usart::on_udre_interrupt`] (the firmware binaries; the benchmark
-//! transmits by polling), `TIMER2_COMPA` to [`clock::on_tick_interrupt`] and `EE_READY` to
-//! [`eeprom::on_ready_interrupt`] (the firmware binaries through [`forward_interrupts!`]).
+//! transmits by polling), `TIMER2_COMPA` to [`clock::on_tick_interrupt`], `TWI` to [`twi::on_interrupt`] and
+//! `EE_READY` to [`eeprom::on_ready_interrupt`] (the firmware binaries through [`forward_interrupts!`]).
 
 #![no_std]
 #![feature(asm_experimental_arch)]
@@ -36,9 +38,11 @@ pub mod bench;
 pub mod clock;
 pub mod eeprom;
 pub mod harness;
+pub mod imu;
 pub mod mem;
 pub mod servo;
 pub mod stack;
+pub mod twi;
 pub mod usart;
 pub mod watchdog;
 

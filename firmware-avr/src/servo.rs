@@ -240,6 +240,12 @@ static BUSY: Shared<u8> = Shared::new(0);
 /// PWM periods begun, wrapping (counted by the tick interrupt from Timer1's overflow flag,
 /// which the chip sets at TOP, the end of each period).
 static PERIODS: Shared<u8> = Shared::new(0);
+
+/// The PWM periods begun, modulo 256 (counted by the clock's tick): the device runs a servo
+/// frame in the first `Device::poll` after it changes.
+pub fn periods_mod_256() -> u8 {
+    PERIODS.get()
+}
 /// [`PERIODS`] when the last staged state was written to the registers: the chip takes it over
 /// when the next period begins.
 static APPLIED_IN: Shared<u8> = Shared::new(0);

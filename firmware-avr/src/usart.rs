@@ -82,25 +82,25 @@ impl Baud {
 /// LLVM's AVR backend brackets every atomic access with `cli` and a restore of SREG, the very
 /// interrupts-off stretches this module avoids. Volatile accesses plus compiler fences give
 /// the ordering a single core needs.
-struct SharedU8(UnsafeCell<u8>);
+pub(crate) struct SharedU8(UnsafeCell<u8>);
 
 // SAFETY: single-core MCU; each `SharedU8` has one writer (documented at its use) and its
 // accesses are single-instruction volatile loads and stores.
 unsafe impl Sync for SharedU8 {}
 
 impl SharedU8 {
-    const fn new(v: u8) -> SharedU8 {
+    pub(crate) const fn new(v: u8) -> SharedU8 {
         SharedU8(UnsafeCell::new(v))
     }
 
     #[inline(always)]
-    fn load(&self) -> u8 {
+    pub(crate) fn load(&self) -> u8 {
         // SAFETY: a valid, aligned byte; see the `Sync` impl.
         unsafe { self.0.get().read_volatile() }
     }
 
     #[inline(always)]
-    fn store(&self, v: u8) {
+    pub(crate) fn store(&self, v: u8) {
         // SAFETY: as in `load`.
         unsafe { self.0.get().write_volatile(v) }
     }

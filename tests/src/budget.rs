@@ -1,7 +1,7 @@
 //! The firmware's flash and SRAM budget, measured: flash and static SRAM from the release ELF's
 //! sections, the stack as the deepest of the firmware's own paint mark and the stack pointer's
 //! low-water mark in simavr, after a workload that sends every request type and runs every
-//! onboard motion (`cargo xtask ci
+//! onboard motion with the MPU-6050 on the bus and read throughout (`cargo xtask ci
 //! budget`, `cargo run -p integration-tests --bin firmware-budget`).
 //!
 //! The budget leaves most of the ATmega2560 (248 KB of flash for the application, 8 KB of SRAM)
@@ -16,8 +16,9 @@ use kin_core::motion::gait::{GaitParams, Pattern};
 use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
 use kin_core::{LegId, Pose, ReachPolicy, RotationOrder};
+use quad_device::sim::imu::{LevelStill, Noisy};
 use quad_host::client::{Client, ClientConfig};
-use quad_host::emu::elf;
+use quad_host::emu::{elf, SharedImuSource};
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::{
     DeviceToHost, LegSet, LinkLossAction, LinkTimeout, MotionCommand, PoseConfig, Request, ServoId,
@@ -157,8 +158,12 @@ fn workload(poses: &[Pose]) -> Vec<Request> {
 /// # Panics
 /// When the ELF cannot be read or booted, or a request gets no answer.
 pub fn measure(elf_path: &Path, poses: &[Pose]) -> Figures {
-    let link = EmulatorLink::boot(elf_path, EmulatorConfig::new(115_200))
-        .unwrap_or_else(|e| panic!("{e}"));
+    // With the sensor read all along: its driver's path and the TWI interrupt count too.
+    let config = EmulatorConfig {
+        imu: Some(SharedImuSource::new(Noisy::mpu6050(LevelStill, 1))),
+        ..EmulatorConfig::new(115_200)
+    };
+    let link = EmulatorLink::boot(elf_path, config).unwrap_or_else(|e| panic!("{e}"));
     let mut client = Client::new(link, ClientConfig::emulator());
     let mut last_angles = [0.0f32; 12];
     for request in workload(poses) {

@@ -36,7 +36,7 @@ const BYTE_CYCLES_AT_1MBAUD: u64 = 160;
 
 /// A `SetBodyPose`'s last byte → its answer's first byte, beyond the body IK itself (as the
 /// firmware runs it: its solver built at boot), at most (cycles; 1 ms at 16 MHz). Measured
-/// 0.91 ms at 115,200 baud and 0.96 ms at 1 Mbaud (BENCHMARKS.md), where more of the request's
+/// 0.90 ms at 115,200 baud and 0.98 ms at 1 Mbaud (BENCHMARKS.md), where more of the request's
 /// bytes are decoded after its last byte.
 const ROUND_TRIP_OVER_IK_CYCLES: u64 = 16_000;
 

@@ -10,6 +10,11 @@
 //! Frames: readings are in the **body frame** of kin-core (x forward, y left, z up), the sensor's
 //! mounting already applied by the driver. At rest and level the accelerometer reads
 //! `(0, 0, +g)` (it measures the reaction to gravity).
+//!
+//! The sensor itself, for the firmware's driver and the emulator's virtual chip alike:
+//! [`mpu6050`].
+
+pub mod mpu6050;
 
 /// One reading of a six-axis inertial sensor, SI units, body frame.
 #[derive(Clone, Copy, Debug, PartialEq)]

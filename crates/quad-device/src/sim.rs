@@ -11,8 +11,13 @@
 //! - [`RamEeprom`]: bytes in RAM, erased to `0xFF`, with a power-cut budget on writes and a fault
 //!   budget on reads.
 //!
+//! - [`imu`]: sources of inertial readings ([`imu::ImuSource`]) for the simulated device, the
+//!   emulator's virtual MPU-6050 and the twin.
+//!
 //! What one user needs on top stays with it as a thin wrapper (the host's EEPROM image file,
 //! the twin's frame-by-frame clock). Needs `alloc`; the firmware builds without the feature.
+
+pub mod imu;
 
 use crate::hal::{Clock, ServoOutputs, Storage};
 use alloc::rc::Rc;

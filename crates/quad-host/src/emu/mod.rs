@@ -7,7 +7,8 @@
 //! - [`Mega2560`]: one ELF in simavr at 16 MHz, instruction by instruction, with a cycle
 //!   counter that survives resets, USART0 in both directions (bytes time-stamped in cycles),
 //!   the twelve servo pins (Timer1/3/4/5 incl. port L) with pulse capture, SRAM, I/O registers
-//!   and EEPROM access, reset detection, and fault injection (a hung CPU).
+//!   and EEPROM access, reset detection, fault injection (a hung CPU), and a virtual MPU-6050
+//!   on the TWI ([`Mega2560::attach_imu`], fed by a [`SharedImuSource`]).
 //! - [`elf`]: section sizes and symbol addresses of an ELF (flash, static SRAM, the stack
 //!   paint's start).
 //!
@@ -20,7 +21,9 @@ pub mod elf;
 #[allow(unsafe_code)]
 mod simavr;
 
-pub use simavr::{EmuError, InterruptsOff, Mega2560, Pulse, Resets, EEPROM_LEN};
+pub use simavr::{
+    EmuError, ImuBus, InterruptsOff, Mega2560, Pulse, Resets, SharedImuSource, EEPROM_LEN,
+};
 
 /// CPU clock of the Mega 2560, Hz.
 pub const F_CPU_HZ: u32 = 16_000_000;

@@ -32,6 +32,28 @@
 //! [`super::sim::SimLink`]. Frames are the host's [`Link::send`] calls and the device's
 //! answers (`00 … 00`).
 //!
+//! ## Inertial sensor
+//! [`EmulatorConfig::imu`] puts a virtual MPU-6050 at 0x68 on the chip's TWI (simavr's own
+//! TWI peripheral; the firmware's driver is the flashed one), fed by a
+//! [`quad_device::sim::imu::ImuSource`] shared through [`SharedImuSource`]: level and still, a
+//! CSV script, a closure (the twin), with seeded noise, bias and fault windows (NAK, stuck
+//! data, absent, SDA held low). The sensor refreshes its data at the sample rate the firmware
+//! configured; [`EmulatorLink::imu_bus`] counts the bursts the firmware read and lists the
+//! registers it wrote.
+//!
+//! ```no_run
+//! use quad_device::sim::imu::{LevelStill, Noisy};
+//! use quad_host::emu::SharedImuSource;
+//! use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
+//!
+//! let config = EmulatorConfig {
+//!     imu: Some(SharedImuSource::new(Noisy::mpu6050(LevelStill, 1))),
+//!     ..EmulatorConfig::new(115_200)
+//! };
+//! let link = EmulatorLink::boot_built(config)?;
+//! # Ok::<(), quad_host::link::emulator::Error>(())
+//! ```
+//!
 //! ## Pin check
 //! Every pulse on the twelve servo pins (Timer1/3/4/5 incl. port L) is measured and compared
 //! with the readbacks the firmware sent (decoded from its UART output before any line fault):
@@ -48,8 +70,8 @@
 
 use super::{Faults, LineStats, Link};
 use crate::emu::{
-    self, build, cycles_to_duration, duration_to_cycles, duration_to_cycles_ceil, EmuError,
-    Mega2560, Pulse, CYCLES_PER_TICK, PERIOD_CYCLES, SERVO_PINS,
+    self, build, cycles_to_duration, duration_to_cycles, duration_to_cycles_ceil, EmuError, ImuBus,
+    Mega2560, Pulse, SharedImuSource, CYCLES_PER_TICK, PERIOD_CYCLES, SERVO_PINS,
 };
 use quad_protocol::{Accumulator, DeviceToHost, Feed, Flags, MAX_DECODED_LEN};
 use seeded_rng::SplitMix64;
@@ -88,6 +110,9 @@ pub struct EmulatorConfig {
     /// Fail on an interrupts-off stretch beyond [`receive_cover_cycles`] while bytes arrive
     /// (see the module docs); on by default.
     pub check_interrupts_off: bool,
+    /// The MPU-6050 on the TWI and its source (`None`: nothing at 0x68, as on a board without
+    /// the sensor). See the module docs' "Inertial sensor".
+    pub imu: Option<SharedImuSource>,
 }
 
 impl EmulatorConfig {
@@ -99,6 +124,7 @@ impl EmulatorConfig {
             seed: 1,
             eeprom: None,
             check_interrupts_off: true,
+            imu: None,
         }
     }
 }
@@ -453,6 +479,9 @@ impl EmulatorLink {
         if let Some(image) = &config.eeprom {
             mcu.set_eeprom(image);
         }
+        if let Some(source) = &config.imu {
+            mcu.attach_imu(source.clone());
+        }
         mcu.capture_pulses(true);
         let limit = duration_to_cycles(BOOT_LIMIT);
         let firmware_baud = loop {
@@ -526,6 +555,11 @@ impl EmulatorLink {
             rx_overflow: self.mcu.rx_overruns(),
             ..self.stats
         }
+    }
+
+    /// What the virtual MPU-6050 saw on the bus (`None`: no sensor configured).
+    pub fn imu_bus(&self) -> Option<&ImuBus> {
+        self.mcu.imu_bus()
     }
 
     /// Bytes the chip's receive buffer lost because the firmware did not read them in time.

@@ -23,9 +23,12 @@
 //! - [`Device::poll`] (the link-loss failsafe, the servo frames of the motion engine) runs
 //!   before every byte and whenever the host's clock advances, at every millisecond boundary
 //!   in between. The device's millisecond clock is the virtual clock.
-//! - **Inertial sensor**: before those polls, every [`IMU_PERIOD_NS`] (100 Hz, the firmware
-//!   driver's rate), the device gets a level-and-still reading ([`LEVEL_AND_STILL`],
-//!   `Device::on_imu`): its sensor reports ok once the start-up second has passed.
+//! - **Inertial sensor** ([`SimLink::attach_imu`]): the device gets the source's reading every
+//!   [`READ_PERIOD_MS`] ms of virtual time, at the millisecond boundary, before that
+//!   millisecond's poll, as the firmware's driver reads its MPU-6050 (the same sources as the
+//!   emulator's virtual sensor, `quad_device::sim::imu`; a fault reading is pushed as the
+//!   fault). A new link's sensor is level and still (`LevelStill`): its health reads ok once
+//!   the start-up second has passed.
 //!
 //! ## Faults
 //! [`Faults`] apply to both directions, drawn from one seeded generator (the same seed, the
@@ -34,9 +37,12 @@
 //! (its line time passes, nothing arrives) and a bit flip.
 
 use super::{byte_time, Error, Faults, LineStats, Link};
+use crate::emu::SharedImuSource;
 use kin_core::DefaultMath;
+use quad_device::imu::mpu6050::READ_PERIOD_MS;
 use quad_device::sim::{EepromError, Outputs, RamEeprom, VirtualClock, EEPROM_LEN};
-use quad_device::{Config, ConfigError, Device, ImuReading, ImuSample, Storage};
+use quad_device::sim::imu::LevelStill;
+use quad_device::{Config, ConfigError, Device, Storage};
 use std::collections::VecDeque;
 use std::fmt;
 use std::path::PathBuf;
@@ -210,19 +216,9 @@ pub struct SimLink {
     clock: VirtualClock,
     device: Simulated,
     stats: LineStats,
-    /// When the device's inertial sensor gives its next reading, ns.
-    next_imu_ns: u64,
+    /// The inertial sensor's source, when attached.
+    imu: Option<SharedImuSource>,
 }
-
-/// The simulated device's inertial sensor reads every 10 ms (100 Hz, as the firmware's driver).
-pub const IMU_PERIOD_NS: u64 = 10_000_000;
-
-/// The simulated sensor's reading: level and still (the robot on flat ground; the shared
-/// sensor sources replace it).
-pub const LEVEL_AND_STILL: ImuSample = ImuSample {
-    accel_m_s2: [0.0, 0.0, kin_core::attitude::G_M_S2],
-    gyro_rad_s: [0.0; 3],
-};
 
 impl SimLink {
     /// A line to a freshly powered-on device built with `device_config` on `storage`, at
@@ -250,8 +246,14 @@ impl SimLink {
             clock,
             device,
             stats: LineStats::default(),
-            next_imu_ns: 0,
+            imu: Some(SharedImuSource::new(LevelStill)),
         })
+    }
+
+    /// Gives the device an inertial sensor fed by `source` (see the module docs); replaces an
+    /// earlier one. It stays attached across [`SimLink::reset_device`].
+    pub fn attach_imu(&mut self, source: SharedImuSource) {
+        self.imu = Some(source);
     }
 
     /// The simulated device, for inspection.
@@ -338,23 +340,16 @@ impl SimLink {
         let mut t = (self.clock.now_ns() / MS_NS + 1) * MS_NS;
         while t < t_ns {
             self.clock.set_ns(t);
-            self.imu_tick();
+            if let Some(imu) = &self.imu {
+                if (t / MS_NS) % u64::from(READ_PERIOD_MS) == 0 {
+                    self.device.on_imu(imu.read(t as f64 * 1e-9));
+                }
+            }
             self.device.poll();
             t += MS_NS;
         }
         self.set_device_time(t_ns);
-        self.imu_tick();
         self.device.poll();
-    }
-
-    /// Pushes the sensor's reading when its period has come ([`IMU_PERIOD_NS`]), as a
-    /// driver does from the main loop.
-    fn imu_tick(&mut self) {
-        let now = self.clock.now_ns();
-        if now >= self.next_imu_ns {
-            self.device.on_imu(ImuReading::Sample(LEVEL_AND_STILL));
-            self.next_imu_ns = now - now % IMU_PERIOD_NS + IMU_PERIOD_NS;
-        }
     }
 
     fn set_device_time(&mut self, t_ns: u64) {
@@ -447,6 +442,30 @@ mod tests {
         encode_frame(&HostToDevice { seq, request }, &mut buf)
             .unwrap()
             .to_vec()
+    }
+
+    #[test]
+    fn an_attached_sensor_is_read_at_the_firmware_s_rate_and_its_faults_reach_the_device() {
+        use quad_device::imu::{ImuFault, ImuReading};
+        use quad_device::sim::imu::{Feed, LevelStill};
+        let mut link = SimLink::new(
+            SimConfig::default(),
+            Config::fernando2025(),
+            EepromImage::erased(),
+        )
+        .unwrap();
+        link.attach_imu(SharedImuSource::new(LevelStill));
+        let mut buf = [0u8; 16];
+        assert_eq!(link.recv(&mut buf, Duration::from_secs(1)).unwrap(), 0);
+        let imu = *link.device().imu();
+        // Reads at 8, 16, …, 992 ms: 124 in the first second.
+        assert_eq!(imu.samples, 1000 / u32::from(READ_PERIOD_MS) - 1);
+        assert_eq!(imu.fault, None);
+        link.attach_imu(SharedImuSource::new(Feed(|_t: f64| {
+            ImuReading::Fault(ImuFault::Nak)
+        })));
+        link.recv(&mut buf, Duration::from_millis(20)).unwrap();
+        assert_eq!(link.device().imu().fault, Some(ImuFault::Nak));
     }
 
     #[test]

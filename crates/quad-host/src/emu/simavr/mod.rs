@@ -42,14 +42,21 @@
 //! - simavr applies a compare register at once, not at the next period as the chip does (the
 //!   firmware writes them between pulses, where both agree).
 //!
+//! - TWI: simavr's master runs the firmware's transfers; a slave answers through IRQ hooks.
+//!   [`Mega2560::attach_imu`] puts a virtual MPU-6050 at 0x68 on it (`twi.rs`); without one
+//!   nothing answers there, as on a board without the sensor.
+//!
 //! Files: this one the simulator itself (set-up, stepping, resets, memory, the EEPROM);
 //! `uart.rs` USART0 as strict as the chip and the interrupts-off stretches; `pins.rs` the pins
-//! and the servo pulses on them, with the compare-register commit.
+//! and the servo pulses on them, with the compare-register commit; `twi.rs` the virtual
+//! MPU-6050 on the TWI.
 
 mod pins;
+mod twi;
 mod uart;
 
 pub use pins::Pulse;
+pub use twi::{ImuBus, SharedImuSource};
 pub use uart::InterruptsOff;
 
 use super::CYCLES_PER_US;
@@ -202,6 +209,8 @@ pub struct Mega2560 {
     /// True between a write of SPH and the write of SPL that completes a stack-pointer update:
     /// the stack pointer read in between mixes the new high byte with the old low byte.
     sp_half_written: bool,
+    /// The virtual MPU-6050 on the TWI, when attached.
+    imu: Option<Box<twi::VirtualMpu>>,
 }
 
 impl Mega2560 {
@@ -315,6 +324,7 @@ impl Mega2560 {
                 output: VecDeque::new(),
                 min_sp: u16::MAX,
                 sp_half_written: false,
+                imu: None,
             })
         }
     }
@@ -353,6 +363,9 @@ impl Mega2560 {
         self.feed_uart();
         let before = self.cycle();
         let pc_before = self.pc();
+        if let Some(imu) = self.imu.as_deref_mut() {
+            imu.now_cycle = before;
+        }
         // SAFETY: a valid, initialised simulator; hooks registered with live parameters.
         let state = unsafe { ffi::avr_run(self.avr.as_ptr()) } as u32;
         let raw = self.avr().cycle;
@@ -387,7 +400,11 @@ impl Mega2560 {
         self.output.extend(hooks.out.drain(..));
         self.owe_dor();
         self.track_interrupts_off(before, pc_before);
-        let step = self.cycle().saturating_sub(before).max(1);
+        let now = self.cycle();
+        if let Some(imu) = self.imu.as_deref_mut() {
+            imu.tick(now);
+        }
+        let step = now.saturating_sub(before).max(1);
         self.track_servos(step);
         let sp = self.sp();
         // A frame is set up (or torn down) by `out SPH` then `out SPL`, interrupts held off in
@@ -561,6 +578,25 @@ impl Mega2560 {
         };
     }
 
+    /// Puts a virtual MPU-6050 at 0x68 on the TWI, fed by `source` (see `twi.rs`: the register
+    /// file, the sample rate the firmware configures, the source's faults on the bus), and
+    /// pulls the bus lines up as the GY-521 does. Attach before the firmware runs (it probes
+    /// the sensor at boot); a second call replaces the first sensor's source.
+    pub fn attach_imu(&mut self, source: SharedImuSource) {
+        if let Some(imu) = self.imu.as_deref_mut() {
+            imu.source = source;
+            return;
+        }
+        // SAFETY: the simulator is live and initialised; the box is kept until `drop`, after
+        // `avr_terminate`.
+        self.imu = Some(unsafe { twi::VirtualMpu::attach(self.avr.as_ptr(), source) });
+    }
+
+    /// What the virtual MPU-6050 saw on the bus (`None`: no sensor attached).
+    pub fn imu_bus(&self) -> Option<&ImuBus> {
+        self.imu.as_deref().map(twi::VirtualMpu::bus)
+    }
+
     /// Fault injection: moves the program counter to `byte_addr`, as a corrupted return
     /// address or a runaway jump would. The emulator tests use it to hang the CPU in the C
     /// runtime's final `cli; rjmp .` loop (`_exit`), where nothing feeds the watchdog.
@@ -579,6 +615,7 @@ impl Drop for Mega2560 {
             ffi::avr_terminate(self.avr.as_ptr());
             free(self.avr.as_ptr().cast());
             drop(Box::from_raw(self.hooks.as_ptr()));
+            drop(self.imu.take());
         }
     }
 }
