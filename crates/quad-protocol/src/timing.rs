@@ -181,7 +181,7 @@ impl Kind {
             Kind::StartWalk => [67_500, 57_600],
             Kind::StartStableTurn => [47_200, 37_400],
             Kind::StopMotion => [13_300, 2_100],
-            Kind::GetMotion => [16_600, 4_800],
+            Kind::GetMotion => [16_900, 6_900],
             Kind::SetVelocity => [25_900, 17_100],
             Kind::SetJointSpeedLimit => [9_200, 1_700],
             Kind::SetBalance => [9_200, 2_200],
