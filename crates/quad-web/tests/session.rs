@@ -344,3 +344,40 @@ fn without_a_sensor_the_switch_is_refused_in_words() {
     // Switching off is no refusal.
     s.set_balance(false).unwrap();
 }
+
+/// Poses streamed in `span` of link time, reading the sensor every `imu_every` (if any), as
+/// the server's device thread interleaves its reads with a page's stream of poses.
+fn poses_streamed(span: Duration, imu_every: Option<Duration>) -> u32 {
+    let mut s = session(LinkLossAction::Hold);
+    let t0 = s.link_elapsed();
+    let mut next_imu = t0;
+    let mut n = 0u32;
+    while s.link_elapsed() - t0 < span {
+        if let Some(every) = imu_every {
+            if s.link_elapsed() >= next_imu {
+                s.read_imu().unwrap();
+                next_imu += every;
+            }
+        }
+        let roll_rad = 0.1 * ((n % 20) as f32 / 20.0);
+        s.set_pose(Pose::rotation(roll_rad, 0.0, 0.0), n + 1)
+            .unwrap();
+        n += 1;
+    }
+    n
+}
+
+#[test]
+fn reading_the_sensor_at_its_rate_leaves_the_pose_stream_its_line() {
+    let span = Duration::from_secs(5);
+    let alone = poses_streamed(span, None);
+    let with_imu = poses_streamed(span, Some(quad_web::balance::IMU_PERIOD));
+    let ratio = f64::from(with_imu) / f64::from(alone);
+    println!(
+        "poses in {} s of a 115200 baud simulated line: {alone} alone, {with_imu} with the sensor read every {} ms ({:.1} %)",
+        span.as_secs(),
+        quad_web::balance::IMU_PERIOD.as_millis(),
+        ratio * 100.0
+    );
+    assert!(ratio >= 0.9, "{ratio}");
+}
