@@ -511,7 +511,7 @@ mod tests {
             config: quad_protocol::BalanceConfig::DEFAULT,
         };
         let imu = crate::balance::ImuState::from(&report);
-        let v = serde_json::to_value(&imu).unwrap();
+        let v = serde_json::to_value(imu).unwrap();
         assert_eq!(v["health"], "starting");
         assert_eq!(v["leveling"], false);
         assert_eq!(v["fall"], serde_json::Value::Null);
