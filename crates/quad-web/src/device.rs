@@ -29,6 +29,12 @@
 //! which the thread also reads between commands (`GetMotion` instead of `GetState`). A
 //! simulated or emulated device's clock runs only while its link is read, so the thread idles
 //! the link up to the wall clock while it waits for events: its motions run in real time.
+//!
+//! ## The inertial sensor
+//! A device of protocol 2.3 reports its sensor and balance functions (`GetImu`): read at
+//! connection and then every [`balance::IMU_PERIOD`] on a schedule of its own, between
+//! commands (a stream of commands holds off the state read, not this one). The leveling switch
+//! sends `SetBalance` with the device's other settings kept ([`Session::set_balance`]).
 
 use crate::balance::{self, ImuState};
 use crate::motion;
