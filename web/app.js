@@ -1,6 +1,6 @@
 // The control panel: WebSocket to `quadctl serve`, the 3D view from the device's readback,
 // the pose sliders previewed by kin-core in WebAssembly, the device's onboard motions and the
-// walk's joystick, plots, calibration.
+// walk's joystick, the inertial sensor's horizon and the leveling switch, plots, calibration.
 //
 // Units: SI on the wire (rad, m); degrees and millimetres only on the sliders.
 // `window.panel` exposes the page's state for the browser tests and for debugging.
@@ -197,6 +197,7 @@ function connect() {
     panel.controller = null;
     awaiting = [];
     velocitiesInFlight = 0;
+    balancePending = false;
     updateControl();
     setTimeout(connect, 1000);
   };
@@ -215,6 +216,7 @@ function connect() {
           motionClick = null;
         }
         if (['set_pose', 'set_stance_height'].includes(msg.command)) { inFlight = false; pump(); }
+        if (msg.command === 'set_balance') balanceAnswered(null);
         break;
       case 'error': {
         const cmd = answered();
@@ -222,6 +224,7 @@ function connect() {
         message(msg.message);
         if (msg.field) showRefusal(msg.message, msg.field);
         if (cmd === 'start_motion') motionClick = null;
+        if (cmd === 'set_balance') balanceAnswered(msg.message);
         inFlight = false;
         pump();
         break;
@@ -270,6 +273,7 @@ function onState(msg) {
   updateReadback(msg);
   pushPlots(msg);
   showHealth(msg);
+  showImu(msg.imu, msg.flags);
   showCalibration(msg);
 }
 
@@ -284,6 +288,7 @@ function updateControl() {
     $(id).disabled = !mine;
   }
   for (const b of document.querySelectorAll('[data-jog]')) b.disabled = !mine;
+  $('balance-switch').disabled = !mine || balancePending || !panel.state || panel.state.imu === null;
 }
 
 // ---------------------------------------------------------------- 3D view
@@ -547,6 +552,182 @@ function showHealth(s) {
     stance ${(s.stance_height_m * 1000).toFixed(0)} mm · poses sent ${s.poses_sent} · pages ${s.pages}`;
 }
 
+// ---------------------------------------------------------------- inertial sensor and balance
+// The device's `Imu` report (protocol 2.3; the server reads it 10 times a second): an
+// artificial horizon from its roll and pitch, the sensor's health, the leveling and a latched
+// fall, and the leveling switch (`set_balance`).
+
+const HORIZON_PX_PER_DEG = 2.5; // pitch: the horizon moves this far per degree
+const ROLL_TICKS_DEG = [-60, -45, -30, -20, -10, 0, 10, 20, 30, 45, 60];
+
+// The attitude indicator: sky and ground split by the horizon, turned by the roll (positive:
+// right side down) and moved by the pitch (positive: nose down, the horizon goes up), a pitch ladder every 10° (unlabelled), the roll
+// scale on the rim with its pointer and the fall angle in red, the body's symbol fixed in the
+// middle; the numbers, in degrees, only at the edge.
+function drawHorizon(imu, fallLatched) {
+  const c = $('horizon');
+  const g = c.getContext('2d');
+  const { width: w, height: h } = c;
+  const r = Math.min(w, h) / 2 - 2;
+  const cx = w / 2; const cy = h / 2;
+  const ok = imu !== null && imu.health === 'ok';
+  const roll = ok ? imu.roll_rad / DEG : 0;
+  const pitch = ok ? imu.pitch_rad / DEG : 0;
+  g.clearRect(0, 0, w, h);
+  g.save();
+  g.beginPath();
+  g.arc(cx, cy, r, 0, 2 * Math.PI);
+  g.clip();
+  g.translate(cx, cy);
+  // A body rolled right (positive roll) sees the horizon turn left.
+  g.rotate(-roll * DEG);
+  // Positive pitch (zyx, about y to the left) is nose down: the horizon goes up.
+  const dy = -pitch * HORIZON_PX_PER_DEG;
+  g.globalAlpha = ok ? 1 : 0.35;
+  g.fillStyle = '#3b79b8';
+  g.fillRect(-2 * r, -2 * r + dy, 4 * r, 2 * r);
+  g.fillStyle = '#7a5530';
+  g.fillRect(-2 * r, dy, 4 * r, 2 * r);
+  g.strokeStyle = '#fff';
+  g.lineWidth = 2;
+  g.beginPath(); g.moveTo(-2 * r, dy); g.lineTo(2 * r, dy); g.stroke();
+  g.lineWidth = 1;
+  for (let p = -30; p <= 30; p += 10) {
+    if (p === 0) continue;
+    const y = dy - p * HORIZON_PX_PER_DEG;
+    const half = Math.abs(p) % 20 === 0 ? r * 0.3 : r * 0.18;
+    g.beginPath(); g.moveTo(-half, y); g.lineTo(half, y); g.stroke();
+  }
+  g.restore();
+  // The roll scale, fixed on the rim, and the pointer that turns with the horizon.
+  g.save();
+  g.translate(cx, cy);
+  g.strokeStyle = '#dde';
+  for (const t of ROLL_TICKS_DEG) {
+    g.save();
+    g.rotate(t * DEG);
+    g.beginPath(); g.moveTo(0, -r); g.lineTo(0, -r + (t % 30 === 0 ? 12 : 7)); g.stroke();
+    g.restore();
+  }
+  if (imu !== null && imu.fall_detection) {
+    for (const s of [-1, 1]) {
+      g.save();
+      g.rotate(s * imu.fall_angle_rad);
+      g.strokeStyle = '#ff5c5c';
+      g.lineWidth = 3;
+      g.beginPath(); g.moveTo(0, -r); g.lineTo(0, -r + 12); g.stroke();
+      g.restore();
+    }
+  }
+  g.save();
+  g.rotate(-roll * DEG);
+  g.fillStyle = '#ffd34d';
+  g.beginPath(); g.moveTo(0, -r + 13); g.lineTo(-6, -r + 23); g.lineTo(6, -r + 23); g.closePath(); g.fill();
+  g.restore();
+  // The body, fixed.
+  g.strokeStyle = '#ffd34d';
+  g.lineWidth = 3;
+  g.beginPath(); g.moveTo(-r * 0.45, 0); g.lineTo(-r * 0.15, 0); g.lineTo(0, r * 0.1); g.lineTo(r * 0.15, 0); g.lineTo(r * 0.45, 0); g.stroke();
+  g.fillStyle = '#ffd34d';
+  g.beginPath(); g.arc(0, 0, 2.5, 0, 2 * Math.PI); g.fill();
+  g.restore();
+  // The rim: red while a fall is latched.
+  g.strokeStyle = fallLatched ? '#ff3b30' : '#556070';
+  g.lineWidth = fallLatched ? 4 : 2;
+  g.beginPath(); g.arc(cx, cy, r, 0, 2 * Math.PI); g.stroke();
+  // The numbers at the edge only.
+  g.font = '11px system-ui, sans-serif';
+  g.fillStyle = '#eef';
+  g.textBaseline = 'bottom';
+  g.textAlign = 'left';
+  g.fillText(ok ? `R ${roll >= 0 ? '+' : '−'}${Math.abs(roll).toFixed(1)}°` : '', 2, h - 1);
+  g.textAlign = 'right';
+  g.fillText(ok ? `P ${pitch >= 0 ? '+' : '−'}${Math.abs(pitch).toFixed(1)}°` : '', w - 2, h - 1);
+  if (!ok) {
+    g.textAlign = 'center';
+    g.textBaseline = 'middle';
+    g.fillStyle = '#fc8';
+    g.fillText(imu === null ? 'no report' : `no attitude: ${imu.health}`, cx, cy + r * 0.45);
+  }
+  panel.horizon = { roll_deg: roll, pitch_deg: pitch, ok, fallLatched, drawn: (panel.horizon?.drawn ?? 0) + 1 };
+}
+
+const FAULT_WORDS = { wrong_id: 'wrong id', nak: 'no acknowledge', stuck: 'stuck data', bus_held: 'bus held' };
+const signed = (rad) => `${rad >= 0 ? '+' : '−'}${Math.abs(rad / DEG).toFixed(2)}°`;
+
+// The sensor's part of a state: `imu` (null: a device older than 2.3) and the flags.
+function showImu(imu, flags) {
+  panel.imu = imu;
+  const fallLatched = flags.fall_detected || (imu !== null && imu.fall !== null);
+  drawHorizon(imu, fallLatched);
+  const badge = $('imu-health');
+  const sw = $('balance-switch');
+  if (imu === null) {
+    badge.textContent = 'no report';
+    badge.className = 'badge';
+    $('imu-detail').textContent = 'the device speaks a protocol older than 2.3: no inertial sensor';
+    $('imu-leveling').textContent = 'leveling: not available';
+    $('imu-fall').textContent = '';
+    $('imu-fall').className = '';
+    $('balance-note').textContent = '';
+    sw.checked = false;
+    sw.disabled = true;
+    return;
+  }
+  const health = imu.health === 'fault' ? `fault (${FAULT_WORDS[imu.fault_kind] ?? imu.fault_kind})` : imu.health;
+  badge.textContent = health;
+  badge.className = `badge ${imu.health === 'ok' ? 'ok' : imu.health === 'starting' ? '' : 'bad'}`;
+  $('imu-detail').textContent = {
+    absent: 'nothing answers on the sensor bus: the motions run open loop',
+    starting: 'measuring the gyro bias: keep the robot still',
+    ok: `attitude estimated · ${imu.samples} samples`,
+    fault: 'the last reading failed: leveling is off until it is switched on again',
+  }[imu.health] ?? '';
+  let lev;
+  if (!imu.leveling) lev = 'leveling <b>off</b>';
+  else if (!imu.leveling_active) lev = 'leveling <b>on</b>, waiting (needs the sensor ok and a stance held or a sway running)';
+  else lev = `leveling <b>on</b> · correction roll ${signed(imu.correction_roll_rad)} pitch ${signed(imu.correction_pitch_rad)}${imu.correction_limited ? ' (limited)' : ''}`;
+  $('imu-leveling').innerHTML = lev;
+  const fall = $('imu-fall');
+  if (fallLatched) {
+    const kind = imu.fall === 'free_fall' ? 'free fall' : imu.fall === 'tilt' ? 'tilt' : 'fall';
+    fall.textContent = `FALL latched (${kind}): the outputs went to their safe state (${imu.safe_state}). `
+      + 'Set the robot on its feet, then a motion (Stand on the Motion tab), a pose or Outputs on clears it.';
+    fall.className = 'latched';
+  } else {
+    fall.textContent = imu.fall_detection
+      ? `fall detection on (beyond ${(imu.fall_angle_rad / DEG).toFixed(0)}° → ${imu.safe_state})`
+      : 'fall detection off';
+    fall.className = '';
+  }
+  $('balance-note').textContent = imu.health === 'absent'
+    ? 'no sensor: the device refuses leveling'
+    : imu.health === 'fault' ? 'sensor fault: the device refuses leveling' : '';
+  if (!balancePending) sw.checked = imu.leveling;
+  sw.disabled = !panel.controlling || balancePending;
+}
+panel.showImu = showImu;
+
+let balancePending = false;
+function buildBalance() {
+  const sw = $('balance-switch');
+  sw.addEventListener('change', () => {
+    $('balance-error').textContent = '';
+    balancePending = true;
+    sw.disabled = true;
+    panel.balanceRequests = (panel.balanceRequests ?? 0) + 1;
+    send({ type: 'set_balance', leveling: sw.checked });
+  });
+}
+
+// The switch's answer: done, or the device's refusal in words; the switch shows the device's
+// setting again either way.
+function balanceAnswered(error) {
+  balancePending = false;
+  $('balance-error').textContent = error ?? '';
+  if (panel.state) showImu(panel.state.imu, panel.state.flags);
+}
+
 // ---------------------------------------------------------------- motions and teleop
 // Each motion's parameters as the form shows them (degrees and millimetres on the page, SI on
 // the wire, as the sliders); a duration of 0 runs until Stop.
@@ -794,6 +975,7 @@ panel.benchIk = (n) => {
 async function main() {
   buildSliders();
   buildMotion();
+  buildBalance();
   tabs();
   updateControl();
   resize();

@@ -29,7 +29,14 @@
 //! which the thread also reads between commands (`GetMotion` instead of `GetState`). A
 //! simulated or emulated device's clock runs only while its link is read, so the thread idles
 //! the link up to the wall clock while it waits for events: its motions run in real time.
+//!
+//! ## The inertial sensor
+//! A device of protocol 2.3 reports its sensor and balance functions (`GetImu`): read at
+//! connection and then every [`balance::IMU_PERIOD`] on a schedule of its own, between
+//! commands (a stream of commands holds off the state read, not this one). The leveling switch
+//! sends `SetBalance` with the device's other settings kept ([`Session::set_balance`]).
 
+use crate::balance::{self, ImuState};
 use crate::motion;
 use crate::msg::{self, FlagsMsg, LinkMsg, State};
 use kin_core::body::Pose;
@@ -40,8 +47,8 @@ use quad_host::client::{
 use quad_host::link::{self, Link, Target};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
-    DeviceInfo, DeviceToHost, Flags, LinkLossAction, MotionStage, MotionStatus, NackReason,
-    PoseConfig, Ranges, Readback, Request, RobotPreset, ServoId,
+    DeviceInfo, DeviceToHost, Flags, ImuReport, LinkLossAction, MotionStage, MotionStatus,
+    NackReason, PoseConfig, Ranges, Readback, Request, RobotPreset, ServoId,
 };
 use std::time::{Duration, Instant};
 
@@ -127,6 +134,22 @@ pub enum Error {
         /// Why.
         reason: NackReason,
     },
+    /// The device refused the balance switch (`SetBalance`): nothing changed.
+    #[error("the device refused SetBalance: {}", balance::words(.0))]
+    BalanceRefused(NackReason),
+    /// A balance setting the protocol's range check refuses: not sent.
+    #[error("not sent: the balance settings fail the range check ({0})")]
+    BalanceRange(NackReason),
+    /// The device speaks a protocol older than 2.3: it has no inertial sensor requests.
+    #[error(
+        "the device speaks protocol {major}.{minor}: the inertial sensor and balance need 2.3"
+    )]
+    NoBalance {
+        /// Its major version.
+        major: u8,
+        /// Its minor version.
+        minor: u8,
+    },
     /// The device refused a motion request; a running motion keeps running.
     #[error("the device refused {}: {}", client::request_name(.request), motion::words(.reason, .request))]
     MotionRefused {
@@ -163,6 +186,10 @@ pub struct Session<L> {
     motion: MotionStatus,
     /// The device speaks protocol 2.1 or later: it has the motion requests.
     motions: bool,
+    /// The device speaks protocol 2.3 or later: it has the inertial sensor's requests.
+    balance: bool,
+    /// Its last `Imu` report.
+    imu: Option<ImuReport>,
     /// Attempts of the last exchange.
     attempts: u32,
     /// The link's clock when the session connected.
@@ -194,8 +221,9 @@ impl<L: Link> Session<L> {
         let calibration = client.calibrations()?;
         let readback = client.ack(Request::GetState)?;
         let motions = quad_protocol::version_minor(info.version) >= 1;
+        let balance = quad_protocol::version_minor(info.version) >= 3;
         let link_epoch = client.link().now();
-        Ok(Session {
+        let mut session = Session {
             link_epoch,
             motion: MotionStatus {
                 kind: None,
@@ -205,6 +233,8 @@ impl<L: Link> Session<L> {
                 fault: None,
             },
             motions,
+            balance,
+            imu: None,
             attempts: 0,
             client,
             ranges: Ranges::of(&robot),
@@ -217,7 +247,9 @@ impl<L: Link> Session<L> {
             pose: None,
             poses_sent: 0,
             link: LinkMsg::default(),
-        })
+        };
+        session.read_imu()?;
+        Ok(session)
     }
 
     /// The device's `HelloAck`.
@@ -306,6 +338,67 @@ impl<L: Link> Session<L> {
             self.motion(Request::GetMotion)
         } else {
             self.ack(Request::GetState).map(|_| ())
+        }
+    }
+
+    /// Reads the device's inertial sensor and balance functions (`GetImu`) when it has them
+    /// (protocol 2.3); nothing is sent to an older device.
+    ///
+    /// # Errors
+    /// Link failures, no answer, an unexpected answer.
+    pub fn read_imu(&mut self) -> Result<(), Error> {
+        if self.balance {
+            self.imu_request(Request::GetImu)?;
+        }
+        Ok(())
+    }
+
+    /// The last `Imu` report, if the device has sent one.
+    pub fn imu(&self) -> Option<&ImuReport> {
+        self.imu.as_ref()
+    }
+
+    /// Switches the device's leveling on or off, its other balance settings kept as it last
+    /// reported them (read first when none was read yet).
+    ///
+    /// # Errors
+    /// [`Error::NoBalance`] for a device older than 2.3 and [`Error::BalanceRange`] (nothing
+    /// sent), [`Error::BalanceRefused`] with the device's reason (no sensor, a sensor fault),
+    /// link failures.
+    pub fn set_balance(&mut self, leveling: bool) -> Result<(), Error> {
+        if !self.balance {
+            return Err(Error::NoBalance {
+                major: quad_protocol::version_major(self.info.version),
+                minor: quad_protocol::version_minor(self.info.version),
+            });
+        }
+        let current = match self.imu {
+            Some(r) => r.config,
+            None => self.imu_request(Request::GetImu)?.config,
+        };
+        let request =
+            balance::request(&current, leveling, &self.ranges).map_err(Error::BalanceRange)?;
+        match self.imu_request(request) {
+            Err(Error::Refused { reason, .. }) => {
+                // The refusal changed nothing; the report shows the settings in force.
+                self.imu_request(Request::GetImu)?;
+                Err(Error::BalanceRefused(reason))
+            }
+            other => other.map(|_| ()),
+        }
+    }
+
+    /// `GetImu` or `SetBalance`, answered by an `Imu` report that is kept.
+    fn imu_request(&mut self, request: Request) -> Result<ImuReport, Error> {
+        match self.exchange(request, |_| client::Verdict::Accept)? {
+            DeviceToHost::Imu { report, .. } => {
+                self.imu = Some(report);
+                Ok(report)
+            }
+            other => Err(Error::Client(client::Error::Unexpected {
+                request: client::request_name(&request),
+                answer: Box::new(other),
+            })),
         }
     }
 
@@ -559,6 +652,7 @@ impl<L: Link> Session<L> {
             pages: 0,
             link_up: true,
             motion: motion::MotionState::from(&self.motion),
+            imu: self.imu.as_ref().map(ImuState::from),
         }
     }
 
@@ -585,6 +679,7 @@ impl<L: Link> Session<L> {
                 Some(m) => self.motion_command(&m),
                 None => Ok(()),
             },
+            M::SetBalance { leveling } => self.set_balance(leveling),
             M::TakeControl | M::ReleaseControl => Ok(()),
         }
     }
@@ -724,14 +819,40 @@ pub fn run(
     let mut link_up = true;
     let wall_epoch = Instant::now();
     let mut last_state = Instant::now();
+    let mut imu_due = Instant::now() + balance::IMU_PERIOD;
     loop {
+        // The sensor's report on its own schedule: a stream of commands, which holds off the
+        // state read (each command's answer carries the state), does not hold it off.
+        if Instant::now() >= imu_due {
+            imu_due += balance::IMU_PERIOD;
+            if imu_due < Instant::now() {
+                imu_due = Instant::now() + balance::IMU_PERIOD;
+            }
+            if link_up {
+                match session.read_imu() {
+                    Ok(()) => {}
+                    Err(Error::Link(e)) => {
+                        eprintln!("quadctl serve: device link failed: {e}");
+                        link_up = false;
+                    }
+                    Err(e) => eprintln!("quadctl serve: sensor read failed: {e}"),
+                }
+                publish(&session, link_up);
+            }
+        }
         let event = next_event(
             &events,
             &mut session,
             &mut link_up,
             wall_epoch,
-            last_state + setup.poll,
+            (last_state + setup.poll).min(imu_due),
         );
+        if matches!(event, Err(std::sync::mpsc::RecvTimeoutError::Timeout))
+            && Instant::now() < last_state + setup.poll
+        {
+            // The sensor's read is due, not the state's.
+            continue;
+        }
         last_state = Instant::now();
         match event {
             Ok(Event::Job(job)) => {

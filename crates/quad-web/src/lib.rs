@@ -11,14 +11,18 @@
 //! - the device's onboard motions (its motion engine): start, stop, a walk's velocity from a
 //!   joystick, the engine's status live, its refusals named by field;
 //! - live plots of the twelve joints and pulses, link health and device state;
-//! - a calibration tab: pick a servo, jog its pulse, set its centre and direction, save.
+//! - a calibration tab: pick a servo, jog its pulse, set its centre and direction, save;
+//! - the inertial sensor (protocol 2.3): an artificial horizon from the device's attitude, the
+//!   sensor's health, the leveling and a latched fall, and the leveling switch.
 //!
-//! Modules: [`msg`] (the WebSocket messages and their validation), [`device`] (the thread
+//! Modules: [`msg`] (the WebSocket messages and their validation), [`balance`] (the sensor's
+//! report for the pages and the leveling switch), [`device`] (the thread
 //! that owns the link and the checks every command passes), [`motion`] (the Motion tab's
 //! commands and their device requests), [`server`] (HTTP, WebSockets, who
 //! controls, the state as JSON for scripts at `GET /api/state`), [`assets`] (the embedded files).
 
 pub mod assets;
+pub mod balance;
 pub mod device;
 pub mod motion;
 pub mod msg;

@@ -9,6 +9,7 @@
 //! larger than [`MAX_JOG_US`]). A refused message reaches neither the device thread nor the
 //! device.
 
+use crate::balance::ImuState;
 use crate::motion::{self, Command, VelocityMsg};
 use kin_core::body::Pose;
 use kin_core::Robot;
@@ -84,6 +85,12 @@ pub enum ClientMsg {
     SetVelocity {
         /// The velocity.
         velocity: VelocityMsg,
+    },
+    /// Switches the device's leveling on or off (`SetBalance`, its other balance settings
+    /// kept; see [`crate::balance`]).
+    SetBalance {
+        /// True to level the body.
+        leveling: bool,
     },
 }
 
@@ -189,7 +196,8 @@ impl ClientMsg {
             | ClientMsg::ReadCalibration
             | ClientMsg::StartMotion { .. }
             | ClientMsg::StopMotion
-            | ClientMsg::SetVelocity { .. } => Ok(()),
+            | ClientMsg::SetVelocity { .. }
+            | ClientMsg::SetBalance { .. } => Ok(()),
         }
     }
 
@@ -221,6 +229,9 @@ pub struct FlagsMsg {
     pub limited: bool,
     /// The last target was clamped.
     pub clamped: bool,
+    /// A fall was detected and the outputs went to their safe state: latched until an
+    /// explicit motion request (protocol 2.3).
+    pub fall_detected: bool,
 }
 
 impl From<quad_protocol::Flags> for FlagsMsg {
@@ -234,6 +245,7 @@ impl From<quad_protocol::Flags> for FlagsMsg {
             calibration_default: f.contains(F::CALIBRATION_DEFAULT),
             limited: f.contains(F::LIMITED),
             clamped: f.contains(F::CLAMPED),
+            fall_detected: f.contains(F::FALL_DETECTED),
         }
     }
 }
@@ -296,6 +308,10 @@ pub struct State {
     pub link_up: bool,
     /// The device's motion engine, from its last `MotionAck`.
     pub motion: motion::MotionState,
+    /// The device's inertial sensor and balance functions, from its last `Imu` report (read
+    /// every [`crate::balance::IMU_PERIOD`]); `None` for a device older than protocol 2.3,
+    /// or before the first report.
+    pub imu: Option<ImuState>,
 }
 
 /// What the server tells a page.
@@ -354,6 +370,7 @@ impl ClientMsg {
             ClientMsg::StartMotion { .. } => "start_motion",
             ClientMsg::StopMotion => "stop_motion",
             ClientMsg::SetVelocity { .. } => "set_velocity",
+            ClientMsg::SetBalance { .. } => "set_balance",
         }
     }
 }
@@ -460,6 +477,44 @@ mod tests {
         }
         let e = ClientMsg::parse(r#"{"type":"start_motion","motion":"dance"}"#).unwrap_err();
         assert!(e.to_string().contains("unknown variant `dance`"), "{e}");
+    }
+
+    #[test]
+    fn the_balance_switch_parses_and_the_state_carries_the_sensor() {
+        let m = ClientMsg::parse(r#"{"type":"set_balance","leveling":true}"#).unwrap();
+        assert_eq!(m, ClientMsg::SetBalance { leveling: true });
+        assert_eq!(m.name(), "set_balance");
+        assert_eq!(m.motion(), None);
+        for bad in [
+            r#"{"type":"set_balance"}"#,
+            r#"{"type":"set_balance","leveling":1}"#,
+            r#"{"type":"set_balance","leveling":true,"kp":0.3}"#,
+        ] {
+            assert!(
+                matches!(ClientMsg::parse(bad), Err(Error::Malformed(_))),
+                "{bad}"
+            );
+        }
+        // The fall flag by name, the report under `imu`.
+        let flags = FlagsMsg::from(quad_protocol::Flags(quad_protocol::Flags::FALL_DETECTED));
+        assert!(flags.fall_detected && !flags.outputs_enabled);
+        let report = quad_protocol::ImuReport {
+            health: quad_protocol::ImuHealth::Starting,
+            roll_rad: 0.0,
+            pitch_rad: 0.0,
+            correction_roll_rad: 0.0,
+            correction_pitch_rad: 0.0,
+            leveling_active: false,
+            correction_limited: false,
+            fall: None,
+            samples: 7,
+            config: quad_protocol::BalanceConfig::DEFAULT,
+        };
+        let imu = crate::balance::ImuState::from(&report);
+        let v = serde_json::to_value(imu).unwrap();
+        assert_eq!(v["health"], "starting");
+        assert_eq!(v["leveling"], false);
+        assert_eq!(v["fall"], serde_json::Value::Null);
     }
 
     #[test]

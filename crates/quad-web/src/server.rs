@@ -142,6 +142,7 @@ fn initial_state() -> State {
         pages: 0,
         link_up: false,
         motion: crate::motion::MotionState::default(),
+        imu: None,
     }
 }
 

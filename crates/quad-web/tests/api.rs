@@ -66,6 +66,7 @@ fn every_documented_page_message_parses_and_every_command_is_documented() {
         "start_motion",
         "stop_motion",
         "set_velocity",
+        "set_balance",
     ];
     assert_eq!(names, every.into_iter().collect());
     // And what the server refuses is refused: the same parser.
@@ -138,6 +139,14 @@ fn the_state_endpoint_answers_json_and_every_field_the_server_sends_is_documente
     assert_eq!(state["link_up"], true);
     assert_eq!(state["stance_height_m"].as_f64(), Some(0.4));
     assert_eq!(state["motion"]["stage"], "idle");
+    // The simulated device's sensor, level and still: measuring its gyro bias for its first
+    // second, then ok.
+    let health = state["imu"]["health"]
+        .as_str()
+        .expect("the sensor's report");
+    assert!(["starting", "ok"].contains(&health), "{health}");
+    assert_eq!(state["imu"]["leveling"], false);
+    assert_eq!(state["flags"]["fall_detected"], false);
     // Every field of the state, the welcome, done and error is named in the docs.
     let welcome = ServerMsg::Welcome {
         page_id: 1,

@@ -550,3 +550,194 @@ async fn motion_tab(b: &Browser, dir: &std::path::Path, what: &str) {
     );
     b.click("tab-pose").await;
 }
+
+/// A script that runs `before`, then returns the colour class of the horizon's pixels at
+/// `points` (`sky`, `ground` or `other`) and the attitude it drew, all at once (so that no
+/// state from the device redraws it in between).
+fn horizon_pixels(before: &str, points: &[(u32, u32)]) -> String {
+    let pts = serde_json::to_string(points).unwrap();
+    format!(
+        "(() => {{ {before}; const g = document.getElementById('horizon').getContext('2d'); \
+         const px = {pts}.map(([x, y]) => {{ const [r, gr, bl] = g.getImageData(x, y, 1, 1).data; \
+         return bl > r + 40 ? 'sky' : r > bl + 40 ? 'ground' : 'other'; }}); \
+         return {{ px, pitch_deg: panel.horizon.pitch_deg, roll_deg: panel.horizon.roll_deg }}; }})()"
+    )
+}
+
+/// The attitude on the simulated device (its sensor level and still): the report reaches the
+/// page, the horizon is drawn from it (and turns and moves the right way for a given
+/// attitude), the health reads ok, the leveling switch sends `set_balance` and the device's
+/// setting comes back, and a latched fall is said with how to clear it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn sim_attitude() {
+    let dir = scratch("panel-attitude");
+    let server = serve(browser::sim(None));
+    let b = Browser::start(&dir.join("profile")).await;
+    b.open(server.addr).await;
+    // The sensor measures its gyro bias for its first second, then reads level.
+    b.wait(
+        "panel.state.imu && panel.state.imu.health === 'ok' && panel.horizon && panel.horizon.ok",
+        WAIT,
+    )
+    .await;
+    assert_eq!(
+        b.js("document.getElementById('imu-health').textContent")
+            .await,
+        "ok"
+    );
+    let h = b.js("panel.horizon").await;
+    assert!(h["roll_deg"].as_f64().unwrap().abs() < 0.5, "{h}");
+    assert!(h["pitch_deg"].as_f64().unwrap().abs() < 0.5, "{h}");
+    // Level: sky above the middle, ground below.
+    let level = b
+        .js(&horizon_pixels("", &[(90, 60), (90, 120), (140, 80)]))
+        .await;
+    assert_eq!(level["px"], serde_json::json!(["sky", "ground", "sky"]));
+    // A given attitude (a state handed to the page's renderer): 30° of roll (right side down)
+    // raises the horizon's right end; 10° of pitch (nose down) raises the horizon.
+    let rolled = b
+        .js(&horizon_pixels(
+            "panel.showImu({...panel.state.imu, roll_rad: 30 * Math.PI / 180, pitch_rad: 0}, panel.state.flags)",
+            &[(140, 80), (40, 100)],
+        ))
+        .await;
+    assert_eq!(rolled["px"], serde_json::json!(["ground", "sky"]));
+    assert!(
+        (rolled["roll_deg"].as_f64().unwrap() - 30.0).abs() < 1e-6,
+        "{rolled}"
+    );
+    let pitched = b
+        .js(&horizon_pixels(
+            "panel.showImu({...panel.state.imu, roll_rad: 0, pitch_rad: 10 * Math.PI / 180}, panel.state.flags)",
+            &[(90, 82), (90, 60)],
+        ))
+        .await;
+    assert_eq!(pitched["px"], serde_json::json!(["ground", "sky"]));
+    assert!(
+        (pitched["pitch_deg"].as_f64().unwrap() - 10.0).abs() < 1e-6,
+        "{pitched}"
+    );
+
+    // Watching: the switch is off and cannot be used.
+    assert_eq!(
+        b.js("document.getElementById('balance-switch').disabled")
+            .await,
+        true
+    );
+    // In control: the switch sends `set_balance`; the device's report shows leveling on.
+    b.click("take-control").await;
+    b.wait(
+        "panel.controlling && !document.getElementById('balance-switch').disabled",
+        WAIT,
+    )
+    .await;
+    let frames = b.js("panel.state.link.frames_sent").await.as_u64().unwrap();
+    b.click("balance-switch").await;
+    b.wait("panel.done.includes('set_balance')", WAIT).await;
+    assert_eq!(b.js("panel.balanceRequests").await, 1);
+    b.wait(
+        "panel.state.imu.leveling === true && document.getElementById('balance-switch').checked",
+        WAIT,
+    )
+    .await;
+    assert!(b.js("panel.state.link.frames_sent").await.as_u64().unwrap() > frames);
+    let leveling = b
+        .js("document.getElementById('imu-leveling').textContent")
+        .await;
+    assert!(
+        leveling.as_str().unwrap().starts_with("leveling on"),
+        "{leveling}"
+    );
+    assert_eq!(
+        b.js("document.getElementById('balance-error').textContent")
+            .await,
+        ""
+    );
+    std::fs::write(dir.join("panel-horizon.png"), b.screenshot().await).unwrap();
+    // And off again.
+    b.click("balance-switch").await;
+    b.wait(
+        "panel.state.imu.leveling === false && !document.getElementById('balance-switch').checked \
+         && panel.done.filter((c) => c === 'set_balance').length === 2",
+        WAIT,
+    )
+    .await;
+
+    // A latched fall (a state handed to the renderer: the simulated sensor stays level): said,
+    // with how to clear it, and the horizon's rim marked.
+    let fall = b
+        .js("(panel.showImu({...panel.state.imu, fall: 'tilt', roll_rad: 1.2}, {...panel.state.flags, fall_detected: true}), \
+              [document.getElementById('imu-fall').textContent, panel.horizon.fallLatched])")
+        .await;
+    let text = fall[0].as_str().unwrap();
+    assert!(
+        text.contains("FALL latched (tilt)")
+            && text.contains("safe state (rest)")
+            && text.contains("clears it"),
+        "{text}"
+    );
+    assert_eq!(fall[1], true, "the rim marked");
+    // The next state from the device (no fall) replaces it.
+    b.wait("panel.horizon.fallLatched === false", WAIT).await;
+    b.close().await;
+    server.stop().unwrap();
+}
+
+/// The firmware in simavr has no sensor on its bus: the page says `absent` and the switch's
+/// refusal in words, the switch back off.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn emulator_attitude_without_a_sensor() {
+    let dir = scratch("panel-emulator-attitude");
+    let server = serve(browser::emulator(None));
+    let b = Browser::start(&dir.join("profile")).await;
+    b.open(server.addr).await;
+    b.wait(
+        "panel.state.imu && panel.state.imu.health === 'absent'",
+        WAIT,
+    )
+    .await;
+    assert_eq!(
+        b.js("document.getElementById('imu-health').textContent")
+            .await,
+        "absent"
+    );
+    let note = b
+        .js("document.getElementById('balance-note').textContent")
+        .await;
+    assert!(note.as_str().unwrap().contains("no sensor"), "{note}");
+    assert_eq!(b.js("panel.horizon.ok").await, false);
+    b.click("take-control").await;
+    b.wait(
+        "panel.controlling && !document.getElementById('balance-switch').disabled",
+        WAIT,
+    )
+    .await;
+    let n = b.js("panel.errors.length").await.as_u64().unwrap();
+    b.click("balance-switch").await;
+    let refusal = b
+        .wait(
+            &format!("panel.errors.length > {n} && panel.errors[{n}]"),
+            WAIT,
+        )
+        .await;
+    let refusal = refusal.as_str().unwrap();
+    assert!(
+        refusal.contains("the device refused SetBalance") && refusal.contains("no sensor"),
+        "{refusal}"
+    );
+    b.wait(
+        "!document.getElementById('balance-switch').checked && !document.getElementById('balance-switch').disabled",
+        WAIT,
+    )
+    .await;
+    assert_eq!(
+        b.js("document.getElementById('balance-error').textContent")
+            .await
+            .as_str(),
+        Some(refusal)
+    );
+    assert_eq!(b.js("panel.state.imu.leveling").await, false);
+    std::fs::write(dir.join("panel-emulator-absent.png"), b.screenshot().await).unwrap();
+    b.close().await;
+    server.stop().unwrap();
+}

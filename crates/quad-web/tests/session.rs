@@ -251,3 +251,133 @@ fn losing_the_controlling_page_stops_a_running_motion_cleanly() {
     assert!(!s.state(0.0).flags.outputs_enabled);
     assert_eq!(s.state(0.0).motion.kind, None);
 }
+
+/// A session on the simulated device whose sensor reads `source` (see `SimLink::attach_imu`).
+fn session_with_imu(source: quad_host::emu::SharedImuSource) -> Session<Box<dyn Link>> {
+    let config = quad_device::Config::for_preset(RobotPreset::Shahriar2023).unwrap();
+    let mut sim = link::sim::SimLink::new(
+        SimConfig::default(),
+        config,
+        link::sim::EepromImage::erased(),
+    )
+    .unwrap();
+    sim.attach_imu(source);
+    let client = Client::new(
+        Box::new(sim) as Box<dyn Link>,
+        ClientConfig::sim(Duration::ZERO),
+    );
+    Session::connect(
+        client,
+        Robot::shahriar2023(),
+        RobotPreset::Shahriar2023,
+        AngleCheck::Exact,
+    )
+    .unwrap()
+}
+
+#[test]
+fn the_sensor_report_reaches_the_state_and_the_switch_sets_leveling() {
+    let mut s = session(LinkLossAction::Hold);
+    // Read at connection: level and still, its gyro bias being measured for a second.
+    let imu = s.state(0.0).imu.expect("a report from a 2.3 device");
+    assert_eq!(imu.health, "starting");
+    assert!(!imu.leveling);
+    s.idle(Duration::from_millis(1200)).unwrap();
+    let frames = s.state(0.0).link.frames_sent;
+    s.read_imu().unwrap();
+    let state = s.state(0.0);
+    assert_eq!(state.link.frames_sent, frames + 1, "one GetImu");
+    let imu = state.imu.unwrap();
+    assert_eq!(imu.health, "ok");
+    assert!(
+        imu.roll_rad.abs() < 0.01 && imu.pitch_rad.abs() < 0.01,
+        "{imu:?}"
+    );
+    assert!(imu.samples > 0);
+    let imu_rtt_ms = state.link.rtt_ms;
+    s.poll().unwrap();
+    let poll_rtt_ms = s.state(0.0).link.rtt_ms;
+    println!(
+        "GetImu round trip {imu_rtt_ms:.2} ms, GetMotion {poll_rtt_ms:.2} ms (simulated line, 115200 baud)"
+    );
+    // The switch: on, as the device reports it; the other settings kept; off again.
+    s.command(&ClientMsg::SetBalance { leveling: true })
+        .unwrap();
+    let report = *s.imu().unwrap();
+    assert!(report.config.leveling);
+    assert_eq!(
+        quad_protocol::BalanceConfig {
+            leveling: false,
+            ..report.config
+        },
+        quad_protocol::BalanceConfig::DEFAULT
+    );
+    assert!(s.state(0.0).imu.unwrap().leveling);
+    s.set_balance(false).unwrap();
+    assert!(!s.state(0.0).imu.unwrap().leveling);
+}
+
+#[test]
+fn without_a_sensor_the_switch_is_refused_in_words() {
+    use quad_device::imu::{ImuFault, ImuReading};
+    use quad_device::sim::imu::Feed;
+    let mut s = session_with_imu(quad_host::emu::SharedImuSource::new(Feed(|_t: f64| {
+        ImuReading::Fault(ImuFault::Absent)
+    })));
+    s.idle(Duration::from_millis(200)).unwrap();
+    s.read_imu().unwrap();
+    assert_eq!(s.state(0.0).imu.unwrap().health, "absent");
+    let err = s.set_balance(true).unwrap_err();
+    assert!(
+        matches!(err, Error::BalanceRefused(NackReason::ImuAbsent)),
+        "{err}"
+    );
+    let words = err.to_string();
+    assert!(
+        words.contains("refused SetBalance") && words.contains("no sensor"),
+        "{words}"
+    );
+    assert_eq!(err.field(), None);
+    let imu = s.state(0.0).imu.unwrap();
+    assert!(!imu.leveling, "nothing changed");
+    assert_eq!(imu.health, "absent");
+    // Switching off is no refusal.
+    s.set_balance(false).unwrap();
+}
+
+/// Poses streamed in `span` of link time, reading the sensor every `imu_every` (if any), as
+/// the server's device thread interleaves its reads with a page's stream of poses.
+fn poses_streamed(span: Duration, imu_every: Option<Duration>) -> u32 {
+    let mut s = session(LinkLossAction::Hold);
+    let t0 = s.link_elapsed();
+    let mut next_imu = t0;
+    let mut n = 0u32;
+    while s.link_elapsed() - t0 < span {
+        if let Some(every) = imu_every {
+            if s.link_elapsed() >= next_imu {
+                s.read_imu().unwrap();
+                next_imu += every;
+            }
+        }
+        let roll_rad = 0.1 * ((n % 20) as f32 / 20.0);
+        s.set_pose(Pose::rotation(roll_rad, 0.0, 0.0), n + 1)
+            .unwrap();
+        n += 1;
+    }
+    n
+}
+
+#[test]
+fn reading_the_sensor_at_its_rate_leaves_the_pose_stream_its_line() {
+    let span = Duration::from_secs(5);
+    let alone = poses_streamed(span, None);
+    let with_imu = poses_streamed(span, Some(quad_web::balance::IMU_PERIOD));
+    let ratio = f64::from(with_imu) / f64::from(alone);
+    println!(
+        "poses in {} s of a 115200 baud simulated line: {alone} alone, {with_imu} with the sensor read every {} ms ({:.1} %)",
+        span.as_secs(),
+        quad_web::balance::IMU_PERIOD.as_millis(),
+        ratio * 100.0
+    );
+    assert!(ratio >= 0.9, "{ratio}");
+}

@@ -29,6 +29,10 @@ centre and direction and saves to EEPROM. The Motion tab starts and stops the de
 motions (stand, sit, rest, sways, yaw turn, foot paths, trot/walk) and shows the device's motion
 status; while a walk runs, its joystick (keys W/S A/D Q/E, a gamepad) sends the velocity every
 50 ms. The device checks a motion's parameters and its refusal names the field.
+An artificial horizon shows the device's attitude from its inertial sensor (protocol 2.3; read
+10 times a second), with the sensor's health (absent, starting, ok, fault and its kind), the
+leveling and a latched fall; the leveling switch sends SetBalance, and a device without a
+working sensor refuses it (the refusal is shown).
 
 Several pages may watch; one controls at a time (`Take control` on the page). The outputs are
 switched on only by the page's `Outputs on` button. Every command passes the same checks as the
