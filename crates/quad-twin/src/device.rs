@@ -7,6 +7,7 @@ use quad_device::imu::ImuState;
 use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
 use quad_device::{Config, ConfigError, Device, ImuReading};
 use quad_protocol::servo::Error as ServoError;
+use quad_protocol::{BalanceConfig, ImuHealth, ImuReport};
 use quad_protocol::{DeviceToHost, HostToDevice, NackReason, Request, ServoId, PROTOCOL_VERSION};
 
 /// Why the device refused a step.
@@ -50,6 +51,8 @@ pub struct InProcess {
     device: Device<Outputs, VirtualClock, RamEeprom>,
     clock: VirtualClock,
     seq: u16,
+    /// Balance settings to send once the sensor has given a reading.
+    pending_balance: Option<BalanceConfig>,
 }
 
 impl InProcess {
@@ -71,6 +74,7 @@ impl InProcess {
             device,
             clock,
             seq: 0,
+            pending_balance: None,
         };
         d.request(Request::Hello {
             version: PROTOCOL_VERSION,
@@ -125,6 +129,34 @@ impl InProcess {
         }
         self.clock.set_ns(start_ns + frame_ns);
         self.device.poll();
+        self.send_pending_balance();
+    }
+
+    /// Configures the balance functions with `config` as a `SetBalance` request, at the end of
+    /// the first frame after which the device has a reading from its sensor (leveling is
+    /// refused while the sensor is absent; from the first reading the device measures the gyro
+    /// bias for a second, then levels).
+    pub fn set_balance_when_ready(&mut self, config: BalanceConfig) {
+        self.pending_balance = Some(config);
+        self.send_pending_balance();
+    }
+
+    fn send_pending_balance(&mut self) {
+        let Some(config) = self.pending_balance else {
+            return;
+        };
+        if self.device.imu_report().health == ImuHealth::Absent {
+            return;
+        }
+        // A refusal (a sensor fault since) leaves it pending.
+        if self.request(Request::SetBalance(config)).is_ok() {
+            self.pending_balance = None;
+        }
+    }
+
+    /// The balance functions' report (what `GetImu` answers).
+    pub fn imu_report(&self) -> ImuReport {
+        self.device.imu_report()
     }
 
     /// What the device knows of its inertial sensor.

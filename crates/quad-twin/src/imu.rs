@@ -19,9 +19,8 @@
 //! positive rate about +x.
 
 use quad_device::{ImuReading, ImuSample};
-use std::cell::RefCell;
 use std::collections::VecDeque;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// The twin's IMU sample period, s (200 Hz: four samples in each 20 ms servo frame; the
 /// MPU-6050 is read at ≥ 100 Hz on the board).
@@ -54,7 +53,8 @@ struct Queue {
 /// gravity's reaction, [`crate::scenario::Scenario::at_rest_accel_m_s2`]; the gyroscope zero).
 ///
 /// Clones share one queue (as [`quad_device::sim::VirtualClock`]'s clones share one time): the
-/// frame source pushes into one clone, the emulated sensor reads another. A sensor source of
+/// frame source pushes into one clone, the emulated sensor reads another (the emulator's
+/// sensor sources are `Send`: the queue is behind a mutex). A sensor source of
 /// the emulator with a callback feed takes it as `move |t_s| feed.read(t_s)`; reading is
 /// infallible (the twin's sensor has no bus faults of its own: faults are the emulated
 /// chip's).
@@ -64,7 +64,7 @@ struct Queue {
 /// ([`TwinImu::push`]): where two frames overlap on the reader's clock, the later physics
 /// wins.
 #[derive(Debug, Clone)]
-pub struct TwinImu(Rc<RefCell<Queue>>);
+pub struct TwinImu(Arc<Mutex<Queue>>);
 
 /// A sample's time is not a finite number ([`TwinImu::push`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,12 +84,20 @@ impl std::error::Error for NotFinite {}
 impl TwinImu {
     /// An empty feed that reads `at_rest` until the first sample.
     pub fn new(at_rest: ImuSample) -> TwinImu {
-        TwinImu(Rc::new(RefCell::new(Queue {
+        TwinImu(Arc::new(Mutex::new(Queue {
             samples: VecDeque::new(),
             at_rest,
             dropped: 0,
             replaced: 0,
         })))
+    }
+
+    /// The queue, locked (a panic while it was held left it consistent: every change is a
+    /// single push or pop).
+    fn queue(&self) -> MutexGuard<'_, Queue> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
     /// Appends `sample`, taken at `t_s` on the reader's clock; queued samples at or after
@@ -101,7 +109,7 @@ impl TwinImu {
         if !t_s.is_finite() {
             return Err(NotFinite { t_s });
         }
-        let mut q = self.0.borrow_mut();
+        let mut q = self.queue();
         while q.samples.back().is_some_and(|&(last_s, _)| last_s >= t_s) {
             q.samples.pop_back();
             q.replaced += 1;
@@ -117,7 +125,7 @@ impl TwinImu {
     /// What the sensor reads at `t_s`: the latest sample at or before `t_s`; before the first
     /// sample, the robot at rest. Drops the samples before the one it answers with.
     pub fn read(&self, t_s: f64) -> ImuReading {
-        let mut q = self.0.borrow_mut();
+        let mut q = self.queue();
         // Keep the latest sample at or before t_s at the front.
         while q.samples.len() > 1 && q.samples[1].0 <= t_s {
             q.samples.pop_front();
@@ -131,22 +139,22 @@ impl TwinImu {
 
     /// Samples waiting (the one a read last answered with included).
     pub fn len(&self) -> usize {
-        self.0.borrow().samples.len()
+        self.queue().samples.len()
     }
 
     /// True when no sample waits.
     pub fn is_empty(&self) -> bool {
-        self.0.borrow().samples.is_empty()
+        self.queue().samples.is_empty()
     }
 
     /// Samples dropped unread because the queue was full ([`TWIN_IMU_CAPACITY`]).
     pub fn dropped(&self) -> u64 {
-        self.0.borrow().dropped
+        self.queue().dropped
     }
 
     /// Samples replaced by an earlier one pushed after them (overlapping frames).
     pub fn replaced(&self) -> u64 {
-        self.0.borrow().replaced
+        self.queue().replaced
     }
 }
 
