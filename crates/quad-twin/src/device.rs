@@ -84,7 +84,8 @@ impl InProcess {
     }
 
     /// Sends one request at message level and checks it is acknowledged (`Ack`, `HelloAck`,
-    /// or `MotionAck` for the motion engine's requests).
+    /// `MotionAck` for the motion engine's requests, or the balance report that answers
+    /// `SetBalance`).
     ///
     /// # Errors
     /// [`DeviceError::Nack`] or [`DeviceError::Unexpected`].
@@ -96,7 +97,8 @@ impl InProcess {
         }) {
             DeviceToHost::Ack { .. }
             | DeviceToHost::HelloAck { .. }
-            | DeviceToHost::MotionAck { .. } => Ok(()),
+            | DeviceToHost::MotionAck { .. }
+            | DeviceToHost::Imu { .. } => Ok(()),
             DeviceToHost::Nack { reason, .. } => Err(DeviceError::Nack(reason)),
             _ => Err(DeviceError::Unexpected),
         }

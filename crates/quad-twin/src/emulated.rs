@@ -22,8 +22,11 @@
 //! finds the samples up to its time. Host-driven, a frame's exchange can take the MCU less
 //! than a period; the next frame's samples then replace the overlapped ones. The emulator's
 //! virtual MPU-6050 at 0x68 on the chip's TWI reads them through a callback source
-//! (`Feed(move |t_s| feed.read(t_s))`, `t_s` the MCU's cycle count over [`F_CPU_HZ`]): the
-//! firmware's own TWI driver reads the twin's accelerometer and gyroscope.
+//! (`Feed(move |t_s| feed.sample_at(t_s))`, `t_s` the MCU's cycle count over [`F_CPU_HZ`]): the
+//! firmware's own TWI driver reads the twin's accelerometer and gyroscope, with the
+//! MPU-6050's noise added ([`Noisy::mpu6050`]: noiseless readings that repeat exactly, as the
+//! robot at rest before the twin's first sample, are what the firmware's stuck-sensor check
+//! catches).
 //!
 //! With balance settings ([`Emulated::set_balance`]) the firmware gets them as a `SetBalance`
 //! request at the first frame (retried each frame while it answers that its sensor is absent),
@@ -38,7 +41,7 @@ use crate::motions::Plan;
 use crate::scenario::Scenario;
 use crate::source::{imu_readings, onboard_request, DeviceFrame, FrameSource};
 use kin_core::motion::gait::Velocity;
-use quad_device::sim::imu::Feed;
+use quad_device::sim::imu::{Feed, Noisy};
 use quad_device::Config;
 use quad_device::{ImuReading, ImuSample};
 use quad_host::client::{Client, ClientConfig};
@@ -51,6 +54,9 @@ use std::path::Path;
 
 /// The line rate of the firmware the emulated source boots (`firmware.elf`), bit/s.
 pub const FIRMWARE_BAUD: u32 = 115_200;
+
+/// The seed of the emulated MPU-6050's noise ([`Noisy::mpu6050`] on the twin's samples).
+pub const IMU_NOISE_SEED: u64 = 22;
 
 /// The firmware in simavr, driven by a host sending `SetFeet` every frame.
 pub struct Emulated {
@@ -121,7 +127,13 @@ impl Emulated {
         });
         let feed = imu.clone();
         let emulator = EmulatorConfig {
-            imu: Some(SharedImuSource::new(Feed(move |t_s| feed.read(t_s)))),
+            // With the MPU-6050's own noise: a noiseless reading repeats exactly (the robot at
+            // rest before the twin's first sample), which the firmware rightly takes for a
+            // stuck sensor.
+            imu: Some(SharedImuSource::new(Noisy::mpu6050(
+                Feed(move |t_s| feed.sample_at(t_s)),
+                IMU_NOISE_SEED,
+            ))),
             ..EmulatorConfig::new(FIRMWARE_BAUD)
         };
         let link = match elf {
@@ -172,12 +184,30 @@ impl Emulated {
         self.hold_pose = config.leveling;
     }
 
+    /// The firmware's balance report now (`GetImu`).
+    ///
+    /// # Errors
+    /// [`crate::Error::Emulator`] when the exchange fails, [`crate::Error::Protocol`] for
+    /// another answer.
+    pub fn imu_report(&mut self) -> Result<quad_protocol::ImuReport, crate::Error> {
+        match self
+            .client
+            .request(Request::GetImu)
+            .map_err(crate::Error::Emulator)?
+        {
+            DeviceToHost::Imu { report, .. } => Ok(report),
+            _ => Err(crate::Error::Protocol("expected the IMU report")),
+        }
+    }
+
     /// Sends the pending balance settings and reads the balance report: the frame's estimate
     /// and fall flag (none, false: no report read).
     fn balance_exchange(&mut self) -> Result<(Option<[f32; 3]>, bool), crate::Error> {
         if let Some(config) = self.pending_balance {
-            match self.client.ack(Request::SetBalance(config)) {
-                Ok(_) => self.pending_balance = None,
+            // The firmware answers with its balance report.
+            match self.client.request(Request::SetBalance(config)) {
+                Ok(DeviceToHost::Imu { .. }) => self.pending_balance = None,
+                Ok(_) => return Err(crate::Error::Protocol("expected the IMU report")),
                 Err(quad_host::client::Error::Refused {
                     reason: NackReason::ImuAbsent,
                     ..
@@ -188,17 +218,11 @@ impl Emulated {
         if !self.read_imu {
             return Ok((None, false));
         }
-        match self
-            .client
-            .request(Request::GetImu)
-            .map_err(crate::Error::Emulator)?
-        {
-            DeviceToHost::Imu { report, .. } => Ok((
-                crate::source::estimated_rpy_rad(&report),
-                report.fall.is_some(),
-            )),
-            _ => Err(crate::Error::Protocol("expected the IMU report")),
-        }
+        let report = self.imu_report()?;
+        Ok((
+            crate::source::estimated_rpy_rad(&report),
+            report.fall.is_some(),
+        ))
     }
 
     /// The twin's IMU samples, timed on the MCU's clock (a clone sharing the queue): what the

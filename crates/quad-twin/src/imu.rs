@@ -43,6 +43,8 @@ struct Queue {
     dropped: u64,
     /// Samples replaced by an earlier one pushed later.
     replaced: u64,
+    /// The latest time a [`TwinImu::sample_at`] asked for: samples up to it have been read.
+    read_up_to_s: f64,
 }
 
 /// The twin's IMU samples as a sensor source reads them: a queue of samples timed on the
@@ -54,8 +56,9 @@ struct Queue {
 ///
 /// Clones share one queue (as [`quad_device::sim::VirtualClock`]'s clones share one time): the
 /// frame source pushes into one clone, the emulated sensor reads another (the emulator's
-/// sensor sources are `Send`: the queue is behind a mutex). A sensor source of
-/// the emulator with a callback feed takes it as `move |t_s| feed.read(t_s)`; reading is
+/// sensor sources are `Send`: the queue is behind a mutex). The emulator's sensor source
+/// reads it without consuming it ([`TwinImu::sample_at`]; `Feed(move |t_s|
+/// feed.sample_at(t_s))`); reading is
 /// infallible (the twin's sensor has no bus faults of its own: faults are the emulated
 /// chip's).
 ///
@@ -89,6 +92,7 @@ impl TwinImu {
             at_rest,
             dropped: 0,
             replaced: 0,
+            read_up_to_s: f64::NEG_INFINITY,
         })))
     }
 
@@ -115,8 +119,12 @@ impl TwinImu {
             q.replaced += 1;
         }
         if q.samples.len() == TWIN_IMU_CAPACITY {
-            q.samples.pop_front();
-            q.dropped += 1;
+            if let Some((oldest_s, _)) = q.samples.pop_front() {
+                // Unread unless a later read passed it.
+                if oldest_s > q.read_up_to_s {
+                    q.dropped += 1;
+                }
+            }
         }
         q.samples.push_back((t_s, sample));
         Ok(())
@@ -133,6 +141,24 @@ impl TwinImu {
         let sample = match q.samples.front() {
             Some(&(t0, sample)) if t0 <= t_s => sample,
             _ => q.at_rest,
+        };
+        ImuReading::Sample(sample)
+    }
+
+    /// What the sensor reads at `t_s`, as [`TwinImu::read`], but keeping the queue: the
+    /// emulated MPU-6050's source (`Feed(move |t_s| feed.sample_at(t_s))`), so that the
+    /// queue's count stays what the twin pushed (the oldest go only when it is full, and
+    /// count as [`TwinImu::dropped`] only when no read had passed them).
+    pub fn sample_at(&self, t_s: f64) -> ImuReading {
+        let mut q = self.queue();
+        if t_s > q.read_up_to_s {
+            q.read_up_to_s = t_s;
+        }
+        // Samples at or before t_s form a prefix (the queue is in time order).
+        let n = q.samples.partition_point(|&(t, _)| t <= t_s);
+        let sample = match n {
+            0 => q.at_rest,
+            _ => q.samples[n - 1].1,
         };
         ImuReading::Sample(sample)
     }
@@ -185,6 +211,23 @@ mod tests {
         assert_eq!(reader.len(), 1);
         // The last sample stays until a later one replaces it.
         assert_eq!(reader.read(2.0), ImuReading::Sample(sample(3.0)));
+    }
+
+    #[test]
+    fn sample_at_keeps_the_queue_and_a_full_queue_drops_read_samples_uncounted() {
+        let feed = TwinImu::new(sample(-1.0));
+        for i in 0..TWIN_IMU_CAPACITY {
+            feed.push(i as f64, sample(i as f32)).unwrap();
+        }
+        assert_eq!(feed.sample_at(-0.5), ImuReading::Sample(sample(-1.0)));
+        assert_eq!(feed.sample_at(2.5), ImuReading::Sample(sample(2.0)));
+        assert_eq!(feed.len(), TWIN_IMU_CAPACITY);
+        // The oldest, read, goes uncounted; then an unread one goes counted.
+        for i in 0..4 {
+            feed.push((TWIN_IMU_CAPACITY + i) as f64, sample(0.0))
+                .unwrap();
+        }
+        assert_eq!(feed.dropped(), 1);
     }
 
     #[test]
