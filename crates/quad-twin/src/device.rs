@@ -45,6 +45,11 @@ impl core::fmt::Display for DeviceError {
 
 impl std::error::Error for DeviceError {}
 
+/// Servo frames a device with balance settings runs, the robot still, before a run (1.1 s:
+/// the gyro-bias measurement's second and a margin), so that it estimates and levels from the
+/// run's first frame.
+pub const REST_BEFORE_RUN_FRAMES: u32 = 55;
+
 /// The device controller in this process, powered on, its outputs enabled: requests at message
 /// level, its clock advanced one frame at a time by the loop.
 pub struct InProcess {
@@ -132,6 +137,31 @@ impl InProcess {
         self.clock.set_ns(start_ns + frame_ns);
         self.device.poll();
         self.send_pending_balance();
+    }
+
+    /// Runs the device for `frames` servo frames before the run with the robot still and its
+    /// outputs off, its sensor reading `at_rest` at 200 Hz (as the robot at rest on the floor
+    /// reads; the emulated sensor reads the same before the twin's first sample), then enables
+    /// the outputs again: the device powered on before the motion starts, long enough for its
+    /// gyro-bias measurement ([`quad_device::balance::BIAS_WINDOW_MS`];
+    /// [`REST_BEFORE_RUN_FRAMES`]). The outputs off meanwhile, the run's first target is taken
+    /// at once as after any enabling (no limiter ramp from the power-on pose).
+    ///
+    /// # Errors
+    /// [`DeviceError`] when the device refuses to switch its outputs.
+    pub fn rest_before_run(
+        &mut self,
+        at_rest: quad_device::ImuSample,
+        frames: u32,
+    ) -> Result<(), DeviceError> {
+        let readings: Vec<(u64, ImuReading)> = (0..4)
+            .map(|i| (i * 5_000_000 + 4_000_000, ImuReading::Sample(at_rest)))
+            .collect();
+        self.request(Request::SetOutputs { enabled: false })?;
+        for _ in 0..frames {
+            self.tick_with_imu(20, &readings);
+        }
+        self.request(Request::SetOutputs { enabled: true })
     }
 
     /// Configures the balance functions with `config` as a `SetBalance` request, at the end of

@@ -178,10 +178,30 @@ impl Emulated {
     /// the frames.
     /// Host-driven with leveling on, the zero pose is held while the plan holds the stance
     /// ([`crate::source::host_request`]): leveling acts on a held pose.
-    pub fn set_balance(&mut self, config: BalanceConfig) {
+    ///
+    /// The MCU first runs [`crate::device::REST_BEFORE_RUN_FRAMES`] servo frames idle with
+    /// its outputs off, its sensor reading the robot at rest (the feed before the twin's first
+    /// sample), for its gyro-bias measurement; then the outputs are enabled again.
+    ///
+    /// # Errors
+    /// [`crate::Error::Emulator`] when the emulator fails meanwhile.
+    pub fn set_balance(&mut self, config: BalanceConfig) -> Result<(), crate::Error> {
         self.pending_balance = Some(config);
         self.read_imu = true;
         self.hold_pose = config.leveling;
+        self.client
+            .ack(Request::SetOutputs { enabled: false })
+            .map_err(crate::Error::Emulator)?;
+        self.client
+            .link_mut()
+            .idle(std::time::Duration::from_millis(
+                u64::from(crate::device::REST_BEFORE_RUN_FRAMES) * 20,
+            ))
+            .map_err(|e| crate::Error::Emulator(e.into()))?;
+        self.client
+            .ack(Request::SetOutputs { enabled: true })
+            .map_err(crate::Error::Emulator)?;
+        Ok(())
     }
 
     /// The firmware's balance report now (`GetImu`).

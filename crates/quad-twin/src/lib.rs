@@ -353,7 +353,9 @@ pub struct RunOptions {
     pub scenario: Scenario,
     /// The device's balance functions (`SetBalance`, sent once its sensor has a reading: in
     /// process [`device::InProcess::set_balance_when_ready`], emulated
-    /// [`emulated::Emulated::set_balance`]); none: the device's power-on settings (leveling
+    /// [`emulated::Emulated::set_balance`]). The device then first runs 1.1 s with the robot
+    /// still before the run ([`device::REST_BEFORE_RUN_FRAMES`]; its gyro-bias measurement
+    /// needs a second of stillness), so that it estimates from the first frame; none: the device's power-on settings (leveling
     /// off, fall detection on). The in-process device's attitude estimate is in every frame;
     /// the emulated firmware's only with balance settings (a `GetImu` every frame).
     pub balance: Option<quad_protocol::BalanceConfig>,
@@ -558,6 +560,15 @@ pub fn run_plan(
             let mut device = device::InProcess::start(*config)
                 .map_err(|error| Error::Device { frame: 0, error })?;
             if let Some(balance) = options.balance {
+                device
+                    .rest_before_run(
+                        quad_device::ImuSample {
+                            accel_m_s2: options.scenario.at_rest_accel_m_s2(imu::GRAVITY_M_S2),
+                            gyro_rad_s: [0.0; 3],
+                        },
+                        device::REST_BEFORE_RUN_FRAMES,
+                    )
+                    .map_err(|error| Error::Device { frame: 0, error })?;
                 device.set_balance_when_ready(balance);
             }
             if options.onboard {
@@ -581,7 +592,7 @@ pub fn run_plan(
                 &options.scenario,
             )?;
             if let Some(balance) = options.balance {
-                emulated.set_balance(balance);
+                emulated.set_balance(balance)?;
             }
             Box::new(emulated)
         }

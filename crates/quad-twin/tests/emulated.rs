@@ -166,10 +166,12 @@ fn the_emulated_firmware_reads_the_twins_imu_over_its_twi_and_levels_on_a_slope(
     let plan = Plan::new(MotionKind::Stand, &config).unwrap();
     let mut firmware =
         Emulated::boot_on(plan, &config, None, false, &scenario).unwrap_or_else(|e| panic!("{e}"));
-    firmware.set_balance(quad_protocol::BalanceConfig {
-        leveling: true,
-        ..quad_protocol::BalanceConfig::DEFAULT
-    });
+    firmware
+        .set_balance(quad_protocol::BalanceConfig {
+            leveling: true,
+            ..quad_protocol::BalanceConfig::DEFAULT
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
     let model = quad_model::Model::new(config.robot, physical).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("model.xml");
