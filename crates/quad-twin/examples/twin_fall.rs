@@ -29,13 +29,16 @@ const FALL_ANGLE_RAD: f64 = std::f64::consts::FRAC_PI_3;
 /// The push that tips each preset over, N·s (about three times the largest one it survives).
 const PUSHES_N_S: [f32; 2] = [9.0, 48.0];
 
+/// One frame as recorded: the samples the device took before it (`t_s`, true max tilt),
+/// whether its report shows the fall, whether its outputs are on, and the frame's start on the
+/// twin's clock (the end of the previous frame).
+type Recorded = (Vec<(f64, f64)>, bool, bool, Option<f64>);
+
 /// The frames of a run and the samples before each.
 struct Recorder {
     inner: HostDriven,
-    /// Per frame `k`: the samples the device took before it (`t_s`, true max tilt), whether
-    /// its report shows the fall, whether its outputs are on, and the frame's start on the
-    /// twin's clock (the end of the previous frame).
-    frames: Vec<(Vec<(f64, f64)>, bool, bool, Option<f64>)>,
+    /// Per frame `k`.
+    frames: Vec<Recorded>,
 }
 
 impl FrameSource for Recorder {
