@@ -80,6 +80,8 @@ pub struct Emulated {
     hold_pose: bool,
     /// The pose was sent.
     pose_held: bool,
+    /// The outputs are to be enabled again with the first frame's request.
+    enable_at_start: bool,
 }
 
 impl Emulated {
@@ -169,6 +171,7 @@ impl Emulated {
             read_imu: false,
             hold_pose: false,
             pose_held: false,
+            enable_at_start: false,
         })
     }
 
@@ -181,7 +184,8 @@ impl Emulated {
     ///
     /// The MCU first runs [`crate::device::REST_BEFORE_RUN_FRAMES`] servo frames idle with
     /// its outputs off, its sensor reading the robot at rest (the feed before the twin's first
-    /// sample), for its gyro-bias measurement; then the outputs are enabled again.
+    /// sample), for its gyro-bias measurement; the outputs are enabled again just before the
+    /// first frame's request.
     ///
     /// # Errors
     /// [`crate::Error::Emulator`] when the emulator fails meanwhile.
@@ -198,9 +202,7 @@ impl Emulated {
                 u64::from(crate::device::REST_BEFORE_RUN_FRAMES) * 20,
             ))
             .map_err(|e| crate::Error::Emulator(e.into()))?;
-        self.client
-            .ack(Request::SetOutputs { enabled: true })
-            .map_err(crate::Error::Emulator)?;
+        self.enable_at_start = true;
         Ok(())
     }
 
@@ -280,6 +282,11 @@ impl FrameSource for Emulated {
         }
         let t_s = k as f32 * crate::source::FRAME_S;
         let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
+        if std::mem::take(&mut self.enable_at_start) {
+            self.client
+                .ack(Request::SetOutputs { enabled: true })
+                .map_err(crate::Error::Emulator)?;
+        }
         // The MCU cycle from which the twin holds this frame's pulses: the end of its PWM
         // period onboard, else when they were measured.
         let mut held_from = None;
