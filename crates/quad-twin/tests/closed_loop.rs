@@ -110,3 +110,124 @@ fn the_devices_estimate_follows_the_true_attitude_during_the_onboard_trot() {
     );
     assert!(e.max_error_rad.to_degrees() <= TROT_MAX_ERROR_DEG, "{e:?}");
 }
+
+/// A fall: the true |roll| or |pitch| past the fall angle → the device latches the fall on a
+/// sample at most this later, s (issue 22: 100 ms; measured 0–15 ms on seed 000's robot).
+const FALL_DETECTED_WITHIN_S: f64 = 0.1;
+/// ... and its outputs are off (safe state `Off`) at most one servo frame after that sample, s.
+const OUTPUTS_SAFE_WITHIN_S: f64 = 0.02;
+/// The push that tips seed 000's robot over standing, N·s (about three times the largest it
+/// survives).
+const TIPPING_PUSH_N_S: f32 = 9.0;
+
+/// Per frame: the samples before it (`t_s`, true max tilt), the device's fall flag, its
+/// outputs on, the frame's start on the twin's clock.
+type Recorded = (Vec<(f64, f64)>, bool, bool, Option<f64>);
+
+struct Recorder {
+    inner: quad_twin::source::HostDriven,
+    frames: Vec<Recorded>,
+}
+
+impl quad_twin::source::FrameSource for Recorder {
+    fn frame_count(&self) -> u32 {
+        self.inner.frame_count()
+    }
+
+    fn next(
+        &mut self,
+        k: u32,
+        feedback: Option<&quad_twin::link::BodyState>,
+    ) -> Result<quad_twin::source::DeviceFrame, quad_twin::Error> {
+        let frame = self.inner.next(k, feedback)?;
+        let samples = feedback.map_or_else(Vec::new, |s| {
+            s.imu
+                .iter()
+                .map(|i| (i.t_s, i.rpy_rad[0].abs().max(i.rpy_rad[1].abs())))
+                .collect()
+        });
+        self.frames.push((
+            samples,
+            frame.fall_detected,
+            frame.enabled,
+            feedback.map(|s| s.t_s),
+        ));
+        Ok(frame)
+    }
+}
+
+#[test]
+fn a_fall_is_caught_within_100_ms_and_the_outputs_are_off_within_a_frame() {
+    let physical = Physical::shahriar2023();
+    let config = Config {
+        joint_speed_limit_rad_s: quad_device::engine::limit_for_servo(
+            physical.servo.no_load_speed_rad_s,
+        ),
+        ..Config::shahriar2023()
+    };
+    let scenario = Scenario::new(SlopeAxis::Roll, 0.0, false, Some(TIPPING_PUSH_N_S)).unwrap();
+    let plan = quad_twin::Plan::new(MotionKind::Stand, &config)
+        .unwrap()
+        .lasting_at_least(scenario.min_duration_s().unwrap());
+    let mut device = quad_twin::device::InProcess::start(config).unwrap();
+    device
+        .rest_before_run(
+            quad_device::ImuSample {
+                accel_m_s2: [0.0, 0.0, quad_twin::imu::GRAVITY_M_S2],
+                gyro_rad_s: [0.0; 3],
+            },
+            quad_twin::device::REST_BEFORE_RUN_FRAMES,
+        )
+        .unwrap();
+    device.set_balance_when_ready(BalanceConfig {
+        leveling: true,
+        safe_state: quad_protocol::SafeState::Off,
+        ..BalanceConfig::DEFAULT
+    });
+    let mut recorder = Recorder {
+        inner: quad_twin::source::HostDriven::new(plan, device).hold_pose(),
+        frames: Vec::new(),
+    };
+    let model = quad_model::Model::new(config.robot, physical).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.xml");
+    quad_model::mjcf::write(&model, &path).unwrap();
+    let run = quad_twin::run_source_in(
+        &mut recorder,
+        &path,
+        quad_model::mjcf::robot_name(&model),
+        &plan,
+        None,
+        false,
+        &scenario,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(run.summary.fell, "the push tips the robot over");
+    let crossed = recorder
+        .frames
+        .iter()
+        .flat_map(|f| f.0.iter())
+        .find(|&&(_, tilt)| tilt > std::f64::consts::FRAC_PI_3)
+        .map(|&(t, _)| t)
+        .expect("the true tilt passes 60°");
+    let (samples, ..) = recorder
+        .frames
+        .iter()
+        .find(|f| f.1)
+        .expect("the device latches the fall");
+    let first = samples.first().expect("samples").0;
+    let last = samples.last().expect("samples").0;
+    let off = recorder
+        .frames
+        .iter()
+        .find(|f| !f.2)
+        .and_then(|f| f.3)
+        .expect("the outputs go off");
+    eprintln!(
+        "fall: true tilt past 60° at {crossed:.3} s, latched on a sample at {first:.3}–{last:.3} s, outputs off from {off:.3} s"
+    );
+    // The latch lies on one of the frame's samples: between its first and its last.
+    assert!(last - crossed <= FALL_DETECTED_WITHIN_S);
+    assert!(first >= crossed - 0.005, "latched before the true crossing");
+    assert!(off - first <= OUTPUTS_SAFE_WITHIN_S && off >= last);
+}
