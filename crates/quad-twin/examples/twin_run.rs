@@ -6,7 +6,8 @@
 //! #          --emulator (the firmware in simavr instead of the in-process device);
 //! #          the trot's shape: --cycle-s T, --duty D, --step-height-fraction F (of H),
 //! #          --speed-heights-per-s V (kin-core's own trot: --duty 0.5 --cycle-s 0.8);
-//! #          the world: --slope-deg D, --slope-axis roll|pitch, --tilt-floor, --push-n-s I
+//! #          the world: --slope-deg D, --slope-axis roll|pitch, --tilt-floor, --push-n-s I;
+//! #          --balance (the device levels the body and detects falls)
 //! ```
 //!
 //! `quadctl sim` is the command; this example keeps the parameter studies scriptable.
@@ -106,6 +107,13 @@ fn main() -> ExitCode {
         },
         onboard: args.iter().any(|a| a == "--onboard"),
         scenario,
+        balance: args
+            .iter()
+            .any(|a| a == "--balance")
+            .then_some(quad_protocol::BalanceConfig {
+                leveling: true,
+                ..quad_protocol::BalanceConfig::DEFAULT
+            }),
         ..RunOptions::default()
     };
     let number = |flag: &str| -> Result<Option<f32>, String> {

@@ -2,7 +2,7 @@
 //! host-driven, `stand`:
 //!
 //! ```sh
-//! cargo run --release -p quad-twin --example twin_scenarios [-- --out-dir DIR]
+//! cargo run --release -p quad-twin --example twin_scenarios [-- --out-dir DIR] [--balance] [--push-only]
 //! ```
 //!
 //! - standing on a 10° slope, roll then pitch: the body's settled roll and pitch;
@@ -11,7 +11,9 @@
 //! - the largest sideways impulse survived standing: a bisection over the impulse (to
 //!   [`RELATIVE_TOLERANCE`] of it) between one the robot survives and one that fells it.
 //!
-//! With `--out-dir DIR`, each slope and tilt run, and the push runs at the largest impulse
+//! With `--balance` the device's balance functions are on (leveling and fall detection, the
+//! protocol's defaults; the figures of the closed loop); `--push-only` runs only the push's
+//! bisection. With `--out-dir DIR`, each slope and tilt run, and the push runs at the largest impulse
 //! survived and the smallest that fells, keep their files (plots, pictures) in
 //! `DIR/PRESET-CASE`.
 
@@ -34,11 +36,16 @@ fn stand(
     physical: &Physical,
     scenario: Scenario,
     out_dir: Option<PathBuf>,
+    balance: bool,
 ) -> Result<Summary, String> {
     let options = RunOptions {
         render: out_dir.is_some(),
         out_dir,
         scenario,
+        balance: balance.then_some(quad_protocol::BalanceConfig {
+            leveling: true,
+            ..quad_protocol::BalanceConfig::DEFAULT
+        }),
         ..RunOptions::default()
     };
     run(config, physical, MotionKind::Stand, &options)
@@ -67,6 +74,8 @@ fn main() -> ExitCode {
         .position(|a| a == "--out-dir")
         .and_then(|i| args.get(i + 1))
         .map(PathBuf::from);
+    let balance = args.iter().any(|a| a == "--balance");
+    let push_only = args.iter().any(|a| a == "--push-only");
     let dir = |name: &str, case: &str| out_dir.as_ref().map(|d| d.join(format!("{name}-{case}")));
     let presets = [
         (
@@ -82,21 +91,21 @@ fn main() -> ExitCode {
     ];
     let result = (|| -> Result<(), String> {
         for (name, config, physical) in &presets {
-            for axis in SlopeAxis::ALL {
+            for axis in SlopeAxis::ALL.into_iter().filter(|_| !push_only) {
                 let case = format!("slope-{}", axis.name());
                 let scenario =
                     Scenario::new(axis, SLOPE_DEG, false, None).map_err(|e| e.to_string())?;
-                let s = stand(config, physical, scenario, dir(name, &case))?;
+                let s = stand(config, physical, scenario, dir(name, &case), balance)?;
                 line(name, &format!("slope {SLOPE_DEG}° {}", axis.name()), &s);
                 let case = format!("tilt-{}", axis.name());
                 let scenario = Scenario::new(axis, 0.0, true, None).map_err(|e| e.to_string())?;
-                let s = stand(config, physical, scenario, dir(name, &case))?;
+                let s = stand(config, physical, scenario, dir(name, &case), balance)?;
                 line(name, &format!("floor tilting 10° {}", axis.name()), &s);
             }
             let push = |impulse: f32, out: Option<PathBuf>| -> Result<Summary, String> {
                 let scenario = Scenario::new(SlopeAxis::Roll, 0.0, false, Some(impulse))
                     .map_err(|e| e.to_string())?;
-                stand(config, physical, scenario, out)
+                stand(config, physical, scenario, out, balance)
             };
             let mut lo = 0.0_f32;
             let mut hi = FIRST_IMPULSE_N_S_PER_KG * physical.total_mass_kg();

@@ -7,6 +7,7 @@ use quad_device::imu::ImuState;
 use quad_device::sim::{Outputs, RamEeprom, VirtualClock};
 use quad_device::{Config, ConfigError, Device, ImuReading};
 use quad_protocol::servo::Error as ServoError;
+use quad_protocol::{BalanceConfig, ImuHealth, ImuReport};
 use quad_protocol::{DeviceToHost, HostToDevice, NackReason, Request, ServoId, PROTOCOL_VERSION};
 
 /// Why the device refused a step.
@@ -44,12 +45,19 @@ impl core::fmt::Display for DeviceError {
 
 impl std::error::Error for DeviceError {}
 
+/// Servo frames a device with balance settings runs, the robot still, before a run (1.1 s:
+/// the gyro-bias measurement's second and a margin), so that it estimates and levels from the
+/// run's first frame.
+pub const REST_BEFORE_RUN_FRAMES: u32 = 55;
+
 /// The device controller in this process, powered on, its outputs enabled: requests at message
 /// level, its clock advanced one frame at a time by the loop.
 pub struct InProcess {
     device: Device<Outputs, VirtualClock, RamEeprom>,
     clock: VirtualClock,
     seq: u16,
+    /// Balance settings to send once the sensor has given a reading.
+    pending_balance: Option<BalanceConfig>,
 }
 
 impl InProcess {
@@ -71,6 +79,7 @@ impl InProcess {
             device,
             clock,
             seq: 0,
+            pending_balance: None,
         };
         d.request(Request::Hello {
             version: PROTOCOL_VERSION,
@@ -80,7 +89,8 @@ impl InProcess {
     }
 
     /// Sends one request at message level and checks it is acknowledged (`Ack`, `HelloAck`,
-    /// or `MotionAck` for the motion engine's requests).
+    /// `MotionAck` for the motion engine's requests, or the balance report that answers
+    /// `SetBalance`).
     ///
     /// # Errors
     /// [`DeviceError::Nack`] or [`DeviceError::Unexpected`].
@@ -92,7 +102,8 @@ impl InProcess {
         }) {
             DeviceToHost::Ack { .. }
             | DeviceToHost::HelloAck { .. }
-            | DeviceToHost::MotionAck { .. } => Ok(()),
+            | DeviceToHost::MotionAck { .. }
+            | DeviceToHost::Imu { .. } => Ok(()),
             DeviceToHost::Nack { reason, .. } => Err(DeviceError::Nack(reason)),
             _ => Err(DeviceError::Unexpected),
         }
@@ -125,6 +136,59 @@ impl InProcess {
         }
         self.clock.set_ns(start_ns + frame_ns);
         self.device.poll();
+        self.send_pending_balance();
+    }
+
+    /// Runs the device for `frames` servo frames before the run with the robot still and its
+    /// outputs off, its sensor reading `at_rest` at 200 Hz (as the robot at rest on the floor
+    /// reads; the emulated sensor reads the same before the twin's first sample), then enables
+    /// the outputs again: the device powered on before the motion starts, long enough for its
+    /// gyro-bias measurement ([`quad_device::balance::BIAS_WINDOW_MS`];
+    /// [`REST_BEFORE_RUN_FRAMES`]). The outputs off meanwhile, the run's first target is taken
+    /// at once as after any enabling (no limiter ramp from the power-on pose).
+    ///
+    /// # Errors
+    /// [`DeviceError`] when the device refuses to switch its outputs.
+    pub fn rest_before_run(
+        &mut self,
+        at_rest: quad_device::ImuSample,
+        frames: u32,
+    ) -> Result<(), DeviceError> {
+        let readings: Vec<(u64, ImuReading)> = (0..4)
+            .map(|i| (i * 5_000_000 + 4_000_000, ImuReading::Sample(at_rest)))
+            .collect();
+        self.request(Request::SetOutputs { enabled: false })?;
+        for _ in 0..frames {
+            self.tick_with_imu(20, &readings);
+        }
+        self.request(Request::SetOutputs { enabled: true })
+    }
+
+    /// Configures the balance functions with `config` as a `SetBalance` request, at the end of
+    /// the first frame after which the device has a reading from its sensor (leveling is
+    /// refused while the sensor is absent; from the first reading the device measures the gyro
+    /// bias for a second, then levels).
+    pub fn set_balance_when_ready(&mut self, config: BalanceConfig) {
+        self.pending_balance = Some(config);
+        self.send_pending_balance();
+    }
+
+    fn send_pending_balance(&mut self) {
+        let Some(config) = self.pending_balance else {
+            return;
+        };
+        if self.device.imu_report().health == ImuHealth::Absent {
+            return;
+        }
+        // A refusal (a sensor fault since) leaves it pending.
+        if self.request(Request::SetBalance(config)).is_ok() {
+            self.pending_balance = None;
+        }
+    }
+
+    /// The balance functions' report (what `GetImu` answers).
+    pub fn imu_report(&self) -> ImuReport {
+        self.device.imu_report()
     }
 
     /// What the device knows of its inertial sensor.

@@ -20,9 +20,19 @@
 //! taken `δ` into that frame is due at that time plus `δ`. The samples of frame `k` arrive
 //! before the MCU runs on for frame `k + 1`, so a sensor that reads the feed as the MCU runs
 //! finds the samples up to its time. Host-driven, a frame's exchange can take the MCU less
-//! than a period; the next frame's samples then replace the overlapped ones. The emulator's MPU-6050 reads them
-//! through a callback source (`move |t_s| feed.read(t_s)`, `t_s` the MCU's cycle count over
-//! [`F_CPU_HZ`]) once the emulator link takes one; until then the feed only fills.
+//! than a period; the next frame's samples then replace the overlapped ones. The emulator's
+//! virtual MPU-6050 at 0x68 on the chip's TWI reads them through a callback source
+//! (`Feed(move |t_s| feed.sample_at(t_s))`, `t_s` the MCU's cycle count over [`F_CPU_HZ`]): the
+//! firmware's own TWI driver reads the twin's accelerometer and gyroscope, with the
+//! MPU-6050's noise added ([`Noisy::mpu6050`]: noiseless readings that repeat exactly, as the
+//! robot at rest before the twin's first sample, are what the firmware's stuck-sensor check
+//! catches).
+//!
+//! With balance settings ([`Emulated::set_balance`]) the firmware gets them as a `SetBalance`
+//! request at the first frame (retried each frame while it answers that its sensor is absent),
+//! and every frame, after the frame's own request, a `GetImu`: its estimated roll and pitch go
+//! into the frame ([`DeviceFrame::estimated_rpy_rad`], the firmware's estimate from the
+//! samples it read up to that exchange: the physics about one frame old) with its fall flag.
 
 use crate::device::DeviceError;
 use crate::imu::{TwinImu, GRAVITY_M_S2};
@@ -31,17 +41,22 @@ use crate::motions::Plan;
 use crate::scenario::Scenario;
 use crate::source::{imu_readings, onboard_request, DeviceFrame, FrameSource};
 use kin_core::motion::gait::Velocity;
+use quad_device::sim::imu::{Feed, Noisy};
 use quad_device::Config;
 use quad_device::{ImuReading, ImuSample};
 use quad_host::client::{Client, ClientConfig};
+use quad_host::emu::SharedImuSource;
 use quad_host::emu::{CYCLES_PER_TICK, F_CPU_HZ, PERIOD_CYCLES};
 use quad_host::link::emulator::{EmulatorConfig, EmulatorLink};
 use quad_protocol::servo::Calibration;
-use quad_protocol::{MotionCommand, Request, ServoId};
+use quad_protocol::{BalanceConfig, DeviceToHost, MotionCommand, NackReason, Request, ServoId};
 use std::path::Path;
 
 /// The line rate of the firmware the emulated source boots (`firmware.elf`), bit/s.
 pub const FIRMWARE_BAUD: u32 = 115_200;
+
+/// The seed of the emulated MPU-6050's noise ([`Noisy::mpu6050`] on the twin's samples).
+pub const IMU_NOISE_SEED: u64 = 22;
 
 /// The firmware in simavr, driven by a host sending `SetFeet` every frame.
 pub struct Emulated {
@@ -57,6 +72,16 @@ pub struct Emulated {
     /// The MCU cycle at which the last frame's pulses were measured: when the twin began to
     /// hold them.
     frame_cycle: Option<u64>,
+    /// Balance settings not yet accepted.
+    pending_balance: Option<BalanceConfig>,
+    /// Read the firmware's balance report every frame.
+    read_imu: bool,
+    /// Hold the pose while the plan holds the stance (host-driven, leveling on).
+    hold_pose: bool,
+    /// The pose was sent.
+    pose_held: bool,
+    /// The outputs are to be enabled again with the first frame's request.
+    enable_at_start: bool,
 }
 
 impl Emulated {
@@ -102,7 +127,17 @@ impl Emulated {
             accel_m_s2: scenario.at_rest_accel_m_s2(GRAVITY_M_S2),
             gyro_rad_s: [0.0; 3],
         });
-        let emulator = EmulatorConfig::new(FIRMWARE_BAUD);
+        let feed = imu.clone();
+        let emulator = EmulatorConfig {
+            // With the MPU-6050's own noise: a noiseless reading repeats exactly (the robot at
+            // rest before the twin's first sample), which the firmware rightly takes for a
+            // stuck sensor.
+            imu: Some(SharedImuSource::new(Noisy::mpu6050(
+                Feed(move |t_s| feed.sample_at(t_s)),
+                IMU_NOISE_SEED,
+            ))),
+            ..EmulatorConfig::new(FIRMWARE_BAUD)
+        };
         let link = match elf {
             Some(path) => EmulatorLink::boot(path, emulator),
             None => EmulatorLink::boot_built(emulator),
@@ -132,7 +167,84 @@ impl Emulated {
             start_cycle: None,
             imu,
             frame_cycle: None,
+            pending_balance: None,
+            read_imu: false,
+            hold_pose: false,
+            pose_held: false,
+            enable_at_start: false,
         })
+    }
+
+    /// Configures the firmware's balance functions with `config` (a `SetBalance` at the next
+    /// frame, retried each frame while the firmware has no reading yet) and reads its balance
+    /// report (`GetImu`) every frame from then on: its attitude estimate and fall flag go into
+    /// the frames.
+    /// Host-driven with leveling on, the zero pose is held while the plan holds the stance
+    /// ([`crate::source::host_request`]): leveling acts on a held pose.
+    ///
+    /// The MCU first runs [`crate::device::REST_BEFORE_RUN_FRAMES`] servo frames idle with
+    /// its outputs off, its sensor reading the robot at rest (the feed before the twin's first
+    /// sample), for its gyro-bias measurement; the outputs are enabled again just before the
+    /// first frame's request.
+    ///
+    /// # Errors
+    /// [`crate::Error::Emulator`] when the emulator fails meanwhile.
+    pub fn set_balance(&mut self, config: BalanceConfig) -> Result<(), crate::Error> {
+        self.pending_balance = Some(config);
+        self.read_imu = true;
+        self.hold_pose = config.leveling;
+        self.client
+            .ack(Request::SetOutputs { enabled: false })
+            .map_err(crate::Error::Emulator)?;
+        self.client
+            .link_mut()
+            .idle(std::time::Duration::from_millis(
+                u64::from(crate::device::REST_BEFORE_RUN_FRAMES) * 20,
+            ))
+            .map_err(|e| crate::Error::Emulator(e.into()))?;
+        self.enable_at_start = true;
+        Ok(())
+    }
+
+    /// The firmware's balance report now (`GetImu`).
+    ///
+    /// # Errors
+    /// [`crate::Error::Emulator`] when the exchange fails, [`crate::Error::Protocol`] for
+    /// another answer.
+    pub fn imu_report(&mut self) -> Result<quad_protocol::ImuReport, crate::Error> {
+        match self
+            .client
+            .request(Request::GetImu)
+            .map_err(crate::Error::Emulator)?
+        {
+            DeviceToHost::Imu { report, .. } => Ok(report),
+            _ => Err(crate::Error::Protocol("expected the IMU report")),
+        }
+    }
+
+    /// Sends the pending balance settings and reads the balance report: the frame's estimate
+    /// and fall flag (none, false: no report read).
+    fn balance_exchange(&mut self) -> Result<(Option<[f32; 3]>, bool), crate::Error> {
+        if let Some(config) = self.pending_balance {
+            // The firmware answers with its balance report.
+            match self.client.request(Request::SetBalance(config)) {
+                Ok(DeviceToHost::Imu { .. }) => self.pending_balance = None,
+                Ok(_) => return Err(crate::Error::Protocol("expected the IMU report")),
+                Err(quad_host::client::Error::Refused {
+                    reason: NackReason::ImuAbsent,
+                    ..
+                }) => {}
+                Err(e) => return Err(crate::Error::Emulator(e)),
+            }
+        }
+        if !self.read_imu {
+            return Ok((None, false));
+        }
+        let report = self.imu_report()?;
+        Ok((
+            crate::source::estimated_rpy_rad(&report),
+            report.fall.is_some(),
+        ))
     }
 
     /// The twin's IMU samples, timed on the MCU's clock (a clone sharing the queue): what the
@@ -170,16 +282,27 @@ impl FrameSource for Emulated {
         }
         let t_s = k as f32 * crate::source::FRAME_S;
         let target = self.plan.target(t_s).map_err(crate::Error::Motion)?;
+        if std::mem::take(&mut self.enable_at_start) {
+            self.client
+                .ack(Request::SetOutputs { enabled: true })
+                .map_err(crate::Error::Emulator)?;
+        }
         // The MCU cycle from which the twin holds this frame's pulses: the end of its PWM
         // period onboard, else when they were measured.
         let mut held_from = None;
+        let balance;
         let pulses = match self.onboard {
             None => {
-                self.client
-                    .ack(Request::SetFeet {
-                        feet_in_body_m: target.feet_in_body_m,
-                    })
-                    .map_err(crate::Error::Emulator)?;
+                if let Some(request) = crate::source::host_request(
+                    &self.plan,
+                    k,
+                    &target,
+                    self.hold_pose,
+                    &mut self.pose_held,
+                ) {
+                    self.client.ack(request).map_err(crate::Error::Emulator)?;
+                }
+                balance = self.balance_exchange()?;
                 self.client
                     .link_mut()
                     .next_pulses()
@@ -194,6 +317,7 @@ impl FrameSource for Emulated {
                         .request(request)
                         .map_err(crate::Error::Emulator)?;
                 }
+                balance = self.balance_exchange()?;
                 let end = start + (u64::from(k) + 1) * PERIOD_CYCLES;
                 held_from = Some(end);
                 let now = self.client.link().mcu().cycle();
@@ -238,7 +362,8 @@ impl FrameSource for Emulated {
             angles_rad,
             commanded_pose: target.pose,
             stance: target.stance,
-            estimated_rpy_rad: None,
+            estimated_rpy_rad: balance.0,
+            fall_detected: balance.1,
         })
     }
 }

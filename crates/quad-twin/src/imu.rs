@@ -19,9 +19,8 @@
 //! positive rate about +x.
 
 use quad_device::{ImuReading, ImuSample};
-use std::cell::RefCell;
 use std::collections::VecDeque;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// The twin's IMU sample period, s (200 Hz: four samples in each 20 ms servo frame; the
 /// MPU-6050 is read at ≥ 100 Hz on the board).
@@ -44,6 +43,8 @@ struct Queue {
     dropped: u64,
     /// Samples replaced by an earlier one pushed later.
     replaced: u64,
+    /// The latest time a [`TwinImu::sample_at`] asked for: samples up to it have been read.
+    read_up_to_s: f64,
 }
 
 /// The twin's IMU samples as a sensor source reads them: a queue of samples timed on the
@@ -54,8 +55,10 @@ struct Queue {
 /// gravity's reaction, [`crate::scenario::Scenario::at_rest_accel_m_s2`]; the gyroscope zero).
 ///
 /// Clones share one queue (as [`quad_device::sim::VirtualClock`]'s clones share one time): the
-/// frame source pushes into one clone, the emulated sensor reads another. A sensor source of
-/// the emulator with a callback feed takes it as `move |t_s| feed.read(t_s)`; reading is
+/// frame source pushes into one clone, the emulated sensor reads another (the emulator's
+/// sensor sources are `Send`: the queue is behind a mutex). The emulator's sensor source
+/// reads it without consuming it ([`TwinImu::sample_at`]; `Feed(move |t_s|
+/// feed.sample_at(t_s))`); reading is
 /// infallible (the twin's sensor has no bus faults of its own: faults are the emulated
 /// chip's).
 ///
@@ -64,7 +67,7 @@ struct Queue {
 /// ([`TwinImu::push`]): where two frames overlap on the reader's clock, the later physics
 /// wins.
 #[derive(Debug, Clone)]
-pub struct TwinImu(Rc<RefCell<Queue>>);
+pub struct TwinImu(Arc<Mutex<Queue>>);
 
 /// A sample's time is not a finite number ([`TwinImu::push`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,12 +87,21 @@ impl std::error::Error for NotFinite {}
 impl TwinImu {
     /// An empty feed that reads `at_rest` until the first sample.
     pub fn new(at_rest: ImuSample) -> TwinImu {
-        TwinImu(Rc::new(RefCell::new(Queue {
+        TwinImu(Arc::new(Mutex::new(Queue {
             samples: VecDeque::new(),
             at_rest,
             dropped: 0,
             replaced: 0,
+            read_up_to_s: f64::NEG_INFINITY,
         })))
+    }
+
+    /// The queue, locked (a panic while it was held left it consistent: every change is a
+    /// single push or pop).
+    fn queue(&self) -> MutexGuard<'_, Queue> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
     /// Appends `sample`, taken at `t_s` on the reader's clock; queued samples at or after
@@ -101,14 +113,18 @@ impl TwinImu {
         if !t_s.is_finite() {
             return Err(NotFinite { t_s });
         }
-        let mut q = self.0.borrow_mut();
+        let mut q = self.queue();
         while q.samples.back().is_some_and(|&(last_s, _)| last_s >= t_s) {
             q.samples.pop_back();
             q.replaced += 1;
         }
         if q.samples.len() == TWIN_IMU_CAPACITY {
-            q.samples.pop_front();
-            q.dropped += 1;
+            if let Some((oldest_s, _)) = q.samples.pop_front() {
+                // Unread unless a later read passed it.
+                if oldest_s > q.read_up_to_s {
+                    q.dropped += 1;
+                }
+            }
         }
         q.samples.push_back((t_s, sample));
         Ok(())
@@ -117,7 +133,7 @@ impl TwinImu {
     /// What the sensor reads at `t_s`: the latest sample at or before `t_s`; before the first
     /// sample, the robot at rest. Drops the samples before the one it answers with.
     pub fn read(&self, t_s: f64) -> ImuReading {
-        let mut q = self.0.borrow_mut();
+        let mut q = self.queue();
         // Keep the latest sample at or before t_s at the front.
         while q.samples.len() > 1 && q.samples[1].0 <= t_s {
             q.samples.pop_front();
@@ -129,24 +145,42 @@ impl TwinImu {
         ImuReading::Sample(sample)
     }
 
+    /// What the sensor reads at `t_s`, as [`TwinImu::read`], but keeping the queue: the
+    /// emulated MPU-6050's source (`Feed(move |t_s| feed.sample_at(t_s))`), so that the
+    /// queue's count stays what the twin pushed (the oldest go only when it is full, and
+    /// count as [`TwinImu::dropped`] only when no read had passed them).
+    pub fn sample_at(&self, t_s: f64) -> ImuReading {
+        let mut q = self.queue();
+        if t_s > q.read_up_to_s {
+            q.read_up_to_s = t_s;
+        }
+        // Samples at or before t_s form a prefix (the queue is in time order).
+        let n = q.samples.partition_point(|&(t, _)| t <= t_s);
+        let sample = match n {
+            0 => q.at_rest,
+            _ => q.samples[n - 1].1,
+        };
+        ImuReading::Sample(sample)
+    }
+
     /// Samples waiting (the one a read last answered with included).
     pub fn len(&self) -> usize {
-        self.0.borrow().samples.len()
+        self.queue().samples.len()
     }
 
     /// True when no sample waits.
     pub fn is_empty(&self) -> bool {
-        self.0.borrow().samples.is_empty()
+        self.queue().samples.is_empty()
     }
 
     /// Samples dropped unread because the queue was full ([`TWIN_IMU_CAPACITY`]).
     pub fn dropped(&self) -> u64 {
-        self.0.borrow().dropped
+        self.queue().dropped
     }
 
     /// Samples replaced by an earlier one pushed after them (overlapping frames).
     pub fn replaced(&self) -> u64 {
-        self.0.borrow().replaced
+        self.queue().replaced
     }
 }
 
@@ -177,6 +211,23 @@ mod tests {
         assert_eq!(reader.len(), 1);
         // The last sample stays until a later one replaces it.
         assert_eq!(reader.read(2.0), ImuReading::Sample(sample(3.0)));
+    }
+
+    #[test]
+    fn sample_at_keeps_the_queue_and_a_full_queue_drops_read_samples_uncounted() {
+        let feed = TwinImu::new(sample(-1.0));
+        for i in 0..TWIN_IMU_CAPACITY {
+            feed.push(i as f64, sample(i as f32)).unwrap();
+        }
+        assert_eq!(feed.sample_at(-0.5), ImuReading::Sample(sample(-1.0)));
+        assert_eq!(feed.sample_at(2.5), ImuReading::Sample(sample(2.0)));
+        assert_eq!(feed.len(), TWIN_IMU_CAPACITY);
+        // The oldest, read, goes uncounted; then an unread one goes counted.
+        for i in 0..4 {
+            feed.push((TWIN_IMU_CAPACITY + i) as f64, sample(0.0))
+                .unwrap();
+        }
+        assert_eq!(feed.dropped(), 1);
     }
 
     #[test]

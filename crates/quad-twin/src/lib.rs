@@ -351,6 +351,14 @@ pub struct RunOptions {
     pub onboard: bool,
     /// The floor and a push ([`scenario`]); the default: a level floor, no push.
     pub scenario: Scenario,
+    /// The device's balance functions (`SetBalance`, sent once its sensor has a reading: in
+    /// process [`device::InProcess::set_balance_when_ready`], emulated
+    /// [`emulated::Emulated::set_balance`]). The device then first runs 1.1 s with the robot
+    /// still before the run ([`device::REST_BEFORE_RUN_FRAMES`]; its gyro-bias measurement
+    /// needs a second of stillness), so that it estimates from the first frame; none: the device's power-on settings (leveling
+    /// off, fall detection on). The in-process device's attitude estimate is in every frame;
+    /// the emulated firmware's only with balance settings (a `GetImu` every frame).
+    pub balance: Option<quad_protocol::BalanceConfig>,
 }
 
 /// Time the first frame is held before the motion starts, s: the robot, placed with its feet
@@ -549,23 +557,45 @@ pub fn run_plan(
         .map_err(Error::Motion)?;
     let mut source: Box<dyn FrameSource> = match &options.driver {
         Driver::Device => {
-            let device = device::InProcess::start(*config)
+            let mut device = device::InProcess::start(*config)
                 .map_err(|error| Error::Device { frame: 0, error })?;
+            if let Some(balance) = options.balance {
+                device
+                    .rest_before_run(
+                        quad_device::ImuSample {
+                            accel_m_s2: options.scenario.at_rest_accel_m_s2(imu::GRAVITY_M_S2),
+                            gyro_rad_s: [0.0; 3],
+                        },
+                        device::REST_BEFORE_RUN_FRAMES,
+                    )
+                    .map_err(|error| Error::Device { frame: 0, error })?;
+                device.set_balance_when_ready(balance);
+            }
             if options.onboard {
                 Box::new(source::Onboard::new(plan, device).ok_or(Error::NotOnboard {
                     motion: plan.kind().name(),
                 })?)
             } else {
-                Box::new(source::HostDriven::new(plan, device))
+                let source = source::HostDriven::new(plan, device);
+                Box::new(match options.balance {
+                    Some(b) if b.leveling => source.hold_pose(),
+                    _ => source,
+                })
             }
         }
-        Driver::Emulator { elf } => Box::new(emulated::Emulated::boot_on(
-            plan,
-            config,
-            elf.as_deref(),
-            options.onboard,
-            &options.scenario,
-        )?),
+        Driver::Emulator { elf } => {
+            let mut emulated = emulated::Emulated::boot_on(
+                plan,
+                config,
+                elf.as_deref(),
+                options.onboard,
+                &options.scenario,
+            )?;
+            if let Some(balance) = options.balance {
+                emulated.set_balance(balance)?;
+            }
+            Box::new(emulated)
+        }
     };
     let tmp = tempfile::tempdir().map_err(Error::Io)?;
     let out_dir = match (&options.out_dir, &options.picture) {

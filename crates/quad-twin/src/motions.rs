@@ -374,6 +374,14 @@ impl Plan {
         })
     }
 
+    /// True when the plan holds the device's nominal stance at `t_s` (a stand-up's hold: the
+    /// body level at the stance height, the feet at the stance): a host may then hold the
+    /// pose on the device (`SetBodyPose` with the zero pose) instead of sending the feet every
+    /// frame, which lets the device's leveling correct it.
+    pub fn holds_stance(&self, t_s: f32) -> bool {
+        matches!(self.script, Script::StandUp { .. }) && t_s >= STAND_RAMP_S
+    }
+
     /// The plan as the device's motion engine runs it: the `StartMotion` command with the
     /// plan's parameters and, for the trots, the velocity to keep commanding. `None` for the
     /// stand-up, whose crouch-to-stance ramp the device does from its own rest pose instead.

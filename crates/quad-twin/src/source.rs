@@ -31,9 +31,13 @@ pub struct DeviceFrame {
     pub commanded_pose: Pose,
     /// The feet the motion has on the ground (for the slip metric).
     pub stance: [bool; 4],
-    /// The device's estimate of the body's roll, pitch, yaw, rad, when it reports one (none
-    /// today: the device has no estimator yet); the twin scores it against the true attitude.
+    /// The device's estimate of the body's roll, pitch, yaw, rad, once its sensor is
+    /// healthy ([`estimated_rpy_rad`]); the twin scores roll and pitch against the true
+    /// attitude. The device estimates no yaw: 0.
     pub estimated_rpy_rad: Option<[f32; 3]>,
+    /// The device reports a fall (latched; [`quad_protocol::ImuReport::fall`]); false when the
+    /// source does not read the report.
+    pub fall_detected: bool,
 }
 
 impl DeviceFrame {
@@ -50,6 +54,16 @@ impl DeviceFrame {
             estimated_rpy_rad: self.estimated_rpy_rad,
         }
     }
+}
+
+/// The attitude a device's balance report gives: roll and pitch (yaw 0: not estimated)
+/// while its sensor is healthy, else none.
+pub fn estimated_rpy_rad(report: &quad_protocol::ImuReport) -> Option<[f32; 3]> {
+    (report.health == quad_protocol::ImuHealth::Ok).then_some([
+        report.roll_rad,
+        report.pitch_rad,
+        0.0,
+    ])
 }
 
 /// The IMU samples of the frame the twin answered with `state`, as readings for the device:
@@ -93,18 +107,65 @@ pub trait FrameSource {
 pub struct HostDriven {
     plan: Plan,
     device: InProcess,
+    /// Hold the pose on the device while the plan holds the stance ([`HostDriven::hold_pose`]).
+    hold_pose: bool,
+    /// The pose was sent.
+    pose_held: bool,
 }
 
 impl HostDriven {
     /// Drives `device` (started, outputs enabled) through `plan`.
     pub fn new(plan: Plan, device: InProcess) -> HostDriven {
-        HostDriven { plan, device }
+        HostDriven {
+            plan,
+            device,
+            hold_pose: false,
+            pose_held: false,
+        }
+    }
+
+    /// While the plan holds the stance ([`Plan::holds_stance`]), sends the device the zero
+    /// pose once (`SetBodyPose`) and no feet: the device holds the pose itself, and its
+    /// leveling corrects it (leveling acts on a held pose, not on feet set directly).
+    pub fn hold_pose(mut self) -> HostDriven {
+        self.hold_pose = true;
+        self
     }
 
     /// The device.
     pub fn device(&self) -> &InProcess {
         &self.device
     }
+}
+
+impl Onboard {
+    /// The device.
+    pub fn device(&self) -> &InProcess {
+        &self.device
+    }
+}
+
+/// The request a host sends at frame `k` of `plan` (target `target`): the feet; with
+/// `hold_pose`, while the plan holds the stance, the zero pose once (`pose_held` remembers
+/// it) and then nothing.
+pub fn host_request(
+    plan: &Plan,
+    k: u32,
+    target: &crate::motions::Target,
+    hold_pose: bool,
+    pose_held: &mut bool,
+) -> Option<Request> {
+    if hold_pose && plan.holds_stance(k as f32 * FRAME_S) {
+        if *pose_held {
+            return None;
+        }
+        *pose_held = true;
+        return Some(Request::SetBodyPose(Pose::default()));
+    }
+    *pose_held = false;
+    Some(Request::SetFeet {
+        feet_in_body_m: target.feet_in_body_m,
+    })
 }
 
 /// Frames of a run of `plan`: its duration in frames and the final one.
@@ -122,10 +183,8 @@ impl FrameSource for HostDriven {
             .plan
             .target(k as f32 * FRAME_S)
             .map_err(crate::Error::Motion)?;
-        let request = Request::SetFeet {
-            feet_in_body_m: target.feet_in_body_m,
-        };
-        step(&mut self.device, k, Some(request), &target, feedback)
+        let request = host_request(&self.plan, k, &target, self.hold_pose, &mut self.pose_held);
+        step(&mut self.device, k, request, &target, feedback)
     }
 }
 
@@ -214,6 +273,7 @@ fn step(
     };
     device.tick_with_imu(FRAME_MS, &readings);
     let outputs = device.outputs();
+    let report = device.imu_report();
     Ok(DeviceFrame {
         t_s: k as f32 * FRAME_S,
         enabled: outputs.enabled,
@@ -221,6 +281,7 @@ fn step(
         angles_rad: device.output_angles_rad().map_err(device_error)?,
         commanded_pose: target.pose,
         stance: target.stance,
-        estimated_rpy_rad: None,
+        estimated_rpy_rad: estimated_rpy_rad(&report),
+        fall_detected: report.fall.is_some(),
     })
 }

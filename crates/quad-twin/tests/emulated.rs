@@ -152,3 +152,87 @@ fn the_twins_imu_samples_queue_on_the_mcus_clock_for_the_emulated_sensor() {
         assert!(((a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt() - g).abs() < 0.2);
     }
 }
+
+#[test]
+fn the_emulated_firmware_reads_the_twins_imu_over_its_twi_and_levels_on_a_slope() {
+    // Standing on a 10° roll slope with balance on: the firmware's own TWI driver reads the
+    // twin's IMU from the emulated MPU-6050; its estimate follows the true attitude, and its
+    // leveling (the held stance as a pose) brings the body towards level.
+    let config = Config::shahriar2023();
+    let physical = quad_model::Physical::shahriar2023();
+    let scenario =
+        quad_twin::scenario::Scenario::new(quad_twin::scenario::SlopeAxis::Roll, 10.0, false, None)
+            .unwrap();
+    let plan = Plan::new(MotionKind::Stand, &config).unwrap();
+    let mut firmware =
+        Emulated::boot_on(plan, &config, None, false, &scenario).unwrap_or_else(|e| panic!("{e}"));
+    firmware
+        .set_balance(quad_protocol::BalanceConfig {
+            leveling: true,
+            ..quad_protocol::BalanceConfig::DEFAULT
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+    let model = quad_model::Model::new(config.robot, physical).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.xml");
+    quad_model::mjcf::write(&model, &path).unwrap();
+    let run = quad_twin::run_source_in(
+        &mut firmware,
+        &path,
+        "shahriar2023",
+        &plan,
+        None,
+        false,
+        &scenario,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let s = run.summary;
+    assert!(!s.fell, "{:?}", s.fall_reason);
+    let report = firmware.imu_report().unwrap_or_else(|e| panic!("{e}"));
+    let sc = s.scenario.unwrap();
+    let estimate = s
+        .attitude
+        .unwrap()
+        .estimate
+        .expect("the firmware's estimate");
+    eprintln!(
+        "emulated, balance on, 10° roll slope: settled roll {:.2}°, pitch {:.2}°; report {report:?}; estimate {estimate:?}",
+        sc.settled_roll_rad.to_degrees(),
+        sc.settled_pitch_rad.to_degrees()
+    );
+    assert_eq!(report.health, quad_protocol::ImuHealth::Ok);
+    assert!(report.samples >= 300, "{report:?}");
+    assert!(
+        (f64::from(report.roll_rad) - sc.settled_roll_rad).abs() < 1f64.to_radians(),
+        "{report:?}"
+    );
+    assert!(
+        estimate.roll_rms_error_rad < EMULATED_ESTIMATE_RMS_RAD,
+        "{estimate:?}"
+    );
+    assert!(
+        estimate.pitch_rms_error_rad < EMULATED_ESTIMATE_RMS_RAD,
+        "{estimate:?}"
+    );
+    assert!(
+        estimate.max_error_rad < EMULATED_ESTIMATE_MAX_ERROR_RAD,
+        "{estimate:?}"
+    );
+    // Leveling: well below the slope's 10° (open loop it settles at 11°).
+    assert!(sc.settled_roll_rad.abs() < EMULATED_LEVEL_MAX_RAD, "{sc:?}");
+}
+
+/// The emulated firmware's attitude estimate on the slope, against the true attitude: RMS
+/// error of roll and of pitch, rad (5.7°; measured 3.95° / 1.57°). Host-driven, the emulated
+/// stand-up rolls the body from 11° to 24–27° and back on this slope within its first second,
+/// with balance or without (in process it stays at 11°); through that transient the estimate
+/// runs up to 13° off (the accelerometer's correction reads the body's own accelerations as
+/// tilt), then follows within 0.5° (docs/twin.md).
+const EMULATED_ESTIMATE_RMS_RAD: f64 = 0.1;
+
+/// The largest roll or pitch error, rad (15°; measured 12.8°, in the stand-up's transient).
+const EMULATED_ESTIMATE_MAX_ERROR_RAD: f64 = 0.26;
+
+/// The emulated firmware's leveled body on a 10° slope: largest settled |roll|, rad (3°;
+/// measured 0.03°, open loop 11.1°).
+const EMULATED_LEVEL_MAX_RAD: f64 = 0.052;

@@ -32,7 +32,14 @@ at its centre of mass along the world's +y, the robot's left; negative: to the r
 A tilt or a push makes the run last 3 s past it; the report adds the body's largest |roll| and
 |pitch| from the disturbance, their settled values and the settling time. Every run reports the
 IMU's samples (200 Hz: accelerometer, gyroscope and the true attitude, in trace.npz), which the
-device receives at their times.
+device receives at their times (--emulator: the firmware reads them from its emulated MPU-6050
+over its TWI driver).
+
+--balance switches the device's balance functions on (SetBalance with the protocol's default
+gains: leveling the body while it stands or sways, fall detection at 60° with the rest pose as
+the safe state), sent once its sensor has given a reading (the device then measures the gyro
+bias for 1 s before it levels). The report adds the device's attitude estimate against the
+true attitude (in-process always; --emulator with --balance, a GetImu every frame).
 
 --render FILE writes an animation of the run (GIF; a strip of frames when FILE ends in .png);
 --out-dir DIR keeps the model, summary.json, plots.png, and with --render, motion.gif and
@@ -52,6 +59,7 @@ Examples (from the repository root):
   quadctl sim stand --emulator --out-dir stand --render stand.gif
   quadctl sim trot --onboard
   quadctl sim stand --slope-deg 10 --render target/twin/slope.png
+  quadctl sim stand --slope-deg 10 --balance --render target/twin/slope-balance.png
   quadctl sim stand --tilt-floor --slope-axis pitch
   quadctl sim stand --push-n-s 2";
 
@@ -106,6 +114,10 @@ pub struct Args {
     /// Push the body sideways with an impulse of I N·s at 2.5 s (along +y, the robot's left).
     #[arg(long, value_name = "I", allow_negative_numbers = true, value_parser = args::parse_finite)]
     pub push_n_s: Option<f32>,
+    /// Switch the device's balance functions on: leveling and fall detection with the
+    /// protocol's default settings.
+    #[arg(long)]
+    pub balance: bool,
 }
 
 /// `--slope-axis`: roll or pitch.
@@ -155,6 +167,11 @@ pub fn run(args: &Args) -> ExitCode {
             },
             onboard: args.onboard,
             scenario,
+            balance: args.balance.then_some(quad_protocol::BalanceConfig {
+                leveling: true,
+                fall_detection: true,
+                ..quad_protocol::BalanceConfig::DEFAULT
+            }),
         },
     };
     match command::sim(&request) {
