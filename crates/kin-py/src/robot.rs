@@ -2,6 +2,7 @@
 //! numpy arrays: leg IK/FK, body IK/FK, the leg Jacobian and the singularity measure.
 
 use crate::arrays::{self, for_rows};
+use kin_core::batch::code;
 use kin_core::body::{self, BodyConfig, Pose};
 use kin_core::jacobian;
 use kin_core::{
@@ -26,27 +27,21 @@ type BodyRows<'py> = (
     Bound<'py, PyArray1<i8>>,
 );
 
+// The reach codes are kin-core's batch codes (`kin_core::batch::code`), as numpy's int8.
 /// Reach code of a row that was solved exactly.
-pub const OK: i8 = 0;
+pub const OK: i8 = code::OK as i8;
 /// Reach code: the foot is farther than femur + tibia.
-pub const TOO_FAR: i8 = 1;
+pub const TOO_FAR: i8 = code::TOO_FAR as i8;
 /// Reach code: the foot is closer than |femur − tibia|.
-pub const TOO_CLOSE: i8 = 2;
+pub const TOO_CLOSE: i8 = code::TOO_CLOSE as i8;
 /// Reach code: the foot lies within `d_lat` of the abduction axis.
-pub const INSIDE_OFFSET: i8 = 3;
+pub const INSIDE_OFFSET: i8 = code::INSIDE_OFFSET as i8;
 /// Reach code: a joint would leave its limits.
-pub const JOINT_LIMIT: i8 = 4;
+pub const JOINT_LIMIT: i8 = code::JOINT_LIMIT as i8;
 /// Reach code: an input value is NaN or infinite.
-pub const NON_FINITE: i8 = 5;
+pub const NON_FINITE: i8 = code::NON_FINITE as i8;
 /// The names of the reach codes, indexed by code.
-pub const CODE_NAMES: [&str; 6] = [
-    "ok",
-    "too_far",
-    "too_close",
-    "inside_offset",
-    "joint_limit",
-    "non_finite",
-];
+pub const CODE_NAMES: [&str; 6] = code::NAMES;
 
 /// The reach code of kin-core's reason.
 pub fn code_of(kind: Unreachable) -> i8 {
