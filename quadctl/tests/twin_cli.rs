@@ -57,6 +57,31 @@ fn export_writes_mjcf_and_urdf_and_a_urdf_reads_back_as_the_robot() {
 }
 
 #[test]
+fn export_writes_a_toml_robot_file_that_reads_back_as_the_same_robot_and_body() {
+    // A robot of neither preset's lengths, with a [physical] table of its own.
+    let custom = temp_file(
+        "export-custom.toml",
+        "d_lat_m = 0.05\nd_ax_m = 0.01\nfemur_m = 0.21\ntibia_m = 0.23\nbody_length_m = 0.45\n\
+         body_width_m = 0.2\n[limits]\nknee_rad = [-2.6, -0.1]\n[physical]\nbody_mass_kg = 1.9\n",
+    );
+    for source in [s(&custom), "shahriar2023", "fernando2025"] {
+        let run = quadctl(&["export", "--format", "toml", "--robot", source], "");
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let toml = temp_file("export-roundtrip.toml", &run.stdout);
+        // The TOML, the URDF written from it and the source give the same model.
+        let urdf = quadctl(&["export", "--format", "urdf", "--robot", s(&toml)], "");
+        assert_eq!(urdf.code, 0, "{}", urdf.stderr);
+        let from_source = quadctl(&["export", "--format", "mjcf", "--robot", source], "");
+        let from_toml = quadctl(&["export", "--format", "mjcf", "--robot", s(&toml)], "");
+        assert_eq!(from_toml.code, 0, "{}", from_toml.stderr);
+        assert_eq!(from_toml.stdout, from_source.stdout, "{}", run.stdout);
+        // And the TOML written again from the TOML is the same text.
+        let again = quadctl(&["export", "--format", "toml", "--robot", s(&toml)], "");
+        assert_eq!(again.stdout, run.stdout);
+    }
+}
+
+#[test]
 fn export_takes_the_physical_table_of_a_robot_file() {
     let file = temp_file(
         "heavy.toml",

@@ -93,17 +93,20 @@ pub enum Format {
     Mjcf,
     /// URDF (for RViz, PyBullet, …).
     Urdf,
+    /// This project's TOML robot file (docs/robots.md), every key explicit.
+    Toml,
 }
 
 impl Format {
     /// Every format.
-    pub const ALL: [Format; 2] = [Format::Mjcf, Format::Urdf];
+    pub const ALL: [Format; 3] = [Format::Mjcf, Format::Urdf, Format::Toml];
 
     /// Command-line name.
     pub const fn name(self) -> &'static str {
         match self {
             Format::Mjcf => "mjcf",
             Format::Urdf => "urdf",
+            Format::Toml => "toml",
         }
     }
 }
@@ -123,6 +126,11 @@ pub fn export(
     let text = match format {
         Format::Mjcf => quad_model::mjcf::to_string(&model),
         Format::Urdf => quad_model::urdf::to_string(&model).map_err(Error::Model)?,
+        Format::Toml => robot_file::to_toml(&Description {
+            robot: *model.robot(),
+            physical: *model.physical(),
+        })
+        .map_err(Error::Robot)?,
     };
     match output {
         Some(path) => quad_model::write_atomic(path, text.as_bytes()).map_err(Error::Model),

@@ -1,4 +1,4 @@
-//! `quadctl export`: the robot as a MuJoCo MJCF model or a URDF.
+//! `quadctl export`: the robot as a MuJoCo MJCF model, a URDF or a TOML robot file.
 
 use crate::args;
 use quad_twin::command::{self, Format};
@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 const LONG_ABOUT: &str = "\
-Write the robot as a MuJoCo MJCF model or a URDF (for RViz, PyBullet): the body box, the leg
+Write the robot as a MuJoCo MJCF model, a URDF (for RViz, PyBullet) or a TOML robot file (every
+key explicit, for editing; `--robot` reads each of them back): the body box, the leg
 chain of the README's convention (abduction about x, hip and knee about y), spherical feet with
 friction, masses and inertias from the robot's physical preset or its TOML [physical] table,
 the servos as position actuators (MJCF). docs/twin.md lists the assumptions.
@@ -18,12 +19,13 @@ left at --output).";
 pub const EXAMPLES: &str = "\
 Examples (from the repository root):
   quadctl export --format mjcf --output robot.xml
-  quadctl export --format urdf --robot examples/robots/shahriar2023.toml --output shahriar2023.urdf";
+  quadctl export --format urdf --robot examples/robots/shahriar2023.toml --output shahriar2023.urdf
+  quadctl export --format toml --robot shahriar2023.urdf --output my-robot.toml";
 
 /// Arguments of `quadctl export`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 #[command(
-    about = "Write the robot as a MuJoCo MJCF model or a URDF",
+    about = "Write the robot as a MuJoCo MJCF model, a URDF or a TOML robot file",
     long_about = LONG_ABOUT,
     after_help = EXAMPLES
 )]
@@ -48,6 +50,9 @@ fn format() -> impl clap::builder::TypedValueParser<Value = Format> {
         match f {
             Format::Mjcf => "MuJoCo MJCF (XML), with the servos as actuators",
             Format::Urdf => "URDF (XML)",
+            Format::Toml => {
+                "this project's TOML robot file (every key explicit; --robot reads it back)"
+            }
         }
         .to_owned()
     }
