@@ -49,6 +49,7 @@ use crate::names;
 use kin_core::robot::RobotError;
 use kin_core::{JointLimits, KneeBend, LegGeometry, Robot};
 use quad_model::{Model, Physical, ServoModel};
+use quad_protocol::{DeviceInfo, RobotPreset};
 use serde::{Deserialize, Deserializer};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -440,6 +441,49 @@ pub fn parse_description(text: &str) -> Result<Description, Error> {
     let (file, robot) = parse_file(text)?;
     let physical = file.physical.physical(&robot, text)?;
     Ok(Description { robot, physical })
+}
+
+/// Why the robot of a device could not be known.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DeviceRobotError {
+    /// The device runs a robot that is no preset, and no robot file was given.
+    #[error(
+        "the device runs a robot that is no preset (`custom`): give its robot file with \
+         --robot FILE.toml"
+    )]
+    Custom,
+    /// The robot given is not the preset the device runs.
+    #[error(
+        "the device runs robot {}, the robot given is another: leave --robot out (the device's \
+         own robot is used) or give that preset",
+        names::robot_preset_name(*device)
+    )]
+    Mismatch {
+        /// The device's preset.
+        device: RobotPreset,
+    },
+}
+
+/// The robot the device runs, from its `HelloAck`: the preset it reports, or `file` (a robot
+/// file given on the command line) for a device whose robot is no preset. A robot given for a
+/// preset device must be that preset's geometry.
+///
+/// Every operation that plans with the device's own robot (the guided calibration's posture and
+/// test poses, the panel's calibration tab) obtains it here, so that a device that reports its
+/// geometry itself changes this function only.
+///
+/// # Errors
+/// [`DeviceRobotError::Custom`] for a custom device without `file`,
+/// [`DeviceRobotError::Mismatch`] for a preset device and another robot.
+pub fn device_robot(info: &DeviceInfo, file: Option<&Robot>) -> Result<Robot, DeviceRobotError> {
+    match (info.robot.robot(), file) {
+        (Some(robot), None) => Ok(robot),
+        (Some(robot), Some(given)) if robot.equals(given) => Ok(robot),
+        (Some(_), Some(_)) => Err(DeviceRobotError::Mismatch { device: info.robot }),
+        (None, Some(given)) => Ok(*given),
+        (None, None) => Err(DeviceRobotError::Custom),
+    }
 }
 
 /// Resolves a `--robot` argument with its physical properties: a preset name (its physical
