@@ -628,7 +628,16 @@ impl Guide {
                         ));
                     }
                 }
-                Action::SetJoints { .. } => self.posture_held = true,
+                Action::SetJoints { angles_rad } => {
+                    self.posture_held = true;
+                    if self.step == Step::Posture {
+                        self.message = Some(format!(
+                            "the device holds the calibration posture: abduction {} rad, hip {} \
+                             rad, knee {} rad",
+                            angles_rad[0], angles_rad[1], angles_rad[2]
+                        ));
+                    }
+                }
                 Action::Test(pose) => {
                     if self.step == Step::Test(pose) {
                         self.test_ran = true;
