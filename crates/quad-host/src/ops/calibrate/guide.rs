@@ -113,9 +113,9 @@ pub fn posture_rad(robot: &Robot) -> Result<[f32; 12], PostureError> {
     Ok(out)
 }
 
-/// A key of the guide. Every front end names them alike ([`Key::parse`], [`Key::name`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
+/// A key of the guide. Every front end names them alike ([`Key::parse`], [`Key::name`]; serde
+/// reads and writes the name too).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Key {
     /// `+`: fine jog towards positive angles.
     FineUp,
@@ -177,6 +177,23 @@ impl Key {
             "y" | "enter" => Some(Key::Next),
             other => Key::ALL.into_iter().find(|k| k.name() == other),
         }
+    }
+}
+
+impl Serialize for Key {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Key {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Key, D::Error> {
+        let name = String::deserialize(d)?;
+        Key::parse(&name).ok_or_else(|| {
+            serde::de::Error::custom(format!(
+                "`{name}` is no key of the guide (+ - ] [ n b t r s q, y, enter)"
+            ))
+        })
     }
 }
 
@@ -308,7 +325,7 @@ impl fmt::Display for Refusal {
         } else {
             write!(
                 f,
-                "{} not sent: {} (the device's own range check)",
+                "{} not sent: {} (the host's check, which the device runs alike)",
                 self.request,
                 onboard::words(&self.reason)
             )
@@ -1070,5 +1087,9 @@ mod tests {
         }
         assert_eq!(Key::parse("enter"), Some(Key::Next));
         assert_eq!(Key::parse("x"), None);
+        let k: Key = serde_json::from_str("\"]\"").unwrap();
+        assert_eq!(k, Key::CoarseUp);
+        assert_eq!(serde_json::to_string(&Key::FineDown).unwrap(), "\"-\"");
+        assert!(serde_json::from_str::<Key>("\"x\"").is_err());
     }
 }
