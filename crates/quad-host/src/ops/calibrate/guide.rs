@@ -367,6 +367,9 @@ pub struct View {
     pub keys: Vec<KeyHelp>,
     /// The last message: a refusal with its reason, or what the last key did.
     pub message: Option<String>,
+    /// True when the message is a refusal (of the device, or of the host's check before
+    /// sending).
+    pub refused: bool,
 }
 
 /// The guided calibration's step machine (module docs).
@@ -387,6 +390,8 @@ pub struct Guide {
     queue: VecDeque<Action>,
     in_flight: Option<Action>,
     message: Option<String>,
+    /// The message is a refusal.
+    refused: bool,
     /// Refusals so far.
     refusals: u32,
     /// Jogs the device acked.
@@ -425,6 +430,7 @@ impl Guide {
             queue: VecDeque::new(),
             in_flight: None,
             message: None,
+            refused: false,
             refusals: 0,
             jogs: 0,
             not_restored: Vec::new(),
@@ -559,6 +565,7 @@ impl Guide {
             return;
         }
         self.message = None;
+        self.refused = false;
         match (self.step, key) {
             (Step::Posture, Key::Next) if self.posture_held => {
                 self.enter_jog(self.servo, false);
@@ -629,6 +636,9 @@ impl Guide {
         let Some(action) = self.in_flight.take() else {
             return;
         };
+        if result.is_ok() && self.step != Step::Aborted {
+            self.refused = false;
+        }
         match result {
             Ok(()) => match action {
                 Action::SetCalibration { servo, calibration } => {
@@ -668,6 +678,7 @@ impl Guide {
             },
             Err(refusal) => {
                 self.refusals += 1;
+                self.refused = true;
                 if self.step == Step::Aborted {
                     if let Action::SetCalibration { servo, .. } = action {
                         self.not_restored.push(servo);
@@ -783,6 +794,7 @@ impl Guide {
                 .collect(),
             keys: self.keys(),
             message: self.message.clone(),
+            refused: self.refused,
         }
     }
 }
