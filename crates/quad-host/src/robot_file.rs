@@ -545,6 +545,41 @@ mod tests {
     const MINIMAL: &str = "d_lat_m = 0.044\nd_ax_m = 0.0\nfemur_m = 0.28\ntibia_m = 0.277\n\
                            body_length_m = 0.6\nbody_width_m = 0.28\n";
 
+    /// The `HelloAck` of a device running `preset`.
+    fn info(preset: RobotPreset) -> DeviceInfo {
+        let c = quad_device::Config::shahriar2023();
+        DeviceInfo {
+            version: quad_protocol::PROTOCOL_VERSION,
+            firmware: c.firmware,
+            robot: preset,
+            max_frame_len: 128,
+            pose_config: c.pose_config,
+            link_timeout: c.link_timeout,
+        }
+    }
+
+    #[test]
+    fn the_device_robot_is_the_preset_it_reports_or_the_file_given_for_a_custom_one() {
+        let fernando = info(RobotPreset::Fernando2025);
+        assert_eq!(device_robot(&fernando, None), Ok(Robot::fernando2025()));
+        assert_eq!(
+            device_robot(&fernando, Some(&Robot::fernando2025())),
+            Ok(Robot::fernando2025())
+        );
+        assert_eq!(
+            device_robot(&fernando, Some(&Robot::shahriar2023())),
+            Err(DeviceRobotError::Mismatch {
+                device: RobotPreset::Fernando2025
+            })
+        );
+        let custom = info(RobotPreset::Custom);
+        let e = device_robot(&custom, None).unwrap_err();
+        assert_eq!(e, DeviceRobotError::Custom);
+        assert!(e.to_string().contains("--robot FILE.toml"), "{e}");
+        let file = parse(MINIMAL).expect("valid file");
+        assert_eq!(device_robot(&custom, Some(&file)), Ok(file));
+    }
+
     #[test]
     fn limits_default_to_the_full_turn_and_knee_to_backward() {
         let robot = parse(MINIMAL).expect("valid file");
