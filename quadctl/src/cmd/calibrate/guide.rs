@@ -284,3 +284,32 @@ pub fn main(args: &Args, target: &Target, retries: u32, robot: Option<&Robot>) -
         Err(e) => args::fail("quadctl", &e),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scripts_and_terminal_keys_name_the_guides_keys() {
+        let keys = parse_script("n,+ +\n] [ - t y enter r b s q").unwrap();
+        assert_eq!(keys.len(), 13);
+        assert_eq!(keys[0], Key::Next);
+        assert_eq!(keys[3], Key::CoarseUp);
+        assert!(matches!(parse_script("n,,x"), Err(Error::Key(k)) if k == "x"));
+        assert_eq!(
+            key_of(KeyCode::Char('c'), KeyModifiers::CONTROL),
+            Some(Key::Abort)
+        );
+        assert_eq!(key_of(KeyCode::Char('c'), KeyModifiers::NONE), None);
+        assert_eq!(
+            key_of(KeyCode::Char('S'), KeyModifiers::SHIFT),
+            Some(Key::Save)
+        );
+        assert_eq!(key_of(KeyCode::Enter, KeyModifiers::NONE), Some(Key::Next));
+        assert_eq!(
+            key_of(KeyCode::PageDown, KeyModifiers::NONE),
+            Some(Key::CoarseDown)
+        );
+        assert_eq!(key_of(KeyCode::Esc, KeyModifiers::NONE), Some(Key::Abort));
+    }
+}
