@@ -275,6 +275,7 @@ function onState(msg) {
   showHealth(msg);
   showImu(msg.imu, msg.flags);
   showCalibration(msg);
+  showGuide(msg.guide);
 }
 
 function updateControl() {
@@ -284,7 +285,7 @@ function updateControl() {
   $('control-badge').className = `badge ${mine ? 'mine' : ''}`;
   $('take-control').disabled = mine;
   $('release-control').disabled = !mine;
-  for (const id of ['outputs-on', 'outputs-off', 'cal-save', 'cal-read', 'cal-set-center', 'cal-set-direction', 'motion-start', 'motion-stop']) {
+  for (const id of ['outputs-on', 'outputs-off', 'cal-save', 'cal-read', 'cal-set-center', 'cal-set-direction', 'motion-start', 'motion-stop', 'guide-start']) {
     $(id).disabled = !mine;
   }
   for (const b of document.querySelectorAll('[data-jog]')) b.disabled = !mine;
@@ -927,6 +928,42 @@ function buildCalibration(servos) {
   $('cal-set-direction').addEventListener('click', () => send({ type: 'set_direction', servo: calServo, reversed: $('cal-reversed').checked }));
   $('cal-save').addEventListener('click', () => send({ type: 'save_calibration' }));
   $('cal-read').addEventListener('click', () => send({ type: 'read_calibration' }));
+  $('guide-start').addEventListener('click', () => send({ type: 'guide_start' }));
+}
+
+// The guided calibration: the server runs the step machine; the page shows its view and sends
+// the keys of the step as buttons.
+let shownGuide = null;
+let shownGuideKeys = null;
+function showGuide(g) {
+  const box = $('guide');
+  box.classList.toggle('hidden', !g);
+  if (!g) return;
+  const key = JSON.stringify(g) + panel.controlling;
+  if (key === shownGuide) return;
+  shownGuide = key;
+  box.dataset.step = g.step;
+  $('guide-prompt').textContent = g.prompt;
+  $('guide-servo').textContent = g.servo
+    ? `${g.servo}: centre ${g.center_us} µs (${g.center_us - g.start_center_us >= 0 ? '+' : ''}${g.center_us - g.start_center_us} µs from the start)`
+    : g.changed.length ? `changed in RAM: ${g.changed.join(', ')}` : '';
+  // The buttons are rebuilt only when the step's keys change (not under the pointer).
+  const keysKey = JSON.stringify(g.keys);
+  const keys = $('guide-keys');
+  if (keysKey !== shownGuideKeys) {
+    shownGuideKeys = keysKey;
+    keys.replaceChildren(...g.keys.map((k) => {
+      const b = document.createElement('button');
+      b.textContent = `${k.key} · ${k.does}`;
+      b.dataset.guideKey = k.key;
+      if (k.key === 'q' || k.key === 's') b.className = 'warn';
+      b.addEventListener('click', () => send({ type: 'guide_key', key: k.key }));
+      return b;
+    }));
+  }
+  for (const b of keys.children) b.disabled = !panel.controlling;
+  $('guide-message').textContent = g.message ?? '';
+  $('guide-message').className = g.refused ? 'unreachable' : 'note';
 }
 
 let shownCal = null;

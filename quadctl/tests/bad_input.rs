@@ -687,7 +687,17 @@ fn an_empty_calibration_file_is_refused_by_name() {
     for (name, text) in [("empty.toml", ""), ("comments.toml", "# nothing here\n\n")] {
         let path = dir.join(name);
         std::fs::write(&path, text).expect("file written");
-        let run = quadctl(&["calibrate", "--sim", "set", s(&path)], "");
+        let run = quadctl(
+            &[
+                "calibrate",
+                "--sim",
+                "--robot",
+                "fernando2025",
+                "set",
+                s(&path),
+            ],
+            "",
+        );
         assert_refused(&run, 2, &format!("{}: no servo calibration", s(&path)));
         assert_eq!(run.stdout, "", "nothing printed as if it were set");
     }

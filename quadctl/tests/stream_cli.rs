@@ -155,7 +155,15 @@ fn calibrate_get_set_save_through_a_simulated_eeprom() {
     let eeprom_s = eeprom.to_str().unwrap();
     let get = || {
         quadctl(
-            &["calibrate", "--sim", "--sim-storage", eeprom_s, "get"],
+            &[
+                "calibrate",
+                "--sim",
+                "--robot",
+                "fernando2025",
+                "--sim-storage",
+                eeprom_s,
+                "get",
+            ],
             "",
         )
     };
@@ -184,6 +192,8 @@ fn calibrate_get_set_save_through_a_simulated_eeprom() {
         let mut args = vec![
             "calibrate",
             "--sim",
+            "--robot",
+            "fernando2025",
             "--sim-storage",
             eeprom_s,
             "set",
@@ -220,7 +230,17 @@ fn calibrate_get_set_save_through_a_simulated_eeprom() {
     );
     // An invalid file is refused before anything is sent.
     std::fs::write(&file, "FR_knee = { zero_rad = 0.0 }\n").unwrap();
-    let run = quadctl(&["calibrate", "--sim", "set", file_s], "");
+    let run = quadctl(
+        &[
+            "calibrate",
+            "--sim",
+            "--robot",
+            "fernando2025",
+            "set",
+            file_s,
+        ],
+        "",
+    );
     assert_eq!(run.code, 2);
     let _ = std::fs::remove_dir_all(&dir);
 }

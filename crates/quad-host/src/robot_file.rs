@@ -49,6 +49,7 @@ use crate::names;
 use kin_core::robot::RobotError;
 use kin_core::{JointLimits, KneeBend, LegGeometry, Robot};
 use quad_model::{Model, Physical, ServoModel};
+use quad_protocol::{DeviceInfo, RobotPreset};
 use serde::{Deserialize, Deserializer};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -445,6 +446,49 @@ pub fn parse_description(text: &str) -> Result<Description, Error> {
     Ok(Description { robot, physical })
 }
 
+/// Why the robot of a device could not be known.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DeviceRobotError {
+    /// The device runs a robot that is no preset, and no robot file was given.
+    #[error(
+        "the device runs a robot that is no preset (`custom`): give its robot file with \
+         --robot FILE.toml"
+    )]
+    Custom,
+    /// The robot given is not the preset the device runs.
+    #[error(
+        "the device runs robot {}, the robot given is another: leave --robot out (the device's \
+         own robot is used) or give that preset",
+        names::robot_preset_name(*device)
+    )]
+    Mismatch {
+        /// The device's preset.
+        device: RobotPreset,
+    },
+}
+
+/// The robot the device runs, from its `HelloAck`: the preset it reports, or `file` (a robot
+/// file given on the command line) for a device whose robot is no preset. A robot given for a
+/// preset device must be that preset's geometry.
+///
+/// Every operation that plans with the device's own robot (the guided calibration's posture and
+/// test poses, the panel's calibration tab) obtains it here, so that a device that reports its
+/// geometry itself changes this function only.
+///
+/// # Errors
+/// [`DeviceRobotError::Custom`] for a custom device without `file`,
+/// [`DeviceRobotError::Mismatch`] for a preset device and another robot.
+pub fn device_robot(info: &DeviceInfo, file: Option<&Robot>) -> Result<Robot, DeviceRobotError> {
+    match (info.robot.robot(), file) {
+        (Some(robot), None) => Ok(robot),
+        (Some(robot), Some(given)) if robot.equals(given) => Ok(robot),
+        (Some(_), Some(_)) => Err(DeviceRobotError::Mismatch { device: info.robot }),
+        (None, Some(given)) => Ok(*given),
+        (None, None) => Err(DeviceRobotError::Custom),
+    }
+}
+
 /// Resolves a `--robot` argument with its physical properties: a preset name (its physical
 /// preset), a URDF file (`.urdf`, legs with this project's chain, [`quad_model::urdf`]; the
 /// physical preset of [`default_physical`]) or else a TOML file path (see
@@ -594,6 +638,41 @@ mod tests {
 
     const MINIMAL: &str = "d_lat_m = 0.044\nd_ax_m = 0.0\nfemur_m = 0.28\ntibia_m = 0.277\n\
                            body_length_m = 0.6\nbody_width_m = 0.28\n";
+
+    /// The `HelloAck` of a device running `preset`.
+    fn info(preset: RobotPreset) -> DeviceInfo {
+        let c = quad_device::Config::shahriar2023();
+        DeviceInfo {
+            version: quad_protocol::PROTOCOL_VERSION,
+            firmware: c.firmware,
+            robot: preset,
+            max_frame_len: 128,
+            pose_config: c.pose_config,
+            link_timeout: c.link_timeout,
+        }
+    }
+
+    #[test]
+    fn the_device_robot_is_the_preset_it_reports_or_the_file_given_for_a_custom_one() {
+        let fernando = info(RobotPreset::Fernando2025);
+        assert_eq!(device_robot(&fernando, None), Ok(Robot::fernando2025()));
+        assert_eq!(
+            device_robot(&fernando, Some(&Robot::fernando2025())),
+            Ok(Robot::fernando2025())
+        );
+        assert_eq!(
+            device_robot(&fernando, Some(&Robot::shahriar2023())),
+            Err(DeviceRobotError::Mismatch {
+                device: RobotPreset::Fernando2025
+            })
+        );
+        let custom = info(RobotPreset::Custom);
+        let e = device_robot(&custom, None).unwrap_err();
+        assert_eq!(e, DeviceRobotError::Custom);
+        assert!(e.to_string().contains("--robot FILE.toml"), "{e}");
+        let file = parse(MINIMAL).expect("valid file");
+        assert_eq!(device_robot(&custom, Some(&file)), Ok(file));
+    }
 
     #[test]
     fn limits_default_to_the_full_turn_and_knee_to_backward() {

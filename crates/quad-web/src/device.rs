@@ -30,6 +30,16 @@
 //! simulated or emulated device's clock runs only while its link is read, so the thread idles
 //! the link up to the wall clock while it waits for events: its motions run in real time.
 //!
+//! ## The guided calibration
+//! `guide_start` and `guide_key` drive the step machine of `quadctl calibrate guide`
+//! ([`quad_host::ops::calibrate::guide`]) on this session: its actions go through the checks
+//! above (a calibration is validated and checked against the held angle, then read back) and
+//! its test poses through [`motion::request`]; a test pose runs to its end while the state is
+//! published every [`GUIDE_POLL`] at the wall clock's pace. The robot is the device's own
+//! ([`quad_host::robot_file::device_robot`]). A device refusal becomes the guide's message, not
+//! a failed command. When the controlling page goes away, a running guide is aborted (the
+//! calibration read at its start restored) before the link-loss rule applies.
+//!
 //! ## The inertial sensor
 //! A device of protocol 2.3 reports its sensor and balance functions (`GetImu`): read at
 //! connection and then every [`balance::IMU_PERIOD`] on a schedule of its own, between
@@ -45,6 +55,7 @@ use quad_host::client::{
     self, expected, judge, AngleCheck, Client, ClientConfig, Expected, Outcome,
 };
 use quad_host::link::{self, Link, Target};
+use quad_host::ops::calibrate::guide::{self, Action, Guide, Refusal};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     DeviceInfo, DeviceToHost, Flags, ImuReport, LinkLossAction, MotionStage, MotionStatus,
@@ -150,6 +161,18 @@ pub enum Error {
         /// Its minor version.
         minor: u8,
     },
+    /// The guided calibration could not start.
+    #[error("the guided calibration: {0}")]
+    Guide(String),
+    /// A guide key without a guided calibration.
+    #[error("no guided calibration runs: start one first (guide_start)")]
+    NoGuide,
+    /// A motion the session waited for stopped early on the device.
+    #[error("the motion stopped early on the device: {0}")]
+    MotionFault(NackReason),
+    /// A motion the session waited for did not end in time.
+    #[error("the motion did not end within {0:?}")]
+    NoEnd(Duration),
     /// The device refused a motion request; a running motion keeps running.
     #[error("the device refused {}: {}", client::request_name(.request), motion::words(.reason, .request))]
     MotionRefused {
@@ -197,7 +220,16 @@ pub struct Session<L> {
     pose: Option<(Pose, u32)>,
     poses_sent: u64,
     link: LinkMsg,
+    /// The guided calibration, once a page started one.
+    guide: Option<Guide>,
 }
+
+/// How often the state is read and published while the guided calibration waits for a test
+/// pose (or the stand-up that switches the outputs on) to end.
+pub const GUIDE_POLL: Duration = Duration::from_millis(100);
+
+/// The longest a test pose of the guided calibration may take, link time.
+pub const GUIDE_MOTION_LIMIT: Duration = Duration::from_secs(60);
 
 impl<L: Link> Session<L> {
     /// Handshake, robot check, calibration read, current state. Nothing moves: the outputs
@@ -247,6 +279,7 @@ impl<L: Link> Session<L> {
             pose: None,
             poses_sent: 0,
             link: LinkMsg::default(),
+            guide: None,
         };
         session.read_imu()?;
         Ok(session)
@@ -570,6 +603,14 @@ impl<L: Link> Session<L> {
     /// # Errors
     /// Link failures, no answer.
     pub fn control_lost(&mut self) -> Result<(), Error> {
+        if self.guide.as_ref().is_some_and(|g| !g.step().is_done()) {
+            self.guide_command(
+                &msg::ClientMsg::GuideKey {
+                    key: guide::Key::Abort,
+                },
+                &|_| {},
+            )?;
+        }
         if let Some(stop) = motion::on_control_lost(self.info.link_timeout.action) {
             if self.motions {
                 self.motion(stop)?;
@@ -625,6 +666,146 @@ impl<L: Link> Session<L> {
         Ok(())
     }
 
+    /// Holds twelve joint angles (`SetJoints`); the held body pose is gone.
+    ///
+    /// # Errors
+    /// The device's refusal, link failures.
+    pub fn set_joints(&mut self, angles_rad: [f32; 12]) -> Result<(), Error> {
+        self.ack(Request::SetJoints { angles_rad })?;
+        self.pose = None;
+        Ok(())
+    }
+
+    /// Lets `d` of link time pass, then waits until the wall clock has caught up with the link
+    /// time since `link_start` (at `wall_start`): a simulated device's motion then runs at its
+    /// real pace.
+    fn idle_paced(
+        &mut self,
+        d: Duration,
+        wall_start: Instant,
+        link_start: Duration,
+    ) -> Result<(), Error> {
+        self.idle(d)?;
+        let link = self.link_elapsed().saturating_sub(link_start);
+        if let Some(ahead) = link.checked_sub(wall_start.elapsed()) {
+            std::thread::sleep(ahead);
+        }
+        Ok(())
+    }
+
+    /// Reads the state every [`GUIDE_POLL`], publishing each, until no motion runs.
+    fn wait_motion(&mut self, publish: &dyn Fn(&Session<L>)) -> Result<(), Error> {
+        let (wall, link) = (Instant::now(), self.link_elapsed());
+        loop {
+            self.poll()?;
+            publish(self);
+            if self.motion.kind.is_none() {
+                return match self.motion.fault {
+                    Some(fault) => Err(Error::MotionFault(fault)),
+                    None => Ok(()),
+                };
+            }
+            if self.link_elapsed().saturating_sub(link) > GUIDE_MOTION_LIMIT {
+                return Err(Error::NoEnd(GUIDE_MOTION_LIMIT));
+            }
+            self.idle_paced(GUIDE_POLL, wall, link)?;
+        }
+    }
+
+    /// Runs a test pose of the guided calibration to its end.
+    fn guide_test(
+        &mut self,
+        pose: guide::TestPose,
+        publish: &dyn Fn(&Session<L>),
+    ) -> Result<(), Error> {
+        let (start, velocity) = pose.motion(self.pose_config.stance_height_m);
+        self.motion_command(&motion::Command::Start(start))?;
+        publish(self);
+        if let Some(v) = velocity {
+            let (wall, link) = (Instant::now(), self.link_elapsed());
+            let hold = Duration::from_secs_f32(v.duration_s);
+            while self.link_elapsed().saturating_sub(link) < hold {
+                self.motion_command(&motion::Command::Velocity(motion::VelocityMsg {
+                    forward_m_s: v.forward_m_s,
+                    lateral_m_s: v.lateral_m_s,
+                    yaw_rate_rad_s: v.yaw_rate_rad_s,
+                }))?;
+                publish(self);
+                self.idle_paced(GUIDE_POLL, wall, link)?;
+            }
+            self.motion_command(&motion::Command::Stop)?;
+        }
+        self.wait_motion(publish)
+    }
+
+    /// Carries out one action of the guided calibration.
+    fn guide_act(&mut self, action: &Action, publish: &dyn Fn(&Session<L>)) -> Result<(), Error> {
+        match *action {
+            Action::OutputsOn if self.readback.flags.contains(Flags::OUTPUTS_ENABLED) => Ok(()),
+            Action::OutputsOn => {
+                self.motion_command(&motion::Command::Start(
+                    quad_protocol::MotionCommand::StandUp,
+                ))?;
+                self.wait_motion(publish)
+            }
+            Action::SetJoints { angles_rad } => self.set_joints(angles_rad),
+            Action::SetCalibration { servo, calibration } => {
+                self.set_calibration(servo, calibration)
+            }
+            Action::Save => self.save_calibration(),
+            Action::Test(pose) => self.guide_test(pose, publish),
+        }
+    }
+
+    /// `guide_start` or `guide_key`: the step machine's actions carried out, the state
+    /// published after each (see the module docs).
+    ///
+    /// # Errors
+    /// [`Error::Guide`] when the device's robot is not known or has no calibration posture,
+    /// [`Error::NoGuide`] for a key without a guide, link failures. A device refusal is the
+    /// guide's message, not an error.
+    pub fn guide_command(
+        &mut self,
+        cmd: &msg::ClientMsg,
+        publish: &dyn Fn(&Session<L>),
+    ) -> Result<(), Error> {
+        let mut g = match *cmd {
+            msg::ClientMsg::GuideStart => {
+                if self.guide.as_ref().is_some_and(|g| !g.step().is_done()) {
+                    return Err(Error::Guide(
+                        "one is running: abort it first (q)".to_owned(),
+                    ));
+                }
+                let robot = quad_host::robot_file::device_robot(&self.info, Some(&self.robot))
+                    .map_err(|e| Error::Guide(e.to_string()))?;
+                self.read_calibration()?;
+                Guide::new(&robot, self.calibration).map_err(|e| Error::Guide(e.to_string()))?
+            }
+            msg::ClientMsg::GuideKey { key } => {
+                let mut g = self.guide.take().ok_or(Error::NoGuide)?;
+                g.key(key);
+                g
+            }
+            _ => return Ok(()),
+        };
+        let result = loop {
+            let Some(action) = g.next_action() else {
+                break Ok(());
+            };
+            // The state shows the guide's step while its action runs.
+            self.guide = Some(g.clone());
+            let done = self.guide_act(&action, publish);
+            match refusal(done) {
+                Ok(answer) => g.answer(answer),
+                Err(e) => break Err(e),
+            }
+            self.guide = Some(g.clone());
+            publish(self);
+        };
+        self.guide = Some(g);
+        result
+    }
+
     /// The state for the pages.
     pub fn state(&self, t_ms: f64) -> State {
         let c = self.client.counters();
@@ -653,6 +834,7 @@ impl<L: Link> Session<L> {
             link_up: true,
             motion: motion::MotionState::from(&self.motion),
             imu: self.imu.as_ref().map(ImuState::from),
+            guide: self.guide.as_ref().map(Guide::view),
         }
     }
 
@@ -680,8 +862,45 @@ impl<L: Link> Session<L> {
                 None => Ok(()),
             },
             M::SetBalance { leveling } => self.set_balance(leveling),
+            M::GuideStart | M::GuideKey { .. } => self.guide_command(cmd, &|_| {}),
             M::TakeControl | M::ReleaseControl => Ok(()),
         }
+    }
+}
+
+/// A refusal (the device's, or a check of the host that the device runs alike) as the guided
+/// calibration's [`Refusal`]; any other error as it is.
+fn refusal(result: Result<(), Error>) -> Result<Result<(), Refusal>, Error> {
+    let refused = |request, reason, sent| {
+        Ok(Err(Refusal {
+            request,
+            reason,
+            sent,
+        }))
+    };
+    match result {
+        Ok(()) => Ok(Ok(())),
+        Err(Error::Refused { request, reason }) => refused(request, reason, true),
+        Err(Error::MotionRefused { request, reason }) => {
+            refused(client::request_name(&request), reason, true)
+        }
+        Err(Error::Motion { request, reason }) => {
+            refused(client::request_name(&request), reason, false)
+        }
+        Err(Error::MotionFault(reason)) => refused("StartMotion", reason, true),
+        Err(Error::BadCalibration { source, .. }) => {
+            refused("SetCalibration", NackReason::BadCalibration(source), false)
+        }
+        Err(Error::Travel { servo, source }) => refused(
+            "SetCalibration",
+            NackReason::ServoRange {
+                leg: servo.leg,
+                joint: servo.joint,
+                fault: source,
+            },
+            false,
+        ),
+        Err(e) => Err(e),
     }
 }
 
@@ -857,7 +1076,13 @@ pub fn run(
         match event {
             Ok(Event::Job(job)) => {
                 let result = if link_up {
-                    session.command(&job.cmd)
+                    match job.cmd {
+                        msg::ClientMsg::GuideStart | msg::ClientMsg::GuideKey { .. } => session
+                            .guide_command(&job.cmd, &|s: &Session<Box<dyn Link>>| {
+                                publish(s, true)
+                            }),
+                        _ => session.command(&job.cmd),
+                    }
                 } else {
                     Err(Error::LinkDown)
                 };

@@ -13,6 +13,7 @@ use crate::balance::ImuState;
 use crate::motion::{self, Command, VelocityMsg};
 use kin_core::body::Pose;
 use kin_core::Robot;
+use quad_host::ops::calibrate::guide::{self, Key};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{MotionCommand, ServoId};
 use serde::{Deserialize, Serialize};
@@ -91,6 +92,14 @@ pub enum ClientMsg {
     SetBalance {
         /// True to level the body.
         leveling: bool,
+    },
+    /// Starts the guided calibration ([`quad_host::ops::calibrate::guide`]) on the device's
+    /// own robot: the device moves to the calibration posture. Refused while one runs.
+    GuideStart,
+    /// A key of the guided calibration, by name: `+ - ] [ n b t r s q` (`y`, `enter`: `n`).
+    GuideKey {
+        /// The key.
+        key: Key,
     },
 }
 
@@ -197,7 +206,9 @@ impl ClientMsg {
             | ClientMsg::StartMotion { .. }
             | ClientMsg::StopMotion
             | ClientMsg::SetVelocity { .. }
-            | ClientMsg::SetBalance { .. } => Ok(()),
+            | ClientMsg::SetBalance { .. }
+            | ClientMsg::GuideStart
+            | ClientMsg::GuideKey { .. } => Ok(()),
         }
     }
 
@@ -312,6 +323,8 @@ pub struct State {
     /// every [`crate::balance::IMU_PERIOD`]); `None` for a device older than protocol 2.3,
     /// or before the first report.
     pub imu: Option<ImuState>,
+    /// The guided calibration, since a page started it (its last state stays after the end).
+    pub guide: Option<guide::View>,
 }
 
 /// What the server tells a page.
@@ -371,6 +384,8 @@ impl ClientMsg {
             ClientMsg::StopMotion => "stop_motion",
             ClientMsg::SetVelocity { .. } => "set_velocity",
             ClientMsg::SetBalance { .. } => "set_balance",
+            ClientMsg::GuideStart => "guide_start",
+            ClientMsg::GuideKey { .. } => "guide_key",
         }
     }
 }
@@ -515,6 +530,20 @@ mod tests {
         assert_eq!(v["health"], "starting");
         assert_eq!(v["leveling"], false);
         assert_eq!(v["fall"], serde_json::Value::Null);
+    }
+
+    #[test]
+    fn the_guide_messages_parse_with_the_keys_by_name() {
+        assert_eq!(
+            ClientMsg::parse(r#"{"type":"guide_start"}"#).unwrap(),
+            ClientMsg::GuideStart
+        );
+        let m = ClientMsg::parse(r#"{"type":"guide_key","key":"]"}"#).unwrap();
+        assert_eq!(m, ClientMsg::GuideKey { key: Key::CoarseUp });
+        assert_eq!(m.name(), "guide_key");
+        let e = ClientMsg::parse(r#"{"type":"guide_key","key":"fine_up"}"#).unwrap_err();
+        assert!(e.to_string().contains("no key of the guide"), "{e}");
+        assert!(ClientMsg::parse(r#"{"type":"guide_key"}"#).is_err());
     }
 
     #[test]

@@ -143,6 +143,7 @@ fn initial_state() -> State {
         link_up: false,
         motion: crate::motion::MotionState::default(),
         imu: None,
+        guide: None,
     }
 }
 

@@ -67,6 +67,8 @@ fn every_documented_page_message_parses_and_every_command_is_documented() {
         "stop_motion",
         "set_velocity",
         "set_balance",
+        "guide_start",
+        "guide_key",
     ];
     assert_eq!(names, every.into_iter().collect());
     // And what the server refuses is refused: the same parser.
@@ -176,6 +178,35 @@ fn the_state_endpoint_answers_json_and_every_field_the_server_sends_is_documente
         assert!(
             doc.contains(&format!("\"{field}\"")),
             "`{field}` is not in docs/panel.md's WebSocket section"
+        );
+    }
+}
+
+#[test]
+fn every_field_of_the_guided_calibration_in_the_state_is_documented() {
+    use quad_host::ops::calibrate::guide::{settle, Action, Device, Guide, Key, Refusal};
+    /// Acks everything.
+    struct Acks;
+    impl Device for Acks {
+        type Error = std::convert::Infallible;
+        fn act(&mut self, _: &Action) -> Result<Result<(), Refusal>, Self::Error> {
+            Ok(Ok(()))
+        }
+    }
+    let table = [quad_protocol::servo::Calibration::STANDARD; 12];
+    let mut g = Guide::new(&Robot::shahriar2023(), table).expect("a posture");
+    settle(&mut g, &mut Acks).expect("acked");
+    g.key(Key::Next);
+    settle(&mut g, &mut Acks).expect("acked");
+    let v = serde_json::to_value(g.view()).expect("serializes");
+    let mut fields = BTreeSet::new();
+    keys(&v, &mut fields);
+    assert!(fields.contains("servo_index") && fields.contains("does"));
+    let doc = section();
+    for field in &fields {
+        assert!(
+            doc.contains(&format!("\"{field}\"")),
+            "`{field}` of the guide is not in docs/panel.md's WebSocket section"
         );
     }
 }

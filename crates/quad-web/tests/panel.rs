@@ -269,6 +269,89 @@ impl Browser {
     }
 }
 
+impl Browser {
+    /// Clicks the guided calibration's button of `key` and waits until the server has
+    /// carried it out.
+    async fn guide_key(&self, key: &str) {
+        self.js("(panel.done.length = 0, 1)").await;
+        self.client
+            .find(fantoccini::Locator::Css(&format!(
+                "[data-guide-key='{key}']"
+            )))
+            .await
+            .unwrap_or_else(|e| panic!("guide key {key}: {e}"))
+            .click()
+            .await
+            .unwrap();
+        self.wait("panel.done.includes('guide_key')", WAIT).await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn sim_guided_calibration() {
+    let dir = scratch("panel-guide");
+    let eeprom = dir.join("eeprom.bin");
+    let server = serve(browser::sim(Some(eeprom.clone())));
+    let b = Browser::start(&dir.join("profile")).await;
+    b.open(server.addr).await;
+    b.click("tab-cal").await;
+    // Watching: the guide cannot be started.
+    assert_eq!(
+        b.js("document.getElementById('guide-start').disabled")
+            .await,
+        true
+    );
+    b.click("take-control").await;
+    b.wait("panel.controlling", WAIT).await;
+    b.click("guide-start").await;
+    b.wait(
+        "panel.state.guide && panel.state.guide.step === 'posture' && panel.state.guide.message",
+        WAIT,
+    )
+    .await;
+    // The device holds the posture the server's guide asked for, outputs on.
+    assert_eq!(
+        b.js("panel.state.angles_rad").await,
+        b.js("panel.state.guide.posture_rad").await
+    );
+    assert_eq!(b.js("panel.state.flags.outputs_enabled").await, true);
+    b.guide_key("n").await;
+    b.wait("panel.state.guide.servo === 'FL_abduction'", WAIT)
+        .await;
+    b.guide_key("n").await;
+    b.wait("panel.state.guide.servo === 'FL_hip'", WAIT).await;
+    // FL hip: a coarse jog and a fine one back.
+    let pulse0 = b.js("panel.state.pulses_us[1]").await.as_f64().unwrap();
+    b.guide_key("]").await;
+    b.guide_key("-").await;
+    b.wait("panel.state.guide.center_us === 1518", WAIT).await;
+    let pulse1 = b.js("panel.state.pulses_us[1]").await.as_f64().unwrap();
+    assert_eq!(pulse1 - pulse0, 18.0, "the pulse moved by the jogs");
+    b.wait(
+        "document.getElementById('guide-servo').textContent.includes('+18 µs')",
+        WAIT,
+    )
+    .await;
+    keep_screenshot(&b.screenshot().await, "panel-guided-calibration.png", &dir);
+    b.guide_key("t").await;
+    // The state may follow the command's `done`: waited for.
+    for test in ["rest", "stand", "step_in_place"] {
+        b.wait(&format!("panel.state.guide.test === '{test}'"), WAIT)
+            .await;
+        b.guide_key("n").await;
+    }
+    b.wait("panel.state.guide.step === 'save'", WAIT).await;
+    b.guide_key("s").await;
+    b.wait("panel.state.guide.step === 'saved'", WAIT).await;
+    assert_eq!(b.js("panel.state.flags.calibration_unsaved").await, false);
+    assert_eq!(
+        b.js("panel.state.calibration[1].center_us").await.as_u64(),
+        Some(1518)
+    );
+    b.close().await;
+    server.stop().unwrap();
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn emulator_pose_and_calibration() {
     let dir = scratch("panel-emulator");

@@ -381,3 +381,73 @@ fn reading_the_sensor_at_its_rate_leaves_the_pose_stream_its_line() {
     );
     assert!(ratio >= 0.9, "{ratio}");
 }
+
+/// The guide's view in the state.
+fn guide(s: &Session<Box<dyn Link>>) -> quad_host::ops::calibrate::guide::View {
+    s.state(0.0).guide.expect("a guide")
+}
+
+fn key(s: &mut Session<Box<dyn Link>>, name: &str) {
+    let cmd = ClientMsg::parse(&format!(r#"{{"type":"guide_key","key":"{name}"}}"#)).unwrap();
+    s.command(&cmd).unwrap();
+}
+
+#[test]
+fn the_guided_calibration_walks_the_steps_and_saves() {
+    let mut s = session(LinkLossAction::Hold);
+    assert!(matches!(
+        s.command(&ClientMsg::parse(r#"{"type":"guide_key","key":"n"}"#).unwrap()),
+        Err(Error::NoGuide)
+    ));
+    s.command(&ClientMsg::GuideStart).unwrap();
+    let v = guide(&s);
+    assert_eq!(v.step, "posture");
+    // The outputs came on through the stand-up; the device holds the posture.
+    assert!(s.state(0.0).flags.outputs_enabled);
+    assert_eq!(s.state(0.0).angles_rad, v.posture_rad);
+    // A second start while one runs is refused.
+    assert!(matches!(
+        s.command(&ClientMsg::GuideStart),
+        Err(Error::Guide(_))
+    ));
+    key(&mut s, "n");
+    let p0 = s.state(0.0).pulses_us[0];
+    key(&mut s, "]");
+    key(&mut s, "-");
+    let v = guide(&s);
+    assert_eq!(
+        (v.servo.as_deref(), v.center_us),
+        (Some("FL_abduction"), Some(1518))
+    );
+    assert_eq!(s.state(0.0).pulses_us[0] - p0, 18.0);
+    assert_eq!(s.state(0.0).calibration[0].center_us, 1518);
+    for k in ["t", "n", "n", "n"] {
+        key(&mut s, k);
+    }
+    assert_eq!(guide(&s).step, "save");
+    key(&mut s, "s");
+    assert_eq!(guide(&s).step, "saved");
+    assert!(!s.state(0.0).flags.calibration_unsaved);
+    s.read_calibration().unwrap();
+    assert_eq!(s.state(0.0).calibration[0].center_us, 1518);
+}
+
+#[test]
+fn a_guide_aborts_when_the_controlling_page_goes_away() {
+    let mut s = session(LinkLossAction::Hold);
+    s.command(&ClientMsg::GuideStart).unwrap();
+    key(&mut s, "n");
+    key(&mut s, "]");
+    // A refusal is the guide's message, not a failed command: beyond the travel's end.
+    for _ in 0..60 {
+        key(&mut s, "]");
+    }
+    let v = guide(&s);
+    let m = v.message.expect("a message");
+    assert!(m.contains("SetCalibration"), "{m}");
+    assert_eq!(s.state(0.0).calibration[0].center_us, 2500);
+    s.control_lost().unwrap();
+    assert_eq!(guide(&s).step, "aborted");
+    s.read_calibration().unwrap();
+    assert_eq!(s.state(0.0).calibration[0].center_us, 1500);
+}

@@ -315,9 +315,25 @@ impl<L: Link> Session<L> {
     ///
     /// # Errors
     /// The handshake's errors, [`client::Error::Robot`] for another robot.
-    pub fn connect(mut client: Client<L>, preset: RobotPreset) -> Result<Session<L>, Error> {
+    pub fn connect(client: Client<L>, preset: RobotPreset) -> Result<Session<L>, Error> {
+        Session::connect_checking(client, Some(preset))
+    }
+
+    /// Handshake and calibration read-back, on whatever robot the device runs (the
+    /// operations that plan with the device's own robot: [`crate::robot_file::device_robot`]).
+    ///
+    /// # Errors
+    /// The handshake's errors.
+    pub fn connect_to_device(client: Client<L>) -> Result<Session<L>, Error> {
+        Session::connect_checking(client, None)
+    }
+
+    fn connect_checking(
+        mut client: Client<L>,
+        preset: Option<RobotPreset>,
+    ) -> Result<Session<L>, Error> {
         let info = client.hello()?;
-        if info.robot != preset {
+        if let Some(preset) = preset.filter(|p| *p != info.robot) {
             return Err(client::Error::Robot {
                 device: info.robot,
                 host: preset,

@@ -1,5 +1,7 @@
 //! The device's servo calibration: its TOML file (read and written) and the operation behind
-//! `quadctl calibrate` (read, edit, save).
+//! `quadctl calibrate` (read, edit, save), and the guided calibration ([`guide`]).
+
+pub mod guide;
 
 use crate::client::{self, Client, ClientConfig};
 use crate::csv::Num;
@@ -250,6 +252,51 @@ pub fn run(target: &Target, retries: u32, action: &Action) -> Result<[Calibratio
         }
     }
     Ok(table)
+}
+
+/// Why the guided calibration could not start.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum GuideError {
+    /// The link could not be opened.
+    #[error(transparent)]
+    Link(#[from] link::Error),
+    /// The handshake or the calibration read failed.
+    #[error(transparent)]
+    Session(#[from] crate::ops::onboard::Error),
+    /// The device's robot is not known.
+    #[error(transparent)]
+    Robot(#[from] crate::robot_file::DeviceRobotError),
+    /// The robot has no calibration posture.
+    #[error(transparent)]
+    Posture(#[from] guide::PostureError),
+}
+
+/// Opens the device at `target` (`retries` resends per request), reads its calibration and
+/// starts a [`guide::Guide`] on the device's own robot ([`crate::robot_file::device_robot`];
+/// `robot_file` for a device whose robot is no preset).
+///
+/// # Errors
+/// See [`GuideError`].
+pub fn open_guide(
+    target: &Target,
+    retries: u32,
+    robot_file: Option<&kin_core::Robot>,
+) -> Result<
+    (
+        crate::ops::onboard::Session<Box<dyn link::Link>>,
+        guide::Guide,
+    ),
+    GuideError,
+> {
+    let link = link::open(target)?;
+    let session = crate::ops::onboard::Session::connect_to_device(Client::new(
+        link,
+        ClientConfig::for_target(target, retries),
+    ))?;
+    let robot = crate::robot_file::device_robot(session.info(), robot_file)?;
+    let guide = guide::Guide::new(&robot, *session.calibration())?;
+    Ok((session, guide))
 }
 
 #[cfg(test)]
