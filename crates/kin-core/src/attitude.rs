@@ -40,7 +40,7 @@
 //!   zero at a steady gait); the mean of its *direction* is not, because the samples of the
 //!   push-off (small `|a|`, body accelerating forward) weigh as much as those of the
 //!   touchdown. Normalised, the physics twin's trot read 1.2–1.3° of pitch that was not there
-//!   (`docs/benchmark-journal.md`, "Attitude estimator").
+//!   (`docs/benchmark-journal.md`, "Attitude estimator during the trot").
 //! - **An adaptive gain** (R. G. Valenti, I. Dryanovski, J. Xiao, *Keeping a Good Attitude: A
 //!   Quaternion-Based Orientation Filter for IMUs and MARGs*, Sensors 15(8), 2015, §5.3 and
 //!   eq. 60): the correction's weight is 1 while `| |a|/g − 1 |` is within

@@ -10,9 +10,9 @@ use quad_twin::scenario::{Scenario, SlopeAxis};
 use quad_twin::{run, MotionKind, RunOptions, Summary};
 
 /// Leveling on, standing on a 10° slope or after the floor tilted by 10°: the body's settled
-/// |roll| and |pitch|, degrees (issue 22's aim; open loop 10.3–11.1°; measured ≤ 0.30°).
+/// |roll| and |pitch|, degrees (issue 22's aim; open loop 10.3–11.1°; measured ≤ 0.22°).
 const LEVEL_SETTLED_MAX_DEG: f64 = 1.5;
-/// ... settled within this of the tilt's end, s (measured 0.46–0.62 s).
+/// ... settled within this of the tilt's end, s (measured 0.44–0.60 s).
 const LEVEL_SETTLING_MAX_S: f64 = 1.0;
 /// The floor's angle, degrees.
 const SLOPE_DEG: f32 = 10.0;
