@@ -673,3 +673,51 @@ fn balance_fields_out_of_range_are_refused_naming_the_field() {
     // Nothing changed.
     assert_eq!(report(&mut dev).config, d);
 }
+
+#[test]
+fn a_body_tipping_sideways_leans_the_other_way_and_returns_when_upright() {
+    use quad_device::balance::{Balance, REFLEX_MAX_SHARE};
+    let mut b = Balance::<kin_core::DefaultMath>::new();
+    let still = ImuReading::Sample(ImuSample {
+        accel_m_s2: [0.0, 0.0, G],
+        gyro_rad_s: [0.0; 3],
+    });
+    let mut now = 0;
+    for _ in 0..=(BIAS_WINDOW_MS / SAMPLE_MS) {
+        b.push(still, now, true);
+        now += SAMPLE_MS;
+    }
+    b.configure(leveling_on()).unwrap();
+    b.level(0.02);
+    assert_eq!(b.shift_share(), [0.0; 2], "still: no lean");
+    // Rolling toward +y (left side down: negative roll) at 0.9 rad/s.
+    let tipping = ImuReading::Sample(ImuSample {
+        accel_m_s2: [0.0, 0.0, G],
+        gyro_rad_s: [-0.9, 0.0, 0.0],
+    });
+    b.push(tipping, now, true);
+    now += SAMPLE_MS;
+    b.level(0.02);
+    let [x, y] = b.shift_share();
+    assert!(x == 0.0 && y < 0.0 && y >= -REFLEX_MAX_SHARE, "{x} {y}");
+    // Nose down (positive pitch rate): the body shifts back.
+    let pitching = ImuReading::Sample(ImuSample {
+        accel_m_s2: [0.0, 0.0, G],
+        gyro_rad_s: [0.0, 2.0, 0.0],
+    });
+    b.push(pitching, now, true);
+    now += SAMPLE_MS;
+    b.level(0.02);
+    assert_eq!(
+        b.shift_share()[0],
+        -REFLEX_MAX_SHARE,
+        "held within its bound"
+    );
+    // Upright and still again: no lean.
+    for _ in 0..100 {
+        b.push(still, now, true);
+        now += SAMPLE_MS;
+    }
+    b.level(0.02);
+    assert_eq!(b.shift_share(), [0.0; 2]);
+}
