@@ -30,22 +30,6 @@
 //! `correction_limited`. On a slope of `s` the body's measured roll is `s + c` (the feet stand
 //! on the slope), so the integral settles at `c = −s`: level.
 //!
-//! ## Lean reflex (with leveling, on a held pose)
-//! Leveling turns the body over its feet; a push that tips the robot over its feet on one
-//! side is decided within 0.2–0.3 s, before the PI has moved much, and by the support: the
-//! distance from the centre of mass to the edge it tips over. While the leveling levels a held
-//! pose, each frame also shifts the body **away from the side it tips toward** (tipping
-//! toward +y, roll negative: toward −y; nose down, pitch positive: toward −x), which moves the
-//! centre of mass back over the loaded feet and the edge of the support away from it:
-//! `shift = h·(k_θ·dz(e, θ₀) + k_ω·dz(ω, ω₀))` per axis, within `±h·`[`REFLEX_MAX_SHARE`],
-//! with `h` the stance height, `e` the leveling error, `ω` the gyro's rate (bias removed: it
-//! sees the tip at once, where the accelerometer first reads the push's own force as tilt)
-//! and `dz(x, x₀)` the part of `x` beyond a dead band of `±x₀` ([`REFLEX_TILT_RAD`],
-//! [`REFLEX_RATE_RAD_S`]): nothing while the body is upright and slow, and the shift returns
-//! to zero as it rights itself. The shift goes through the same body IK, reach shares and
-//! joint-speed limiter as the correction. Measured in the physics twin (BENCHMARKS.md, the
-//! balance rows): the largest sideways impulse survived standing.
-//!
 //! ## Fall detection
 //! While the outputs are driven and fall detection is on: `|roll|` or `|pitch|` beyond
 //! `fall_angle_rad` ([`FallKind::Tilt`]), or a specific force below [`FREE_FALL_SHARE`] of `g`
@@ -103,26 +87,6 @@ pub const FREE_FALL_MS: u32 = 60;
 /// below it is the limit instead.
 pub const START_TILT_MAX_RAD: f32 = 0.61;
 
-/// The body's roll or pitch rate from which the lean reflex acts, rad/s (module docs,
-/// "Lean reflex"; standing, the body turns slower than this; a push that tips it over turns
-/// it at 0.6–1 rad/s within 50 ms).
-pub const REFLEX_RATE_RAD_S: f32 = 0.3;
-
-/// The leveling error (measured − intended roll or pitch) from which the lean reflex acts,
-/// rad (4°; a 10° tilting floor, leveled, stays within 3°).
-pub const REFLEX_TILT_RAD: f32 = 0.07;
-
-/// The lean reflex's shift per rad/s of rate beyond [`REFLEX_RATE_RAD_S`], a share of the
-/// stance height.
-pub const REFLEX_RATE_GAIN_S: f32 = 0.2;
-
-/// The lean reflex's shift per rad of leveling error beyond [`REFLEX_TILT_RAD`], a share of
-/// the stance height.
-pub const REFLEX_TILT_GAIN: f32 = 1.0;
-
-/// The lean reflex's largest shift on each axis, a share of the stance height.
-pub const REFLEX_MAX_SHARE: f32 = 0.15;
-
 /// What the device must do after a reading ([`Balance::push`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Event {
@@ -169,10 +133,6 @@ pub struct Balance<M> {
     limited: bool,
     fall: Option<FallKind>,
     samples: u32,
-    /// The body's roll and pitch rates of the last sample, the gyro bias removed, rad/s.
-    rate_rad_s: [f32; 2],
-    /// The lean reflex's shift (x, y), a share of the stance height.
-    shift_share: [f32; 2],
 }
 
 fn clamp_abs(x: f32, m: f32) -> f32 {
@@ -206,8 +166,6 @@ impl<M: Math> Balance<M> {
             limited: false,
             fall: None,
             samples: 0,
-            rate_rad_s: [0.0; 2],
-            shift_share: [0.0; 2],
         }
     }
 
@@ -305,8 +263,6 @@ impl<M: Math> Balance<M> {
                 self.estimator
                     .update(sample.gyro_rad_s, sample.accel_m_s2, dt_s);
                 self.attitude = self.estimator.attitude();
-                let b = self.estimator.bias_rad_s();
-                self.rate_rad_s = [sample.gyro_rad_s[0] - b[0], sample.gyro_rad_s[1] - b[1]];
             }
         }
         if !outputs_on || !self.config.fall_detection || self.fall.is_some() {
@@ -379,7 +335,6 @@ impl<M: Math> Balance<M> {
     fn stop_leveling(&mut self) {
         self.integral_rad = [0.0; 2];
         self.correction_rad = [0.0; 2];
-        self.shift_share = [0.0; 2];
         self.active = false;
         self.limited = false;
     }
@@ -405,27 +360,12 @@ impl<M: Math> Balance<M> {
         } = self.config;
         let measured = [self.attitude.roll_rad, self.attitude.pitch_rad];
         let mut c = [0.0; 2];
-        let mut lean = [0.0; 2];
         for i in 0..2 {
             let e = measured[i] - self.intended_rad[i];
             self.integral_rad[i] = clamp_abs(self.integral_rad[i] + level_ki_per_s * e * dt_s, m);
             c[i] = clamp_abs(-(level_kp * e + self.integral_rad[i]), m);
-            lean[i] = clamp_abs(
-                REFLEX_TILT_GAIN * beyond(e, REFLEX_TILT_RAD)
-                    + REFLEX_RATE_GAIN_S * beyond(self.rate_rad_s[i], REFLEX_RATE_RAD_S),
-                REFLEX_MAX_SHARE,
-            );
         }
-        // Rolling toward +y (negative roll) shifts the body toward −y; pitching nose down
-        // (positive pitch) shifts it toward −x (module docs, "Lean reflex").
-        self.shift_share = [-lean[1], lean[0]];
         Some(c)
-    }
-
-    /// The lean reflex's body shift (x, y) for this frame, a share of the stance height
-    /// (module docs, "Lean reflex"); zero while leveling is not running.
-    pub fn shift_share(&self) -> [f32; 2] {
-        self.shift_share
     }
 
     /// Records what a frame applied: the set point (the roll and pitch the pose or the motion
@@ -506,17 +446,6 @@ impl<M: Math> Balance<M> {
 impl<M: Math> Default for Balance<M> {
     fn default() -> Self {
         Self::new()
-    }
-}
-
-/// `x` beyond a dead band of `±band`: 0 within it, `x ∓ band` outside.
-fn beyond(x: f32, band: f32) -> f32 {
-    if x > band {
-        x - band
-    } else if x < -band {
-        x + band
-    } else {
-        0.0
     }
 }
 

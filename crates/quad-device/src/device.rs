@@ -426,22 +426,14 @@ where
     /// it was limited; `None` when not even the pose itself maps.
     // Out of line: the body solve's locals stay out of the frame tick's stack frame.
     #[inline(never)]
-    fn level_pose(
-        &mut self,
-        pose: &Pose,
-        c: [f32; 2],
-        shift_share: [f32; 2],
-    ) -> Option<([f32; 2], [f32; 2], bool)> {
+    fn level_pose(&mut self, pose: &Pose, c: [f32; 2]) -> Option<([f32; 2], [f32; 2], bool)> {
         let pc = self.config.pose_config;
         let intended = [pose.roll_rad, pose.pitch_rad];
-        let shift_m = shift_share.map(|s| s * pc.stance_height_m);
         for share in LEVEL_SHARES {
             let applied = [c[0] * share, c[1] * share];
             let leveled = Pose {
                 roll_rad: pose.roll_rad + applied[0],
                 pitch_rad: pose.pitch_rad + applied[1],
-                x_m: pose.x_m + shift_m[0] * share,
-                y_m: pose.y_m + shift_m[1] * share,
                 ..*pose
             };
             let mut solution = BodySolution::default();
@@ -453,7 +445,7 @@ where
                 &mut solution,
             );
             if solved.is_ok() && self.hold_angles(&solution.angles_rad).is_ok() {
-                let limited = share < 1.0 && (c != [0.0; 2] || shift_share != [0.0; 2]);
+                let limited = share < 1.0 && (c[0] != 0.0 || c[1] != 0.0);
                 return Some((intended, applied, limited));
             }
         }
@@ -566,12 +558,10 @@ where
             }
         } else if let Some(pose) = self.base_pose {
             match correction {
-                Some(c) => {
-                    applied = self.level_pose(&pose, c, self.balance.shift_share());
-                }
+                Some(c) => applied = self.level_pose(&pose, c),
                 // Leveling just ended: the pose without its correction, once.
                 None if had_correction => {
-                    self.level_pose(&pose, [0.0; 2], [0.0; 2]);
+                    self.level_pose(&pose, [0.0; 2]);
                 }
                 None => {}
             }

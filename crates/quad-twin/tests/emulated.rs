@@ -226,7 +226,7 @@ fn the_emulated_firmware_reads_the_twins_imu_over_its_twi_and_levels_on_a_slope(
 /// error of roll and of pitch, rad (5.7°; measured 3.82° / 1.49°). Host-driven, the emulated
 /// stand-up rolls the body from 11° to 24–27° and back on this slope within its first second,
 /// with balance or without (in process it stays at 11°); through that transient the estimate
-/// runs up to 12° off (the accelerometer's correction reads the body's own accelerations as
+/// runs up to 13° off (the accelerometer's correction reads the body's own accelerations as
 /// tilt), then follows within 0.5° (docs/twin.md).
 const EMULATED_ESTIMATE_RMS_RAD: f64 = 0.1;
 
