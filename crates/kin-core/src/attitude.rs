@@ -48,9 +48,13 @@
 //!   0 beyond (free fall, a landing, a kick): the gyro alone carries the estimate through
 //!   such a sample. Its thresholds are wider than the paper's (0.1 and 0.2): a trot's
 //!   readings spread ±25 % around `g`, and a narrow band keeps the samples of one phase of
-//!   the stride and drops the other's, which biases the mean as normalising does. Weighting
-//!   by the gyro's rate, the other common refinement, was measured and not kept: in a trot the
-//!   rate is correlated with the stride's phase too, and it made the error larger.
+//!   the stride and drops the other's, which biases the mean as normalising does.
+//! - **The same weight on the rate**: full below [`Gains::rate_trust_rad_s`], none from
+//!   [`Gains::rate_reject_rad_s`]. A sensor off the centre of a fast turn (a fall, a tumble)
+//!   reads its centripetal and tangential acceleration as tilt: in the twin's fall the
+//!   estimate crossed 60° one sample before the body. The thresholds lie far above a trot's
+//!   rates (at most 0.8 rad/s in the twin's): at 1–2 rad/s the rate follows the stride's
+//!   phase, the weight selects a phase, and the trot's error grew.
 //!
 //! A zero or non-finite sample corrects nothing; nothing here produces a NaN from finite
 //! input.
@@ -75,6 +79,12 @@ pub struct Gains {
     /// The `| |a|/g − 1 |` from which a sample corrects nothing; between the two shares its
     /// weight falls linearly. Greater than [`Gains::accel_trust_share`].
     pub accel_reject_share: f32,
+    /// The largest rate (the bias removed) at which a sample corrects the estimate with its
+    /// full weight, rad/s (module docs, "Accelerometer weighting").
+    pub rate_trust_rad_s: f32,
+    /// The rate from which a sample corrects nothing, rad/s; between the two the weight falls
+    /// linearly. Greater than [`Gains::rate_trust_rad_s`].
+    pub rate_reject_rad_s: f32,
     /// The largest bias estimate per axis, rad/s (the MPU-6050's datasheet allows ±20 °/s at
     /// 25 °C): the integral is held within it.
     pub max_bias_rad_s: f32,
@@ -90,6 +100,8 @@ impl Gains {
         ki_per_s2: 0.05,
         accel_trust_share: 0.3,
         accel_reject_share: 0.6,
+        rate_trust_rad_s: 2.0,
+        rate_reject_rad_s: 4.0,
         max_bias_rad_s: 0.35,
     };
 }
@@ -183,6 +195,8 @@ impl<M: Math> Estimator<M> {
             ki_per_s2,
             accel_trust_share: trust,
             accel_reject_share: reject,
+            rate_trust_rad_s,
+            rate_reject_rad_s,
             max_bias_rad_s,
         } = self.gains;
         let mut omega = [
@@ -195,16 +209,25 @@ impl<M: Math> Estimator<M> {
         let (lo, hi) = (1.0 - reject, 1.0 + reject);
         // |a| short of the rejecting share, compared squared (no square root for a rejected
         // sample).
-        let trusted = finite3(accel_m_s2) && n2 > lo * lo * g2 && n2 < hi * hi * g2;
+        let w2 = dot(omega, omega);
+        let trusted = finite3(accel_m_s2)
+            && n2 > lo * lo * g2
+            && n2 < hi * hi * g2
+            && w2 < rate_reject_rad_s * rate_reject_rad_s;
         if trusted {
             let off = (M::sqrt(n2) * (1.0 / G_M_S2) - 1.0).abs();
             // Valenti et al. 2015 eq. 60: full weight within `trust`, linearly to 0 at
             // `reject`.
-            let weight = if off <= trust {
+            let mut weight = if off <= trust {
                 1.0
             } else {
                 (reject - off) / (reject - trust)
             };
+            // The same on the rate (no square root below `rate_trust_rad_s`).
+            if w2 > rate_trust_rad_s * rate_trust_rad_s {
+                weight *=
+                    (rate_reject_rad_s - M::sqrt(w2)) / (rate_reject_rad_s - rate_trust_rad_s);
+            }
             // The correction linear in the reading (module docs): a/g, not a/|a|.
             let k = weight * (1.0 / G_M_S2);
             let measured = accel_m_s2.map(|a| a * k);
