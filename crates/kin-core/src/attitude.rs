@@ -34,7 +34,7 @@
 //! ## Accelerometer weighting
 //! The accelerometer tells the up direction only on average: a walking body accelerates
 //! back and forth, up and down, and its specific force swings around `g` within each stride.
-//! Two refinements of the plain filter keep that from reading as tilt:
+//! Three refinements of the plain filter keep that from reading as tilt:
 //! - **The correction is linear in the reading**: `e = (a/g) × v̂`, not `(a/|a|) × v̂`. The
 //!   mean of the specific force over a stride is gravity (the body's mean acceleration is
 //!   zero at a steady gait); the mean of its *direction* is not, because the samples of the
@@ -42,8 +42,8 @@
 //!   touchdown. Normalised, the physics twin's trot read 1.2–1.3° of pitch that was not there
 //!   (`docs/benchmark-journal.md`, "Attitude estimator during the trot").
 //! - **An adaptive gain** (R. G. Valenti, I. Dryanovski, J. Xiao, *Keeping a Good Attitude: A
-//!   Quaternion-Based Orientation Filter for IMUs and MARGs*, Sensors 15(8), 2015, §5.3 and
-//!   eq. 60): the correction's weight is 1 while `| |a|/g − 1 |` is within
+//!   Quaternion-Based Orientation Filter for IMUs and MARGs*, Sensors 15(8), 2015, its
+//!   adaptive gain): the correction's weight is 1 while `| |a|/g − 1 |` is within
 //!   [`Gains::accel_trust_share`], falls linearly to 0 at [`Gains::accel_reject_share`] and is
 //!   0 beyond (free fall, a landing, a kick): the gyro alone carries the estimate through
 //!   such a sample. Its thresholds are wider than the paper's (0.1 and 0.2): a trot's
@@ -184,8 +184,9 @@ impl<M: Math> Estimator<M> {
     /// One sample: the gyro's rates and the accelerometer's specific force (body frame, SI)
     /// after `dt_s` seconds. A sample with a non-finite rate, or a `dt_s` that is not finite and
     /// positive, changes nothing; an accelerometer reading outside
-    /// [`Gains::accel_reject_share`] (module docs) does not correct. Returns true when the
-    /// accelerometer corrected the estimate.
+    /// [`Gains::accel_reject_share`], or taken at a rate beyond [`Gains::rate_reject_rad_s`]
+    /// (module docs), does not correct. Returns true when the accelerometer corrected the
+    /// estimate.
     pub fn update(&mut self, gyro_rad_s: [f32; 3], accel_m_s2: [f32; 3], dt_s: f32) -> bool {
         if !(finite3(gyro_rad_s) && dt_s > 0.0 && dt_s.is_finite()) {
             return false;
@@ -216,7 +217,7 @@ impl<M: Math> Estimator<M> {
             && w2 < rate_reject_rad_s * rate_reject_rad_s;
         if trusted {
             let off = (M::sqrt(n2) * (1.0 / G_M_S2) - 1.0).abs();
-            // Valenti et al. 2015 eq. 60: full weight within `trust`, linearly to 0 at
+            // Valenti et al. 2015's adaptive gain: full weight within `trust`, linearly to 0 at
             // `reject`.
             let mut weight = if off <= trust {
                 1.0
