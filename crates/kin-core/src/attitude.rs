@@ -31,12 +31,33 @@
 //! `roll = atan2(v_y, v_z)` and `pitch = atan2(−v_x, √(v_y² + v_z²))`. Roll is in `[−π, π]`
 //! (upside down is ±π), pitch in `[−π/2, π/2]`.
 //!
-//! ## Accelerometer gating
-//! The accelerometer tells the up direction only while the body's own acceleration is small. A
-//! sample whose specific force differs from `g` by more than [`Gains::accel_gate`] (a share of
-//! `g`; free fall, a landing, a kick) corrects nothing: the gyro alone carries the estimate
-//! through it. A zero or non-finite sample is skipped the same way; nothing here produces a NaN
-//! from finite input.
+//! ## Accelerometer weighting
+//! The accelerometer tells the up direction only on average: a walking body accelerates
+//! back and forth, up and down, and its specific force swings around `g` within each stride.
+//! Three refinements of the plain filter keep that from reading as tilt:
+//! - **The correction is linear in the reading**: `e = (a/g) × v̂`, not `(a/|a|) × v̂`. The
+//!   mean of the specific force over a stride is gravity (the body's mean acceleration is
+//!   zero at a steady gait); the mean of its *direction* is not, because the samples of the
+//!   push-off (small `|a|`, body accelerating forward) weigh as much as those of the
+//!   touchdown. Normalised, the physics twin's trot read 1.2–1.3° of pitch that was not there
+//!   (`docs/benchmark-journal.md`, "Attitude estimator during the trot").
+//! - **An adaptive gain** (R. G. Valenti, I. Dryanovski, J. Xiao, *Keeping a Good Attitude: A
+//!   Quaternion-Based Orientation Filter for IMUs and MARGs*, Sensors 15(8), 2015, its
+//!   adaptive gain): the correction's weight is 1 while `| |a|/g − 1 |` is within
+//!   [`Gains::accel_trust_share`], falls linearly to 0 at [`Gains::accel_reject_share`] and is
+//!   0 beyond (free fall, a landing, a kick): the gyro alone carries the estimate through
+//!   such a sample. Its thresholds are wider than the paper's (0.1 and 0.2): a trot's
+//!   readings spread ±25 % around `g`, and a narrow band keeps the samples of one phase of
+//!   the stride and drops the other's, which biases the mean as normalising does.
+//! - **The same weight on the rate**: full below [`Gains::rate_trust_rad_s`], none from
+//!   [`Gains::rate_reject_rad_s`]. A sensor off the centre of a fast turn (a fall, a tumble)
+//!   reads its centripetal and tangential acceleration as tilt: in the twin's fall the
+//!   estimate crossed 60° one sample before the body. The thresholds lie far above a trot's
+//!   rates (at most 0.8 rad/s in the twin's): at 1–2 rad/s the rate follows the stride's
+//!   phase, the weight selects a phase, and the trot's error grew.
+//!
+//! A zero or non-finite sample corrects nothing; nothing here produces a NaN from finite
+//! input.
 
 use crate::math::Math;
 use core::marker::PhantomData;
@@ -52,8 +73,18 @@ pub struct Gains {
     pub kp_per_s: f32,
     /// Integral gain `k_I`, rad/s² per unit of error (how fast the bias estimate follows).
     pub ki_per_s2: f32,
-    /// The largest `| |a|/g − 1 |` of a sample that still corrects the estimate.
-    pub accel_gate: f32,
+    /// The largest `| |a|/g − 1 |` of a sample that corrects the estimate with its full
+    /// weight (module docs, "Accelerometer weighting").
+    pub accel_trust_share: f32,
+    /// The `| |a|/g − 1 |` from which a sample corrects nothing; between the two shares its
+    /// weight falls linearly. Greater than [`Gains::accel_trust_share`].
+    pub accel_reject_share: f32,
+    /// The largest rate (the bias removed) at which a sample corrects the estimate with its
+    /// full weight, rad/s (module docs, "Accelerometer weighting").
+    pub rate_trust_rad_s: f32,
+    /// The rate from which a sample corrects nothing, rad/s; between the two the weight falls
+    /// linearly. Greater than [`Gains::rate_trust_rad_s`].
+    pub rate_reject_rad_s: f32,
     /// The largest bias estimate per axis, rad/s (the MPU-6050's datasheet allows ±20 °/s at
     /// 25 °C): the integral is held within it.
     pub max_bias_rad_s: f32,
@@ -61,12 +92,16 @@ pub struct Gains {
 
 impl Gains {
     /// The gains the device uses: a crossover of 0.16 Hz (`k_P` = 1 rad/s), a bias time
-    /// constant of about 20 s, samples within 25 % of `g` trusted. Measured in the tests below
-    /// (still, sway, trot-like vibration with noise and bias).
+    /// constant of about 20 s, samples within 30 % of `g` trusted fully, beyond 60 % not at
+    /// all. Measured in the tests (`tests/attitude.rs`: still, sway, trot-like vibration with
+    /// noise and bias) and on the physics twin's trot of both robots.
     pub const DEFAULT: Gains = Gains {
         kp_per_s: 1.0,
         ki_per_s2: 0.05,
-        accel_gate: 0.25,
+        accel_trust_share: 0.3,
+        accel_reject_share: 0.6,
+        rate_trust_rad_s: 2.0,
+        rate_reject_rad_s: 4.0,
         max_bias_rad_s: 0.35,
     };
 }
@@ -148,8 +183,10 @@ impl<M: Math> Estimator<M> {
 
     /// One sample: the gyro's rates and the accelerometer's specific force (body frame, SI)
     /// after `dt_s` seconds. A sample with a non-finite rate, or a `dt_s` that is not finite and
-    /// positive, changes nothing; an accelerometer reading outside the gate (module docs) does
-    /// not correct. Returns true when the accelerometer corrected the estimate.
+    /// positive, changes nothing; an accelerometer reading outside
+    /// [`Gains::accel_reject_share`], or taken at a rate beyond [`Gains::rate_reject_rad_s`]
+    /// (module docs), does not correct. Returns true when the accelerometer corrected the
+    /// estimate.
     pub fn update(&mut self, gyro_rad_s: [f32; 3], accel_m_s2: [f32; 3], dt_s: f32) -> bool {
         if !(finite3(gyro_rad_s) && dt_s > 0.0 && dt_s.is_finite()) {
             return false;
@@ -157,7 +194,10 @@ impl<M: Math> Estimator<M> {
         let Gains {
             kp_per_s,
             ki_per_s2,
-            accel_gate,
+            accel_trust_share: trust,
+            accel_reject_share: reject,
+            rate_trust_rad_s,
+            rate_reject_rad_s,
             max_bias_rad_s,
         } = self.gains;
         let mut omega = [
@@ -167,12 +207,31 @@ impl<M: Math> Estimator<M> {
         ];
         let n2 = dot(accel_m_s2, accel_m_s2);
         let g2 = G_M_S2 * G_M_S2;
-        let (lo, hi) = (1.0 - accel_gate, 1.0 + accel_gate);
-        // |a| within the gate, compared squared (no square root for a rejected sample).
-        let trusted = finite3(accel_m_s2) && n2 >= lo * lo * g2 && n2 <= hi * hi * g2;
+        let (lo, hi) = (1.0 - reject, 1.0 + reject);
+        // |a| short of the rejecting share, compared squared (no square root for a rejected
+        // sample).
+        let w2 = dot(omega, omega);
+        let trusted = finite3(accel_m_s2)
+            && n2 > lo * lo * g2
+            && n2 < hi * hi * g2
+            && w2 < rate_reject_rad_s * rate_reject_rad_s;
         if trusted {
-            let inv = 1.0 / M::sqrt(n2);
-            let measured = accel_m_s2.map(|a| a * inv);
+            let off = (M::sqrt(n2) * (1.0 / G_M_S2) - 1.0).abs();
+            // Valenti et al. 2015's adaptive gain: full weight within `trust`, linearly to 0 at
+            // `reject`.
+            let mut weight = if off <= trust {
+                1.0
+            } else {
+                (reject - off) / (reject - trust)
+            };
+            // The same on the rate (no square root below `rate_trust_rad_s`).
+            if w2 > rate_trust_rad_s * rate_trust_rad_s {
+                weight *=
+                    (rate_reject_rad_s - M::sqrt(w2)) / (rate_reject_rad_s - rate_trust_rad_s);
+            }
+            // The correction linear in the reading (module docs): a/g, not a/|a|.
+            let k = weight * (1.0 / G_M_S2);
+            let measured = accel_m_s2.map(|a| a * k);
             // Mahony eq. 32: the error rotates the estimate toward the measurement.
             let e = cross(measured, self.up);
             for i in 0..3 {

@@ -223,16 +223,16 @@ fn the_emulated_firmware_reads_the_twins_imu_over_its_twi_and_levels_on_a_slope(
 }
 
 /// The emulated firmware's attitude estimate on the slope, against the true attitude: RMS
-/// error of roll and of pitch, rad (5.7°; measured 3.95° / 1.57°). Host-driven, the emulated
+/// error of roll and of pitch, rad (5.7°; measured 3.82° / 1.49°). Host-driven, the emulated
 /// stand-up rolls the body from 11° to 24–27° and back on this slope within its first second,
 /// with balance or without (in process it stays at 11°); through that transient the estimate
 /// runs up to 13° off (the accelerometer's correction reads the body's own accelerations as
 /// tilt), then follows within 0.5° (docs/twin.md).
 const EMULATED_ESTIMATE_RMS_RAD: f64 = 0.1;
 
-/// The largest roll or pitch error, rad (15°; measured 12.8°, in the stand-up's transient).
+/// The largest roll or pitch error, rad (15°; measured 12.2°, in the stand-up's transient).
 const EMULATED_ESTIMATE_MAX_ERROR_RAD: f64 = 0.26;
 
 /// The emulated firmware's leveled body on a 10° slope: largest settled |roll|, rad (3°;
-/// measured 0.03°, open loop 11.1°).
+/// measured 0.07°, open loop 11.1°).
 const EMULATED_LEVEL_MAX_RAD: f64 = 0.052;
