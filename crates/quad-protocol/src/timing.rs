@@ -58,11 +58,14 @@ pub enum Kind {
     SetJointSpeedLimit,
     SetBalance,
     GetImu,
+    SetRobot,
+    GetRobot,
+    SaveRobot,
 }
 
 impl Kind {
     /// Every row, in the order of the table.
-    pub const ALL: [Kind; 25] = [
+    pub const ALL: [Kind; 28] = [
         Kind::Hello,
         Kind::GetState,
         Kind::SetBodyPose,
@@ -88,6 +91,9 @@ impl Kind {
         Kind::SetJointSpeedLimit,
         Kind::SetBalance,
         Kind::GetImu,
+        Kind::SetRobot,
+        Kind::GetRobot,
+        Kind::SaveRobot,
     ];
 
     /// The row of `request`.
@@ -120,6 +126,9 @@ impl Kind {
             Request::SetJointSpeedLimit { .. } => Kind::SetJointSpeedLimit,
             Request::SetBalance(_) => Kind::SetBalance,
             Request::GetImu => Kind::GetImu,
+            Request::SetRobot(_) => Kind::SetRobot,
+            Request::GetRobot => Kind::GetRobot,
+            Request::SaveRobot => Kind::SaveRobot,
         }
     }
 
@@ -151,6 +160,9 @@ impl Kind {
             Kind::SetJointSpeedLimit => "SetJointSpeedLimit",
             Kind::SetBalance => "SetBalance",
             Kind::GetImu => "GetImu",
+            Kind::SetRobot => "SetRobot",
+            Kind::GetRobot => "GetRobot",
+            Kind::SaveRobot => "SaveRobot",
         }
     }
 
@@ -186,6 +198,9 @@ impl Kind {
             Kind::SetJointSpeedLimit => [9_200, 1_700],
             Kind::SetBalance => [9_200, 2_200],
             Kind::GetImu => [5_500, 1_100],
+            Kind::SetRobot => [30_000, 12_000],
+            Kind::GetRobot => [9_000, 2_000],
+            Kind::SaveRobot => [330_000, 320_000],
         }
     }
 
