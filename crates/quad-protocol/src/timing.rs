@@ -173,7 +173,7 @@ impl Kind {
     /// [`FRAME_ALLOWANCE`] more; [`Kind::timeout`]'s margin covers both.
     pub const fn worst_us(self) -> [u32; 2] {
         match self {
-            Kind::Hello => [7_500, 5_600],
+            Kind::Hello => [9_800, 7_600],
             Kind::GetState => [7_600, 1_400],
             Kind::SetBodyPose => [13_600, 4_700],
             Kind::SetFeet => [16_000, 5_000],
@@ -198,9 +198,9 @@ impl Kind {
             Kind::SetJointSpeedLimit => [9_200, 1_700],
             Kind::SetBalance => [9_200, 2_200],
             Kind::GetImu => [5_500, 1_100],
-            Kind::SetRobot => [30_000, 12_000],
-            Kind::GetRobot => [9_000, 2_000],
-            Kind::SaveRobot => [330_000, 320_000],
+            Kind::SetRobot => [22_500, 9_100],
+            Kind::GetRobot => [8_900, 1_500],
+            Kind::SaveRobot => [297_900, 291_500],
         }
     }
 

@@ -666,17 +666,31 @@ wire_index! {
 }
 
 /// A kin-core [`kin_core::Robot`] on the wire (since 2.4, in [`crate::RobotDescription`]), for serde's
-/// `with`: a tuple of `d_lat_m`, `d_ax_m`, `femur_m`, `tibia_m`, `body_length_m`,
-/// `body_width_m`, the three `min_rad` and the three `max_rad` (abduction, hip, knee), all f32,
-/// then the knee bend ([`knee_bend`]). In the text form (feature `text`) kin-core's own serde
-/// form.
+/// `with`: the fields `d_lat_m`, `d_ax_m`, `femur_m`, `tibia_m`, `body_length_m`,
+/// `body_width_m`, the three minima and the three maxima of the joint limits (abduction, hip,
+/// knee), all f32, then the knee bend ([`knee_bend`]). In the text form (feature `text`)
+/// kin-core's own serde form.
 pub mod robot {
     use kin_core::{JointLimits, LegGeometry, Robot};
     use serde::de::{self, Deserializer, SeqAccess, Visitor};
-    use serde::ser::{SerializeTuple, Serializer};
+    use serde::ser::{SerializeStruct, Serializer};
 
-    /// Elements of the tuple: twelve lengths and limits, the knee bend.
-    const LEN: usize = 13;
+    /// The fields in wire order: twelve lengths and limits, the knee bend.
+    const FIELDS: [&str; 13] = [
+        "d_lat_m",
+        "d_ax_m",
+        "femur_m",
+        "tibia_m",
+        "body_length_m",
+        "body_width_m",
+        "min_abduction_rad",
+        "min_hip_rad",
+        "min_knee_rad",
+        "max_abduction_rad",
+        "max_hip_rad",
+        "max_knee_rad",
+        "knee_bend",
+    ];
 
     /// The twelve numbers in wire order.
     fn numbers(r: &Robot) -> [f32; 12] {
@@ -706,15 +720,14 @@ pub mod robot {
         if s.is_human_readable() {
             return ::serde::Serialize::serialize(robot, s);
         }
-        let mut t = s.serialize_tuple(LEN)?;
-        for v in numbers(robot) {
-            t.serialize_element(&v)?;
+        let mut t = s.serialize_struct("Robot", FIELDS.len())?;
+        for (name, v) in FIELDS.iter().zip(numbers(robot)) {
+            t.serialize_field(name, &v)?;
         }
-        t.serialize_element(super::wire_ser_field!(
-            &robot.knee_bend,
-            kin_core::KneeBend,
-            super::knee_bend
-        ))?;
+        t.serialize_field(
+            FIELDS[12],
+            super::wire_ser_field!(&robot.knee_bend, kin_core::KneeBend, super::knee_bend),
+        )?;
         t.end()
     }
 
@@ -761,7 +774,7 @@ pub mod robot {
                 })
             }
         }
-        d.deserialize_tuple(LEN, Fields)
+        d.deserialize_struct("Robot", &FIELDS, Fields)
     }
 }
 
