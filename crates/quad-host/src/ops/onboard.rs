@@ -12,6 +12,7 @@
 
 use crate::client::{self, Client, ClientConfig, Outcome, Verdict};
 use crate::link::{self, Link, Target};
+use crate::robot_file;
 use quad_protocol::range::{self, ParamRange, Ranges};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
@@ -29,12 +30,17 @@ pub const POLL_PERIOD: Duration = Duration::from_millis(100);
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The robot is not a preset.
+    /// The robot is not a preset and the device is older than protocol 2.4 (it cannot tell
+    /// which robot it holds beyond its preset).
     #[error(
-        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
-         device reports its preset and both sides must run the same geometry"
+        "--robot {0}: the device speaks a protocol older than 2.4 and needs a preset robot \
+         (shahriar2023, fernando2025): it reports its preset and both sides must run the same \
+         geometry"
     )]
     NotAPreset(String),
+    /// The robot file was refused (before anything was sent).
+    #[error(transparent)]
+    Robot(#[from] crate::robot_file::DeviceError),
     /// The link could not be opened.
     #[error(transparent)]
     Link(#[from] link::Error),
@@ -612,17 +618,40 @@ impl<L: Link> Session<L> {
     }
 }
 
-/// Opens `target` and connects a [`Session`] for `robot` (a preset name).
+/// Opens `target` and connects a [`Session`] for `robot`: a preset, a TOML or a URDF robot
+/// file ([`robot_file::device_description`]). A device of protocol 2.4 or later must hold
+/// that robot (the hashes are compared, [`Session::connect_robot`]); an older device must run
+/// the preset named ([`Session::connect`]).
 ///
 /// # Errors
-/// [`Error::NotAPreset`], the link's and the handshake's errors.
+/// [`Error::Robot`] for a robot file refused (before the link is opened),
+/// [`Error::NotAPreset`] for a robot file and a device older than 2.4,
+/// [`client::Error::RobotMismatch`] for a device holding another robot, the link's and the
+/// handshake's errors.
 pub fn open(robot: &str, target: &Target, retries: u32) -> Result<Session<Box<dyn Link>>, Error> {
+    let wanted = robot_file::device_description(robot)?;
+    let link = link::open(target)?;
+    let mut client = Client::new(link, ClientConfig::for_target(target, retries));
+    let info = client.hello()?;
+    if quad_protocol::version_minor(info.version) >= 4 {
+        return Session::connect_robot(client, Some(&wanted));
+    }
     let preset =
         RobotPreset::from_name(robot.trim()).ok_or_else(|| Error::NotAPreset(robot.to_owned()))?;
+    Session::connect(client, preset)
+}
+
+/// [`open`] without a robot: the host plans with the robot the device holds (protocol 2.4,
+/// [`Session::connect_robot`]).
+///
+/// # Errors
+/// [`client::Error::NoRobotRequests`] for a device older than 2.4, the link's and the
+/// handshake's errors.
+pub fn open_device_robot(target: &Target, retries: u32) -> Result<Session<Box<dyn Link>>, Error> {
     let link = link::open(target)?;
-    Session::connect(
+    Session::connect_robot(
         Client::new(link, ClientConfig::for_target(target, retries)),
-        preset,
+        None,
     )
 }
 
