@@ -280,7 +280,10 @@ impl SessionArgs {
     /// The library's session. The simulated device runs the robot given; the session refuses
     /// a robot that is not a preset before the link is opened.
     pub fn session(&self) -> Session {
-        let preset = RobotPreset::from_name(self.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
+        // A robot file: the simulated device compiled with the firmware's preset, holding what
+        // its --sim-storage EEPROM holds (protocol 2.4; the session compares the hashes).
+        let preset =
+            RobotPreset::from_name(self.robot.robot.trim()).unwrap_or(RobotPreset::Shahriar2023);
         Session {
             robot: self.robot.robot.clone(),
             target: self.target.target(preset),

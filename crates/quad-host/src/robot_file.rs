@@ -57,7 +57,8 @@
 //! joint_speed_limit_rad_s = 3.0   # default: the device's default limit
 //! ```
 //!
-//! The device checks what it is sent (`quad_protocol::check_robot`, which the host runs first):
+//! A key left out of a file with a preset's geometry takes the preset's value (its name, stance
+//! height, rotation order and joint-speed limit). The device checks what it is sent (`quad_protocol::check_robot`, which the host runs first):
 //! the lengths and limits within their ranges, the stance reachable by every leg, the rest pose
 //! within the limits.
 
@@ -538,7 +539,8 @@ pub enum DeviceError {
 /// name (the preset's own description, `quad_device::Config::description`), a URDF file (its
 /// stem as name, the defaults below) or a TOML file (its `[device]` table over the defaults:
 /// the file's stem as name, [`default_stance_height_m`], rotation order zyx, the device's
-/// default joint-speed limit). Checked as the device checks it.
+/// default joint-speed limit; for a file with a preset's geometry, the preset's description).
+/// Checked as the device checks it.
 ///
 /// # Errors
 /// [`DeviceError`].
@@ -568,25 +570,39 @@ pub fn device_description(spec: &str) -> Result<quad_protocol::RobotDescription,
         let (file, robot) = parse_file(text).map_err(|e| e.in_file(path))?;
         (robot, file.device)
     };
-    let name = table
-        .name
-        .unwrap_or_else(|| stem.chars().take(16).collect());
+    // A file with a preset's geometry defaults to the preset's description (the robot the
+    // device calls by the preset's name).
+    let base = [
+        quad_protocol::RobotPreset::Shahriar2023,
+        quad_protocol::RobotPreset::Fernando2025,
+    ]
+    .into_iter()
+    .filter_map(quad_device::Config::for_preset)
+    .map(|c| c.description())
+    .find(|d| d.robot == robot);
+    let name = match (table.name, &base) {
+        (Some(n), _) => n,
+        (None, Some(b)) => b.name_str().unwrap_or_default().to_owned(),
+        (None, None) => stem.chars().take(16).collect(),
+    };
     let name_bytes =
         RobotDescription::name_bytes(&name).map_err(|source| DeviceError::Name { name, source })?;
     let order = match table.rotation_order {
         Some(o) => kin_core::RotationOrder::parse(&o).ok_or(DeviceError::RotationOrder(o))?,
-        None => kin_core::RotationOrder::Zyx,
+        None => base.map_or(kin_core::RotationOrder::Zyx, |b| b.order),
     };
     let d = RobotDescription {
         name: name_bytes,
         robot,
-        stance_height_m: table
-            .stance_height_m
-            .unwrap_or_else(|| default_stance_height_m(&robot)),
+        stance_height_m: table.stance_height_m.unwrap_or_else(|| {
+            base.map_or_else(|| default_stance_height_m(&robot), |b| b.stance_height_m)
+        }),
         order,
-        joint_speed_limit_rad_s: table
-            .joint_speed_limit_rad_s
-            .unwrap_or(quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S),
+        joint_speed_limit_rad_s: table.joint_speed_limit_rad_s.unwrap_or_else(|| {
+            base.map_or(quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S, |b| {
+                b.joint_speed_limit_rad_s
+            })
+        }),
     };
     quad_protocol::check_robot::<kin_core::DefaultMath>(&d).map_err(DeviceError::Refused)?;
     Ok(d)
