@@ -648,7 +648,7 @@ pub const JOINT_LIMIT_RAD: ParamRange = ParamRange::symmetric(PI);
 ///
 /// | field | admissible |
 /// |---|---|
-/// | name | printable ASCII, 1‥16 bytes, zero-padded ([`RobotDescription::name_str`]) |
+/// | name | printable ASCII, 1‥16 bytes, zero-padded ([`RobotDescription::name_len`]) |
 /// | `femur_m`, `tibia_m` | [`LINK_LENGTH_M`]: `[0.01, 2]` m |
 /// | `d_lat_m`, `d_ax_m` | [`LEG_OFFSET_M`]: `[0, 1]` m |
 /// | `body_length_m`, `body_width_m` | [`BODY_SIZE_M`]: `[0, 4]` m |
@@ -666,7 +666,7 @@ pub const JOINT_LIMIT_RAD: ParamRange = ParamRange::symmetric(PI);
 /// [`NackReason::BadRobot`] naming the first field refused.
 pub fn check_robot<M: Math>(d: &RobotDescription) -> Result<body::Solver<M>, NackReason> {
     let bad = |field| Err(NackReason::BadRobot(field));
-    if d.name_str().is_none() {
+    if d.name_len().is_none() {
         return bad(RobotField::Name);
     }
     let r = &d.robot;

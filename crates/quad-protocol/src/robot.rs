@@ -98,16 +98,21 @@ impl RobotDescription {
         Ok(self)
     }
 
-    /// The name without its padding; `None` when it is not a valid name (see
-    /// [`RobotDescription::name`]).
-    pub fn name_str(&self) -> Option<&str> {
+    /// The length of the name without its padding; `None` when it is not a valid name (see
+    /// [`RobotDescription::name`]). Bytes only: no UTF-8 decoding (whose 256-byte table
+    /// would be copied into the ATmega2560's SRAM).
+    pub fn name_len(&self) -> Option<usize> {
         let len = self.name.iter().position(|&b| b == 0).unwrap_or(NAME_LEN);
         let (text, pad) = self.name.split_at(len);
         let printable = text.iter().all(|b| (0x20..=0x7E).contains(b));
-        if len == 0 || !printable || pad.iter().any(|&b| b != 0) {
-            return None;
-        }
-        core::str::from_utf8(text).ok()
+        (len > 0 && printable && pad.iter().all(|&b| b == 0)).then_some(len)
+    }
+
+    /// The name without its padding; `None` when it is not a valid name (see
+    /// [`RobotDescription::name`]).
+    pub fn name_str(&self) -> Option<&str> {
+        let len = self.name_len()?;
+        core::str::from_utf8(&self.name[..len]).ok()
     }
 
     /// The wire bytes (module docs): always [`RobotDescription::WIRE_LEN`] of them (every
