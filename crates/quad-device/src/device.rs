@@ -71,6 +71,12 @@ struct Held {
 ///   [`NackReason::InvalidParameter`] naming it, before the motion engine does any maths.
 /// - Configuration requests are answered with [`DeviceToHost::Configured`], echoing the setting
 ///   as applied.
+/// - The robot (protocol 2.4): at boot the one stored ([`Request::SaveRobot`]) when a valid
+///   one is, else the configuration's. [`Request::SetRobot`] is refused while the outputs are
+///   on ([`NackReason::OutputsEnabled`]) and when [`quad_protocol::check_robot`]
+///   refuses the robot ([`NackReason::BadRobot`]), changing nothing; accepted, it replaces the
+///   geometry, ranges, stance height, rotation order and joint-speed limit at once and holds
+///   the new stance (with the outputs off). The hello reports its hash to a host of minor 4.
 /// - Link loss: when no valid frame arrived for `timeout_ms` (≠ 0), the failsafe holds the
 ///   pulses or stops the outputs ([`LinkLossAction`]) and sets [`Flags::FAILSAFE_ACTIVE`],
 ///   latched until an answer that carries a readback has reported it. Stopped outputs stay
