@@ -44,6 +44,23 @@
 //!
 //! A non-positive or non-finite value, an unknown servo or physical preset is refused naming the
 //! key and its line ([`Error::Physical`]; unknown presets list the known ones).
+//!
+//! An optional `[device]` table gives what the device holds besides the geometry when the robot
+//! is sent to it (protocol 2.4, `quadctl robot send`; [`device_description`]); every key is
+//! optional:
+//!
+//! ```toml
+//! [device]
+//! name = "bench-pup"              # printable ASCII, at most 16 bytes; default: the file's stem
+//! stance_height_m = 0.32          # default: see `default_stance_height_m`
+//! rotation_order = "zyx"          # of body poses; default zyx
+//! joint_speed_limit_rad_s = 3.0   # default: the device's default limit
+//! ```
+//!
+//! A key left out of a file with a preset's geometry takes the preset's value (its name, stance
+//! height, rotation order and joint-speed limit). The device checks what it is sent (`quad_protocol::check_robot`, which the host runs first):
+//! the lengths and limits within their ranges, the stance reachable by every leg, the rest pose
+//! within the limits.
 
 use crate::names;
 use kin_core::robot::RobotError;
@@ -200,6 +217,18 @@ struct RobotFile {
     limits: LimitsTable,
     #[serde(default)]
     physical: PhysicalTable,
+    #[serde(default)]
+    device: DeviceTable,
+}
+
+/// The `[device]` table (module docs): every key optional.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DeviceTable {
+    name: Option<String>,
+    stance_height_m: Option<f32>,
+    rotation_order: Option<String>,
+    joint_speed_limit_rad_s: Option<f32>,
 }
 
 /// The longest link or body dimension a robot file may give, m. Any longer is taken for a value
@@ -611,6 +640,110 @@ pub fn to_toml(description: &Description) -> Result<String, Error> {
     Ok(format!(
         "# A robot file (docs/robots.md): lengths in m, limits in rad, masses in kg.\n{body}"
     ))
+}
+
+/// The default stance height of a robot sent to the device without one, m: the hip joint's
+/// offset plus 80 % of the stretched femur and tibia (a knee bent about 75° for equal links),
+/// what every robot of this leg chain reaches within the usual limits.
+pub fn default_stance_height_m(robot: &Robot) -> f32 {
+    robot.leg.d_ax_m + 0.8 * (robot.leg.femur_m + robot.leg.tibia_m)
+}
+
+/// Why a robot could not be made a device's robot description.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DeviceError {
+    /// The robot file or argument was refused.
+    #[error(transparent)]
+    Robot(#[from] Error),
+    /// The `[device]` name is not a valid name (printable ASCII, 1 to 16 bytes).
+    #[error("[device] name `{name}`: {source}")]
+    Name {
+        /// The name given.
+        name: String,
+        /// What is wrong with it.
+        source: quad_protocol::robot::NameError,
+    },
+    /// The `[device]` rotation order is not one of the six.
+    #[error("[device] rotation_order `{0}`: not one of xyz, xzy, yxz, yzx, zxy, zyx")]
+    RotationOrder(String),
+    /// The description is one the device refuses (`quad_protocol::check_robot`, whose
+    /// [`quad_protocol::NackReason::BadRobot`] names the field).
+    #[error("the device cannot hold this robot ({0}); not sent")]
+    Refused(quad_protocol::NackReason),
+}
+
+/// Resolves a `--robot` argument into the description a device holds (protocol 2.4): a preset
+/// name (the preset's own description, `quad_device::Config::description`), a URDF file (its
+/// stem as name, the defaults below) or a TOML file (its `[device]` table over the defaults:
+/// the file's stem as name, [`default_stance_height_m`], rotation order zyx, the device's
+/// default joint-speed limit; for a file with a preset's geometry, the preset's description).
+/// Checked as the device checks it.
+///
+/// # Errors
+/// [`DeviceError`].
+pub fn device_description(spec: &str) -> Result<quad_protocol::RobotDescription, DeviceError> {
+    use quad_protocol::RobotDescription;
+    if let Some(preset) = quad_protocol::RobotPreset::from_name(spec.trim()) {
+        if let Some(config) = quad_device::Config::for_preset(preset) {
+            return Ok(config.description());
+        }
+    }
+    let path = Path::new(spec);
+    let stem: String = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let (robot, table) = if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        (resolve_description(spec)?.robot, DeviceTable::default())
+    } else {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let (file, robot) = parse_file(text).map_err(|e| e.in_file(path))?;
+        (robot, file.device)
+    };
+    // A file with a preset's geometry defaults to the preset's description (the robot the
+    // device calls by the preset's name).
+    let base = [
+        quad_protocol::RobotPreset::Shahriar2023,
+        quad_protocol::RobotPreset::Fernando2025,
+    ]
+    .into_iter()
+    .filter_map(quad_device::Config::for_preset)
+    .map(|c| c.description())
+    .find(|d| d.robot == robot);
+    let name = match (table.name, &base) {
+        (Some(n), _) => n,
+        (None, Some(b)) => b.name_str().unwrap_or_default().to_owned(),
+        (None, None) => stem.chars().take(16).collect(),
+    };
+    let name_bytes =
+        RobotDescription::name_bytes(&name).map_err(|source| DeviceError::Name { name, source })?;
+    let order = match table.rotation_order {
+        Some(o) => kin_core::RotationOrder::parse(&o).ok_or(DeviceError::RotationOrder(o))?,
+        None => base.map_or(kin_core::RotationOrder::Zyx, |b| b.order),
+    };
+    let d = RobotDescription {
+        name: name_bytes,
+        robot,
+        stance_height_m: table.stance_height_m.unwrap_or_else(|| {
+            base.map_or_else(|| default_stance_height_m(&robot), |b| b.stance_height_m)
+        }),
+        order,
+        joint_speed_limit_rad_s: table.joint_speed_limit_rad_s.unwrap_or_else(|| {
+            base.map_or(quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S, |b| {
+                b.joint_speed_limit_rad_s
+            })
+        }),
+    };
+    quad_protocol::check_robot::<kin_core::DefaultMath>(&d).map_err(DeviceError::Refused)?;
+    Ok(d)
 }
 
 /// Reads and validates a robot file.
