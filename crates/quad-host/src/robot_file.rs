@@ -476,7 +476,7 @@ pub fn parse_description(text: &str) -> Result<Description, Error> {
 }
 
 /// Why the robot of a device could not be known.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum DeviceRobotError {
     /// The device runs a robot that is no preset, and no robot file was given.
@@ -495,20 +495,46 @@ pub enum DeviceRobotError {
         /// The device's preset.
         device: RobotPreset,
     },
+    /// The robot given is not the robot the device holds (protocol 2.4).
+    #[error(
+        "the device holds robot `{device}` (hash {device_hash:#010x}), the robot given is \
+         another: leave --robot out (the device's own robot is used), or put yours on the \
+         device with `quadctl robot send FILE --save`"
+    )]
+    Differs {
+        /// The name of the device's robot.
+        device: String,
+        /// The hash of the device's robot description.
+        device_hash: u32,
+    },
 }
 
-/// The robot the device runs, from its `HelloAck`: the preset it reports, or `file` (a robot
-/// file given on the command line) for a device whose robot is no preset. A robot given for a
-/// preset device must be that preset's geometry.
+/// The robot the device runs: the description it holds (`held`, read with `GetRobot` from a
+/// device of protocol 2.4 or later), else the preset its `HelloAck` reports, else `file` (a robot
+/// file given on the command line) for an older device whose robot is no preset. A robot given
+/// beside a known robot must be that robot's geometry.
 ///
 /// Every operation that plans with the device's own robot (the guided calibration's posture and
-/// test poses, the panel's calibration tab) obtains it here, so that a device that reports its
-/// geometry itself changes this function only.
+/// test poses, the panel's calibration tab) obtains it here.
 ///
 /// # Errors
-/// [`DeviceRobotError::Custom`] for a custom device without `file`,
-/// [`DeviceRobotError::Mismatch`] for a preset device and another robot.
-pub fn device_robot(info: &DeviceInfo, file: Option<&Robot>) -> Result<Robot, DeviceRobotError> {
+/// [`DeviceRobotError::Custom`] for an older custom device without `file`,
+/// [`DeviceRobotError::Mismatch`] for a preset device and another robot,
+/// [`DeviceRobotError::Differs`] for a held description and another robot.
+pub fn device_robot(
+    info: &DeviceInfo,
+    held: Option<&quad_protocol::RobotDescription>,
+    file: Option<&Robot>,
+) -> Result<Robot, DeviceRobotError> {
+    if let Some(held) = held {
+        return match file {
+            Some(given) if !held.robot.equals(given) => Err(DeviceRobotError::Differs {
+                device: held.name_str().unwrap_or("?").to_owned(),
+                device_hash: held.hash(),
+            }),
+            _ => Ok(held.robot),
+        };
+    }
     match (info.robot.robot(), file) {
         (Some(robot), None) => Ok(robot),
         (Some(robot), Some(given)) if robot.equals(given) => Ok(robot),
@@ -782,29 +808,58 @@ mod tests {
             max_frame_len: 128,
             pose_config: c.pose_config,
             link_timeout: c.link_timeout,
+            robot_hash: None,
         }
     }
 
     #[test]
     fn the_device_robot_is_the_preset_it_reports_or_the_file_given_for_a_custom_one() {
         let fernando = info(RobotPreset::Fernando2025);
-        assert_eq!(device_robot(&fernando, None), Ok(Robot::fernando2025()));
         assert_eq!(
-            device_robot(&fernando, Some(&Robot::fernando2025())),
+            device_robot(&fernando, None, None),
             Ok(Robot::fernando2025())
         );
         assert_eq!(
-            device_robot(&fernando, Some(&Robot::shahriar2023())),
+            device_robot(&fernando, None, Some(&Robot::fernando2025())),
+            Ok(Robot::fernando2025())
+        );
+        assert_eq!(
+            device_robot(&fernando, None, Some(&Robot::shahriar2023())),
             Err(DeviceRobotError::Mismatch {
                 device: RobotPreset::Fernando2025
             })
         );
         let custom = info(RobotPreset::Custom);
-        let e = device_robot(&custom, None).unwrap_err();
+        let e = device_robot(&custom, None, None).unwrap_err();
         assert_eq!(e, DeviceRobotError::Custom);
         assert!(e.to_string().contains("--robot FILE.toml"), "{e}");
         let file = parse(MINIMAL).expect("valid file");
-        assert_eq!(device_robot(&custom, Some(&file)), Ok(file));
+        assert_eq!(device_robot(&custom, None, Some(&file)), Ok(file));
+    }
+
+    #[test]
+    fn a_held_description_is_the_device_robot_and_another_robot_is_refused_naming_it() {
+        // A device of protocol 2.4 reports what it holds: that wins over the hello's preset.
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/robots/bench-pup.toml"
+        );
+        let held = device_description(file).expect("the example robot");
+        let custom = info(RobotPreset::Custom);
+        assert_eq!(device_robot(&custom, Some(&held), None), Ok(held.robot));
+        assert_eq!(
+            device_robot(&custom, Some(&held), Some(&held.robot)),
+            Ok(held.robot)
+        );
+        let e = device_robot(&custom, Some(&held), Some(&Robot::shahriar2023())).unwrap_err();
+        assert_eq!(
+            e,
+            DeviceRobotError::Differs {
+                device: "bench-pup".to_owned(),
+                device_hash: held.hash()
+            }
+        );
+        assert!(e.to_string().contains("quadctl robot send"), "{e}");
     }
 
     #[test]

@@ -59,7 +59,7 @@ use quad_host::ops::calibrate::guide::{self, Action, Guide, Refusal};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     DeviceInfo, DeviceToHost, Flags, ImuReport, LinkLossAction, MotionStage, MotionStatus,
-    NackReason, PoseConfig, Ranges, Readback, Request, RobotPreset, ServoId,
+    NackReason, PoseConfig, Ranges, Readback, Request, ServoId,
 };
 use std::time::{Duration, Instant};
 
@@ -113,14 +113,10 @@ pub enum Error {
     /// The save did not clear the device's "unsaved" flag.
     #[error("the device still reports an unsaved calibration after the save")]
     NotSaved,
-    /// The device runs another robot than the server was given.
-    #[error("the device runs robot {device:?}, the server was given {host:?}")]
-    Robot {
-        /// The device's.
-        device: RobotPreset,
-        /// The server's.
-        host: RobotPreset,
-    },
+    /// The device runs another robot than the server was given, or one the server cannot
+    /// know.
+    #[error(transparent)]
+    Robot(#[from] quad_host::robot_file::DeviceRobotError),
     /// The stance height makes the held pose unreachable: nothing sent.
     #[error(
         "not sent: the held pose is unreachable at stance height {stance_height_m} m ({reason})"
@@ -199,6 +195,8 @@ impl Error {
 pub struct Session<L> {
     client: Client<L>,
     robot: Robot,
+    /// Its name: the description's, or the preset's.
+    robot_name: String,
     /// The protocol's ranges of `robot`.
     ranges: Ranges,
     info: DeviceInfo,
@@ -239,17 +237,22 @@ impl<L: Link> Session<L> {
     /// The handshake's errors, or [`Error::Robot`].
     pub fn connect(
         mut client: Client<L>,
-        robot: Robot,
-        preset: RobotPreset,
+        robot: Option<Robot>,
         check: AngleCheck,
     ) -> Result<Session<L>, Error> {
         let info = client.hello()?;
-        if info.robot != preset {
-            return Err(Error::Robot {
-                device: info.robot,
-                host: preset,
-            });
-        }
+        // The device's own robot: the description a device of protocol 2.4 holds, else its
+        // preset; a robot the server was given must be that one.
+        let held = if quad_protocol::version_minor(info.version) >= 4 {
+            Some(client.get_robot()?)
+        } else {
+            None
+        };
+        let robot = quad_host::robot_file::device_robot(&info, held.as_ref(), robot.as_ref())?;
+        let robot_name = match &held {
+            Some(h) => h.name_str().unwrap_or("custom").to_owned(),
+            None => quad_host::names::robot_preset_name(info.robot).to_owned(),
+        };
         let calibration = client.calibrations()?;
         let readback = client.ack(Request::GetState)?;
         let motions = quad_protocol::version_minor(info.version) >= 1;
@@ -271,6 +274,7 @@ impl<L: Link> Session<L> {
             client,
             ranges: Ranges::of(&robot),
             robot,
+            robot_name,
             info,
             pose_config: info.pose_config,
             calibration,
@@ -288,6 +292,16 @@ impl<L: Link> Session<L> {
     /// The device's `HelloAck`.
     pub fn info(&self) -> &DeviceInfo {
         &self.info
+    }
+
+    /// The robot the device runs, which the session plans and checks with.
+    pub fn robot(&self) -> &Robot {
+        &self.robot
+    }
+
+    /// Its name: the description's (protocol 2.4), or the preset's.
+    pub fn robot_name(&self) -> &str {
+        &self.robot_name
     }
 
     /// The last readback.
@@ -776,8 +790,7 @@ impl<L: Link> Session<L> {
                         "one is running: abort it first (q)".to_owned(),
                     ));
                 }
-                let robot = quad_host::robot_file::device_robot(&self.info, Some(&self.robot))
-                    .map_err(|e| Error::Guide(e.to_string()))?;
+                let robot = self.robot;
                 self.read_calibration()?;
                 Guide::new(&robot, self.calibration).map_err(|e| Error::Guide(e.to_string()))?
             }
@@ -909,10 +922,9 @@ fn refusal(result: Result<(), Error>) -> Result<Result<(), Refusal>, Error> {
 pub struct DeviceSetup {
     /// The device.
     pub target: Target,
-    /// The robot the host checks poses with.
-    pub robot: Robot,
-    /// Its preset (the device's must match).
-    pub preset: RobotPreset,
+    /// The robot the host was given (`--robot`), which the device's must be; `None`: the
+    /// device's own ([`quad_host::robot_file::device_robot`]).
+    pub robot: Option<Robot>,
     /// Resends per request.
     pub retries: u32,
     /// How often the state is read between commands.
@@ -940,6 +952,10 @@ pub enum Event {
 pub struct Ready {
     /// The device's `HelloAck`.
     pub info: DeviceInfo,
+    /// The robot the device runs, which the server plans and checks with.
+    pub robot: Robot,
+    /// Its name (the description's, or the preset's).
+    pub robot_name: String,
 }
 
 /// The device's clock runs this much at a time while it is behind the wall clock: a command
@@ -1005,12 +1021,7 @@ pub fn run(
         let link = link::open(&setup.target)?;
         let config = ClientConfig::for_target(&setup.target, setup.retries);
         let client = Client::new(link, config);
-        Session::connect(
-            client,
-            setup.robot,
-            setup.preset,
-            AngleCheck::for_target(&setup.target),
-        )
+        Session::connect(client, setup.robot, AngleCheck::for_target(&setup.target))
     };
     let mut session = match connect() {
         Ok(s) => s,
@@ -1021,6 +1032,8 @@ pub fn run(
     };
     let _ = ready.send(Ok(Ready {
         info: *session.info(),
+        robot: session.robot,
+        robot_name: session.robot_name.clone(),
     }));
     let now_ms = || started.elapsed().as_secs_f64() * 1e3;
     let publish = |session: &Session<Box<dyn Link>>, link_up: bool| {
