@@ -66,11 +66,19 @@ use crate::names;
 use kin_core::robot::RobotError;
 use kin_core::{JointLimits, KneeBend, LegGeometry, Robot};
 use quad_model::{Model, Physical, ServoModel};
-use quad_protocol::{DeviceInfo, RobotPreset};
+
 use serde::{Deserialize, Deserializer};
 use std::io;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
+
+mod device;
+mod write;
+
+pub use device::{
+    default_stance_height_m, device_description, device_robot, DeviceError, DeviceRobotError,
+};
+pub use write::to_toml;
 
 /// `knee_bend = "backward" | "forward"`, through [`names::knee_bend`].
 fn knee_bend<'de, D: Deserializer<'de>>(d: D) -> Result<KneeBend, D::Error> {
@@ -475,75 +483,6 @@ pub fn parse_description(text: &str) -> Result<Description, Error> {
     Ok(Description { robot, physical })
 }
 
-/// Why the robot of a device could not be known.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
-pub enum DeviceRobotError {
-    /// The device runs a robot that is no preset, and no robot file was given.
-    #[error(
-        "the device runs a robot that is no preset (`custom`): give its robot file with \
-         --robot FILE.toml"
-    )]
-    Custom,
-    /// The robot given is not the preset the device runs.
-    #[error(
-        "the device runs robot {}, the robot given is another: leave --robot out (the device's \
-         own robot is used) or give that preset",
-        names::robot_preset_name(*device)
-    )]
-    Mismatch {
-        /// The device's preset.
-        device: RobotPreset,
-    },
-    /// The robot given is not the robot the device holds (protocol 2.4).
-    #[error(
-        "the device holds robot `{device}` (hash {device_hash:#010x}), the robot given is \
-         another: leave --robot out (the device's own robot is used), or put yours on the \
-         device with `quadctl robot send FILE --save`"
-    )]
-    Differs {
-        /// The name of the device's robot.
-        device: String,
-        /// The hash of the device's robot description.
-        device_hash: u32,
-    },
-}
-
-/// The robot the device runs: the description it holds (`held`, read with `GetRobot` from a
-/// device of protocol 2.4 or later), else the preset its `HelloAck` reports, else `file` (a robot
-/// file given on the command line) for an older device whose robot is no preset. A robot given
-/// beside a known robot must be that robot's geometry.
-///
-/// Every operation that plans with the device's own robot (the guided calibration's posture and
-/// test poses, the panel's calibration tab) obtains it here.
-///
-/// # Errors
-/// [`DeviceRobotError::Custom`] for an older custom device without `file`,
-/// [`DeviceRobotError::Mismatch`] for a preset device and another robot,
-/// [`DeviceRobotError::Differs`] for a held description and another robot.
-pub fn device_robot(
-    info: &DeviceInfo,
-    held: Option<&quad_protocol::RobotDescription>,
-    file: Option<&Robot>,
-) -> Result<Robot, DeviceRobotError> {
-    if let Some(held) = held {
-        return match file {
-            Some(given) if !held.robot.equals(given) => Err(DeviceRobotError::Differs {
-                device: held.name_str().unwrap_or("?").to_owned(),
-                device_hash: held.hash(),
-            }),
-            _ => Ok(held.robot),
-        };
-    }
-    match (info.robot.robot(), file) {
-        (Some(robot), None) => Ok(robot),
-        (Some(robot), Some(given)) if robot.equals(given) => Ok(robot),
-        (Some(_), Some(_)) => Err(DeviceRobotError::Mismatch { device: info.robot }),
-        (None, Some(given)) => Ok(*given),
-        (None, None) => Err(DeviceRobotError::Custom),
-    }
-}
-
 /// Resolves a `--robot` argument with its physical properties: a preset name (its physical
 /// preset), a URDF file (`.urdf`, legs with this project's chain, [`quad_model::urdf`]; the
 /// physical preset of [`default_physical`]) or else a TOML file path (see
@@ -577,201 +516,6 @@ pub fn resolve_description(spec: &str) -> Result<Description, Error> {
     parse_description(text).map_err(|e| e.in_file(path))
 }
 
-/// An `f32` as the `f64` of its shortest decimal form, so that the TOML writer prints `0.28`
-/// (not `0.2800000011920929`) and reading the file back gives the same `f32`.
-fn shortest(x: f32) -> f64 {
-    // The shortest form of a finite f32 always parses as an f64; a non-finite value never
-    // reaches here (a validated robot and physical preset hold finite values only).
-    x.to_string().parse().unwrap_or(f64::from(x))
-}
-
-/// The file layout [`to_toml`] writes: the keys [`parse_description`] reads, in its order.
-#[derive(serde::Serialize)]
-struct RobotFileOut {
-    d_lat_m: f64,
-    d_ax_m: f64,
-    femur_m: f64,
-    tibia_m: f64,
-    body_length_m: f64,
-    body_width_m: f64,
-    knee_bend: &'static str,
-    limits: LimitsOut,
-    physical: PhysicalOut,
-}
-
-/// `[limits]` as written: every joint explicit.
-#[derive(serde::Serialize)]
-struct LimitsOut {
-    abduction_rad: [f64; 2],
-    hip_rad: [f64; 2],
-    knee_rad: [f64; 2],
-}
-
-/// `[physical]` as written: every key explicit, the servo by its preset name.
-#[derive(serde::Serialize)]
-struct PhysicalOut {
-    servo: &'static str,
-    body_mass_kg: f64,
-    body_height_m: f64,
-    abduction_link_mass_kg: f64,
-    femur_mass_kg: f64,
-    tibia_mass_kg: f64,
-    knee_servo_offset_m: f64,
-    foot_radius_m: f64,
-    foot_friction: f64,
-    link_radius_m: f64,
-}
-
-/// The robot file of `description`: every key explicit (the limits of all three joints and the
-/// whole `[physical]` table), so that [`parse_description`] of the text gives `description`
-/// back exactly, whatever the presets' defaults become. `quadctl export --format toml` writes it.
-///
-/// # Errors
-/// [`Error::Write`] when the description cannot be written as TOML (a non-finite value).
-pub fn to_toml(description: &Description) -> Result<String, Error> {
-    let Description { robot, physical } = description;
-    let limit = |j: usize| {
-        [
-            shortest(robot.limits.min_rad[j]),
-            shortest(robot.limits.max_rad[j]),
-        ]
-    };
-    let out = RobotFileOut {
-        d_lat_m: shortest(robot.leg.d_lat_m),
-        d_ax_m: shortest(robot.leg.d_ax_m),
-        femur_m: shortest(robot.leg.femur_m),
-        tibia_m: shortest(robot.leg.tibia_m),
-        body_length_m: shortest(robot.body_length_m),
-        body_width_m: shortest(robot.body_width_m),
-        knee_bend: names::knee_bend_name(robot.knee_bend),
-        limits: LimitsOut {
-            abduction_rad: limit(0),
-            hip_rad: limit(1),
-            knee_rad: limit(2),
-        },
-        physical: PhysicalOut {
-            servo: physical.servo.name,
-            body_mass_kg: shortest(physical.body_mass_kg),
-            body_height_m: shortest(physical.body_height_m),
-            abduction_link_mass_kg: shortest(physical.abduction_link_mass_kg),
-            femur_mass_kg: shortest(physical.femur_mass_kg),
-            tibia_mass_kg: shortest(physical.tibia_mass_kg),
-            knee_servo_offset_m: shortest(physical.knee_servo_offset_m),
-            foot_radius_m: shortest(physical.foot_radius_m),
-            foot_friction: shortest(physical.foot_friction),
-            link_radius_m: shortest(physical.link_radius_m),
-        },
-    };
-    let body = toml::to_string(&out).map_err(|e| Error::Write(e.to_string()))?;
-    Ok(format!(
-        "# A robot file (docs/robots.md): lengths in m, limits in rad, masses in kg.\n{body}"
-    ))
-}
-
-/// The default stance height of a robot sent to the device without one, m: the hip joint's
-/// offset plus 80 % of the stretched femur and tibia (a knee bent about 75° for equal links),
-/// what every robot of this leg chain reaches within the usual limits.
-pub fn default_stance_height_m(robot: &Robot) -> f32 {
-    robot.leg.d_ax_m + 0.8 * (robot.leg.femur_m + robot.leg.tibia_m)
-}
-
-/// Why a robot could not be made a device's robot description.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum DeviceError {
-    /// The robot file or argument was refused.
-    #[error(transparent)]
-    Robot(#[from] Error),
-    /// The `[device]` name is not a valid name (printable ASCII, 1 to 16 bytes).
-    #[error("[device] name `{name}`: {source}")]
-    Name {
-        /// The name given.
-        name: String,
-        /// What is wrong with it.
-        source: quad_protocol::robot::NameError,
-    },
-    /// The `[device]` rotation order is not one of the six.
-    #[error("[device] rotation_order `{0}`: not one of xyz, xzy, yxz, yzx, zxy, zyx")]
-    RotationOrder(String),
-    /// The description is one the device refuses (`quad_protocol::check_robot`, whose
-    /// [`quad_protocol::NackReason::BadRobot`] names the field).
-    #[error("the device cannot hold this robot ({0}); not sent")]
-    Refused(quad_protocol::NackReason),
-}
-
-/// Resolves a `--robot` argument into the description a device holds (protocol 2.4): a preset
-/// name (the preset's own description, `quad_device::Config::description`), a URDF file (its
-/// stem as name, the defaults below) or a TOML file (its `[device]` table over the defaults:
-/// the file's stem as name, [`default_stance_height_m`], rotation order zyx, the device's
-/// default joint-speed limit; for a file with a preset's geometry, the preset's description).
-/// Checked as the device checks it.
-///
-/// # Errors
-/// [`DeviceError`].
-pub fn device_description(spec: &str) -> Result<quad_protocol::RobotDescription, DeviceError> {
-    use quad_protocol::RobotDescription;
-    if let Some(preset) = quad_protocol::RobotPreset::from_name(spec.trim()) {
-        if let Some(config) = quad_device::Config::for_preset(preset) {
-            return Ok(config.description());
-        }
-    }
-    let path = Path::new(spec);
-    let stem: String = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let (robot, table) = if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
-    {
-        (resolve_description(spec)?.robot, DeviceTable::default())
-    } else {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
-            path: path.to_owned(),
-            source,
-        })?;
-        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        let (file, robot) = parse_file(text).map_err(|e| e.in_file(path))?;
-        (robot, file.device)
-    };
-    // A file with a preset's geometry defaults to the preset's description (the robot the
-    // device calls by the preset's name).
-    let base = [
-        quad_protocol::RobotPreset::Shahriar2023,
-        quad_protocol::RobotPreset::Fernando2025,
-    ]
-    .into_iter()
-    .filter_map(quad_device::Config::for_preset)
-    .map(|c| c.description())
-    .find(|d| d.robot == robot);
-    let name = match (table.name, &base) {
-        (Some(n), _) => n,
-        (None, Some(b)) => b.name_str().unwrap_or_default().to_owned(),
-        (None, None) => stem.chars().take(16).collect(),
-    };
-    let name_bytes =
-        RobotDescription::name_bytes(&name).map_err(|source| DeviceError::Name { name, source })?;
-    let order = match table.rotation_order {
-        Some(o) => kin_core::RotationOrder::parse(&o).ok_or(DeviceError::RotationOrder(o))?,
-        None => base.map_or(kin_core::RotationOrder::Zyx, |b| b.order),
-    };
-    let d = RobotDescription {
-        name: name_bytes,
-        robot,
-        stance_height_m: table.stance_height_m.unwrap_or_else(|| {
-            base.map_or_else(|| default_stance_height_m(&robot), |b| b.stance_height_m)
-        }),
-        order,
-        joint_speed_limit_rad_s: table.joint_speed_limit_rad_s.unwrap_or_else(|| {
-            base.map_or(quad_device::engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S, |b| {
-                b.joint_speed_limit_rad_s
-            })
-        }),
-    };
-    quad_protocol::check_robot::<kin_core::DefaultMath>(&d).map_err(DeviceError::Refused)?;
-    Ok(d)
-}
-
 /// Reads and validates a robot file.
 pub fn load_file(path: &Path) -> Result<Robot, Error> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
@@ -797,70 +541,6 @@ mod tests {
 
     const MINIMAL: &str = "d_lat_m = 0.044\nd_ax_m = 0.0\nfemur_m = 0.28\ntibia_m = 0.277\n\
                            body_length_m = 0.6\nbody_width_m = 0.28\n";
-
-    /// The `HelloAck` of a device running `preset`.
-    fn info(preset: RobotPreset) -> DeviceInfo {
-        let c = quad_device::Config::shahriar2023();
-        DeviceInfo {
-            version: quad_protocol::PROTOCOL_VERSION,
-            firmware: c.firmware,
-            robot: preset,
-            max_frame_len: 128,
-            pose_config: c.pose_config,
-            link_timeout: c.link_timeout,
-            robot_hash: None,
-        }
-    }
-
-    #[test]
-    fn the_device_robot_is_the_preset_it_reports_or_the_file_given_for_a_custom_one() {
-        let fernando = info(RobotPreset::Fernando2025);
-        assert_eq!(
-            device_robot(&fernando, None, None),
-            Ok(Robot::fernando2025())
-        );
-        assert_eq!(
-            device_robot(&fernando, None, Some(&Robot::fernando2025())),
-            Ok(Robot::fernando2025())
-        );
-        assert_eq!(
-            device_robot(&fernando, None, Some(&Robot::shahriar2023())),
-            Err(DeviceRobotError::Mismatch {
-                device: RobotPreset::Fernando2025
-            })
-        );
-        let custom = info(RobotPreset::Custom);
-        let e = device_robot(&custom, None, None).unwrap_err();
-        assert_eq!(e, DeviceRobotError::Custom);
-        assert!(e.to_string().contains("--robot FILE.toml"), "{e}");
-        let file = parse(MINIMAL).expect("valid file");
-        assert_eq!(device_robot(&custom, None, Some(&file)), Ok(file));
-    }
-
-    #[test]
-    fn a_held_description_is_the_device_robot_and_another_robot_is_refused_naming_it() {
-        // A device of protocol 2.4 reports what it holds: that wins over the hello's preset.
-        let file = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../examples/robots/bench-pup.toml"
-        );
-        let held = device_description(file).expect("the example robot");
-        let custom = info(RobotPreset::Custom);
-        assert_eq!(device_robot(&custom, Some(&held), None), Ok(held.robot));
-        assert_eq!(
-            device_robot(&custom, Some(&held), Some(&held.robot)),
-            Ok(held.robot)
-        );
-        let e = device_robot(&custom, Some(&held), Some(&Robot::shahriar2023())).unwrap_err();
-        assert_eq!(
-            e,
-            DeviceRobotError::Differs {
-                device: "bench-pup".to_owned(),
-                device_hash: held.hash()
-            }
-        );
-        assert!(e.to_string().contains("quadctl robot send"), "{e}");
-    }
 
     #[test]
     fn limits_default_to_the_full_turn_and_knee_to_backward() {
@@ -999,27 +679,6 @@ mod tests {
             .expect_err("unknown key")
             .to_string();
         assert!(err.contains("unknown field `body_mass`"), "{err}");
-    }
-
-    #[test]
-    fn the_written_file_reads_back_as_the_same_description() {
-        let custom = parse_description(&format!(
-            "{MINIMAL}knee_bend = \"forward\"\n[limits]\nknee_rad = [0.05, 2.7]\n[physical]\nservo = \"qdd17\"\nbody_mass_kg = 2.345\n"
-        ))
-        .unwrap();
-        let presets = Robot::PRESETS.map(|name| resolve_description(name).unwrap());
-        for description in presets.iter().chain([&custom]) {
-            let text = to_toml(description).unwrap();
-            let back = parse_description(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
-            assert_eq!(back.robot, description.robot, "{text}");
-            assert_eq!(back.physical, description.physical, "{text}");
-            // Bit for bit, not only within the tolerance `Robot::eq` may allow.
-            assert_eq!(
-                back.robot.leg.femur_m.to_bits(),
-                description.robot.leg.femur_m.to_bits()
-            );
-            assert!(!text.contains("00000"), "shortest decimals only:\n{text}");
-        }
     }
 
     #[test]
