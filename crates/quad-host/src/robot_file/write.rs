@@ -49,7 +49,7 @@ struct PhysicalOut {
 }
 
 /// The robot file of `description`: every key explicit (the limits of all three joints and the
-/// whole `[physical]` table), so that [`parse_description`] of the text gives `description`
+/// whole `[physical]` table), so that [`super::parse_description`] of the text gives `description`
 /// back exactly, whatever the presets' defaults become. `quadctl export --format toml` writes it.
 ///
 /// # Errors
