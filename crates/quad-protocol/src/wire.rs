@@ -383,12 +383,12 @@ macro_rules! wire_enum {
                             data: A,
                         ) -> Result<(), A::Error> {
                             let (index, $var_access) = $crate::wire::variant_index(data)?;
-                            let $place = self.0;
+                            let $place = &mut *self.0;
                             match index {
                                 $($place_arms)*
                                 other => Err(::serde::de::Error::invalid_value(
                                     ::serde::de::Unexpected::Unsigned(u64::from(other)),
-                                    &concat!("enum ", stringify!($name)),
+                                    &self,
                                 )),
                             }
                         }
