@@ -562,9 +562,10 @@ impl<const N: usize> Accumulator<N> {
         end
     }
 
-    /// What the frame in the buffer is, `remaining` the input after its delimiter. Builds the
-    /// [`Feed`] where the message is decoded: the message (up to 50 bytes) is not moved through
-    /// a `Result` first, each move a copy on the AVR.
+    /// What the frame in the buffer is, `remaining` the input after its delimiter, `decode`
+    /// reading its message (by value, or into the caller's place). Builds the [`Feed`] where
+    /// the message is decoded: it is not moved through another `Result` first, each move a
+    /// copy on the AVR.
     fn finish<'a, M>(
         &self,
         remaining: &'a [u8],
