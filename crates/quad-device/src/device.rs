@@ -436,10 +436,15 @@ where
     /// bytes left, `None` when no frame ended in `bytes`. Not generic over the caller's
     /// closure, so that the firmware has one instance of it.
     fn receive_one<'a>(&mut self, bytes: &'a [u8], tx: &mut dyn FnMut(&[u8])) -> Option<&'a [u8]> {
-        // The request is read where the decoder put it (bound by reference, not moved out).
-        let (reason, remaining) = match &feed_request(&mut self.acc, bytes) {
+        // The request is decoded into this local and read there (never moved).
+        let mut request = HostToDevice {
+            seq: 0,
+            request: Request::GetState,
+        };
+        let msg = &mut request;
+        let (reason, remaining) = match feed_request(&mut self.acc, bytes, msg) {
             Feed::NeedMore => return None,
-            Feed::Frame { msg, remaining } => {
+            Feed::Frame { remaining, .. } => {
                 let (seq, crc) = (msg.seq, self.acc.frame_crc());
                 if let Some(answer) = self.repeated(seq, crc) {
                     self.encode(&answer, tx);
@@ -451,9 +456,9 @@ where
                 self.remember(seq, crc, &answer);
                 return Some(remaining);
             }
-            Feed::BadCrc { remaining } => (NackReason::BadCrc, *remaining),
-            Feed::BadFrame { remaining, .. } => (NackReason::BadFrame, *remaining),
-            Feed::Oversize { remaining } => (NackReason::Oversize, *remaining),
+            Feed::BadCrc { remaining } => (NackReason::BadCrc, remaining),
+            Feed::BadFrame { remaining, .. } => (NackReason::BadFrame, remaining),
+            Feed::Oversize { remaining } => (NackReason::Oversize, remaining),
         };
         let now = self.clock.now_ms();
         let due = self
@@ -1299,9 +1304,15 @@ where
     }
 }
 
-/// The device's receive path: the protocol's frame decoder (postcard) on the accumulator.
-pub fn feed_request<'a>(acc: &mut Accumulator<RX_LEN>, bytes: &'a [u8]) -> Feed<'a, HostToDevice> {
-    acc.feed::<HostToDevice>(bytes)
+/// The device's receive path: the protocol's frame decoder (postcard) on the accumulator,
+/// decoding a request into `request` ([`Accumulator::feed_in_place`]: a [`Feed::Frame`] means
+/// `request` holds the frame's request).
+pub fn feed_request<'a>(
+    acc: &mut Accumulator<RX_LEN>,
+    bytes: &'a [u8],
+    request: &mut HostToDevice,
+) -> Feed<'a, ()> {
+    acc.feed_in_place(bytes, request)
 }
 
 /// The device's answer encoder: [`encode_frame_in_pieces`] (postcard) of `answer` into `out`,

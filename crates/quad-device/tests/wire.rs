@@ -341,9 +341,13 @@ fn frame_of(body: &[u8]) -> Vec<u8> {
 /// The device's decoding of one frame.
 fn device_decode(frame: &[u8]) -> Feed<'static, HostToDevice> {
     let mut acc = Accumulator::<RX_LEN>::new();
-    match feed_request(&mut acc, frame) {
+    let mut msg = HostToDevice {
+        seq: 0,
+        request: Request::GetState,
+    };
+    match feed_request(&mut acc, frame, &mut msg) {
         Feed::NeedMore => Feed::NeedMore,
-        Feed::Frame { msg, .. } => Feed::Frame {
+        Feed::Frame { .. } => Feed::Frame {
             msg,
             remaining: &[],
         },

@@ -291,6 +291,9 @@ fn check_crc(decoded: &[u8]) -> Result<&[u8], Error> {
     Ok(body)
 }
 
+/// postcard's deserializer over a frame's bytes.
+type Decoder<'b> = postcard::Deserializer<'b, postcard::de_flavors::Slice<'b>>;
+
 /// What [`Accumulator::feed`] found. Every variant but `NeedMore` carries the bytes after the
 /// delimiter that ended the frame: feed them again.
 #[derive(Debug, Clone, PartialEq)]
@@ -455,10 +458,37 @@ impl<const N: usize> Accumulator<N> {
     /// Consumes `input` up to and including the first delimiter that ends a non-empty frame,
     /// and reports that frame; or consumes everything and returns [`Feed::NeedMore`].
     pub fn feed<'a, T: DeserializeOwned>(&mut self, input: &'a [u8]) -> Feed<'a, T> {
+        self.feed_by(input, |de| T::deserialize(de))
+    }
+
+    /// [`Accumulator::feed`], decoding the message into `place` instead of returning it: a
+    /// [`Feed::Frame`] means that `place` holds the frame's message (after any other result,
+    /// `place` holds an unspecified valid value). The same bytes are read as by
+    /// [`Accumulator::feed`] (serde's `deserialize_in_place`, which this crate's messages
+    /// implement for that).
+    ///
+    /// Why: a message returned by value is moved at least twice on its way to its receiver
+    /// (out of the deserializer's `Result`, into the message that holds it, into the
+    /// [`Feed`]), each move a copy of the largest message on the ATmega2560; decoded where
+    /// the receiver keeps it, only the fields read are stored.
+    pub fn feed_in_place<'a, T: DeserializeOwned>(
+        &mut self,
+        input: &'a [u8],
+        place: &mut T,
+    ) -> Feed<'a, ()> {
+        self.feed_by(input, |de| T::deserialize_in_place(de, place))
+    }
+
+    /// [`Accumulator::feed`] with `decode` reading the message from the frame's bytes.
+    fn feed_by<'a, M>(
+        &mut self,
+        input: &'a [u8],
+        decode: impl FnOnce(&mut Decoder<'_>) -> postcard::Result<M>,
+    ) -> Feed<'a, M> {
         let Some(end) = self.scan(input) else {
             return Feed::NeedMore;
         };
-        let feed = self.finish::<T>(&input[end + 1..]);
+        let feed = self.finish(&input[end + 1..], decode);
         if let Feed::Frame { .. } = feed {
             self.frame_crc = self.buf[..self.len]
                 .last_chunk::<CRC_LEN>()
@@ -532,10 +562,15 @@ impl<const N: usize> Accumulator<N> {
         end
     }
 
-    /// What the frame in the buffer is, `remaining` the input after its delimiter. Builds the
-    /// [`Feed`] where the message is decoded: the message (up to 50 bytes) is not moved through
-    /// a `Result` first, each move a copy on the AVR.
-    fn finish<'a, T: DeserializeOwned>(&self, remaining: &'a [u8]) -> Feed<'a, T> {
+    /// What the frame in the buffer is, `remaining` the input after its delimiter, `decode`
+    /// reading its message (by value, or into the caller's place). Builds the [`Feed`] where
+    /// the message is decoded: it is not moved through another `Result` first, each move a
+    /// copy on the AVR.
+    fn finish<'a, M>(
+        &self,
+        remaining: &'a [u8],
+        decode: impl FnOnce(&mut Decoder<'_>) -> postcard::Result<M>,
+    ) -> Feed<'a, M> {
         if self.overflow {
             return Feed::Oversize { remaining };
         }
@@ -560,7 +595,7 @@ impl<const N: usize> Accumulator<N> {
                     // postcard's `take_from_bytes` without its `(message, rest)` tuple, one
                     // more move of the message.
                     let mut de = postcard::Deserializer::from_bytes(body);
-                    match T::deserialize(&mut de) {
+                    match decode(&mut de) {
                         Ok(msg) => match de.finalize() {
                             Ok([]) => return Feed::Frame { msg, remaining },
                             Ok(_) => Error::TrailingBytes,

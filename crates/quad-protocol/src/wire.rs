@@ -126,24 +126,30 @@ macro_rules! wire_enum {
     ) => {
         $crate::wire::wire_enum!(@munch
             [$(#[$attr])* $vis $name]
-            [serializer variant]
-            [] [] [] [] []
+            [serializer variant place]
+            [] [] [] [] [] []
             $($body)*
         );
     };
 
     // A unit variant.
-    (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
+    (@munch $head:tt [$ser:ident $var_access:ident $place:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($place_arms:tt)*] [$($text:tt)*]
+        [$($schema:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident
         $(, $($rest:tt)*)?
     ) => {
-        $crate::wire::wire_enum!(@munch $head [$ser $var_access]
+        $crate::wire::wire_enum!(@munch $head [$ser $var_access $place]
             [$($decl)* $(#[$vattr])* $var,]
             [$($ser_arms)* Self::$var => ($idx, stringify!($var)),]
             [$($de_arms)* $idx => {
                 ::serde::de::VariantAccess::unit_variant($var_access)?;
                 Ok(Target::$var)
+            }]
+            [$($place_arms)* $idx => {
+                ::serde::de::VariantAccess::unit_variant($var_access)?;
+                *$place = Target::$var;
+                Ok(())
             }]
             [$($text)* $var,]
             [$($schema)* $crate::wire::VariantSchema {
@@ -153,18 +159,26 @@ macro_rules! wire_enum {
     };
 
     // A one-field tuple variant.
-    (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
+    (@munch $head:tt [$ser:ident $var_access:ident $place:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($place_arms:tt)*] [$($text:tt)*]
+        [$($schema:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident ( $ty:ty $(as $($with:ident)::+)? )
         $(, $($rest:tt)*)?
     ) => {
-        $crate::wire::wire_enum!(@munch $head [$ser $var_access]
+        $crate::wire::wire_enum!(@munch $head [$ser $var_access $place]
             [$($decl)* $(#[$vattr])* $var($ty),]
             [$($ser_arms)* Self::$var(value) => return ::serde::Serializer::serialize_newtype_variant(
                 $ser, NAME, $idx, stringify!($var),
                 $crate::wire::wire_ser_field!(value, $ty $(, $($with)::+)?)),]
             [$($de_arms)* $idx => $crate::wire::wire_de_newtype!(
                 $var_access, Target::$var, $ty $(, $($with)::+)?),]
+            [$($place_arms)* $idx => {
+                // The field is read first, then the variant built where it goes.
+                let value = $crate::wire::wire_de_newtype!(
+                    $var_access, ::core::convert::identity, $ty $(, $($with)::+)?)?;
+                *$place = Target::$var(value);
+                Ok(())
+            }]
             [$($text)* $var($ty),]
             [$($schema)* $crate::wire::VariantSchema {
                 index: $idx, name: stringify!($var),
@@ -174,14 +188,15 @@ macro_rules! wire_enum {
     };
 
     // A struct variant.
-    (@munch $head:tt [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
+    (@munch $head:tt [$ser:ident $var_access:ident $place:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($place_arms:tt)*] [$($text:tt)*]
+        [$($schema:tt)*]
         $(#[$vattr:meta])* $idx:literal => $var:ident {
             $( $(#[$fattr:meta])* $field:ident : $fty:ty $(as $($with:ident)::+)? ),* $(,)?
         }
         $(, $($rest:tt)*)?
     ) => {
-        $crate::wire::wire_enum!(@munch $head [$ser $var_access]
+        $crate::wire::wire_enum!(@munch $head [$ser $var_access $place]
             [$($decl)* $(#[$vattr])* $var { $( $(#[$fattr])* $field: $fty, )* },]
             [$($ser_arms)* Self::$var { $($field),* } => {
                 let mut fields = ::serde::Serializer::serialize_struct_variant(
@@ -219,6 +234,34 @@ macro_rules! wire_enum {
                     Fields,
                 )
             }]
+            [$($place_arms)* $idx => {
+                // Built whole, then stored in place: one copy of the enum.
+                *$place = {
+                    struct Fields;
+                    impl<'de> ::serde::de::Visitor<'de> for Fields {
+                        type Value = Target;
+                        fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                            f.write_str(concat!("the fields of ", stringify!($var)))
+                        }
+                        // The count after the last field is not read.
+                        #[allow(unused_assignments)]
+                        fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
+                            self,
+                            mut seq: A,
+                        ) -> Result<Target, A::Error> {
+                            let mut n = 0usize;
+                            $( let $field = $crate::wire::wire_next_field!(seq, n, &self, $fty $(, $($with)::+)?); )*
+                            Ok(Target::$var { $($field),* })
+                        }
+                    }
+                    ::serde::de::VariantAccess::struct_variant(
+                        $var_access,
+                        &[$(stringify!($field)),*],
+                        Fields,
+                    )
+                }?;
+                Ok(())
+            }]
             [$($text)* $var { $($field: $fty,)* },]
             [$($schema)* $crate::wire::VariantSchema {
                 index: $idx, name: stringify!($var),
@@ -229,8 +272,9 @@ macro_rules! wire_enum {
     };
 
     // All variants read: the enum and its serde implementations.
-    (@munch [$(#[$attr:meta])* $vis:vis $name:ident] [$ser:ident $var_access:ident]
-        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($text:tt)*] [$($schema:tt)*]
+    (@munch [$(#[$attr:meta])* $vis:vis $name:ident] [$ser:ident $var_access:ident $place:ident]
+        [$($decl:tt)*] [$($ser_arms:tt)*] [$($de_arms:tt)*] [$($place_arms:tt)*] [$($text:tt)*]
+        [$($schema:tt)*]
     ) => {
         $(#[$attr])*
         $vis enum $name {
@@ -307,6 +351,49 @@ macro_rules! wire_enum {
                     // postcard does not read the names; they serve self-describing formats'
                     // error messages only.
                     ::serde::Deserializer::deserialize_enum(d, NAME, &[], Variants)
+                }
+
+                // Into `place`: the variant is built where it goes, not returned through a
+                // `Result` and then moved (a newtype variant's field is the only value moved,
+                // a struct variant's whole value once). What a receiver that keeps its
+                // decoded message in place uses (`frame::Accumulator::feed_in_place`); the
+                // bytes read are the same as `deserialize`'s.
+                fn deserialize_in_place<D: ::serde::Deserializer<'de>>(
+                    d: D,
+                    place: &mut Self,
+                ) -> Result<(), D::Error> {
+                    #[cfg(feature = "text")]
+                    if ::serde::Deserializer::is_human_readable(&d) {
+                        *place = Text::deserialize(d)?;
+                        return Ok(());
+                    }
+                    struct InPlace<'p>(&'p mut $name);
+                    impl<'de> ::serde::de::Visitor<'de> for InPlace<'_> {
+                        type Value = ();
+                        fn expecting(
+                            &self,
+                            f: &mut ::core::fmt::Formatter<'_>,
+                        ) -> ::core::fmt::Result {
+                            f.write_str(concat!("enum ", stringify!($name)))
+                        }
+                        // Out of line, as `Variants::visit_enum`.
+                        #[inline(never)]
+                        fn visit_enum<A: ::serde::de::EnumAccess<'de>>(
+                            self,
+                            data: A,
+                        ) -> Result<(), A::Error> {
+                            let (index, $var_access) = $crate::wire::variant_index(data)?;
+                            let $place = &mut *self.0;
+                            match index {
+                                $($place_arms)*
+                                other => Err(::serde::de::Error::invalid_value(
+                                    ::serde::de::Unexpected::Unsigned(u64::from(other)),
+                                    &self,
+                                )),
+                            }
+                        }
+                    }
+                    ::serde::Deserializer::deserialize_enum(d, NAME, &[], InPlace(place))
                 }
             }
         };

@@ -104,6 +104,40 @@ fn feed_all<const N: usize>(
     }
 }
 
+/// [`feed_all`] through [`Accumulator::feed_in_place`], the message of each frame taken from
+/// `place` (which keeps whatever the last frame left in it).
+fn feed_all_in_place<const N: usize>(
+    acc: &mut Accumulator<N>,
+    mut chunk: &[u8],
+    place: &mut HostToDevice,
+    events: &mut Vec<Event<HostToDevice>>,
+) {
+    loop {
+        let feed = acc.feed_in_place(chunk, place);
+        chunk = feed.remaining();
+        events.push(match feed {
+            Feed::NeedMore => return,
+            Feed::Frame { .. } => Event::Frame(*place),
+            Feed::BadCrc { .. } => Event::BadCrc,
+            Feed::BadFrame { error, .. } => Event::BadFrame(error),
+            Feed::Oversize { .. } => Event::Oversize,
+        });
+    }
+}
+
+/// The events' frames as their wire bytes (NaN payloads are not equal to themselves).
+fn comparable(events: &[Event<HostToDevice>]) -> Vec<Event<Vec<u8>>> {
+    events
+        .iter()
+        .map(|e| match e {
+            Event::Frame(m) => Event::Frame(frame_of(m)),
+            Event::BadCrc => Event::BadCrc,
+            Event::BadFrame(error) => Event::BadFrame(*error),
+            Event::Oversize => Event::Oversize,
+        })
+        .collect()
+}
+
 fn frames(msgs: &[HostToDevice]) -> Vec<Event<HostToDevice>> {
     msgs.iter().copied().map(Event::Frame).collect()
 }
@@ -716,6 +750,32 @@ proptest! {
         let stream: Vec<u8> = segments.concat();
         check_stream::<MAX_DECODED_LEN>(&stream, &cuts)?;
         check_stream::<32>(&stream, &cuts)?;
+    }
+
+    /// Decoding in place (the device's way) reports the same frames, errors and messages as
+    /// decoding by value, in any chunking, the place reused from frame to frame.
+    #[test]
+    fn in_place_decoding_reads_what_decoding_by_value_reads(
+        segments in prop::collection::vec(arb_segment(), 0..12),
+        cuts in prop::collection::vec(1usize..64, 0..30),
+    ) {
+        let stream: Vec<u8> = segments.concat();
+        let (mut by_value, mut in_place) = (Vec::new(), Vec::new());
+        let mut a = Accumulator::<MAX_DECODED_LEN>::new();
+        let mut b = Accumulator::<MAX_DECODED_LEN>::new();
+        let mut place = messages()[3];
+        let mut rest = &stream[..];
+        let mut k = 0;
+        while !rest.is_empty() {
+            let take = cuts.get(k).copied().unwrap_or(rest.len()).clamp(1, rest.len());
+            k += 1;
+            feed_all(&mut a, &rest[..take], &mut by_value);
+            feed_all_in_place(&mut b, &rest[..take], &mut place, &mut in_place);
+            rest = &rest[take..];
+        }
+        prop_assert_eq!(comparable(&by_value), comparable(&in_place));
+        prop_assert_eq!((a.frames_ok(), a.frames_bad()), (b.frames_ok(), b.frames_bad()));
+        prop_assert_eq!(a.frame_crc(), b.frame_crc());
     }
 
     #[test]

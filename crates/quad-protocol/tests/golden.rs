@@ -52,6 +52,24 @@ fn check<T: Serialize + DeserializeOwned + PartialEq + core::fmt::Debug>(
     assert_eq!(&decode_frame::<T>(frame), msg, "frame round trip of {name}");
 }
 
+/// The device's decoding ([`Accumulator::feed_in_place`]) reads every golden request as the
+/// host's ([`Accumulator::feed`]) does, into a place that held another request before (the
+/// previous case's, the last case's for the first).
+#[test]
+fn every_golden_request_decodes_in_place_as_by_value() {
+    let cases = requests();
+    let mut acc = Accumulator::<MAX_DECODED_LEN>::new();
+    let mut place = cases[cases.len() - 1].1;
+    for (name, msg, golden) in &cases {
+        let frame = ref_frame(&hex(golden));
+        match acc.feed_in_place(&frame, &mut place) {
+            Feed::Frame { remaining, .. } => assert!(remaining.is_empty(), "{name}"),
+            other => panic!("{name}: {other:?}"),
+        }
+        assert_eq!(&place, msg, "{name} decoded in place");
+    }
+}
+
 #[test]
 fn every_request_has_its_golden_bytes() {
     let cases = requests();
