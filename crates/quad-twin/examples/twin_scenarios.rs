@@ -3,7 +3,7 @@
 //!
 //! ```sh
 //! cargo run --release -p quad-twin --example twin_scenarios [-- --out-dir DIR] [--balance] [--push-only]
-//! cargo run --release -p quad-twin --example twin_scenarios -- --push-compare
+//! cargo run --release -p quad-twin --example twin_scenarios -- --push-compare [--scan-steps N]
 //! ```
 //!
 //! - standing on a 10° slope, roll then pitch: the body's settled roll and pitch;
@@ -15,7 +15,7 @@
 //! With `--balance` the device's balance functions are on (leveling and fall detection, the
 //! protocol's defaults; the figures of the closed loop); `--push-only` runs only the push's
 //! bisection. `--push-compare` runs only the push, in one run: the bisection open loop and with
-//! balance, then a scan of [`SCAN_STEPS`] impulses evenly up to the larger of the two largest
+//! balance, then a scan of `N` impulses ([`SCAN_STEPS`] unless given) evenly up to the larger of the two largest
 //! survived, each with balance and without, naming every impulse that fells the robot with
 //! balance but not open loop. With `--out-dir DIR`, each slope and tilt run, and the push runs at the largest impulse
 //! survived and the smallest that fells, keep their files (plots, pictures) in
@@ -32,8 +32,8 @@ use std::process::ExitCode;
 const SLOPE_DEG: f32 = 10.0;
 /// The bisection stops when the bracket is narrower than this share of its upper end.
 const RELATIVE_TOLERANCE: f32 = 0.03;
-/// Impulses of `--push-compare`'s scan, evenly from 1/`SCAN_STEPS` to all of the larger
-/// largest survived.
+/// Impulses of `--push-compare`'s scan unless `--scan-steps` says, evenly from 1/`SCAN_STEPS`
+/// to all of the larger largest survived.
 const SCAN_STEPS: u16 = 20;
 /// First impulse tried, per kilogram of the robot, N·s/kg (then doubled until the robot falls).
 const FIRST_IMPULSE_N_S_PER_KG: f32 = 0.25;
@@ -83,6 +83,16 @@ fn main() -> ExitCode {
         .map(PathBuf::from);
     let balance = args.iter().any(|a| a == "--balance");
     let push_compare = args.iter().any(|a| a == "--push-compare");
+    let scan_steps = match args.iter().position(|a| a == "--scan-steps") {
+        Some(i) => match args.get(i + 1).and_then(|n| n.parse::<u16>().ok()) {
+            Some(n) if n > 0 => n,
+            _ => {
+                eprintln!("twin_scenarios: --scan-steps takes a count > 0");
+                return ExitCode::FAILURE;
+            }
+        },
+        None => SCAN_STEPS,
+    };
     let push_only = push_compare || args.iter().any(|a| a == "--push-only");
     let dir = |name: &str, case: &str| out_dir.as_ref().map(|d| d.join(format!("{name}-{case}")));
     let presets = [
@@ -154,8 +164,8 @@ fn main() -> ExitCode {
             let closed = largest(true)?;
             let top = open.max(closed);
             let mut worse = Vec::new();
-            for k in 1..=SCAN_STEPS {
-                let impulse = top * f32::from(k) / f32::from(SCAN_STEPS);
+            for k in 1..=scan_steps {
+                let impulse = top * f32::from(k) / f32::from(scan_steps);
                 let off = push(impulse, false, None)?.fell;
                 let on = push(impulse, true, None)?.fell;
                 println!(
