@@ -164,6 +164,10 @@ fn main() -> ExitCode {
             let closed = largest(true)?;
             let top = open.max(closed);
             let mut worse = Vec::new();
+            // With balance: the largest scanned impulse up to which every one was survived,
+            // and every one that fell the robot.
+            let mut unbroken = 0.0_f32;
+            let mut fell_on = Vec::new();
             for k in 1..=scan_steps {
                 let impulse = top * f32::from(k) / f32::from(scan_steps);
                 let off = push(impulse, false, None)?.fell;
@@ -174,10 +178,16 @@ fn main() -> ExitCode {
                 if on && !off {
                     worse.push(impulse);
                 }
+                if on {
+                    fell_on.push(impulse);
+                } else if fell_on.is_empty() {
+                    unbroken = impulse;
+                }
             }
             println!(
-                "{name:13} push, same run: largest survived {closed:.2} N·s with balance, {open:.2} N·s open loop ({:+.1} %); impulses up to {top:.2} N·s that fell the robot with balance and not open loop: {worse:.2?}",
-                100.0 * (closed / open - 1.0)
+                "{name:13} push, same run: largest survived {closed:.2} N·s with balance, {open:.2} N·s open loop ({:+.1} %); impulses up to {top:.2} N·s that fell the robot with balance and not open loop: {worse:.2?}; with balance every scanned impulse up to {unbroken:.2} N·s survived ({:+.1} % on open loop), falls at {fell_on:.2?}",
+                100.0 * (closed / open - 1.0),
+                100.0 * (unbroken / open - 1.0)
             );
         }
         Ok(())
