@@ -21,6 +21,7 @@
 //! - Robot and defaults: [`DEVICE_CONFIG`], [`quad_device::Config::shahriar2023`] (seed 000's
 //!   robot, the one with the Arduino Mega): body poses in rotation order zyx at its default
 //!   stance height, unreachable targets rejected, no link-loss timeout until the host sets one.
+//!   A robot stored in the EEPROM (protocol 2.4, `SaveRobot`) replaces it at boot.
 //! - Math: [`avr_libc_math::AvrFast`] (`sqrt` with avr-libc's bits; kin-core's fixed-point arctangent
 //!   `poly::atan2_fixed` in the assembly form of `AvrLibm::atan2_fixed`, bit for bit the same;
 //!   kin-core's sine/cosine `poly::sin_cos_fixed` with its fixed-point part in the assembly

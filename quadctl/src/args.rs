@@ -103,6 +103,29 @@ pub fn batch_help(examples: &str) -> String {
     format!("{examples}\n\n{BATCH_RULES}")
 }
 
+/// `--robot` of a device command: optional, the device's own robot when not given
+/// (protocol 2.4).
+#[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
+pub struct DeviceRobotArgs {
+    /// Robot the host plans with: a preset (shahriar2023, fernando2025), a TOML or a URDF robot
+    /// file; the device must hold the same (compared by hash; `quadctl robot send` puts it
+    /// there). Not given: the robot the device holds. With --sim, a robot file runs on the
+    /// simulated device compiled with shahriar2023 (the firmware's) and its --sim-storage.
+    #[arg(long, value_name = "PRESET|FILE.toml|FILE.urdf", value_parser = parse_robot)]
+    pub robot: Option<String>,
+}
+
+impl DeviceRobotArgs {
+    /// The preset the simulated device is compiled with: the one named, else the firmware's
+    /// (shahriar2023), whose EEPROM may hold another robot.
+    pub fn sim_preset(&self) -> RobotPreset {
+        self.robot
+            .as_deref()
+            .and_then(|r| RobotPreset::from_name(r.trim()))
+            .unwrap_or(RobotPreset::Shahriar2023)
+    }
+}
+
 /// `--robot`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
 pub struct RobotArgs {
@@ -257,7 +280,10 @@ impl SessionArgs {
     /// The library's session. The simulated device runs the robot given; the session refuses
     /// a robot that is not a preset before the link is opened.
     pub fn session(&self) -> Session {
-        let preset = RobotPreset::from_name(self.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
+        // A robot file: the simulated device compiled with the firmware's preset, holding what
+        // its --sim-storage EEPROM holds (protocol 2.4; the session compares the hashes).
+        let preset =
+            RobotPreset::from_name(self.robot.robot.trim()).unwrap_or(RobotPreset::Shahriar2023);
         Session {
             robot: self.robot.robot.clone(),
             target: self.target.target(preset),

@@ -199,6 +199,12 @@ fn workload() -> Vec<Step> {
     steps.push(Send(Request::StartMotion(MotionCommand::Rest)));
     steps.push(WaitIdle);
     steps.push(Send(Request::SetOutputs { enabled: false }));
+    // The robot's requests (2.4), with the robot the firmware holds (nothing changes).
+    steps.push(Send(Request::GetRobot));
+    steps.push(Send(Request::SetRobot(
+        quad_device::Config::shahriar2023().description(),
+    )));
+    steps.push(Send(Request::SaveRobot));
     steps
 }
 

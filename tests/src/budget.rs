@@ -147,6 +147,10 @@ fn workload(poses: &[Pose]) -> Vec<Request> {
         Request::GetCalibration { servo },
         Request::SaveCalibration,
         Request::SetOutputs { enabled: false },
+        // The robot's requests (2.4), with the robot the firmware holds (nothing changes).
+        Request::GetRobot,
+        Request::SetRobot(quad_device::Config::shahriar2023().description()),
+        Request::SaveRobot,
     ]);
     out
 }

@@ -323,6 +323,10 @@ impl fmt::Display for RobotError {
 
 impl core::error::Error for RobotError {}
 
+/// How far short of the folded end of its range the knee rests in the rest pose
+/// ([`Robot::rest_leg`]), rad.
+pub const REST_KNEE_MARGIN_RAD: f32 = 0.2;
+
 impl Robot {
     /// Seed 000 (Shahriar 2023) Table 4: La = 0.044 m (lateral, ⟂ leg plane), Lb = 0.28 m,
     /// Lc = 0.277 m, body 0.6 × 0.28 m. Its IK treats every quadrant of the abduction circle, so
@@ -444,6 +448,20 @@ impl Robot {
             && a.body_length_m == b.body_length_m
             && a.body_width_m == b.body_width_m
             && a.knee_bend as u8 == b.knee_bend as u8
+    }
+
+    /// The rest pose of one leg (every leg alike): folded under the body — abduction 0, knee
+    /// [`REST_KNEE_MARGIN_RAD`] short of the folded end of its range (the minimum for
+    /// [`KneeBend::Backward`], the maximum for [`KneeBend::Forward`]), hip at minus half the
+    /// knee, which puts the foot below its hip joint. The limits may exclude it
+    /// ([`JointLimits::first_violation`]).
+    pub fn rest_leg(&self) -> JointAngles {
+        let l = &self.limits;
+        let knee = match self.knee_bend {
+            KneeBend::Backward => l.min_rad[2] + REST_KNEE_MARGIN_RAD,
+            KneeBend::Forward => l.max_rad[2] - REST_KNEE_MARGIN_RAD,
+        };
+        JointAngles::new(0.0, -0.5 * knee, knee)
     }
 
     /// Hip (abduction-axis) mount of `leg` in the body frame: `(±length/2, ±width/2, 0)`.

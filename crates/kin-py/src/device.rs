@@ -205,7 +205,8 @@ impl Device {
 
     /// The handshake again: the device's info (``version``, ``firmware``, ``robot``,
     /// ``max_frame_len``, ``stance_height_m``, ``rotation_order``, ``policy``,
-    /// ``link_timeout_ms``, ``link_loss_action``).
+    /// ``link_timeout_ms``, ``link_loss_action``, ``robot_hash``: the hash of the robot the
+    /// device holds, protocol 2.4, else ``None``).
     fn hello<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         self.info = self.client.hello().map_err(|e| self.err(e))?;
         info_dict(py, &self.info)
@@ -552,6 +553,8 @@ fn info_dict<'py>(py: Python<'py>, i: &DeviceInfo) -> PyResult<Bound<'py, PyDict
         "link_loss_action",
         format!("{:?}", i.link_timeout.action).to_lowercase(),
     )?;
+    // The robot's hash (protocol 2.4; None from an older device).
+    d.set_item("robot_hash", i.robot_hash)?;
     Ok(d)
 }
 

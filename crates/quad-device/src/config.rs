@@ -7,8 +7,24 @@ use core::fmt;
 use kin_core::body;
 use kin_core::robot::RobotError;
 use kin_core::{BodyConfig, LegId, Math, ReachPolicy, Robot, RotationOrder};
+use quad_protocol::robot::NAME_LEN;
 use quad_protocol::servo::{Calibration, STANDARD_US_PER_RAD};
-use quad_protocol::{FirmwareVersion, LinkTimeout, PoseConfig, Ranges, RobotPreset};
+use quad_protocol::{
+    FirmwareVersion, LinkTimeout, PoseConfig, Ranges, RobotDescription, RobotPreset,
+};
+
+/// The preset `robot` is: [`RobotPreset::Custom`] unless it equals a preset's
+/// [`Config::description`] in every field, its name included.
+pub fn preset_of(robot: &RobotDescription) -> RobotPreset {
+    for preset in [RobotPreset::Shahriar2023, RobotPreset::Fernando2025] {
+        if let Some(c) = Config::for_preset(preset) {
+            if c.description() == *robot {
+                return preset;
+            }
+        }
+    }
+    RobotPreset::Custom
+}
 
 /// Default stance height of [`Robot::fernando2025`]: seed 001's initial pose (eq. 5, α = 60°,
 /// φ = 120°), `H = l0 + (l1 + l2)·sin 60°`, m.
@@ -38,7 +54,8 @@ pub struct Config {
     pub link_timeout: LinkTimeout,
     /// Firmware release reported in `HelloAck`.
     pub firmware: FirmwareVersion,
-    /// Storage address of calibration bank A; [`crate::store::STORAGE_LEN`] bytes are used.
+    /// Storage address of calibration bank A; [`crate::store::USED_LEN`] bytes are used (the
+    /// calibration's banks, then the robot's, [`crate::store`]).
     pub storage_base: u16,
     /// Joint-speed limit of every output at power-on, rad/s (within the range that
     /// `SetJointSpeedLimit` admits, [`quad_protocol::range::JOINT_SPEED_LIMIT_RAD_S`]; see
@@ -56,7 +73,7 @@ pub enum ConfigError {
     StanceHeight,
     /// The preset names a robot other than [`Config::robot`].
     PresetMismatch,
-    /// The storage banks do not fit below address 65536.
+    /// The storage banks (calibration and robot) do not fit below address 65536.
     StorageBase,
     /// The joint-speed limit is outside the range `SetJointSpeedLimit` admits
     /// ([`quad_protocol::range::JOINT_SPEED_LIMIT_RAD_S`]).
@@ -69,7 +86,7 @@ impl fmt::Display for ConfigError {
             ConfigError::Robot(e) => write!(f, "robot: {e}"),
             ConfigError::StanceHeight => f.write_str("stance height must be a finite length > 0"),
             ConfigError::PresetMismatch => f.write_str("preset and robot geometry differ"),
-            ConfigError::StorageBase => f.write_str("calibration storage exceeds 64 KiB"),
+            ConfigError::StorageBase => f.write_str("the storage exceeds 64 KiB"),
             ConfigError::JointSpeedLimit => f.write_str(
                 "joint speed limit must be within SetJointSpeedLimit's range, [0.1, 157.08] rad/s",
             ),
@@ -136,6 +153,31 @@ impl Config {
         }
     }
 
+    /// The robot this configuration describes, as protocol 2.4 sends and stores it: named
+    /// after the preset (`shahriar2023`, `fernando2025`, `custom`), with the stance height and
+    /// rotation order of [`Config::pose_config`] and [`Config::joint_speed_limit_rad_s`]. The
+    /// one definition of a preset's description: the host compares its hash with the device's.
+    pub const fn description(&self) -> RobotDescription {
+        let name: &[u8] = match self.preset {
+            RobotPreset::Shahriar2023 => b"shahriar2023",
+            RobotPreset::Fernando2025 => b"fernando2025",
+            RobotPreset::Custom => b"custom",
+        };
+        let mut bytes = [0u8; NAME_LEN];
+        let mut i = 0;
+        while i < name.len() {
+            bytes[i] = name[i];
+            i += 1;
+        }
+        RobotDescription {
+            name: bytes,
+            robot: self.robot,
+            stance_height_m: self.pose_config.stance_height_m,
+            order: self.pose_config.order,
+            joint_speed_limit_rad_s: self.joint_speed_limit_rad_s,
+        }
+    }
+
     /// Checks the robot, the pose configuration, that a named preset matches the robot, and
     /// that the storage fits. A `const fn`: a firmware's constant configuration is checked at
     /// compile time ([`ValidConfig::checked`]).
@@ -151,7 +193,7 @@ impl Config {
                 return Err(ConfigError::PresetMismatch);
             }
         }
-        if self.storage_base as u32 + crate::store::STORAGE_LEN as u32 > 0x1_0000 {
+        if self.storage_base as u32 + crate::store::USED_LEN as u32 > 0x1_0000 {
             return Err(ConfigError::StorageBase);
         }
         // The range the wire admits (`SetJointSpeedLimit`), then the limiter's own check.

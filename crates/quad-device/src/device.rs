@@ -3,13 +3,13 @@
 
 use crate::balance::{Balance, Event};
 use crate::config::{
-    validate_pose_config, write_default_calibration, Config, ConfigError, ValidConfig,
+    preset_of, validate_pose_config, write_default_calibration, Config, ConfigError, ValidConfig,
     UNBOOTED_CALIBRATION,
 };
 use crate::engine::{self, Engine, Limiter, PulseMaps, Setup, FRAME_MS, FRAME_S, LEVEL_SHARES};
 use crate::hal::{Clock, ServoOutputs, Storage};
 use crate::imu::{ImuReading, ImuState};
-use crate::store::{Store, Table};
+use crate::store::{RobotImage, RobotStore, Store, Table};
 use kin_core::body::{self, BodySolution, Pose};
 use kin_core::motion::gait::Velocity;
 use kin_core::{BodyConfig, DefaultMath, Math, ReachPolicy, Vec3};
@@ -19,7 +19,8 @@ use quad_protocol::{
     check_request_in, encode_frame_in_pieces, is_compatible, negotiated_minor, Accumulator,
     DeviceInfo, DeviceToHost, Feed, Flags, HostToDevice, LinkLossAction, LinkTimeout,
     MotionCommand, MotionFrames, MotionKind, MotionStatus, NackReason, PoseConfig, Ranges,
-    Readback, Request, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, PROTOCOL_VERSION,
+    Readback, Request, RobotDescription, ServoId, Setting, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN,
+    PROTOCOL_VERSION,
 };
 use quad_protocol::{BalanceConfig, FaultAction, ImuReport, SafeState};
 
@@ -70,6 +71,12 @@ struct Held {
 ///   [`NackReason::InvalidParameter`] naming it, before the motion engine does any maths.
 /// - Configuration requests are answered with [`DeviceToHost::Configured`], echoing the setting
 ///   as applied.
+/// - The robot (protocol 2.4): at boot the one stored ([`Request::SaveRobot`]) when a valid
+///   one is, else the configuration's. [`Request::SetRobot`] is refused while the outputs are
+///   on ([`NackReason::OutputsEnabled`]) and when [`quad_protocol::check_robot`]
+///   refuses the robot ([`NackReason::BadRobot`]), changing nothing; accepted, it replaces the
+///   geometry, ranges, stance height, rotation order and joint-speed limit at once and holds
+///   the new stance (with the outputs off). The hello reports its hash to a host of minor 4.
 /// - Link loss: when no valid frame arrived for `timeout_ms` (≠ 0), the failsafe holds the
 ///   pulses or stops the outputs ([`LinkLossAction`]) and sets [`Flags::FAILSAFE_ACTIVE`],
 ///   latched until an answer that carries a readback has reported it. Stopped outputs stay
@@ -112,9 +119,16 @@ pub struct Device<O, C, S, M: Math = DefaultMath> {
     /// `calibration`, each validated once and precomputed for mapping angles to pulses
     /// (recomputed with every change of `calibration`; [`PulseMap::NONE`] until the boot).
     pulse_maps: PulseMaps,
-    /// The request ranges of `config.robot` (the robot never changes).
+    /// The request ranges of `config.robot` (recomputed when the robot changes).
     ranges: Ranges,
     store: Store,
+    /// The robot held ([`Request::SetRobot`]): its geometry is also `config.robot`, its
+    /// stance height and rotation order `config.pose_config`'s defaults.
+    robot: RobotDescription,
+    /// [`RobotDescription::hash`] of `robot`, reported in the hello.
+    robot_hash: u32,
+    /// Where the robot is stored.
+    robot_store: RobotStore,
     acc: Accumulator<RX_LEN>,
     held: Option<Held>,
     clamped: bool,
@@ -211,6 +225,9 @@ where
             calibration: UNBOOTED_CALIBRATION,
             pulse_maps: [PulseMap::NONE; 12],
             store: Store::new(config.storage_base),
+            robot: config.description(),
+            robot_hash: 0,
+            robot_store: RobotStore::robot(config.storage_base),
             ranges: *valid.ranges(),
             solver: body::Solver::<M>::with_math(&config.robot),
             config,
@@ -244,6 +261,8 @@ where
     /// valid) and holds
     /// the nominal stance (zero body pose) when it maps within that calibration.
     pub fn boot(&mut self) {
+        self.robot_hash = self.robot.hash();
+        self.load_robot();
         self.calibration_default = !self.load_calibration();
         if self.calibration_default {
             // Also over a table that a failing load left half-read.
@@ -281,6 +300,86 @@ where
     /// Loads the calibration from storage (true when a valid one was found).
     fn load_calibration(&mut self) -> bool {
         self.store.load(&mut self.storage, &mut self.calibration)
+    }
+
+    /// Adopts the robot stored (since protocol 2.4) when the storage holds a valid one that
+    /// passes [`quad_protocol::check_robot`]; else the configuration's robot stays.
+    // Out of line: the image and the check's solver stay out of `boot`'s frame.
+    #[inline(never)]
+    fn load_robot(&mut self) {
+        let mut image = RobotImage([0; RobotDescription::WIRE_LEN]);
+        if !self.robot_store.load(&mut self.storage, &mut image) {
+            return;
+        }
+        let Some(robot) = image.robot() else {
+            return;
+        };
+        if let Ok(solver) = quad_protocol::check_robot::<M>(&robot) {
+            self.adopt_robot(&robot, solver);
+        }
+    }
+
+    /// Makes `robot` (checked, with its body solver) the one held: the IK's geometry, the
+    /// request ranges, the stance height and rotation order of body poses, the joint-speed
+    /// limit, the preset and the hash the hello reports.
+    fn adopt_robot(&mut self, robot: &RobotDescription, solver: body::Solver<M>) {
+        self.config.robot = robot.robot;
+        self.config.pose_config.stance_height_m = robot.stance_height_m;
+        self.config.pose_config.order = robot.order;
+        self.config.joint_speed_limit_rad_s = robot.joint_speed_limit_rad_s;
+        self.config.preset = preset_of(robot);
+        self.ranges = Ranges::of(&robot.robot);
+        self.solver = solver;
+        // Within the range `check_robot` admits, which the limiter accepts.
+        let _ = self
+            .engine
+            .set_joint_speed_limit(robot.joint_speed_limit_rad_s);
+        self.robot = *robot;
+        self.robot_hash = robot.hash();
+    }
+
+    /// `SetRobot` (since protocol 2.4): refused while the outputs are on (a geometry change
+    /// must never move powered servos: with the outputs off no motion runs either), checked
+    /// ([`quad_protocol::check_robot`]) before anything changes. Then the robot is adopted
+    /// ([`Device::adopt_robot`]); a default calibration (none stored, none changed since) is
+    /// recomputed for the new stance; the new stance is held when it maps within the
+    /// calibration (else nothing is held, and enabling is refused until a setpoint maps).
+    // Out of line: the check's solver stays out of the dispatcher's frame.
+    #[inline(never)]
+    fn set_robot(&mut self, robot: &RobotDescription) -> Result<(), NackReason> {
+        if self.outputs_enabled {
+            return Err(NackReason::OutputsEnabled);
+        }
+        let solver = quad_protocol::check_robot::<M>(robot)?;
+        self.adopt_robot(robot, solver);
+        if self.calibration_default && !self.calibration_unsaved {
+            write_default_calibration(
+                &self.solver,
+                &self.config.pose_config,
+                &mut self.calibration,
+            );
+            for (m, c) in self.pulse_maps.iter_mut().zip(&self.calibration) {
+                if let Ok(map) = c.pulse_map() {
+                    *m = map;
+                }
+            }
+        }
+        self.held = None;
+        self.base_pose = None;
+        let _ = self.set_body_pose(&Pose::default());
+        Ok(())
+    }
+
+    /// `SaveRobot` (since protocol 2.4): the robot held to the storage's inactive bank.
+    fn save_robot(&mut self) -> Result<(), NackReason> {
+        self.robot_store
+            .save(&mut self.storage, &RobotImage::of(&self.robot))
+            .map_err(|_| NackReason::Storage)
+    }
+
+    /// The robot held (what `GetRobot` answers).
+    pub fn robot(&self) -> &RobotDescription {
+        &self.robot
     }
 
     /// Feeds received bytes (any chunking) and sends one answer frame through `tx` for every
@@ -735,6 +834,12 @@ where
                     calibration: self.calibration[servo.index()],
                 };
             }
+            Request::GetRobot => {
+                return DeviceToHost::Robot {
+                    seq,
+                    robot: self.robot,
+                };
+            }
             _ if !self.hello_done => Err(NackReason::HelloRequired),
             _ if in_range.is_err() => in_range,
             Request::SetBodyPose(pose) => self.set_body_pose(&pose),
@@ -758,6 +863,16 @@ where
                 };
             }
             Request::SaveCalibration => self.save_calibration(),
+            Request::SetRobot(robot) => {
+                return match self.set_robot(&robot) {
+                    Ok(()) => DeviceToHost::Robot {
+                        seq,
+                        robot: self.robot,
+                    },
+                    Err(reason) => nack(Some(seq), reason.for_minor(self.peer_minor)),
+                };
+            }
+            Request::SaveRobot => self.save_robot(),
             Request::SetPoseConfig(p) => {
                 return match self.set_pose_config(p) {
                     Ok(()) => self.configured(seq, Setting::PoseConfig(self.config.pose_config)),
@@ -842,7 +957,7 @@ where
         }
     }
 
-    /// What `HelloAck` reports.
+    /// What `HelloAck` reports (the robot's hash to a host of minor 4 or later only).
     pub fn info(&self) -> DeviceInfo {
         DeviceInfo {
             version: PROTOCOL_VERSION,
@@ -851,6 +966,7 @@ where
             max_frame_len: RX_LEN as u16,
             pose_config: self.config.pose_config,
             link_timeout: self.config.link_timeout,
+            robot_hash: (self.peer_minor >= 4).then_some(self.robot_hash),
         }
     }
 

@@ -24,7 +24,8 @@
 //!   avr-libc backend, the host [`kin_core::DefaultMath`].
 //! - [`config`]: the robot preset, pose interpretation and failsafe at power-on, and the default
 //!   servo calibration.
-//! - [`store`]: the calibration table in storage, two banks with a generation counter and a CRC.
+//! - [`store`]: the calibration table and (protocol 2.4) the robot in storage, each in two banks
+//!   with a generation counter and a CRC.
 //! - `sim` (feature `sim`, needs `alloc`): in-memory servo outputs, clock and EEPROM, the one set
 //!   of fakes the host's simulated link, the twin and the tests use.
 //!

@@ -9,7 +9,7 @@ use common::*;
 use kin_core::motion::gait::Pattern;
 use quad_device::{engine::FRAME_S, Config};
 use quad_protocol::{
-    DeviceToHost, MotionCommand, MotionFrames, MotionStage, MotionStatus, Request, PROTOCOL_VERSION,
+    DeviceToHost, MotionCommand, MotionFrames, MotionStage, MotionStatus, Request,
 };
 
 fn rig(host_version: u16) -> (Dev, VirtualClock) {
@@ -75,7 +75,7 @@ fn a_two_two_host_gets_the_motion_ack_of_two_two() {
 
 #[test]
 fn velocity_commands_and_the_stop_report_the_frame_they_took_effect() {
-    let (mut dev, clock) = rig(PROTOCOL_VERSION);
+    let (mut dev, clock) = rig(0x0203);
     assert_eq!(dev.peer_minor(), 3);
     trot(&mut dev, &clock, 1_000);
     // The approach counts its ramp's steps (none when the walk starts at the stance).
@@ -129,7 +129,7 @@ fn velocity_commands_and_the_stop_report_the_frame_they_took_effect() {
 
 #[test]
 fn the_velocity_timeout_reports_its_stop_frame() {
-    let (mut dev, clock) = rig(PROTOCOL_VERSION);
+    let (mut dev, clock) = rig(0x0203);
     trot(&mut dev, &clock, 200);
     // The approach, then the run with one command and silence.
     loop {

@@ -48,6 +48,9 @@ fn request_index(r: &Request) -> u8 {
         Request::SetJointSpeedLimit { .. } => 15,
         Request::SetBalance(_) => 16,
         Request::GetImu => 17,
+        Request::SetRobot(_) => 18,
+        Request::GetRobot => 19,
+        Request::SaveRobot => 20,
     }
 }
 
@@ -60,6 +63,7 @@ fn answer_index(a: &DeviceToHost) -> u8 {
         DeviceToHost::Configured { .. } => 4,
         DeviceToHost::MotionAck { .. } => 5,
         DeviceToHost::Imu { .. } => 6,
+        DeviceToHost::Robot { .. } => 7,
     }
 }
 
@@ -143,6 +147,9 @@ fn requests() -> Vec<Request> {
             ..BalanceConfig::DEFAULT
         }),
         Request::GetImu,
+        Request::SetRobot(Config::shahriar2023().description()),
+        Request::GetRobot,
+        Request::SaveRobot,
     ]
 }
 
@@ -191,6 +198,8 @@ fn nack_reasons() -> Vec<NackReason> {
         NackReason::ImuAbsent,
         NackReason::ImuFault(ImuFaultKind::Stuck),
         NackReason::NotUpright,
+        NackReason::BadRobot(quad_protocol::RobotField::Stance(LegId::RL)),
+        NackReason::OutputsEnabled,
     ]
 }
 
@@ -210,6 +219,7 @@ fn info(robot: RobotPreset) -> DeviceInfo {
             policy: ReachPolicy::Reject,
         },
         link_timeout: LinkTimeout::default(),
+        robot_hash: Some(0xDEAD_BEEF),
     }
 }
 
@@ -287,6 +297,10 @@ fn answers() -> Vec<DeviceToHost> {
                 samples: 123_456,
                 config: BalanceConfig::DEFAULT,
             },
+        },
+        DeviceToHost::Robot {
+            seq: 13,
+            robot: Config::fernando2025().description(),
         },
     ]
 }

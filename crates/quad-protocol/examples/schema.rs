@@ -13,7 +13,8 @@ use quad_protocol::schema::{self, ENUMS};
 use quad_protocol::wire::FieldsSchema;
 use quad_protocol::{
     servo, DeviceInfo, FirmwareVersion, Flags, HostToDevice, LinkTimeout, MotionFrames, MotionKind,
-    MotionStage, MotionStatus, NackReason, PoseConfig, Readback, Request, RobotPreset, ServoId,
+    MotionStage, MotionStatus, NackReason, PoseConfig, Readback, Request, RobotDescription,
+    RobotPreset, ServoId,
 };
 use schema_shape::Shape;
 use serde_json::{json, Map, Value};
@@ -61,6 +62,14 @@ fn structs() -> Vec<Value> {
             max_frame_len: 0,
             pose_config,
             link_timeout: LinkTimeout::default(),
+            robot_hash: Some(0),
+        }),
+        schema_shape::shape(&RobotDescription {
+            name: [0; 16],
+            robot: kin_core::Robot::shahriar2023(),
+            stance_height_m: 0.2,
+            order: RotationOrder::Zyx,
+            joint_speed_limit_rad_s: 1.0,
         }),
         schema_shape::shape(&Readback {
             angles_rad: [0.0; 12],

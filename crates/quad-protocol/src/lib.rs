@@ -12,6 +12,7 @@
 //! - [`range`]: the admissible range of every request field, one check for host and device.
 //! - [`servo`]: per-joint [`servo::Calibration`] and the angle ↔ pulse mapping.
 //! - [`balance`]: the inertial sensor's report and the balance functions' settings (2.3).
+//! - [`robot`]: the robot a device holds, its hash and the fields a refusal names (2.4).
 //! - [`wire`]: the explicit wire index of every enum variant, and the tables of the kin-core
 //!   types the messages carry.
 //!
@@ -35,6 +36,7 @@ pub mod crc;
 pub mod frame;
 pub mod msg;
 pub mod range;
+pub mod robot;
 pub mod schema;
 pub mod servo;
 pub mod timing;
@@ -53,13 +55,15 @@ pub use msg::{
     NackReason, ParamProblem, PoseConfig, PreflightFault, ReachFault, Readback, Request,
     RobotPreset, ServoId, Setting, DEFAULT_VELOCITY_TIMEOUT_MS,
 };
-pub use range::{check_request, check_request_in, Ranges};
+pub use range::{check_request, check_request_in, check_robot, Ranges};
+pub use robot::{RobotDescription, RobotField};
 
 /// This crate's protocol version: `major << 8 | minor` (2.1: the onboard motions; 2.2: the idle
 /// motion stage and the watchdog-reset flag; 2.3: the inertial sensor and the balance
 /// functions, [`balance`], the motion's frame numbers, [`MotionFrames`], and the statically
-/// stable yaw turn).
-pub const PROTOCOL_VERSION: u16 = 0x0203;
+/// stable yaw turn; 2.4: the robot sent, read and stored on the device, [`robot`], and its
+/// hash in the hello).
+pub const PROTOCOL_VERSION: u16 = 0x0204;
 
 /// Major part of a protocol version.
 #[inline]
@@ -91,9 +95,15 @@ pub const fn negotiated_minor(a: u16, b: u16) -> u8 {
     }
 }
 
-/// Largest decoded [`HostToDevice`] frame of this version (postcard bytes + CRC), bytes:
-/// seq (≤ 3) + variant (1) + `SetFeet`/`SetJoints` (48) + CRC (2).
+/// Largest decoded frame of a setpoint request (postcard bytes + CRC), bytes: seq (≤ 3) +
+/// variant (1) + `SetFeet`/`SetJoints` (48) + CRC (2) — the largest [`HostToDevice`] frame up
+/// to 2.3; since 2.4 a [`Request::SetRobot`] frame is larger, [`SET_ROBOT_MAX_LEN`].
 pub const HOST_TO_DEVICE_MAX_LEN: usize = 3 + 1 + 48 + frame::CRC_LEN;
+
+/// Largest decoded [`Request::SetRobot`] frame (postcard bytes + CRC), bytes, the largest
+/// [`HostToDevice`] frame of 2.4: seq (≤ 3) + variant (1) + the description
+/// ([`RobotDescription::WIRE_LEN`], 74) + CRC (2).
+pub const SET_ROBOT_MAX_LEN: usize = 3 + 1 + RobotDescription::WIRE_LEN + frame::CRC_LEN;
 
 /// Largest [`Readback`] in postcard bytes: angles (48) + pulses (12 × ≤ 3) + flags (1) + two
 /// counters (2 × ≤ 5).
@@ -125,5 +135,9 @@ const _: () = assert!(DEVICE_TO_HOST_MAX_LEN <= MAX_DECODED_LEN);
 // The `Imu` answer (variant, seq, report, CRC) is shorter than the largest answer.
 const _: () =
     assert!(1 + 3 + balance::IMU_REPORT_MAX_LEN + frame::CRC_LEN <= DEVICE_TO_HOST_MAX_LEN);
+const _: () = assert!(SET_ROBOT_MAX_LEN <= MAX_DECODED_LEN);
+// The robot answer (variant, seq, description, CRC) is shorter than the largest answer.
+const _: () =
+    assert!(1 + 3 + robot::RobotDescription::WIRE_LEN + frame::CRC_LEN <= DEVICE_TO_HOST_MAX_LEN);
 // The frame numbers of 2.3 keep the motion ack within 2.2's largest answer.
 const _: () = assert!(MOTION_ACK_MAX_LEN <= CONFIGURED_MAX_LEN);

@@ -15,6 +15,7 @@
 //! FL, FR, RL, RR.
 
 use crate::balance::{BalanceConfig, ImuFaultKind, ImuReport};
+use crate::robot::{RobotDescription, RobotField};
 use crate::servo;
 use crate::wire::{self, wire_enum};
 use core::fmt;
@@ -132,6 +133,20 @@ wire_enum! {
         /// Report the sensor, the attitude and the balance functions (since 2.3).
         /// → [`DeviceToHost::Imu`].
         17 => GetImu,
+        /// Replace the robot the device holds in RAM (since 2.4; not stored until
+        /// [`Request::SaveRobot`]): its geometry, stance, rotation order and joint-speed limit
+        /// take effect at once, and the device holds the new stance. Checked first
+        /// ([`crate::range::check_robot`]); refused while the outputs are on (a geometry change
+        /// must never move powered servos). → [`DeviceToHost::Robot`] echoing the robot as
+        /// held, or [`NackReason::BadRobot`] naming the field, [`NackReason::OutputsEnabled`]
+        /// (nothing changes then).
+        18 => SetRobot(RobotDescription),
+        /// Report the robot the device holds (since 2.4). → [`DeviceToHost::Robot`].
+        19 => GetRobot,
+        /// Store the robot held in RAM in the device's non-volatile storage, the one it
+        /// adopts at power-on (since 2.4). → [`DeviceToHost::Ack`] once written, or
+        /// [`NackReason::Storage`].
+        20 => SaveRobot,
     }
 }
 
@@ -666,7 +681,8 @@ pub struct DeviceInfo {
     pub version: u16,
     /// Firmware release.
     pub firmware: FirmwareVersion,
-    /// Robot geometry compiled into the firmware.
+    /// The preset the robot the device holds is ([`RobotPreset::Custom`] when it is none of
+    /// them; since 2.4 the robot may be sent and stored, [`Request::SetRobot`]).
     pub robot: RobotPreset,
     /// Largest decoded frame (postcard bytes + CRC) the device accepts, bytes.
     #[serde(with = "wire::shared")]
@@ -675,15 +691,26 @@ pub struct DeviceInfo {
     pub pose_config: PoseConfig,
     /// Current link-loss failsafe.
     pub link_timeout: LinkTimeout,
+    /// The [`RobotDescription::hash`] of the robot the device holds (since 2.4): present
+    /// exactly when the negotiated minor is 4 or later, absent (no byte) otherwise
+    /// ([`wire::trailing`]).
+    #[serde(with = "wire::trailing")]
+    pub robot_hash: Option<u32>,
 }
 
 impl DeviceInfo {
     /// The device's answer to [`Request::Hello`] with sequence number `seq` from a host of
     /// version `host_version`: [`DeviceToHost::HelloAck`] when the majors agree, else
     /// [`NackReason::UnknownVersion`] carrying this device's version.
+    ///
+    /// A host of minor < 4 gets no [`DeviceInfo::robot_hash`] (2.3's bytes exactly).
     pub const fn answer_hello(&self, seq: u16, host_version: u16) -> DeviceToHost {
         if crate::version_major(host_version) == crate::version_major(self.version) {
-            DeviceToHost::HelloAck { seq, info: *self }
+            let mut info = *self;
+            if crate::negotiated_minor(host_version, self.version) < 4 {
+                info.robot_hash = None;
+            }
+            DeviceToHost::HelloAck { seq, info }
         } else {
             DeviceToHost::Nack {
                 seq: Some(seq),
@@ -830,6 +857,13 @@ wire_enum! {
             /// The sensor, the attitude and the balance functions after the request.
             report: ImuReport,
         },
+        /// Answer to [`Request::SetRobot`] and [`Request::GetRobot`] (since 2.4).
+        7 => Robot {
+            /// The request's sequence number.
+            seq: u16,
+            /// The robot the device holds after the request.
+            robot: RobotDescription,
+        },
     }
 }
 
@@ -875,7 +909,8 @@ impl DeviceToHost {
             | DeviceToHost::Calibration { seq, .. }
             | DeviceToHost::Configured { seq, .. }
             | DeviceToHost::MotionAck { seq, .. }
-            | DeviceToHost::Imu { seq, .. } => Some(*seq),
+            | DeviceToHost::Imu { seq, .. }
+            | DeviceToHost::Robot { seq, .. } => Some(*seq),
         }
     }
 
@@ -888,7 +923,8 @@ impl DeviceToHost {
             DeviceToHost::Nack { .. }
             | DeviceToHost::HelloAck { .. }
             | DeviceToHost::Calibration { .. }
-            | DeviceToHost::Imu { .. } => None,
+            | DeviceToHost::Imu { .. }
+            | DeviceToHost::Robot { .. } => None,
         }
     }
 }
@@ -993,6 +1029,11 @@ wire_enum! {
         /// minor < 3 the device sends [`NackReason::Busy`] instead,
         /// [`NackReason::for_minor`]).
         21 => NotUpright,
+        /// A robot description was refused (since 2.4): the first field that fails
+        /// [`crate::range::check_robot`].
+        22 => BadRobot(RobotField),
+        /// The request needs the outputs off (since 2.4: [`Request::SetRobot`]).
+        23 => OutputsEnabled,
     }
 }
 
@@ -1000,7 +1041,9 @@ impl NackReason {
     /// This reason as a peer of protocol minor `minor` may receive it: unchanged for minor 3
     /// or later; the reasons of 2.3 that a request of an older minor can meet
     /// ([`NackReason::NotUpright`]) become [`NackReason::Busy`] ("cannot take it now") for an
-    /// older peer.
+    /// older peer. Those of 2.4 (which only its own requests meet) likewise:
+    /// [`NackReason::BadRobot`] becomes [`NackReason::InvalidArgument`] and
+    /// [`NackReason::OutputsEnabled`] [`NackReason::Busy`] for a peer of minor < 4.
     #[must_use]
     pub const fn for_minor(self, minor: u8) -> NackReason {
         match self {
@@ -1009,6 +1052,8 @@ impl NackReason {
             {
                 NackReason::Busy
             }
+            NackReason::BadRobot(_) if minor < 4 => NackReason::InvalidArgument,
+            NackReason::OutputsEnabled if minor < 4 => NackReason::Busy,
             other => other,
         }
     }
@@ -1119,6 +1164,8 @@ impl fmt::Display for NackReason {
             NackReason::ImuAbsent => f.write_str("no inertial sensor"),
             NackReason::ImuFault(kind) => write!(f, "inertial sensor fault: {kind:?}"),
             NackReason::NotUpright => f.write_str("the body is not upright"),
+            NackReason::BadRobot(field) => write!(f, "robot refused: {field}"),
+            NackReason::OutputsEnabled => f.write_str("the outputs are on (switch them off first)"),
         }
     }
 }

@@ -69,8 +69,10 @@
 use crate::msg::{
     Field, MotionCommand, MotionParam, NackReason, ParamProblem, PoseConfig, Request,
 };
+use crate::robot::{RobotDescription, RobotField};
 use core::f32::consts::{FRAC_PI_2, PI};
-use kin_core::{Joint, LegId, Pose, Robot};
+use kin_core::body::{self, BodyConfig};
+use kin_core::{Joint, LegId, Math, Pose, ReachPolicy, Robot};
 
 /// The lowest admissible stance height, m: below it the hips sit on the feet' level, a
 /// stance no legged robot of this shape takes (the bound only has to keep absurd values such
@@ -216,7 +218,12 @@ pub fn check_request_in(request: &Request, ranges: &Ranges) -> Result<(), NackRe
         | Request::GetCalibration { .. }
         | Request::SaveCalibration
         | Request::StopMotion
-        | Request::GetMotion => Ok(()),
+        | Request::GetMotion
+        | Request::GetRobot
+        | Request::SaveRobot => Ok(()),
+        // Its own check, which needs the IK ([`check_robot`]): the device runs it in the
+        // handler, where the solver it builds is kept.
+        Request::SetRobot(_) => Ok(()),
     }
 }
 
@@ -617,6 +624,94 @@ fn motion_in(m: &MotionCommand, ranges: &Ranges) -> Result<(), NackReason> {
             ])?;
             duration(duration_s)
         }
+    }
+}
+
+/// A femur's or a tibia's length, m: `[0.01, 2]`. Below a centimetre no servo moves a link;
+/// beyond 2 m (four times the longest link of the presets) no servo-driven quadruped, and the
+/// f32 IK's resolution (about 0.2 µm at 2 m) stays far below any servo's.
+pub const LINK_LENGTH_M: ParamRange = ParamRange::positive(0.01, 2.0);
+
+/// A leg's offsets `d_lat_m`, `d_ax_m`, m: `[0, 1]` (half the longest link).
+pub const LEG_OFFSET_M: ParamRange = ParamRange::non_negative(1.0);
+
+/// The body's length and width (between the hip mounts), m: `[0, 4]`, four times the largest
+/// preset's length.
+pub const BODY_SIZE_M: ParamRange = ParamRange::non_negative(4.0);
+
+/// One bound of a joint limit, rad: `[−π, π]` (the IK's angles are in this interval).
+pub const JOINT_LIMIT_RAD: ParamRange = ParamRange::symmetric(PI);
+
+/// Checks a robot description (since 2.4) — the one check of [`Request::SetRobot`] that the
+/// host runs before sending and the device before anything changes — and returns its body
+/// solver, built for the stance check (the device keeps it). In this order:
+///
+/// | field | admissible |
+/// |---|---|
+/// | name | printable ASCII, 1‥16 bytes, zero-padded ([`RobotDescription::name_len`]) |
+/// | `femur_m`, `tibia_m` | [`LINK_LENGTH_M`]: `[0.01, 2]` m |
+/// | `d_lat_m`, `d_ax_m` | [`LEG_OFFSET_M`]: `[0, 1]` m |
+/// | `body_length_m`, `body_width_m` | [`BODY_SIZE_M`]: `[0, 4]` m |
+/// | joint limits (abduction, hip, knee) | each bound in [`JOINT_LIMIT_RAD`] `[−π, π]`, min ≤ max |
+/// | `stance_height_m` | `[`[`MIN_STANCE_HEIGHT_M`]`,` [`reach_limit_m`]`]` |
+/// | `joint_speed_limit_rad_s` | [`JOINT_SPEED_LIMIT_RAD_S`] |
+/// | the rest pose ([`Robot::rest_leg`]) | within the joint limits (the device's sit, rest and safe state go there) |
+/// | the stance | every leg reaches its stance foot at the zero body pose within its joint limits (the device holds the stance at power-on) |
+///
+/// The stance check solves the body IK with the math backend `M`: the device's own backend
+/// there, the host's here (they agree to a few ulp; a stance that close to the edge of the
+/// reach is refused by the start checks of every motion anyway).
+///
+/// # Errors
+/// [`NackReason::BadRobot`] naming the first field refused.
+pub fn check_robot<M: Math>(d: &RobotDescription) -> Result<body::Solver<M>, NackReason> {
+    let bad = |field| Err(NackReason::BadRobot(field));
+    if d.name_len().is_none() {
+        return bad(RobotField::Name);
+    }
+    let r = &d.robot;
+    let lengths = [
+        (RobotField::FemurM, LINK_LENGTH_M, r.leg.femur_m),
+        (RobotField::TibiaM, LINK_LENGTH_M, r.leg.tibia_m),
+        (RobotField::DLatM, LEG_OFFSET_M, r.leg.d_lat_m),
+        (RobotField::DAxM, LEG_OFFSET_M, r.leg.d_ax_m),
+        (RobotField::BodyLengthM, BODY_SIZE_M, r.body_length_m),
+        (RobotField::BodyWidthM, BODY_SIZE_M, r.body_width_m),
+    ];
+    for (field, range, v) in lengths {
+        if range.check(v).is_err() {
+            return bad(field);
+        }
+    }
+    for (j, joint) in Joint::ALL.iter().enumerate() {
+        let (lo, hi) = (r.limits.min_rad[j], r.limits.max_rad[j]);
+        // Both finite after the range checks: the float comparison is the order.
+        if JOINT_LIMIT_RAD.check(lo).is_err() || JOINT_LIMIT_RAD.check(hi).is_err() || lo > hi {
+            return bad(RobotField::Limit(*joint));
+        }
+    }
+    let stance = ParamRange::positive(MIN_STANCE_HEIGHT_M, reach_limit_m(r));
+    if stance.check(d.stance_height_m).is_err() {
+        return bad(RobotField::StanceHeightM);
+    }
+    if JOINT_SPEED_LIMIT_RAD_S
+        .check(d.joint_speed_limit_rad_s)
+        .is_err()
+    {
+        return bad(RobotField::JointSpeedLimitRadS);
+    }
+    if let Some(j) = r.limits.first_violation(r.rest_leg()) {
+        return bad(RobotField::RestPose(j));
+    }
+    let solver = body::Solver::<M>::with_math(r);
+    match solver.inverse_at_stance(
+        &Pose::default(),
+        &BodyConfig::about_centre(d.order),
+        d.stance_height_m,
+        ReachPolicy::Reject,
+    ) {
+        Ok(_) => Ok(solver),
+        Err(e) => bad(RobotField::Stance(e.leg)),
     }
 }
 

@@ -21,8 +21,8 @@ use crate::range::{self, ParamRange};
 use crate::wire::{self, VariantSchema};
 use crate::{
     DeviceToHost, Field, LegSet, LinkLossAction, MotionCommand, MotionKind, MotionParam,
-    MotionStage, NackReason, ParamProblem, PreflightFault, ReachFault, Request, RobotPreset,
-    Setting,
+    MotionStage, NackReason, ParamProblem, PreflightFault, ReachFault, Request, RobotField,
+    RobotPreset, Setting,
 };
 
 /// An enum of the protocol and its variants as declared.
@@ -98,6 +98,10 @@ pub const ENUMS: &[EnumSchema] = &[
         variants: RobotPreset::VARIANTS,
     },
     EnumSchema {
+        name: "RobotField",
+        variants: RobotField::VARIANTS,
+    },
+    EnumSchema {
         name: "servo::Error",
         variants: crate::servo::Error::VARIANTS,
     },
@@ -128,6 +132,10 @@ pub const ENUMS: &[EnumSchema] = &[
     EnumSchema {
         name: "Pattern",
         variants: wire::gait_pattern::VARIANTS,
+    },
+    EnumSchema {
+        name: "KneeBend",
+        variants: wire::knee_bend::VARIANTS,
     },
 ];
 

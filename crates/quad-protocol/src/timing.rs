@@ -58,11 +58,14 @@ pub enum Kind {
     SetJointSpeedLimit,
     SetBalance,
     GetImu,
+    SetRobot,
+    GetRobot,
+    SaveRobot,
 }
 
 impl Kind {
     /// Every row, in the order of the table.
-    pub const ALL: [Kind; 25] = [
+    pub const ALL: [Kind; 28] = [
         Kind::Hello,
         Kind::GetState,
         Kind::SetBodyPose,
@@ -88,6 +91,9 @@ impl Kind {
         Kind::SetJointSpeedLimit,
         Kind::SetBalance,
         Kind::GetImu,
+        Kind::SetRobot,
+        Kind::GetRobot,
+        Kind::SaveRobot,
     ];
 
     /// The row of `request`.
@@ -120,6 +126,9 @@ impl Kind {
             Request::SetJointSpeedLimit { .. } => Kind::SetJointSpeedLimit,
             Request::SetBalance(_) => Kind::SetBalance,
             Request::GetImu => Kind::GetImu,
+            Request::SetRobot(_) => Kind::SetRobot,
+            Request::GetRobot => Kind::GetRobot,
+            Request::SaveRobot => Kind::SaveRobot,
         }
     }
 
@@ -151,6 +160,9 @@ impl Kind {
             Kind::SetJointSpeedLimit => "SetJointSpeedLimit",
             Kind::SetBalance => "SetBalance",
             Kind::GetImu => "GetImu",
+            Kind::SetRobot => "SetRobot",
+            Kind::GetRobot => "GetRobot",
+            Kind::SaveRobot => "SaveRobot",
         }
     }
 
@@ -161,7 +173,7 @@ impl Kind {
     /// [`FRAME_ALLOWANCE`] more; [`Kind::timeout`]'s margin covers both.
     pub const fn worst_us(self) -> [u32; 2] {
         match self {
-            Kind::Hello => [7_500, 5_600],
+            Kind::Hello => [9_800, 7_600],
             Kind::GetState => [7_600, 1_400],
             Kind::SetBodyPose => [13_600, 4_700],
             Kind::SetFeet => [16_000, 5_000],
@@ -186,6 +198,9 @@ impl Kind {
             Kind::SetJointSpeedLimit => [9_200, 1_700],
             Kind::SetBalance => [9_200, 2_200],
             Kind::GetImu => [5_500, 1_100],
+            Kind::SetRobot => [22_500, 9_100],
+            Kind::GetRobot => [8_900, 1_500],
+            Kind::SaveRobot => [297_900, 291_500],
         }
     }
 

@@ -34,7 +34,7 @@
 use kin_core::motion::gait::Pattern;
 use kin_core::motion::laws::Axis;
 use kin_core::motion::path::PathKind;
-use kin_core::{Joint, LegId, Pose, ReachPolicy, RotationOrder};
+use kin_core::{Joint, KneeBend, LegId, Pose, ReachPolicy, RotationOrder};
 
 /// One variant of a protocol enum as its declaration writes it (`wire_enum!`, `wire_index!`):
 /// the data of the machine-readable schema (`quad_protocol::schema`).
@@ -660,6 +660,124 @@ wire_index! {
     pub mod gait_pattern for Pattern { 0 => Trot, 1 => Walk }
 }
 
+wire_index! {
+    /// [`KneeBend`] on the wire (since 2.4).
+    pub mod knee_bend for KneeBend { 0 => Backward, 1 => Forward }
+}
+
+/// A kin-core [`kin_core::Robot`] on the wire (since 2.4, in [`crate::RobotDescription`]), for serde's
+/// `with`: the fields `d_lat_m`, `d_ax_m`, `femur_m`, `tibia_m`, `body_length_m`,
+/// `body_width_m`, the three minima and the three maxima of the joint limits (abduction, hip,
+/// knee), all f32, then the knee bend ([`knee_bend`]). In the text form (feature `text`)
+/// kin-core's own serde form.
+pub mod robot {
+    use kin_core::{JointLimits, LegGeometry, Robot};
+    use serde::de::{self, Deserializer, SeqAccess, Visitor};
+    use serde::ser::{SerializeStruct, Serializer};
+
+    /// The fields in wire order: twelve lengths and limits, the knee bend.
+    const FIELDS: [&str; 13] = [
+        "d_lat_m",
+        "d_ax_m",
+        "femur_m",
+        "tibia_m",
+        "body_length_m",
+        "body_width_m",
+        "min_abduction_rad",
+        "min_hip_rad",
+        "min_knee_rad",
+        "max_abduction_rad",
+        "max_hip_rad",
+        "max_knee_rad",
+        "knee_bend",
+    ];
+
+    /// The twelve numbers in wire order.
+    fn numbers(r: &Robot) -> [f32; 12] {
+        let (l, lim) = (&r.leg, &r.limits);
+        [
+            l.d_lat_m,
+            l.d_ax_m,
+            l.femur_m,
+            l.tibia_m,
+            r.body_length_m,
+            r.body_width_m,
+            lim.min_rad[0],
+            lim.min_rad[1],
+            lim.min_rad[2],
+            lim.max_rad[0],
+            lim.max_rad[1],
+            lim.max_rad[2],
+        ]
+    }
+
+    /// Serializes `robot` in the wire order (serde's `with`).
+    ///
+    /// # Errors
+    /// The serializer's.
+    pub fn serialize<S: Serializer>(robot: &Robot, s: S) -> Result<S::Ok, S::Error> {
+        #[cfg(feature = "text")]
+        if s.is_human_readable() {
+            return ::serde::Serialize::serialize(robot, s);
+        }
+        let mut t = s.serialize_struct("Robot", FIELDS.len())?;
+        for (name, v) in FIELDS.iter().zip(numbers(robot)) {
+            t.serialize_field(name, &v)?;
+        }
+        t.serialize_field(
+            FIELDS[12],
+            super::wire_ser_field!(&robot.knee_bend, kin_core::KneeBend, super::knee_bend),
+        )?;
+        t.end()
+    }
+
+    /// Deserializes a robot in the wire order (serde's `with`).
+    ///
+    /// # Errors
+    /// The deserializer's, or an invalid length when the input ends early.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Robot, D::Error> {
+        #[cfg(feature = "text")]
+        if d.is_human_readable() {
+            return <Robot as ::serde::Deserialize>::deserialize(d);
+        }
+        struct Fields;
+        impl<'de> Visitor<'de> for Fields {
+            type Value = Robot;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str("a robot")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Robot, A::Error> {
+                let mut v = [0.0f32; 12];
+                for (i, slot) in v.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                let mut n = 12usize;
+                let knee_bend =
+                    super::wire_next_field!(seq, n, &self, kin_core::KneeBend, super::knee_bend);
+                let _ = n;
+                Ok(Robot {
+                    leg: LegGeometry {
+                        d_lat_m: v[0],
+                        d_ax_m: v[1],
+                        femur_m: v[2],
+                        tibia_m: v[3],
+                    },
+                    body_length_m: v[4],
+                    body_width_m: v[5],
+                    limits: JointLimits {
+                        min_rad: [v[6], v[7], v[8]],
+                        max_rad: [v[9], v[10], v[11]],
+                    },
+                    knee_bend,
+                })
+            }
+        }
+        d.deserialize_struct("Robot", &FIELDS, Fields)
+    }
+}
+
 wire_fields! {
     /// [`Pose`] on the wire: roll, pitch, yaw (rad), then x, y, z (m).
     pub mod pose for Pose {
@@ -717,6 +835,8 @@ mod tests {
             NackReason::ImuAbsent => 19,
             NackReason::ImuFault(_) => 20,
             NackReason::NotUpright => 21,
+            NackReason::BadRobot(_) => 22,
+            NackReason::OutputsEnabled => 23,
         }
     }
 
@@ -1019,6 +1139,8 @@ mod tests {
             NackReason::ImuAbsent,
             NackReason::ImuFault(crate::ImuFaultKind::Nak),
             NackReason::NotUpright,
+            NackReason::BadRobot(crate::RobotField::Name),
+            NackReason::OutputsEnabled,
         ]
         .into();
         // Nack | seq None (00) | reason ...
@@ -1077,6 +1199,7 @@ mod tests {
                     policy: ReachPolicy::Reject,
                 },
                 link_timeout: LinkTimeout::default(),
+                robot_hash: None,
             };
             check(DeviceToHost::HelloAck { seq: 1, info }, 7, i as u8, 3);
         }
@@ -1446,11 +1569,87 @@ mod tests {
             seq: 2,
             request: Request::SetBalance(BalanceConfig::DEFAULT),
         };
-        check(set, 1, 16, 18);
+        // The index after the last request (2.4's `SaveRobot`, 20) is refused.
+        check(set, 1, 16, 21);
         let get = HostToDevice {
             seq: 2,
             request: Request::GetImu,
         };
-        check(get, 1, 17, 18);
+        check(get, 1, 17, 21);
+    }
+
+    #[test]
+    fn every_robot_variant_has_its_index_and_round_trips() {
+        use crate::robot::{RobotDescription, RobotField};
+        use kin_core::{KneeBend, Robot};
+        let fields = [
+            RobotField::Name,
+            RobotField::FemurM,
+            RobotField::TibiaM,
+            RobotField::DLatM,
+            RobotField::DAxM,
+            RobotField::BodyLengthM,
+            RobotField::BodyWidthM,
+            RobotField::Limit(Joint::Knee),
+            RobotField::StanceHeightM,
+            RobotField::JointSpeedLimitRadS,
+            RobotField::RestPose(Joint::Hip),
+            RobotField::Stance(LegId::RL),
+        ];
+        // Nack (00) | None (00) | BadRobot (16) | field
+        for (i, f) in fields.iter().enumerate() {
+            let index = match f {
+                RobotField::Name => 0,
+                RobotField::FemurM => 1,
+                RobotField::TibiaM => 2,
+                RobotField::DLatM => 3,
+                RobotField::DAxM => 4,
+                RobotField::BodyLengthM => 5,
+                RobotField::BodyWidthM => 6,
+                RobotField::Limit(_) => 7,
+                RobotField::StanceHeightM => 8,
+                RobotField::JointSpeedLimitRadS => 9,
+                RobotField::RestPose(_) => 10,
+                RobotField::Stance(_) => 11,
+            };
+            assert_eq!(index, i);
+            check(
+                nack(NackReason::BadRobot(*f)),
+                3,
+                i as u8,
+                fields.len() as u8,
+            );
+        }
+        let description = |knee_bend| RobotDescription {
+            name: RobotDescription::name_bytes("x").unwrap(),
+            robot: Robot {
+                knee_bend,
+                ..Robot::shahriar2023()
+            },
+            stance_height_m: 0.3,
+            order: RotationOrder::Zyx,
+            joint_speed_limit_rad_s: 3.0,
+        };
+        // seq (02) | SetRobot (12) | name (16) | twelve f32 | knee bend
+        for (i, k) in [KneeBend::Backward, KneeBend::Forward].iter().enumerate() {
+            assert_eq!(knee_bend::index(k), i as u32);
+            let set = HostToDevice {
+                seq: 2,
+                request: Request::SetRobot(description(*k)),
+            };
+            check(set, 2 + 16 + 48, i as u8, 2);
+        }
+        for (request, index) in [
+            (Request::SetRobot(description(KneeBend::Backward)), 18),
+            (Request::GetRobot, 19),
+            (Request::SaveRobot, 20),
+        ] {
+            check(HostToDevice { seq: 2, request }, 1, index, 21);
+        }
+        let answer = DeviceToHost::Robot {
+            seq: 2,
+            robot: description(KneeBend::Forward),
+        };
+        check(answer, 0, 7, 8);
     }
 }

@@ -76,6 +76,8 @@ fn every_request_has_its_golden_bytes() {
             | Request::SetJointSpeedLimit { .. }
             | Request::SetBalance(_)
             | Request::GetImu => {}
+            // 2.4's requests: their golden bytes are in the appendix of 2.4 (below).
+            Request::SetRobot(_) | Request::GetRobot | Request::SaveRobot => {}
         }
     }
     assert_eq!(cases.len(), 22);
@@ -133,14 +135,15 @@ fn hand_written_frames() {
 }
 
 #[test]
-fn version_is_two_three() {
+fn version_is_two_four() {
     // 2.1 appended the onboard motion requests, answer and nack reasons to 2.0; 2.2 appended
     // the idle motion stage and the watchdog-reset flag; 2.3 the inertial sensor's requests,
     // answer, nack reasons, parameters and the fall flag, the motion ack's frame numbers and the
-    // statically stable yaw turn.
-    assert_eq!(PROTOCOL_VERSION, 0x0203);
+    // statically stable yaw turn; 2.4 the robot's requests, answer and nack reasons and the
+    // robot's hash at the end of the hello.
+    assert_eq!(PROTOCOL_VERSION, 0x0204);
     assert_eq!(quad_protocol::version_major(PROTOCOL_VERSION), 2);
-    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 3);
+    assert_eq!(quad_protocol::version_minor(PROTOCOL_VERSION), 4);
     assert!(quad_protocol::is_compatible(0x0207));
     assert!(!quad_protocol::is_compatible(0x0100));
     assert!(!quad_protocol::is_compatible(0x0300));
@@ -268,4 +271,105 @@ fn the_appendix_of_two_three_has_its_golden_bytes() {
     // The numbers wrap at 2^14: at most two bytes each.
     assert_eq!(MotionFrames::wrap(16_384 + 5), 5);
     assert_eq!(MotionFrames::wrap(16_383), 16_383);
+}
+
+#[test]
+fn the_appendix_of_two_four_has_its_golden_bytes() {
+    use kin_core::{KneeBend, Robot, RotationOrder};
+    use quad_protocol::{DeviceInfo, RobotDescription, RobotField};
+    // A robot with exactly representable values.
+    let robot = RobotDescription {
+        name: RobotDescription::name_bytes("dog").unwrap(),
+        robot: Robot {
+            leg: kin_core::LegGeometry {
+                d_lat_m: 0.0625,
+                d_ax_m: 0.0,
+                femur_m: 0.25,
+                tibia_m: 0.25,
+            },
+            body_length_m: 0.5,
+            body_width_m: 0.25,
+            limits: kin_core::JointLimits {
+                min_rad: [-1.0, -2.0, -2.5],
+                max_rad: [1.0, 2.0, -0.125],
+            },
+            knee_bend: KneeBend::Backward,
+        },
+        stance_height_m: 0.375,
+        order: RotationOrder::Zyx,
+        joint_speed_limit_rad_s: 4.0,
+    };
+    // name "dog" + 13 zeros | d_lat 0.0625, d_ax 0, femur 0.25, tibia 0.25, length 0.5,
+    // width 0.25 | min -1, -2, -2.5 | max 1, 2, -0.125 | Backward = 0 | stance 0.375 |
+    // Zyx = 5 | 4 rad/s
+    let description = "64 6f 67 00 00 00 00 00 00 00 00 00 00 00 00 00 \
+                       00 00 80 3d 00 00 00 00 00 00 80 3e 00 00 80 3e 00 00 00 3f 00 00 80 3e \
+                       00 00 80 bf 00 00 00 c0 00 00 20 c0 00 00 80 3f 00 00 00 40 00 00 00 be \
+                       00 00 00 c0 3e 05 00 00 80 40";
+    // seq 7 | SetRobot = 0x12 | the description
+    check(
+        "SetRobot",
+        &h2d(7, Request::SetRobot(robot)),
+        &format!("07 12 {description}"),
+    );
+    check("GetRobot", &h2d(7, Request::GetRobot), "07 13");
+    check("SaveRobot", &h2d(7, Request::SaveRobot), "07 14");
+    // Robot = 7 | seq 7 | the description
+    check(
+        "Robot",
+        &DeviceToHost::Robot { seq: 7, robot },
+        &format!("07 07 {description}"),
+    );
+    assert_eq!(hex(description).len(), RobotDescription::WIRE_LEN);
+    // Nack | seq 7 (Some = 01 07) | BadRobot = 0x16 | Limit = 7 | Knee = 2; OutputsEnabled = 0x17
+    check(
+        "Nack BadRobot",
+        &DeviceToHost::Nack {
+            seq: Some(7),
+            reason: NackReason::BadRobot(RobotField::Limit(kin_core::Joint::Knee)),
+        },
+        "00 01 07 16 07 02",
+    );
+    check(
+        "Nack OutputsEnabled",
+        &DeviceToHost::Nack {
+            seq: Some(7),
+            reason: NackReason::OutputsEnabled,
+        },
+        "00 01 07 17",
+    );
+    // The hash is the CRC-32 of the description's bytes.
+    assert_eq!(robot.hash(), quad_protocol::robot::crc32(&hex(description)));
+    // The hello: to a 2.4 host the 2.3 bytes, then the hash as a varint.
+    let (_, hello, _) = common::cases::answers()
+        .into_iter()
+        .find(|(name, _, _)| *name == "HelloAck")
+        .unwrap();
+    let DeviceToHost::HelloAck { info, .. } = hello else {
+        unreachable!()
+    };
+    let with_hash = DeviceInfo {
+        robot_hash: Some(0x1234_5678),
+        ..info
+    };
+    let old = postcard_bytes(&DeviceToHost::HelloAck { seq: 1, info });
+    let new = postcard_bytes(&DeviceToHost::HelloAck {
+        seq: 1,
+        info: with_hash,
+    });
+    assert_eq!(new[..old.len()], old[..]);
+    assert_eq!(new[old.len()..], [0xF8, 0xAC, 0xD1, 0x91, 0x01]);
+    // A device answers a 2.3 host without it, a 2.4 host with it.
+    let device = DeviceInfo {
+        version: PROTOCOL_VERSION,
+        ..with_hash
+    };
+    let DeviceToHost::HelloAck { info: to_23, .. } = device.answer_hello(1, 0x0203) else {
+        unreachable!()
+    };
+    assert_eq!(to_23.robot_hash, None);
+    let DeviceToHost::HelloAck { info: to_24, .. } = device.answer_hello(1, 0x0204) else {
+        unreachable!()
+    };
+    assert_eq!(to_24.robot_hash, Some(0x1234_5678));
 }

@@ -18,6 +18,7 @@ fn info(version: u16) -> DeviceInfo {
             policy: ReachPolicy::Reject,
         },
         link_timeout: LinkTimeout::default(),
+        robot_hash: None,
     }
 }
 

@@ -30,8 +30,6 @@ use tokio::sync::watch;
 pub struct ServeConfig {
     /// The device and the robot.
     pub device: DeviceSetup,
-    /// The robot's name for the page.
-    pub robot_name: String,
     /// Where to listen (127.0.0.1 by default; port 0 picks a free one).
     pub listen: SocketAddr,
 }
@@ -183,8 +181,8 @@ pub fn start(config: ServeConfig, ctrl_c: bool) -> Result<Running, Error> {
         controller: Mutex::new(None),
         next_page: AtomicU64::new(1),
         welcome: Welcome {
-            robot: config.device.robot,
-            robot_name: config.robot_name.clone(),
+            robot: ready.robot,
+            robot_name: ready.robot_name.clone(),
             rotation_order: RotationOrder::ALL
                 .iter()
                 .position(|&o| o == ready.info.pose_config.order)

@@ -119,12 +119,10 @@ fn the_state_endpoint_answers_json_and_every_field_the_server_sends_is_documente
                 config: SimConfig::default(),
                 storage: None,
             },
-            robot: Robot::shahriar2023(),
-            preset,
+            robot: Some(Robot::shahriar2023()),
             retries: 10,
             poll: Duration::from_millis(50),
         },
-        robot_name: "shahriar2023".to_owned(),
         listen: "127.0.0.1:0".parse().expect("an address"),
     };
     let running = quad_web::start(config, false).expect("the server starts");

@@ -31,13 +31,7 @@ fn session(action: LinkLossAction) -> Session<Box<dyn Link>> {
             action,
         }))
         .unwrap();
-    Session::connect(
-        client,
-        Robot::shahriar2023(),
-        RobotPreset::Shahriar2023,
-        AngleCheck::Exact,
-    )
-    .unwrap()
+    Session::connect(client, Some(Robot::shahriar2023()), AngleCheck::Exact).unwrap()
 }
 
 #[test]
@@ -266,13 +260,7 @@ fn session_with_imu(source: quad_host::emu::SharedImuSource) -> Session<Box<dyn 
         Box::new(sim) as Box<dyn Link>,
         ClientConfig::sim(Duration::ZERO),
     );
-    Session::connect(
-        client,
-        Robot::shahriar2023(),
-        RobotPreset::Shahriar2023,
-        AngleCheck::Exact,
-    )
-    .unwrap()
+    Session::connect(client, Some(Robot::shahriar2023()), AngleCheck::Exact).unwrap()
 }
 
 #[test]
@@ -450,4 +438,30 @@ fn a_guide_aborts_when_the_controlling_page_goes_away() {
     assert_eq!(guide(&s).step, "aborted");
     s.read_calibration().unwrap();
     assert_eq!(s.state(0.0).calibration[0].center_us, 1500);
+}
+
+/// A client of the simulated shahriar2023 device.
+fn sim_client() -> Client<Box<dyn Link>> {
+    let target = Target::Sim {
+        preset: RobotPreset::Shahriar2023,
+        config: SimConfig::default(),
+        storage: None,
+    };
+    Client::new(
+        link::open(&target).unwrap(),
+        ClientConfig::sim(Duration::ZERO),
+    )
+}
+
+#[test]
+fn without_a_robot_the_panel_plans_with_the_device_s_own_and_another_is_refused_naming_it() {
+    let s = Session::connect(sim_client(), None, AngleCheck::Exact).expect("the device's robot");
+    assert_eq!(s.robot(), &Robot::shahriar2023());
+    assert_eq!(s.robot_name(), "shahriar2023");
+    let Err(e) = Session::connect(sim_client(), Some(Robot::fernando2025()), AngleCheck::Exact)
+    else {
+        panic!("a device holding shahriar2023 accepted fernando2025");
+    };
+    assert!(matches!(e, Error::Robot(_)), "{e}");
+    assert!(e.to_string().contains("shahriar2023"), "{e}");
 }

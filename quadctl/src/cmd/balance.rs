@@ -2,7 +2,7 @@
 //! health, the attitude, the leveling and a latched fall; protocol 2.3), once or live, and the
 //! balance switch.
 
-use crate::args::{self, RobotArgs, TargetArgs, EXIT_OK};
+use crate::args::{self, DeviceRobotArgs, TargetArgs, EXIT_OK};
 use clap::ValueEnum;
 use quad_host::ops::onboard::{self, Session};
 use quad_protocol::{
@@ -36,7 +36,7 @@ Examples (from the repository root):
 pub struct StatusArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
+    pub robot: DeviceRobotArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
@@ -62,7 +62,7 @@ Examples (from the repository root):
 pub struct WatchArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
+    pub robot: DeviceRobotArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
@@ -130,7 +130,7 @@ pub enum OnFault {
 pub struct BalanceArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
+    pub robot: DeviceRobotArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
@@ -201,12 +201,14 @@ pub struct Status {
 }
 
 fn session(
-    robot: &RobotArgs,
+    robot: &DeviceRobotArgs,
     target: &TargetArgs,
 ) -> Result<Session<Box<dyn quad_host::link::Link>>, onboard::Error> {
-    let preset = quad_protocol::RobotPreset::from_name(robot.robot.trim())
-        .unwrap_or(quad_protocol::RobotPreset::Custom);
-    onboard::open(&robot.robot, &target.target(preset), target.retries)
+    let device = target.target(robot.sim_preset());
+    match &robot.robot {
+        Some(r) => onboard::open(r, &device, target.retries),
+        None => onboard::open_device_robot(&device, target.retries),
+    }
 }
 
 fn poll<L: quad_host::link::Link>(s: &mut Session<L>) -> Result<Status, onboard::Error> {

@@ -1,13 +1,12 @@
 //! `quadctl drive`: keyboard teleop of the onboard trot or walk in the terminal, or a key
 //! script; velocity commands at 20 Hz, the device's state shown live; a JSON summary at the end.
 
-use crate::args::{self, RobotArgs, TargetArgs, EXIT_OK};
+use crate::args::{self, DeviceRobotArgs, TargetArgs, EXIT_OK};
 use crossterm::event::{self, Event, KeyCode, KeyEventKind};
 use crossterm::terminal;
 use kin_core::motion::gait::Pattern;
 use quad_host::ops::drive::{self, Key, ScriptedKey, Steps, Teleop};
 use quad_host::ops::onboard::{self, MotionAnswer, SessionWalker};
-use quad_protocol::RobotPreset;
 use std::collections::VecDeque;
 use std::io::{self, IsTerminal, Write};
 use std::path::PathBuf;
@@ -54,7 +53,7 @@ Examples (from the repository root):
 pub struct Args {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
+    pub robot: DeviceRobotArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
@@ -154,12 +153,12 @@ pub fn main(args: &Args) -> ExitCode {
     if script.is_none() && !io::stdin().is_terminal() {
         return args::fail("quadctl", &KeysError::NoTerminal);
     }
-    let preset = RobotPreset::from_name(args.robot.robot.trim()).unwrap_or(RobotPreset::Custom);
-    let mut session = match onboard::open(
-        &args.robot.robot,
-        &args.target.target(preset),
-        args.target.retries,
-    ) {
+    let device = args.target.target(args.robot.sim_preset());
+    let opened = match &args.robot.robot {
+        Some(r) => onboard::open(r, &device, args.target.retries),
+        None => onboard::open_device_robot(&device, args.target.retries),
+    };
+    let mut session = match opened {
         Ok(s) => s,
         Err(e) => return args::fail("quadctl", &e),
     };

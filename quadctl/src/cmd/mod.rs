@@ -20,6 +20,7 @@ pub mod play;
 pub mod plot;
 pub mod port;
 pub mod pose;
+pub mod robot;
 pub mod serve;
 pub mod sim;
 pub mod stream;

@@ -1,7 +1,7 @@
 //! `quadctl stand`, `sit`, `rest` and `run <motion>`: the motions the device runs by itself,
 //! started and followed to their end; a JSON summary as the last line of stdout.
 
-use crate::args::{self, parse_leg, path_kind, RobotArgs, TargetArgs, EXIT_OK};
+use crate::args::{self, parse_leg, path_kind, DeviceRobotArgs, TargetArgs, EXIT_OK};
 use clap::ValueEnum;
 use kin_core::motion::gait::Pattern;
 use kin_core::motion::laws::Axis;
@@ -49,7 +49,7 @@ Examples (from the repository root):
 pub struct PostureArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
+    pub robot: DeviceRobotArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
@@ -117,7 +117,7 @@ pub struct RunArgs {
     pub motion: Motion,
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
+    pub robot: DeviceRobotArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
@@ -389,12 +389,14 @@ fn finish<L: quad_host::link::Link>(
 }
 
 fn session(
-    robot: &RobotArgs,
+    robot: &DeviceRobotArgs,
     target: &TargetArgs,
 ) -> Result<Session<Box<dyn quad_host::link::Link>>, onboard::Error> {
-    let preset = quad_protocol::RobotPreset::from_name(robot.robot.trim())
-        .unwrap_or(quad_protocol::RobotPreset::Custom);
-    onboard::open(&robot.robot, &target.target(preset), target.retries)
+    let device = target.target(robot.sim_preset());
+    match &robot.robot {
+        Some(r) => onboard::open(r, &device, target.retries),
+        None => onboard::open_device_robot(&device, target.retries),
+    }
 }
 
 /// Runs `quadctl stand`, `sit` or `rest` (`request`) and returns its exit status.

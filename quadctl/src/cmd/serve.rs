@@ -1,19 +1,14 @@
 //! `quadctl serve`: the browser control panel on a local web server, owning the device link.
 
-use crate::args::{self, TargetArgs};
+use crate::args::{self, DeviceRobotArgs, TargetArgs};
 use quad_host::link::Target;
-use quad_protocol::RobotPreset;
+use quad_host::robot_file;
 use quad_web::device::DeviceSetup;
 use quad_web::ServeConfig;
 use std::io::{self, Write};
 use std::net::SocketAddr;
 use std::process::ExitCode;
 use std::time::Duration;
-
-/// Why `--robot` was refused.
-#[derive(Debug, thiserror::Error)]
-#[error("--robot {0}: not a preset (shahriar2023, fernando2025)")]
-struct NotAPreset(String);
 
 const LONG_ABOUT: &str = "\
 Serves the control panel of the device (--sim, --emulator or --port) on a local web server and
@@ -64,9 +59,9 @@ pub struct Args {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
-    /// Robot of the device (a preset; the firmware runs shahriar2023).
-    #[arg(long, value_name = "PRESET", default_value = "shahriar2023", value_parser = crate::args::parse_robot)]
-    pub robot: String,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: DeviceRobotArgs,
     /// Address to listen on.
     #[arg(long, value_name = "ADDR:PORT", default_value = "127.0.0.1:8080")]
     pub listen: SocketAddr,
@@ -80,13 +75,17 @@ pub struct Args {
 
 /// Runs `quadctl serve` and returns its exit status.
 pub fn main(args: &Args) -> ExitCode {
-    let Some(preset) = RobotPreset::from_name(args.robot.trim()) else {
-        return args::fail("quadctl", &NotAPreset(args.robot.clone()));
+    let robot = match args
+        .robot
+        .robot
+        .as_deref()
+        .map(robot_file::resolve_description)
+        .transpose()
+    {
+        Ok(r) => r.map(|d| d.robot),
+        Err(e) => return args::fail("quadctl", &e),
     };
-    let Some(robot) = preset.robot() else {
-        return args::fail("quadctl", &NotAPreset(args.robot.clone()));
-    };
-    let target = args.target.target(preset);
+    let target = args.target.target(args.robot.sim_preset());
     if matches!(target, Target::Emulator { .. }) {
         eprintln!(
             "quadctl serve: booting the firmware in simavr (built from firmware-avr/ if needed)"
@@ -96,11 +95,9 @@ pub fn main(args: &Args) -> ExitCode {
         device: DeviceSetup {
             target,
             robot,
-            preset,
             retries: args.target.retries,
             poll: Duration::from_millis(args.poll_ms),
         },
-        robot_name: args.robot.trim().to_owned(),
         listen: args.listen,
     };
     let running = match quad_web::start(config, true) {

@@ -3,7 +3,7 @@
 
 use super::{
     frames_to_boundary, Engine, Error, Law, LawMotion, Program, PulseMaps, Setup,
-    REST_KNEE_MARGIN_RAD, START_CHECK_SAMPLES,
+    START_CHECK_SAMPLES,
 };
 use kin_core::body::{self, BodyConfig, BodySolution, Pose};
 use kin_core::jacobian::SINGULARITY_THRESHOLD;
@@ -12,30 +12,24 @@ use kin_core::motion::path::{AnyPath, Stride};
 use kin_core::motion::walker::{Walker, WalkerParams};
 use kin_core::motion::{self, Frame, Param};
 use kin_core::preflight::{Failure, FailureKind};
-use kin_core::{IkError, Joint, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
+use kin_core::{IkError, JointAngles, LegId, Math, ReachPolicy, Robot, RotationOrder, Vec3};
 use quad_protocol::{LegSet, MotionCommand, ServoId};
 
 /// The rest pose of `robot`, order FL, FR, RL, RR: legs folded under the body — abduction 0,
-/// knee [`REST_KNEE_MARGIN_RAD`] short of the folded end of its range, hip at minus half the
+/// knee [`REST_KNEE_MARGIN_RAD`](super::REST_KNEE_MARGIN_RAD) short of the folded end of its range, hip at minus half the
 /// knee, which puts each foot below its hip joint. The body then rests low, on the ground or on
 /// its folded legs. Refused when a joint limit excludes it.
 pub fn rest_angles(robot: &Robot) -> Result<[f32; 12], Error> {
-    let l = &robot.limits;
-    let knee = match robot.knee_bend {
-        kin_core::KneeBend::Backward => l.min_rad[2] + REST_KNEE_MARGIN_RAD,
-        kin_core::KneeBend::Forward => l.max_rad[2] - REST_KNEE_MARGIN_RAD,
-    };
-    let leg = [0.0, -0.5 * knee, knee];
-    for (j, &a) in Joint::ALL.iter().zip(&leg) {
-        if !l.admits(*j, a) {
-            return Err(Error::Preflight(Failure {
-                sample: 0,
-                t_s: 0.0,
-                leg: LegId::FL,
-                kind: FailureKind::Unreachable(kin_core::Unreachable::JointLimit(*j)),
-            }));
-        }
+    let rest = robot.rest_leg();
+    if let Some(j) = robot.limits.first_violation(rest) {
+        return Err(Error::Preflight(Failure {
+            sample: 0,
+            t_s: 0.0,
+            leg: LegId::FL,
+            kind: FailureKind::Unreachable(kin_core::Unreachable::JointLimit(j)),
+        }));
     }
+    let leg = rest.to_array();
     let mut out = [0.0; 12];
     for c in out.chunks_exact_mut(3) {
         c.copy_from_slice(&leg);

@@ -121,8 +121,10 @@ pub const FRAME_S: f32 = 0.02;
 /// Samples per period of a law's start check (module docs).
 pub const START_CHECK_SAMPLES: u16 = 4;
 
-/// Knee fold of the rest pose, rad short of the folded end of the knee's range.
-pub const REST_KNEE_MARGIN_RAD: f32 = 0.2;
+/// Knee fold of the rest pose, rad short of the folded end of the knee's range (kin-core's
+/// [`kin_core::robot::REST_KNEE_MARGIN_RAD`], where the rest pose is defined:
+/// [`Robot::rest_leg`](kin_core::Robot::rest_leg)).
+pub const REST_KNEE_MARGIN_RAD: f32 = kin_core::robot::REST_KNEE_MARGIN_RAD;
 
 /// Most frames a late tick catches up with in a walk (1 s); beyond that, motion time is lost.
 const MAX_CATCH_UP_FRAMES: u32 = 50;

@@ -7,8 +7,8 @@ use quad_protocol::servo::Calibration;
 use quad_protocol::timing;
 use quad_protocol::{
     encode_frame, frame, Accumulator, DeviceInfo, DeviceToHost, Feed, HostToDevice, NackReason,
-    Readback, Request, ServoId, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN, MAX_FRAME_LEN,
-    PROTOCOL_VERSION,
+    Readback, Request, RobotDescription, ServoId, DEVICE_TO_HOST_MAX_LEN, MAX_DECODED_LEN,
+    MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 use serde::Serialize;
 use std::time::Duration;
@@ -144,7 +144,7 @@ impl<L: Link> Client<L> {
             AnswerWait::Modelled { compute, save } => {
                 let answer_len = frame::encoded_len_max(DEVICE_TO_HOST_MAX_LEN);
                 let mut t = byte_time(self.link.baud()) * (wire_len + answer_len) as u32 + compute;
-                if matches!(request, Request::SaveCalibration) {
+                if matches!(request, Request::SaveCalibration | Request::SaveRobot) {
                     t += save;
                 }
                 t
@@ -436,6 +436,52 @@ impl<L: Link> Client<L> {
                 answer: Box::new(other),
             }),
         }
+    }
+
+    /// The robot the device holds (protocol 2.4).
+    ///
+    /// # Errors
+    /// As [`Client::request`], or [`Error::Unexpected`].
+    pub fn get_robot(&mut self) -> Result<RobotDescription, Error> {
+        match self.request(Request::GetRobot)? {
+            DeviceToHost::Robot { robot, .. } => Ok(robot),
+            other => Err(Error::Unexpected {
+                request: "GetRobot",
+                answer: Box::new(other),
+            }),
+        }
+    }
+
+    /// Sends `robot` to the device (protocol 2.4; held in RAM until [`Client::save_robot`]).
+    /// The host's own check ([`quad_protocol::check_robot`]) runs first: a robot the device
+    /// would refuse is not sent.
+    ///
+    /// # Errors
+    /// [`Error::Refused`] with [`NackReason::BadRobot`] naming the field (by the host's check
+    /// or the device's), [`NackReason::OutputsEnabled`], as [`Client::request`], or
+    /// [`Error::Unexpected`] (an echo that differs from the robot sent included).
+    pub fn set_robot(&mut self, robot: &RobotDescription) -> Result<(), Error> {
+        quad_protocol::check_robot::<kin_core::DefaultMath>(robot).map_err(|reason| {
+            Error::Refused {
+                request: "SetRobot (not sent)",
+                reason,
+            }
+        })?;
+        match self.request(Request::SetRobot(*robot))? {
+            DeviceToHost::Robot { robot: held, .. } if held == *robot => Ok(()),
+            other => Err(Error::Unexpected {
+                request: "SetRobot",
+                answer: Box::new(other),
+            }),
+        }
+    }
+
+    /// Stores the robot the device holds in its EEPROM (protocol 2.4).
+    ///
+    /// # Errors
+    /// As [`Client::ack`] ([`NackReason::Storage`] when the write failed).
+    pub fn save_robot(&mut self) -> Result<(), Error> {
+        self.ack(Request::SaveRobot).map(|_| ())
     }
 
     /// All twelve calibrations, canonical order.

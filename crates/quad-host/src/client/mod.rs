@@ -222,6 +222,35 @@ pub enum Error {
         /// The host's.
         host: RobotPreset,
     },
+    /// The device holds another robot than the one the host plans with (their hashes differ,
+    /// protocol 2.4).
+    #[error(
+        "the device holds robot {device_name} (hash {device_hash:08x}), the host plans with \
+         {host_name} (hash {host_hash:08x}): send the host's robot to the device with \
+         `quadctl robot send FILE --save` (with the same --sim/--emulator/--port), or run \
+         without --robot to plan with the device's own"
+    )]
+    RobotMismatch {
+        /// The device's robot's name.
+        device_name: String,
+        /// Its hash.
+        device_hash: u32,
+        /// The host's robot's name.
+        host_name: String,
+        /// Its hash.
+        host_hash: u32,
+    },
+    /// The device speaks a protocol older than 2.4: it cannot tell or take its robot.
+    #[error(
+        "the device speaks protocol {}.{}: it holds a preset robot only (sending or reading \
+         the robot needs 2.4)",
+        device >> 8,
+        device & 0xFF
+    )]
+    NoRobotRequests {
+        /// The device's version.
+        device: u16,
+    },
 }
 
 /// Short name of an answer, for messages.
@@ -234,6 +263,7 @@ pub fn answer_name(a: &DeviceToHost) -> &'static str {
         DeviceToHost::Configured { .. } => "Configured",
         DeviceToHost::MotionAck { .. } => "MotionAck",
         DeviceToHost::Imu { .. } => "Imu",
+        DeviceToHost::Robot { .. } => "Robot",
     }
 }
 
@@ -258,5 +288,8 @@ pub fn request_name(r: &Request) -> &'static str {
         Request::SetJointSpeedLimit { .. } => "SetJointSpeedLimit",
         Request::SetBalance(_) => "SetBalance",
         Request::GetImu => "GetImu",
+        Request::SetRobot(_) => "SetRobot",
+        Request::GetRobot => "GetRobot",
+        Request::SaveRobot => "SaveRobot",
     }
 }

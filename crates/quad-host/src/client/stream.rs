@@ -181,6 +181,7 @@ impl<L: Link> PoseStream<L> {
                     policy: ReachPolicy::Reject,
                 },
                 link_timeout: Default::default(),
+                robot_hash: None,
             },
             pose_config: PoseConfig {
                 stance_height_m: 1.0,

@@ -486,7 +486,12 @@ fn replayed_run<L: Link>(
         calibration: *c.calibration,
         stance_height_m: info.pose_config.stance_height_m,
         order: info.pose_config.order,
-        joint_speed_limit_rad_s: engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S,
+        // The device's own robot's limit when the session read it (protocol 2.4).
+        joint_speed_limit_rad_s: session
+            .robot()
+            .map_or(engine::DEFAULT_JOINT_SPEED_LIMIT_RAD_S, |r| {
+                r.joint_speed_limit_rad_s
+            }),
     };
     let commands = Commands {
         request: *request,

@@ -13,5 +13,6 @@ pub mod motion;
 pub mod onboard;
 pub mod play;
 pub mod plot;
+pub mod robot;
 pub mod session;
 pub mod stream;

@@ -12,12 +12,13 @@
 
 use crate::client::{self, Client, ClientConfig, Outcome, Verdict};
 use crate::link::{self, Link, Target};
+use crate::robot_file;
 use quad_protocol::range::{self, ParamRange, Ranges};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     DeviceInfo, DeviceToHost, Flags, ImuReport, MotionCommand, MotionFrames, MotionKind,
     MotionParam, MotionStage, MotionStatus, NackReason, ParamProblem, PreflightFault, Readback,
-    Request, RobotPreset,
+    Request, RobotDescription, RobotPreset,
 };
 use serde::Serialize;
 use std::time::Duration;
@@ -29,12 +30,17 @@ pub const POLL_PERIOD: Duration = Duration::from_millis(100);
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The robot is not a preset.
+    /// The robot is not a preset and the device is older than protocol 2.4 (it cannot tell
+    /// which robot it holds beyond its preset).
     #[error(
-        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
-         device reports its preset and both sides must run the same geometry"
+        "--robot {0}: the device speaks a protocol older than 2.4 and needs a preset robot \
+         (shahriar2023, fernando2025): it reports its preset and both sides must run the same \
+         geometry"
     )]
     NotAPreset(String),
+    /// The robot file was refused (before anything was sent).
+    #[error(transparent)]
+    Robot(#[from] crate::robot_file::DeviceError),
     /// The link could not be opened.
     #[error(transparent)]
     Link(#[from] link::Error),
@@ -300,6 +306,32 @@ pub struct MotionAnswer {
     pub frames: Option<MotionFrames>,
 }
 
+/// Checks that the device's robot (`device`, with the hash its hello reported) is the one the
+/// host plans with (`host`; `None`: the host plans with the device's, nothing to check).
+///
+/// # Errors
+/// [`client::Error::RobotMismatch`] with both names and hashes.
+pub fn check_same_robot(
+    device: &RobotDescription,
+    hello_hash: Option<u32>,
+    host: Option<&RobotDescription>,
+) -> Result<(), client::Error> {
+    let device_hash = hello_hash.unwrap_or_else(|| device.hash());
+    let Some(host) = host else {
+        return Ok(());
+    };
+    if host.hash() == device_hash && device.hash() == device_hash {
+        return Ok(());
+    }
+    let name = |d: &RobotDescription| d.name_str().unwrap_or("(unnamed)").to_owned();
+    Err(client::Error::RobotMismatch {
+        device_name: name(device),
+        device_hash,
+        host_name: name(host),
+        host_hash: host.hash(),
+    })
+}
+
 /// A session with the device for onboard motions: handshake, robot check, calibration.
 pub struct Session<L> {
     client: Client<L>,
@@ -308,6 +340,9 @@ pub struct Session<L> {
     /// The request ranges of the device's robot (`None` for a geometry that is no preset: the
     /// host does not know it, the device alone checks).
     ranges: Option<Ranges>,
+    /// The robot the device holds, read at connection from a device of protocol 2.4 or later
+    /// ([`Session::connect_robot`]).
+    robot: Option<RobotDescription>,
 }
 
 impl<L: Link> Session<L> {
@@ -346,7 +381,50 @@ impl<L: Link> Session<L> {
             info,
             calibration,
             ranges: info.robot.robot().map(|r| Ranges::of(&r)),
+            robot: None,
         })
+    }
+
+    /// Handshake, the robot the device holds (protocol 2.4: `GetRobot`), checked against the
+    /// robot the host plans with when one is given (their hashes,
+    /// [`RobotDescription::hash`], must be equal), calibration read-back. With `host: None`
+    /// the host plans with the device's own robot ([`Session::robot`]).
+    ///
+    /// # Errors
+    /// The handshake's errors; [`client::Error::RobotMismatch`] naming both robots and their
+    /// hashes; [`client::Error::NoRobotRequests`] for a device older than 2.4 (whose robot is
+    /// a preset: [`Session::connect`]).
+    pub fn connect_robot(
+        mut client: Client<L>,
+        host: Option<&RobotDescription>,
+    ) -> Result<Session<L>, Error> {
+        let info = client.hello()?;
+        if quad_protocol::version_minor(info.version) < 4 {
+            return Err(client::Error::NoRobotRequests {
+                device: info.version,
+            }
+            .into());
+        }
+        let robot = client.get_robot()?;
+        check_same_robot(&robot, info.robot_hash, host)?;
+        let calibration = client.calibrations()?;
+        Ok(Session {
+            client,
+            info,
+            calibration,
+            ranges: Some(Ranges::of(&robot.robot)),
+            robot: Some(robot),
+        })
+    }
+
+    /// The client, the session ended (its link stays up).
+    pub fn into_client(self) -> Client<L> {
+        self.client
+    }
+
+    /// The robot the device holds, when read at connection ([`Session::connect_robot`]).
+    pub fn robot(&self) -> Option<&RobotDescription> {
+        self.robot.as_ref()
     }
 
     /// The range check the device runs first ([`quad_protocol::range::check_request`]), on
@@ -556,17 +634,40 @@ impl<L: Link> Session<L> {
     }
 }
 
-/// Opens `target` and connects a [`Session`] for `robot` (a preset name).
+/// Opens `target` and connects a [`Session`] for `robot`: a preset, a TOML or a URDF robot
+/// file ([`robot_file::device_description`]). A device of protocol 2.4 or later must hold
+/// that robot (the hashes are compared, [`Session::connect_robot`]); an older device must run
+/// the preset named ([`Session::connect`]).
 ///
 /// # Errors
-/// [`Error::NotAPreset`], the link's and the handshake's errors.
+/// [`Error::Robot`] for a robot file refused (before the link is opened),
+/// [`Error::NotAPreset`] for a robot file and a device older than 2.4,
+/// [`client::Error::RobotMismatch`] for a device holding another robot, the link's and the
+/// handshake's errors.
 pub fn open(robot: &str, target: &Target, retries: u32) -> Result<Session<Box<dyn Link>>, Error> {
+    let wanted = robot_file::device_description(robot)?;
+    let link = link::open(target)?;
+    let mut client = Client::new(link, ClientConfig::for_target(target, retries));
+    let info = client.hello()?;
+    if quad_protocol::version_minor(info.version) >= 4 {
+        return Session::connect_robot(client, Some(&wanted));
+    }
     let preset =
         RobotPreset::from_name(robot.trim()).ok_or_else(|| Error::NotAPreset(robot.to_owned()))?;
+    Session::connect(client, preset)
+}
+
+/// [`open`] without a robot: the host plans with the robot the device holds (protocol 2.4,
+/// [`Session::connect_robot`]).
+///
+/// # Errors
+/// [`client::Error::NoRobotRequests`] for a device older than 2.4, the link's and the
+/// handshake's errors.
+pub fn open_device_robot(target: &Target, retries: u32) -> Result<Session<Box<dyn Link>>, Error> {
     let link = link::open(target)?;
-    Session::connect(
+    Session::connect_robot(
         Client::new(link, ClientConfig::for_target(target, retries)),
-        preset,
+        None,
     )
 }
 

@@ -8,15 +8,15 @@ use crate::client::{
 use crate::link::{self, Link, Target};
 use crate::robot_file;
 use kin_core::{Robot, RotationOrder};
-use quad_protocol::RobotPreset;
+use quad_protocol::{RobotDescription, RobotPreset};
 use serde::Serialize;
 use std::io::{self, Write};
 
 /// The device side of a stream: robot, device, retries and the configuration set on it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Session {
-    /// The robot: a preset name (the device reports its preset and both sides must run the
-    /// same geometry).
+    /// The robot: a preset, a TOML or a URDF robot file. A device of protocol 2.4 or later
+    /// must hold it (compared by hash); an older device must run the preset named.
     pub robot: String,
     /// The device.
     pub target: Target,
@@ -35,15 +35,19 @@ pub struct Session {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The robot is not a preset.
+    /// The robot is not a preset and the device is older than protocol 2.4.
     #[error(
-        "--robot {0}: the device link needs a preset robot (shahriar2023, fernando2025): the \
-         device reports its preset and both sides must run the same geometry"
+        "--robot {0}: the device speaks a protocol older than 2.4 and needs a preset robot \
+         (shahriar2023, fernando2025): it reports its preset and both sides must run the same \
+         geometry"
     )]
     NotAPreset(String),
     /// The robot could not be resolved.
     #[error(transparent)]
     Robot(#[from] robot_file::Error),
+    /// The robot was refused as a device's robot (before the link is opened).
+    #[error(transparent)]
+    Device(#[from] robot_file::DeviceError),
     /// A negative or non-finite angle tolerance.
     #[error("--angle-tolerance-rad {0} must be finite and >= 0")]
     Tolerance(f32),
@@ -60,6 +64,7 @@ pub enum Error {
 pub struct Checked {
     preset: RobotPreset,
     robot: Robot,
+    description: RobotDescription,
     check: AngleCheck,
 }
 
@@ -67,11 +72,11 @@ impl Session {
     /// Checks the robot and the tolerance, before any file is read or link opened.
     ///
     /// # Errors
-    /// [`Error::NotAPreset`], [`Error::Robot`], [`Error::Tolerance`].
+    /// [`Error::Device`], [`Error::Tolerance`].
     pub fn check(&self) -> Result<Checked, Error> {
-        let preset = RobotPreset::from_name(self.robot.trim())
-            .ok_or_else(|| Error::NotAPreset(self.robot.clone()))?;
-        let robot = robot_file::resolve(&self.robot)?;
+        let preset = RobotPreset::from_name(self.robot.trim()).unwrap_or(RobotPreset::Custom);
+        let description = robot_file::device_description(&self.robot)?;
+        let robot = description.robot;
         let check = match self.angle_tolerance_rad {
             Some(t) if t.is_finite() && t >= 0.0 => AngleCheck::Within(t),
             Some(t) => return Err(Error::Tolerance(t)),
@@ -80,6 +85,7 @@ impl Session {
         Ok(Checked {
             preset,
             robot,
+            description,
             check,
         })
     }
@@ -87,23 +93,42 @@ impl Session {
     /// Opens the link and connects the stream (handshake, configuration); the rotation order
     /// is [`Session::rotation_order`], else `default_order`, else the device's own.
     ///
+    /// A device of protocol 2.4 or later must hold the robot checked (the hashes are
+    /// compared, [`crate::ops::onboard::check_same_robot`]); an older one must run its preset.
+    ///
     /// # Errors
-    /// [`Error::Link`], [`Error::Client`].
+    /// [`Error::Link`], [`Error::Client`] ([`client::Error::RobotMismatch`] for another
+    /// robot), [`Error::NotAPreset`] for a robot file and a device older than 2.4.
     pub fn connect(
         &self,
         checked: Checked,
         default_order: Option<RotationOrder>,
     ) -> Result<PoseStream<Box<dyn Link>>, Error> {
         let link = link::open(&self.target)?;
+        let config = ClientConfig::for_target(&self.target, self.retries);
+        let mut client = Client::new(link, config);
+        let info = client.hello()?;
+        let preset = if quad_protocol::version_minor(info.version) >= 4 {
+            let held = client.get_robot()?;
+            crate::ops::onboard::check_same_robot(
+                &held,
+                info.robot_hash,
+                Some(&checked.description),
+            )?;
+            info.robot
+        } else if checked.preset == RobotPreset::Custom {
+            return Err(Error::NotAPreset(self.robot.clone()));
+        } else {
+            checked.preset
+        };
         let setup = StreamSetup {
             robot: checked.robot,
-            preset: checked.preset,
+            preset,
             stance_height_m: self.stance_height_m,
             order: self.rotation_order.or(default_order),
             check: checked.check,
         };
-        let config = ClientConfig::for_target(&self.target, self.retries);
-        Ok(PoseStream::connect(Client::new(link, config), setup)?)
+        Ok(PoseStream::connect(client, setup)?)
     }
 }
 

@@ -400,6 +400,7 @@ pub fn answers() -> Vec<(&'static str, DeviceToHost, &'static str)> {
                         timeout_ms: 250,
                         action: LinkLossAction::Hold,
                     },
+                    robot_hash: None,
                 },
             },
             "01 01 80 02 00 01 00 01 80 01 00 00 00 3f 05 00 fa 01 00",

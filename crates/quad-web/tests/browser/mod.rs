@@ -55,12 +55,10 @@ pub fn serve(target: Target) -> Running {
     let config = ServeConfig {
         device: DeviceSetup {
             target,
-            robot: kin_core::Robot::shahriar2023(),
-            preset: RobotPreset::Shahriar2023,
+            robot: Some(kin_core::Robot::shahriar2023()),
             retries: 10,
             poll: Duration::from_millis(50),
         },
-        robot_name: "shahriar2023".to_owned(),
         listen: "127.0.0.1:0".parse().unwrap(),
     };
     quad_web::start(config, false).expect("the server starts")

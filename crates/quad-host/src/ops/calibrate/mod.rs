@@ -273,8 +273,9 @@ pub enum GuideError {
 }
 
 /// Opens the device at `target` (`retries` resends per request), reads its calibration and
-/// starts a [`guide::Guide`] on the device's own robot ([`crate::robot_file::device_robot`];
-/// `robot_file` for a device whose robot is no preset).
+/// starts a [`guide::Guide`] on the device's own robot ([`crate::robot_file::device_robot`]: the
+/// robot a device of protocol 2.4 holds; `robot_file` for an older device whose robot is no
+/// preset, and a check against the device's robot otherwise).
 ///
 /// # Errors
 /// See [`GuideError`].
@@ -290,11 +291,15 @@ pub fn open_guide(
     GuideError,
 > {
     let link = link::open(target)?;
-    let session = crate::ops::onboard::Session::connect_to_device(Client::new(
-        link,
-        ClientConfig::for_target(target, retries),
-    ))?;
-    let robot = crate::robot_file::device_robot(session.info(), robot_file)?;
+    let mut client = Client::new(link, ClientConfig::for_target(target, retries));
+    // A device of protocol 2.4 or later tells the robot it holds; an older one only its preset.
+    let info = client.hello().map_err(crate::ops::onboard::Error::from)?;
+    let session = if quad_protocol::version_minor(info.version) >= 4 {
+        crate::ops::onboard::Session::connect_robot(client, None)?
+    } else {
+        crate::ops::onboard::Session::connect_to_device(client)?
+    };
+    let robot = crate::robot_file::device_robot(session.info(), session.robot(), robot_file)?;
     let guide = guide::Guide::new(&robot, *session.calibration())?;
     Ok((session, guide))
 }

@@ -44,16 +44,41 @@
 //!
 //! A non-positive or non-finite value, an unknown servo or physical preset is refused naming the
 //! key and its line ([`Error::Physical`]; unknown presets list the known ones).
+//!
+//! An optional `[device]` table gives what the device holds besides the geometry when the robot
+//! is sent to it (protocol 2.4, `quadctl robot send`; [`device_description`]); every key is
+//! optional:
+//!
+//! ```toml
+//! [device]
+//! name = "bench-pup"              # printable ASCII, at most 16 bytes; default: the file's stem
+//! stance_height_m = 0.32          # default: see `default_stance_height_m`
+//! rotation_order = "zyx"          # of body poses; default zyx
+//! joint_speed_limit_rad_s = 3.0   # default: the device's default limit
+//! ```
+//!
+//! A key left out of a file with a preset's geometry takes the preset's value (its name, stance
+//! height, rotation order and joint-speed limit). The device checks what it is sent (`quad_protocol::check_robot`, which the host runs first):
+//! the lengths and limits within their ranges, the stance reachable by every leg, the rest pose
+//! within the limits.
 
 use crate::names;
 use kin_core::robot::RobotError;
 use kin_core::{JointLimits, KneeBend, LegGeometry, Robot};
 use quad_model::{Model, Physical, ServoModel};
-use quad_protocol::{DeviceInfo, RobotPreset};
+
 use serde::{Deserialize, Deserializer};
 use std::io;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
+
+mod device;
+mod write;
+
+pub use device::{
+    default_stance_height_m, device_description, device_robot, DeviceError, DeviceRobotError,
+};
+pub use write::to_toml;
 
 /// `knee_bend = "backward" | "forward"`, through [`names::knee_bend`].
 fn knee_bend<'de, D: Deserializer<'de>>(d: D) -> Result<KneeBend, D::Error> {
@@ -200,6 +225,18 @@ struct RobotFile {
     limits: LimitsTable,
     #[serde(default)]
     physical: PhysicalTable,
+    #[serde(default)]
+    device: DeviceTable,
+}
+
+/// The `[device]` table (module docs): every key optional.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DeviceTable {
+    name: Option<String>,
+    stance_height_m: Option<f32>,
+    rotation_order: Option<String>,
+    joint_speed_limit_rad_s: Option<f32>,
 }
 
 /// The longest link or body dimension a robot file may give, m. Any longer is taken for a value
@@ -446,49 +483,6 @@ pub fn parse_description(text: &str) -> Result<Description, Error> {
     Ok(Description { robot, physical })
 }
 
-/// Why the robot of a device could not be known.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
-pub enum DeviceRobotError {
-    /// The device runs a robot that is no preset, and no robot file was given.
-    #[error(
-        "the device runs a robot that is no preset (`custom`): give its robot file with \
-         --robot FILE.toml"
-    )]
-    Custom,
-    /// The robot given is not the preset the device runs.
-    #[error(
-        "the device runs robot {}, the robot given is another: leave --robot out (the device's \
-         own robot is used) or give that preset",
-        names::robot_preset_name(*device)
-    )]
-    Mismatch {
-        /// The device's preset.
-        device: RobotPreset,
-    },
-}
-
-/// The robot the device runs, from its `HelloAck`: the preset it reports, or `file` (a robot
-/// file given on the command line) for a device whose robot is no preset. A robot given for a
-/// preset device must be that preset's geometry.
-///
-/// Every operation that plans with the device's own robot (the guided calibration's posture and
-/// test poses, the panel's calibration tab) obtains it here, so that a device that reports its
-/// geometry itself changes this function only.
-///
-/// # Errors
-/// [`DeviceRobotError::Custom`] for a custom device without `file`,
-/// [`DeviceRobotError::Mismatch`] for a preset device and another robot.
-pub fn device_robot(info: &DeviceInfo, file: Option<&Robot>) -> Result<Robot, DeviceRobotError> {
-    match (info.robot.robot(), file) {
-        (Some(robot), None) => Ok(robot),
-        (Some(robot), Some(given)) if robot.equals(given) => Ok(robot),
-        (Some(_), Some(_)) => Err(DeviceRobotError::Mismatch { device: info.robot }),
-        (None, Some(given)) => Ok(*given),
-        (None, None) => Err(DeviceRobotError::Custom),
-    }
-}
-
 /// Resolves a `--robot` argument with its physical properties: a preset name (its physical
 /// preset), a URDF file (`.urdf`, legs with this project's chain, [`quad_model::urdf`]; the
 /// physical preset of [`default_physical`]) or else a TOML file path (see
@@ -522,97 +516,6 @@ pub fn resolve_description(spec: &str) -> Result<Description, Error> {
     parse_description(text).map_err(|e| e.in_file(path))
 }
 
-/// An `f32` as the `f64` of its shortest decimal form, so that the TOML writer prints `0.28`
-/// (not `0.2800000011920929`) and reading the file back gives the same `f32`.
-fn shortest(x: f32) -> f64 {
-    // The shortest form of a finite f32 always parses as an f64; a non-finite value never
-    // reaches here (a validated robot and physical preset hold finite values only).
-    x.to_string().parse().unwrap_or(f64::from(x))
-}
-
-/// The file layout [`to_toml`] writes: the keys [`parse_description`] reads, in its order.
-#[derive(serde::Serialize)]
-struct RobotFileOut {
-    d_lat_m: f64,
-    d_ax_m: f64,
-    femur_m: f64,
-    tibia_m: f64,
-    body_length_m: f64,
-    body_width_m: f64,
-    knee_bend: &'static str,
-    limits: LimitsOut,
-    physical: PhysicalOut,
-}
-
-/// `[limits]` as written: every joint explicit.
-#[derive(serde::Serialize)]
-struct LimitsOut {
-    abduction_rad: [f64; 2],
-    hip_rad: [f64; 2],
-    knee_rad: [f64; 2],
-}
-
-/// `[physical]` as written: every key explicit, the servo by its preset name.
-#[derive(serde::Serialize)]
-struct PhysicalOut {
-    servo: &'static str,
-    body_mass_kg: f64,
-    body_height_m: f64,
-    abduction_link_mass_kg: f64,
-    femur_mass_kg: f64,
-    tibia_mass_kg: f64,
-    knee_servo_offset_m: f64,
-    foot_radius_m: f64,
-    foot_friction: f64,
-    link_radius_m: f64,
-}
-
-/// The robot file of `description`: every key explicit (the limits of all three joints and the
-/// whole `[physical]` table), so that [`parse_description`] of the text gives `description`
-/// back exactly, whatever the presets' defaults become. `quadctl export --format toml` writes it.
-///
-/// # Errors
-/// [`Error::Write`] when the description cannot be written as TOML (a non-finite value).
-pub fn to_toml(description: &Description) -> Result<String, Error> {
-    let Description { robot, physical } = description;
-    let limit = |j: usize| {
-        [
-            shortest(robot.limits.min_rad[j]),
-            shortest(robot.limits.max_rad[j]),
-        ]
-    };
-    let out = RobotFileOut {
-        d_lat_m: shortest(robot.leg.d_lat_m),
-        d_ax_m: shortest(robot.leg.d_ax_m),
-        femur_m: shortest(robot.leg.femur_m),
-        tibia_m: shortest(robot.leg.tibia_m),
-        body_length_m: shortest(robot.body_length_m),
-        body_width_m: shortest(robot.body_width_m),
-        knee_bend: names::knee_bend_name(robot.knee_bend),
-        limits: LimitsOut {
-            abduction_rad: limit(0),
-            hip_rad: limit(1),
-            knee_rad: limit(2),
-        },
-        physical: PhysicalOut {
-            servo: physical.servo.name,
-            body_mass_kg: shortest(physical.body_mass_kg),
-            body_height_m: shortest(physical.body_height_m),
-            abduction_link_mass_kg: shortest(physical.abduction_link_mass_kg),
-            femur_mass_kg: shortest(physical.femur_mass_kg),
-            tibia_mass_kg: shortest(physical.tibia_mass_kg),
-            knee_servo_offset_m: shortest(physical.knee_servo_offset_m),
-            foot_radius_m: shortest(physical.foot_radius_m),
-            foot_friction: shortest(physical.foot_friction),
-            link_radius_m: shortest(physical.link_radius_m),
-        },
-    };
-    let body = toml::to_string(&out).map_err(|e| Error::Write(e.to_string()))?;
-    Ok(format!(
-        "# A robot file (docs/robots.md): lengths in m, limits in rad, masses in kg.\n{body}"
-    ))
-}
-
 /// Reads and validates a robot file.
 pub fn load_file(path: &Path) -> Result<Robot, Error> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
@@ -638,41 +541,6 @@ mod tests {
 
     const MINIMAL: &str = "d_lat_m = 0.044\nd_ax_m = 0.0\nfemur_m = 0.28\ntibia_m = 0.277\n\
                            body_length_m = 0.6\nbody_width_m = 0.28\n";
-
-    /// The `HelloAck` of a device running `preset`.
-    fn info(preset: RobotPreset) -> DeviceInfo {
-        let c = quad_device::Config::shahriar2023();
-        DeviceInfo {
-            version: quad_protocol::PROTOCOL_VERSION,
-            firmware: c.firmware,
-            robot: preset,
-            max_frame_len: 128,
-            pose_config: c.pose_config,
-            link_timeout: c.link_timeout,
-        }
-    }
-
-    #[test]
-    fn the_device_robot_is_the_preset_it_reports_or_the_file_given_for_a_custom_one() {
-        let fernando = info(RobotPreset::Fernando2025);
-        assert_eq!(device_robot(&fernando, None), Ok(Robot::fernando2025()));
-        assert_eq!(
-            device_robot(&fernando, Some(&Robot::fernando2025())),
-            Ok(Robot::fernando2025())
-        );
-        assert_eq!(
-            device_robot(&fernando, Some(&Robot::shahriar2023())),
-            Err(DeviceRobotError::Mismatch {
-                device: RobotPreset::Fernando2025
-            })
-        );
-        let custom = info(RobotPreset::Custom);
-        let e = device_robot(&custom, None).unwrap_err();
-        assert_eq!(e, DeviceRobotError::Custom);
-        assert!(e.to_string().contains("--robot FILE.toml"), "{e}");
-        let file = parse(MINIMAL).expect("valid file");
-        assert_eq!(device_robot(&custom, Some(&file)), Ok(file));
-    }
 
     #[test]
     fn limits_default_to_the_full_turn_and_knee_to_backward() {
@@ -811,27 +679,6 @@ mod tests {
             .expect_err("unknown key")
             .to_string();
         assert!(err.contains("unknown field `body_mass`"), "{err}");
-    }
-
-    #[test]
-    fn the_written_file_reads_back_as_the_same_description() {
-        let custom = parse_description(&format!(
-            "{MINIMAL}knee_bend = \"forward\"\n[limits]\nknee_rad = [0.05, 2.7]\n[physical]\nservo = \"qdd17\"\nbody_mass_kg = 2.345\n"
-        ))
-        .unwrap();
-        let presets = Robot::PRESETS.map(|name| resolve_description(name).unwrap());
-        for description in presets.iter().chain([&custom]) {
-            let text = to_toml(description).unwrap();
-            let back = parse_description(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
-            assert_eq!(back.robot, description.robot, "{text}");
-            assert_eq!(back.physical, description.physical, "{text}");
-            // Bit for bit, not only within the tolerance `Robot::eq` may allow.
-            assert_eq!(
-                back.robot.leg.femur_m.to_bits(),
-                description.robot.leg.femur_m.to_bits()
-            );
-            assert!(!text.contains("00000"), "shortest decimals only:\n{text}");
-        }
     }
 
     #[test]

@@ -51,17 +51,21 @@ use crate::motion;
 use crate::msg::{self, FlagsMsg, LinkMsg, State};
 use kin_core::body::Pose;
 use kin_core::Robot;
-use quad_host::client::{
-    self, expected, judge, AngleCheck, Client, ClientConfig, Expected, Outcome,
-};
-use quad_host::link::{self, Link, Target};
-use quad_host::ops::calibrate::guide::{self, Action, Guide, Refusal};
+use quad_host::client::{self, expected, judge, AngleCheck, Client, Expected, Outcome};
+use quad_host::link::{self, Link};
+use quad_host::ops::calibrate::guide::{self, Guide};
 use quad_protocol::servo::Calibration;
 use quad_protocol::{
     DeviceInfo, DeviceToHost, Flags, ImuReport, LinkLossAction, MotionStage, MotionStatus,
-    NackReason, PoseConfig, Ranges, Readback, Request, RobotPreset, ServoId,
+    NackReason, PoseConfig, Ranges, Readback, Request, ServoId,
 };
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+mod guided;
+mod thread;
+
+pub use guided::{GUIDE_MOTION_LIMIT, GUIDE_POLL};
+pub use thread::{run, DeviceSetup, Event, Job, Ready};
 
 /// Why a command was not carried out.
 #[derive(Debug, thiserror::Error)]
@@ -113,14 +117,10 @@ pub enum Error {
     /// The save did not clear the device's "unsaved" flag.
     #[error("the device still reports an unsaved calibration after the save")]
     NotSaved,
-    /// The device runs another robot than the server was given.
-    #[error("the device runs robot {device:?}, the server was given {host:?}")]
-    Robot {
-        /// The device's.
-        device: RobotPreset,
-        /// The server's.
-        host: RobotPreset,
-    },
+    /// The device runs another robot than the server was given, or one the server cannot
+    /// know.
+    #[error(transparent)]
+    Robot(#[from] quad_host::robot_file::DeviceRobotError),
     /// The stance height makes the held pose unreachable: nothing sent.
     #[error(
         "not sent: the held pose is unreachable at stance height {stance_height_m} m ({reason})"
@@ -199,6 +199,8 @@ impl Error {
 pub struct Session<L> {
     client: Client<L>,
     robot: Robot,
+    /// Its name: the description's, or the preset's.
+    robot_name: String,
     /// The protocol's ranges of `robot`.
     ranges: Ranges,
     info: DeviceInfo,
@@ -224,13 +226,6 @@ pub struct Session<L> {
     guide: Option<Guide>,
 }
 
-/// How often the state is read and published while the guided calibration waits for a test
-/// pose (or the stand-up that switches the outputs on) to end.
-pub const GUIDE_POLL: Duration = Duration::from_millis(100);
-
-/// The longest a test pose of the guided calibration may take, link time.
-pub const GUIDE_MOTION_LIMIT: Duration = Duration::from_secs(60);
-
 impl<L: Link> Session<L> {
     /// Handshake, robot check, calibration read, current state. Nothing moves: the outputs
     /// stay as they are (off at power-on).
@@ -239,17 +234,22 @@ impl<L: Link> Session<L> {
     /// The handshake's errors, or [`Error::Robot`].
     pub fn connect(
         mut client: Client<L>,
-        robot: Robot,
-        preset: RobotPreset,
+        robot: Option<Robot>,
         check: AngleCheck,
     ) -> Result<Session<L>, Error> {
         let info = client.hello()?;
-        if info.robot != preset {
-            return Err(Error::Robot {
-                device: info.robot,
-                host: preset,
-            });
-        }
+        // The device's own robot: the description a device of protocol 2.4 holds, else its
+        // preset; a robot the server was given must be that one.
+        let held = if quad_protocol::version_minor(info.version) >= 4 {
+            Some(client.get_robot()?)
+        } else {
+            None
+        };
+        let robot = quad_host::robot_file::device_robot(&info, held.as_ref(), robot.as_ref())?;
+        let robot_name = match &held {
+            Some(h) => h.name_str().unwrap_or("custom").to_owned(),
+            None => quad_host::names::robot_preset_name(info.robot).to_owned(),
+        };
         let calibration = client.calibrations()?;
         let readback = client.ack(Request::GetState)?;
         let motions = quad_protocol::version_minor(info.version) >= 1;
@@ -271,6 +271,7 @@ impl<L: Link> Session<L> {
             client,
             ranges: Ranges::of(&robot),
             robot,
+            robot_name,
             info,
             pose_config: info.pose_config,
             calibration,
@@ -288,6 +289,16 @@ impl<L: Link> Session<L> {
     /// The device's `HelloAck`.
     pub fn info(&self) -> &DeviceInfo {
         &self.info
+    }
+
+    /// The robot the device runs, which the session plans and checks with.
+    pub fn robot(&self) -> &Robot {
+        &self.robot
+    }
+
+    /// Its name: the description's (protocol 2.4), or the preset's.
+    pub fn robot_name(&self) -> &str {
+        &self.robot_name
     }
 
     /// The last readback.
@@ -676,136 +687,6 @@ impl<L: Link> Session<L> {
         Ok(())
     }
 
-    /// Lets `d` of link time pass, then waits until the wall clock has caught up with the link
-    /// time since `link_start` (at `wall_start`): a simulated device's motion then runs at its
-    /// real pace.
-    fn idle_paced(
-        &mut self,
-        d: Duration,
-        wall_start: Instant,
-        link_start: Duration,
-    ) -> Result<(), Error> {
-        self.idle(d)?;
-        let link = self.link_elapsed().saturating_sub(link_start);
-        if let Some(ahead) = link.checked_sub(wall_start.elapsed()) {
-            std::thread::sleep(ahead);
-        }
-        Ok(())
-    }
-
-    /// Reads the state every [`GUIDE_POLL`], publishing each, until no motion runs.
-    fn wait_motion(&mut self, publish: &dyn Fn(&Session<L>)) -> Result<(), Error> {
-        let (wall, link) = (Instant::now(), self.link_elapsed());
-        loop {
-            self.poll()?;
-            publish(self);
-            if self.motion.kind.is_none() {
-                return match self.motion.fault {
-                    Some(fault) => Err(Error::MotionFault(fault)),
-                    None => Ok(()),
-                };
-            }
-            if self.link_elapsed().saturating_sub(link) > GUIDE_MOTION_LIMIT {
-                return Err(Error::NoEnd(GUIDE_MOTION_LIMIT));
-            }
-            self.idle_paced(GUIDE_POLL, wall, link)?;
-        }
-    }
-
-    /// Runs a test pose of the guided calibration to its end.
-    fn guide_test(
-        &mut self,
-        pose: guide::TestPose,
-        publish: &dyn Fn(&Session<L>),
-    ) -> Result<(), Error> {
-        let (start, velocity) = pose.motion(self.pose_config.stance_height_m);
-        self.motion_command(&motion::Command::Start(start))?;
-        publish(self);
-        if let Some(v) = velocity {
-            let (wall, link) = (Instant::now(), self.link_elapsed());
-            let hold = Duration::from_secs_f32(v.duration_s);
-            while self.link_elapsed().saturating_sub(link) < hold {
-                self.motion_command(&motion::Command::Velocity(motion::VelocityMsg {
-                    forward_m_s: v.forward_m_s,
-                    lateral_m_s: v.lateral_m_s,
-                    yaw_rate_rad_s: v.yaw_rate_rad_s,
-                }))?;
-                publish(self);
-                self.idle_paced(GUIDE_POLL, wall, link)?;
-            }
-            self.motion_command(&motion::Command::Stop)?;
-        }
-        self.wait_motion(publish)
-    }
-
-    /// Carries out one action of the guided calibration.
-    fn guide_act(&mut self, action: &Action, publish: &dyn Fn(&Session<L>)) -> Result<(), Error> {
-        match *action {
-            Action::OutputsOn if self.readback.flags.contains(Flags::OUTPUTS_ENABLED) => Ok(()),
-            Action::OutputsOn => {
-                self.motion_command(&motion::Command::Start(
-                    quad_protocol::MotionCommand::StandUp,
-                ))?;
-                self.wait_motion(publish)
-            }
-            Action::SetJoints { angles_rad } => self.set_joints(angles_rad),
-            Action::SetCalibration { servo, calibration } => {
-                self.set_calibration(servo, calibration)
-            }
-            Action::Save => self.save_calibration(),
-            Action::Test(pose) => self.guide_test(pose, publish),
-        }
-    }
-
-    /// `guide_start` or `guide_key`: the step machine's actions carried out, the state
-    /// published after each (see the module docs).
-    ///
-    /// # Errors
-    /// [`Error::Guide`] when the device's robot is not known or has no calibration posture,
-    /// [`Error::NoGuide`] for a key without a guide, link failures. A device refusal is the
-    /// guide's message, not an error.
-    pub fn guide_command(
-        &mut self,
-        cmd: &msg::ClientMsg,
-        publish: &dyn Fn(&Session<L>),
-    ) -> Result<(), Error> {
-        let mut g = match *cmd {
-            msg::ClientMsg::GuideStart => {
-                if self.guide.as_ref().is_some_and(|g| !g.step().is_done()) {
-                    return Err(Error::Guide(
-                        "one is running: abort it first (q)".to_owned(),
-                    ));
-                }
-                let robot = quad_host::robot_file::device_robot(&self.info, Some(&self.robot))
-                    .map_err(|e| Error::Guide(e.to_string()))?;
-                self.read_calibration()?;
-                Guide::new(&robot, self.calibration).map_err(|e| Error::Guide(e.to_string()))?
-            }
-            msg::ClientMsg::GuideKey { key } => {
-                let mut g = self.guide.take().ok_or(Error::NoGuide)?;
-                g.key(key);
-                g
-            }
-            _ => return Ok(()),
-        };
-        let result = loop {
-            let Some(action) = g.next_action() else {
-                break Ok(());
-            };
-            // The state shows the guide's step while its action runs.
-            self.guide = Some(g.clone());
-            let done = self.guide_act(&action, publish);
-            match refusal(done) {
-                Ok(answer) => g.answer(answer),
-                Err(e) => break Err(e),
-            }
-            self.guide = Some(g.clone());
-            publish(self);
-        };
-        self.guide = Some(g);
-        result
-    }
-
     /// The state for the pages.
     pub fn state(&self, t_ms: f64) -> State {
         let c = self.client.counters();
@@ -864,259 +745,6 @@ impl<L: Link> Session<L> {
             M::SetBalance { leveling } => self.set_balance(leveling),
             M::GuideStart | M::GuideKey { .. } => self.guide_command(cmd, &|_| {}),
             M::TakeControl | M::ReleaseControl => Ok(()),
-        }
-    }
-}
-
-/// A refusal (the device's, or a check of the host that the device runs alike) as the guided
-/// calibration's [`Refusal`]; any other error as it is.
-fn refusal(result: Result<(), Error>) -> Result<Result<(), Refusal>, Error> {
-    let refused = |request, reason, sent| {
-        Ok(Err(Refusal {
-            request,
-            reason,
-            sent,
-        }))
-    };
-    match result {
-        Ok(()) => Ok(Ok(())),
-        Err(Error::Refused { request, reason }) => refused(request, reason, true),
-        Err(Error::MotionRefused { request, reason }) => {
-            refused(client::request_name(&request), reason, true)
-        }
-        Err(Error::Motion { request, reason }) => {
-            refused(client::request_name(&request), reason, false)
-        }
-        Err(Error::MotionFault(reason)) => refused("StartMotion", reason, true),
-        Err(Error::BadCalibration { source, .. }) => {
-            refused("SetCalibration", NackReason::BadCalibration(source), false)
-        }
-        Err(Error::Travel { servo, source }) => refused(
-            "SetCalibration",
-            NackReason::ServoRange {
-                leg: servo.leg,
-                joint: servo.joint,
-                fault: source,
-            },
-            false,
-        ),
-        Err(e) => Err(e),
-    }
-}
-
-/// Where the device is and what the server expects of it.
-#[derive(Debug, Clone)]
-pub struct DeviceSetup {
-    /// The device.
-    pub target: Target,
-    /// The robot the host checks poses with.
-    pub robot: Robot,
-    /// Its preset (the device's must match).
-    pub preset: RobotPreset,
-    /// Resends per request.
-    pub retries: u32,
-    /// How often the state is read between commands.
-    pub poll: Duration,
-}
-
-/// A page command for the device thread, and where its result goes.
-pub struct Job {
-    /// The command (validated).
-    pub cmd: msg::ClientMsg,
-    /// The result.
-    pub reply: tokio::sync::oneshot::Sender<Result<(), Error>>,
-}
-
-/// What the device thread tells the server.
-pub enum Event {
-    /// A job for the device.
-    Job(Job),
-    /// The controlling page went away.
-    ControlLost,
-}
-
-/// What the server learns when the device thread is up.
-#[derive(Debug, Clone)]
-pub struct Ready {
-    /// The device's `HelloAck`.
-    pub info: DeviceInfo,
-}
-
-/// The device's clock runs this much at a time while it is behind the wall clock: a command
-/// that arrives meanwhile waits for at most one slice (an emulated device may need several
-/// times its length of wall time).
-const IDLE_SLICE: Duration = Duration::from_millis(2);
-
-/// Longest wait for an event while the device's clock is up to the wall clock.
-const WAIT_SLICE: Duration = Duration::from_millis(10);
-
-/// The device thread's next event: a job, a lost page, the server's end, or (as a timeout) a
-/// state read due at `poll_due`.
-///
-/// The device's clock follows the server's meanwhile: a simulated or emulated device's time
-/// (and its motion) runs only while its link is read, so the link idles in [`IDLE_SLICE`]s up
-/// to the wall clock, checking for events and a due state read between slices. A device slower
-/// than real time (simavr on a busy machine) thus runs its motions slower rather than delaying
-/// the pages' commands.
-fn next_event<L: Link>(
-    events: &std::sync::mpsc::Receiver<Event>,
-    session: &mut Session<L>,
-    link_up: &mut bool,
-    wall_epoch: Instant,
-    poll_due: Instant,
-) -> Result<Event, std::sync::mpsc::RecvTimeoutError> {
-    use std::sync::mpsc::{RecvTimeoutError, TryRecvError};
-    loop {
-        match events.try_recv() {
-            Ok(e) => return Ok(e),
-            Err(TryRecvError::Disconnected) => return Err(RecvTimeoutError::Disconnected),
-            Err(TryRecvError::Empty) => {}
-        }
-        let now = Instant::now();
-        if now >= poll_due {
-            return Err(RecvTimeoutError::Timeout);
-        }
-        let behind = wall_epoch.elapsed().saturating_sub(session.link_elapsed());
-        if *link_up && behind >= IDLE_SLICE {
-            if let Err(e) = session.idle(IDLE_SLICE) {
-                eprintln!("quadctl serve: device link failed: {e}");
-                *link_up = false;
-            }
-            continue;
-        }
-        match events.recv_timeout((poll_due - now).min(WAIT_SLICE)) {
-            Ok(e) => return Ok(e),
-            Err(RecvTimeoutError::Timeout) => {}
-            Err(RecvTimeoutError::Disconnected) => return Err(RecvTimeoutError::Disconnected),
-        }
-    }
-}
-
-/// Runs the device thread: opens the link, connects, then serves `events` and publishes the
-/// state to `state` until `events` closes. The result of the connection goes to `ready` first.
-pub fn run(
-    setup: DeviceSetup,
-    events: std::sync::mpsc::Receiver<Event>,
-    state: tokio::sync::watch::Sender<State>,
-    ready: std::sync::mpsc::Sender<Result<Ready, Error>>,
-    started: Instant,
-) {
-    let connect = || -> Result<Session<Box<dyn Link>>, Error> {
-        let link = link::open(&setup.target)?;
-        let config = ClientConfig::for_target(&setup.target, setup.retries);
-        let client = Client::new(link, config);
-        Session::connect(
-            client,
-            setup.robot,
-            setup.preset,
-            AngleCheck::for_target(&setup.target),
-        )
-    };
-    let mut session = match connect() {
-        Ok(s) => s,
-        Err(e) => {
-            let _ = ready.send(Err(e));
-            return;
-        }
-    };
-    let _ = ready.send(Ok(Ready {
-        info: *session.info(),
-    }));
-    let now_ms = || started.elapsed().as_secs_f64() * 1e3;
-    let publish = |session: &Session<Box<dyn Link>>, link_up: bool| {
-        state.send_modify(|s| {
-            let (controller, pages) = (s.controller, s.pages);
-            *s = State {
-                controller,
-                pages,
-                link_up,
-                ..session.state(now_ms())
-            };
-        });
-    };
-    publish(&session, true);
-    let mut link_up = true;
-    let wall_epoch = Instant::now();
-    let mut last_state = Instant::now();
-    let mut imu_due = Instant::now() + balance::IMU_PERIOD;
-    loop {
-        // The sensor's report on its own schedule: a stream of commands, which holds off the
-        // state read (each command's answer carries the state), does not hold it off.
-        if Instant::now() >= imu_due {
-            imu_due += balance::IMU_PERIOD;
-            if imu_due < Instant::now() {
-                imu_due = Instant::now() + balance::IMU_PERIOD;
-            }
-            if link_up {
-                match session.read_imu() {
-                    Ok(()) => {}
-                    Err(Error::Link(e)) => {
-                        eprintln!("quadctl serve: device link failed: {e}");
-                        link_up = false;
-                    }
-                    Err(e) => eprintln!("quadctl serve: sensor read failed: {e}"),
-                }
-                publish(&session, link_up);
-            }
-        }
-        let event = next_event(
-            &events,
-            &mut session,
-            &mut link_up,
-            wall_epoch,
-            (last_state + setup.poll).min(imu_due),
-        );
-        if matches!(event, Err(std::sync::mpsc::RecvTimeoutError::Timeout))
-            && Instant::now() < last_state + setup.poll
-        {
-            // The sensor's read is due, not the state's.
-            continue;
-        }
-        last_state = Instant::now();
-        match event {
-            Ok(Event::Job(job)) => {
-                let result = if link_up {
-                    match job.cmd {
-                        msg::ClientMsg::GuideStart | msg::ClientMsg::GuideKey { .. } => session
-                            .guide_command(&job.cmd, &|s: &Session<Box<dyn Link>>| {
-                                publish(s, true)
-                            }),
-                        _ => session.command(&job.cmd),
-                    }
-                } else {
-                    Err(Error::LinkDown)
-                };
-                publish(&session, link_up);
-                let _ = job.reply.send(result);
-            }
-            Ok(Event::ControlLost) => {
-                if link_up {
-                    if let Err(e) = session.control_lost() {
-                        eprintln!("quadctl serve: link-loss action failed: {e}");
-                    }
-                }
-                publish(&session, link_up);
-            }
-            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
-                if link_up {
-                    match session.poll() {
-                        Ok(()) => {}
-                        Err(Error::Link(e)) => {
-                            eprintln!("quadctl serve: device link failed: {e}");
-                            link_up = false;
-                        }
-                        Err(e) => eprintln!("quadctl serve: state read failed: {e}"),
-                    }
-                }
-                publish(&session, link_up);
-            }
-            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                // The server stopped: leave the device as the link-loss rule says.
-                if link_up {
-                    let _ = session.control_lost();
-                }
-                return;
-            }
         }
     }
 }
