@@ -23,12 +23,30 @@
 //! stance after a stand-up or a motion, or a `SetBodyPose`) or a sway runs, each servo frame
 //! corrects the body's commanded roll and pitch: with the error `e` = measured − intended
 //! attitude (the intended one is the held pose's, or the sway's at that frame),
-//! `c = −(k_P·e + k_I·∫e dt)`, each axis within `±max_correction_rad` (the integral held
-//! within the same bound: no wind-up). The correction goes through the same body IK and the
-//! one joint-speed limiter as every target; when the IK cannot reach it, the largest share of
+//! `c = −(k_P·e + k_I·∫e dt + k_ω·dz(ω))`, each axis within `±max_correction_rad` (the
+//! integral held within the same bound: no wind-up); the last term is the rate term below.
+//! The correction goes through the same body IK and the one joint-speed limiter as every
+//! target; when the IK cannot reach it, the largest share of
 //! it that is reachable is applied ([`crate::engine::LEVEL_SHARES`]) and the report says
 //! `correction_limited`. On a slope of `s` the body's measured roll is `s + c` (the feet stand
 //! on the slope), so the integral settles at `c = −s`: level.
+//!
+//! ## The rate term
+//! A sideways push tips the robot over the feet on one side within 0.2–0.3 s, faster than
+//! the PI moves (and the accelerometer first reads the push's own force as a tilt the other
+//! way). The gyro sees the tip at once: the body's rate `ω` about x and y (the bias
+//! removed), beyond a dead band of [`RATE_DEAD_BAND_RAD_S`] (`dz`), adds [`RATE_GAIN_S`] of
+//! correction per rad/s. It acts on a set point held for [`RATE_HELD_FRAMES`]: a sway, or a
+//! new pose the body is still turning to, runs the PI alone. It is part of the leveling and
+//! switched with it (`SetBalance`'s `leveling`: off with it, and after a sensor fault; a
+//! sway's set point moves every frame, so only a held pose gets it); its share of the correction is bounded, reduced
+//! to what the legs reach, and rate limited exactly as the PI's, since it is one sum `c`.
+//! Tipping toward +y (roll falling), it lengthens the legs on the side the robot stands on
+//! and shortens the lifted ones: the loaded feet push the body back up, a torque against the
+//! fall, and the lifted feet reach down. A body that turns slowly adds nothing. Shifting the
+//! body sideways instead (toward the lifted side) was measured and not kept: the sideways
+//! force at the feet first turns the body further toward the fall, and it felled the robot at
+//! pushes the leveling alone survives (`docs/benchmark-journal.md`, "A push with balance").
 //!
 //! ## Fall detection
 //! While the outputs are driven and fall detection is on: `|roll|` or `|pitch|` beyond
@@ -87,6 +105,20 @@ pub const FREE_FALL_MS: u32 = 60;
 /// below it is the limit instead.
 pub const START_TILT_MAX_RAD: f32 = 0.61;
 
+/// The dead band of the leveling's rate term, rad/s (module docs, "The rate term"): a body
+/// turning slower than this against its set point adds nothing (a floor tilting by 10° in
+/// 1 s turns it at 0.17 rad/s; a push that tips it over, at 0.6–1 rad/s within 50 ms).
+pub const RATE_DEAD_BAND_RAD_S: f32 = 0.3;
+
+/// The leveling's correction per rad/s of rate beyond [`RATE_DEAD_BAND_RAD_S`], s (module
+/// docs, "The rate term"; measured in the physics twin: 0.3 s and 0.8 s both keep every push
+/// the leveling alone survives, 0.8 s survives the larger ones).
+pub const RATE_GAIN_S: f32 = 0.8;
+
+/// How many servo frames the set point must have stayed the same before the rate term acts
+/// (25: 0.5 s; module docs, "The rate term").
+pub const RATE_HELD_FRAMES: u8 = 25;
+
 /// What the device must do after a reading ([`Balance::push`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Event {
@@ -133,6 +165,12 @@ pub struct Balance<M> {
     limited: bool,
     fall: Option<FallKind>,
     samples: u32,
+    /// The body's roll and pitch rates of the last sample, the gyro bias removed, rad/s.
+    rate_rad_s: [f32; 2],
+    /// The set point of the frame before the last.
+    intended_before_rad: [f32; 2],
+    /// Frames the set point has stayed the same, up to [`RATE_HELD_FRAMES`].
+    held_frames: u8,
 }
 
 fn clamp_abs(x: f32, m: f32) -> f32 {
@@ -166,6 +204,9 @@ impl<M: Math> Balance<M> {
             limited: false,
             fall: None,
             samples: 0,
+            rate_rad_s: [0.0; 2],
+            intended_before_rad: [0.0; 2],
+            held_frames: 0,
         }
     }
 
@@ -263,6 +304,8 @@ impl<M: Math> Balance<M> {
                 self.estimator
                     .update(sample.gyro_rad_s, sample.accel_m_s2, dt_s);
                 self.attitude = self.estimator.attitude();
+                let b = self.estimator.bias_rad_s();
+                self.rate_rad_s = [sample.gyro_rad_s[0] - b[0], sample.gyro_rad_s[1] - b[1]];
             }
         }
         if !outputs_on || !self.config.fall_detection || self.fall.is_some() {
@@ -333,6 +376,7 @@ impl<M: Math> Balance<M> {
     }
 
     fn stop_leveling(&mut self) {
+        self.held_frames = 0;
         self.integral_rad = [0.0; 2];
         self.correction_rad = [0.0; 2];
         self.active = false;
@@ -359,11 +403,23 @@ impl<M: Math> Balance<M> {
             ..
         } = self.config;
         let measured = [self.attitude.roll_rad, self.attitude.pitch_rad];
+        if self.intended_rad != self.intended_before_rad {
+            self.held_frames = 0;
+        } else if self.held_frames < RATE_HELD_FRAMES {
+            self.held_frames += 1;
+        }
+        self.intended_before_rad = self.intended_rad;
+        let rate_gain = if self.held_frames >= RATE_HELD_FRAMES {
+            RATE_GAIN_S
+        } else {
+            0.0
+        };
         let mut c = [0.0; 2];
         for i in 0..2 {
             let e = measured[i] - self.intended_rad[i];
             self.integral_rad[i] = clamp_abs(self.integral_rad[i] + level_ki_per_s * e * dt_s, m);
-            c[i] = clamp_abs(-(level_kp * e + self.integral_rad[i]), m);
+            let rate = beyond(self.rate_rad_s[i], RATE_DEAD_BAND_RAD_S);
+            c[i] = clamp_abs(-(level_kp * e + self.integral_rad[i] + rate_gain * rate), m);
         }
         Some(c)
     }
@@ -383,6 +439,7 @@ impl<M: Math> Balance<M> {
                 self.active = true;
             }
             None => {
+                self.held_frames = 0;
                 self.correction_rad = [0.0; 2];
                 self.integral_rad = [0.0; 2];
                 self.active = false;
@@ -446,6 +503,17 @@ impl<M: Math> Balance<M> {
 impl<M: Math> Default for Balance<M> {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+/// `x` beyond a dead band of `±band`: 0 within it, `x ∓ band` outside.
+fn beyond(x: f32, band: f32) -> f32 {
+    if x > band {
+        x - band
+    } else if x < -band {
+        x + band
+    } else {
+        0.0
     }
 }
 

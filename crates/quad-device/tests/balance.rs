@@ -673,3 +673,50 @@ fn balance_fields_out_of_range_are_refused_naming_the_field() {
     // Nothing changed.
     assert_eq!(report(&mut dev).config, d);
 }
+
+#[test]
+fn a_fast_tip_on_a_held_pose_is_met_by_the_rate_term_and_a_sway_is_not() {
+    use quad_device::balance::{Balance, RATE_DEAD_BAND_RAD_S, RATE_GAIN_S, RATE_HELD_FRAMES};
+    let reading = |gyro_x: f32| {
+        ImuReading::Sample(ImuSample {
+            accel_m_s2: [0.0, 0.0, G],
+            gyro_rad_s: [gyro_x, 0.0, 0.0],
+        })
+    };
+    let mut b = Balance::<kin_core::DefaultMath>::new();
+    let mut now = 0;
+    for _ in 0..=(BIAS_WINDOW_MS / SAMPLE_MS) {
+        b.push(reading(0.0), now, true);
+        now += SAMPLE_MS;
+    }
+    b.configure(leveling_on()).unwrap();
+    // One frame of the leveling: the set point `intended` held or moved.
+    let mut frame = |b: &mut Balance<kin_core::DefaultMath>, gyro_x: f32, intended: f32| {
+        b.push(reading(gyro_x), now, true);
+        now += 20;
+        let c = b.level(0.02).expect("leveling runs");
+        b.applied(Some(([intended, 0.0], c, false)), c);
+        c
+    };
+    // A held pose, still: nothing to correct.
+    for _ in 0..=RATE_HELD_FRAMES {
+        frame(&mut b, 0.0, 0.0);
+    }
+    let c = frame(&mut b, 0.0, 0.0);
+    assert!(c[0].abs() < 0.01, "{c:?}");
+    // Tipping toward +y (roll falling) at 0.5 rad/s: the rate term lengthens the legs it
+    // stands on (a positive roll correction).
+    let c = frame(&mut b, -0.5, 0.0);
+    let expected = RATE_GAIN_S * (0.5 - RATE_DEAD_BAND_RAD_S);
+    assert!((c[0] - expected).abs() < 0.01, "{c:?} against {expected}");
+    // Within the dead band: nothing.
+    let c = frame(&mut b, -0.9 * RATE_DEAD_BAND_RAD_S, 0.0);
+    assert!(c[0].abs() < 0.01, "{c:?}");
+    // A sway: the set point moves every frame and the body follows it a frame later; its
+    // rate is the body's, no rate term (which would be 0.16 rad here).
+    for k in 1..20 {
+        let gyro_x = if k > 1 { 0.5 } else { 0.0 };
+        let c = frame(&mut b, gyro_x, 0.01 * k as f32);
+        assert!(c[0].abs() < 0.05, "frame {k}: {c:?}");
+    }
+}

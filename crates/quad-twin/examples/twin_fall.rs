@@ -7,10 +7,9 @@
 //! cargo run --release -p quad-twin --example twin_fall
 //! ```
 //!
-//! Printed: when the true |roll| or |pitch| first exceeds 60° (the twin's clock), the frame in
-//! whose samples the device latched the fall (its first and last sample's times: the
-//! detection lies between), and the frame boundary from which the outputs are off (one servo
-//! frame or less after the detection).
+//! Printed: when the true |roll| or |pitch| first exceeds 60° (the twin's clock), the sample
+//! at which the device latched the fall (`DeviceFrame::fall_latched_t_s`), and the frame
+//! boundary from which the outputs are off (one servo frame or less after the detection).
 
 use quad_device::Config;
 use quad_model::Physical;
@@ -30,9 +29,10 @@ const FALL_ANGLE_RAD: f64 = std::f64::consts::FRAC_PI_3;
 const PUSHES_N_S: [f32; 2] = [9.0, 48.0];
 
 /// One frame as recorded: the samples the device took before it (`t_s`, true max tilt),
-/// whether its report shows the fall, whether its outputs are on, and the frame's start on the
-/// twin's clock (the end of the previous frame).
-type Recorded = (Vec<(f64, f64)>, bool, bool, Option<f64>);
+/// the time of the sample at which the device latched the fall (on the latching frame), whether
+/// its outputs are on, and the frame's start on the twin's clock (the end of the previous
+/// frame).
+type Recorded = (Vec<(f64, f64)>, Option<f64>, bool, Option<f64>);
 
 /// The frames of a run and the samples before each.
 struct Recorder {
@@ -60,7 +60,7 @@ impl FrameSource for Recorder {
         });
         self.frames.push((
             samples,
-            frame.fall_detected,
+            frame.fall_latched_t_s,
             frame.enabled,
             feedback.map(|s| s.t_s),
         ));
@@ -145,21 +145,17 @@ fn fall(name: &str, config: &Config, physical: &Physical, push_n_s: f32) -> Resu
         .flat_map(|f| f.0.iter())
         .find(|&&(_, tilt)| tilt > FALL_ANGLE_RAD)
         .map(|&(t, _)| t);
-    let detected = recorder.frames.iter().find(|f| f.1);
+    let detected = recorder.frames.iter().find_map(|f| f.1);
     let off = recorder.frames.iter().find(|f| !f.2);
     let ms = |t: f64| format!("{:.1} ms", 1e3 * t);
     match (crossed, detected, off) {
-        (Some(t_c), Some((samples, ..)), Some((.., Some(t_off)))) => {
-            let first = samples.first().map_or(f64::NAN, |s| s.0);
-            let last = samples.last().map_or(f64::NAN, |s| s.0);
+        (Some(t_c), Some(t_latch), Some((.., Some(t_off)))) => {
             println!(
-                "{name:13} push {push_n_s:.1} N·s (fell={}): true tilt past 60° at {t_c:.3} s; fall latched on a sample at {first:.3}–{last:.3} s ({} to {} after the crossing); outputs off from {t_off:.3} s ({} after the crossing, {} to {} after the detection)",
+                "{name:13} push {push_n_s:.1} N·s (fell={}): true tilt past 60° at {t_c:.3} s; fall latched on the sample at {t_latch:.3} s ({} after the crossing); outputs off from {t_off:.3} s ({} after the crossing, {} after the detection)",
                 run.summary.fell,
-                ms(first - t_c),
-                ms(last - t_c),
+                ms(t_latch - t_c),
                 ms(t_off - t_c),
-                ms(t_off - last),
-                ms(t_off - first),
+                ms(t_off - t_latch),
             );
             Ok(())
         }

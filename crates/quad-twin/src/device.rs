@@ -58,6 +58,8 @@ pub struct InProcess {
     seq: u16,
     /// Balance settings to send once the sensor has given a reading.
     pending_balance: Option<BalanceConfig>,
+    /// The reading of the last [`InProcess::tick_with_imu`] at which the device latched a fall.
+    fall_latched_reading: Option<usize>,
 }
 
 impl InProcess {
@@ -80,6 +82,7 @@ impl InProcess {
             clock,
             seq: 0,
             pending_balance: None,
+            fall_latched_reading: None,
         };
         d.request(Request::Hello {
             version: PROTOCOL_VERSION,
@@ -120,16 +123,24 @@ impl InProcess {
     /// reading pushed ([`Device::on_imu`]), the main loop polled; then the rest of the frame
     /// and its poll, as [`InProcess::tick`]. Readings are `(ns after the frame's start,
     /// reading)`, in time order; one at or past the frame's end is pushed at its end, before
-    /// the frame boundary's poll.
+    /// the frame boundary's poll. The reading at which the device latched a fall, if it did
+    /// within this frame, is [`InProcess::fall_latched_reading`].
     pub fn tick_with_imu(&mut self, frame_ms: u32, readings: &[(u64, ImuReading)]) {
         let start_ns = self.clock.now_ns();
         let frame_ns = u64::from(frame_ms) * 1_000_000;
-        for &(after_ns, reading) in readings {
+        let mut latched = self.device.imu_report().fall.is_some();
+        self.fall_latched_reading = None;
+        for (i, &(after_ns, reading)) in readings.iter().enumerate() {
             let t_ns = start_ns + after_ns.min(frame_ns);
             if t_ns > self.clock.now_ns() {
                 self.clock.set_ns(t_ns);
             }
             self.device.on_imu(reading);
+            // The device latches a fall on a reading ([`quad_device::Device::on_imu`]).
+            if !latched && self.device.imu_report().fall.is_some() {
+                latched = true;
+                self.fall_latched_reading = Some(i);
+            }
             if t_ns < start_ns + frame_ns {
                 self.device.poll();
             }
@@ -184,6 +195,13 @@ impl InProcess {
         if self.request(Request::SetBalance(config)).is_ok() {
             self.pending_balance = None;
         }
+    }
+
+    /// The index, among the readings of the last [`InProcess::tick_with_imu`], of the one at
+    /// which the device latched a fall (its report's `fall` set by that reading); `None` when
+    /// it latched none within that frame (none yet, or one latched before).
+    pub fn fall_latched_reading(&self) -> Option<usize> {
+        self.fall_latched_reading
     }
 
     /// The balance functions' report (what `GetImu` answers).

@@ -364,6 +364,8 @@ impl FrameSource for Emulated {
             stance: target.stance,
             estimated_rpy_rad: balance.0,
             fall_detected: balance.1,
+            // The firmware's report is read once a frame: the sample is not known.
+            fall_latched_t_s: None,
         })
     }
 }

@@ -38,6 +38,12 @@ pub struct DeviceFrame {
     /// The device reports a fall (latched; [`quad_protocol::ImuReport::fall`]); false when the
     /// source does not read the report.
     pub fall_detected: bool,
+    /// The time, on the twin's clock, of the IMU sample at which the device latched the fall,
+    /// s: set on the frame after whose samples the report first shows the fall (the sample
+    /// `BodyState::imu[i]` of the feedback, `i` = [`InProcess::fall_latched_reading`]); `None`
+    /// on every other frame, and always when the source sees the report only once a frame
+    /// (the emulated firmware).
+    pub fall_latched_t_s: Option<f64>,
 }
 
 impl DeviceFrame {
@@ -272,6 +278,10 @@ fn step(
         None => Vec::new(),
     };
     device.tick_with_imu(FRAME_MS, &readings);
+    let fall_latched_t_s = device
+        .fall_latched_reading()
+        .and_then(|i| feedback.and_then(|state| state.imu.get(i)))
+        .map(|sample| sample.t_s);
     let outputs = device.outputs();
     let report = device.imu_report();
     Ok(DeviceFrame {
@@ -283,5 +293,6 @@ fn step(
         stance: target.stance,
         estimated_rpy_rad: estimated_rpy_rad(&report),
         fall_detected: report.fall.is_some(),
+        fall_latched_t_s,
     })
 }
