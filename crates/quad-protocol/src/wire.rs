@@ -210,56 +210,12 @@ macro_rules! wire_enum {
                 )*
                 return ::serde::ser::SerializeStructVariant::end(fields);
             }]
-            [$($de_arms)* $idx => {
-                struct Fields;
-                impl<'de> ::serde::de::Visitor<'de> for Fields {
-                    type Value = Target;
-                    fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
-                        f.write_str(concat!("the fields of ", stringify!($var)))
-                    }
-                    // The count after the last field is not read.
-                    #[allow(unused_assignments)]
-                    fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
-                        self,
-                        mut seq: A,
-                    ) -> Result<Target, A::Error> {
-                        let mut n = 0usize;
-                        $( let $field = $crate::wire::wire_next_field!(seq, n, &self, $fty $(, $($with)::+)?); )*
-                        Ok(Target::$var { $($field),* })
-                    }
-                }
-                ::serde::de::VariantAccess::struct_variant(
-                    $var_access,
-                    &[$(stringify!($field)),*],
-                    Fields,
-                )
-            }]
+            [$($de_arms)* $idx => $crate::wire::wire_de_struct!(
+                $var_access, $var, $( $field: $fty $(as $($with)::+)? ),*),]
             [$($place_arms)* $idx => {
                 // Built whole, then stored in place: one copy of the enum.
-                *$place = {
-                    struct Fields;
-                    impl<'de> ::serde::de::Visitor<'de> for Fields {
-                        type Value = Target;
-                        fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
-                            f.write_str(concat!("the fields of ", stringify!($var)))
-                        }
-                        // The count after the last field is not read.
-                        #[allow(unused_assignments)]
-                        fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
-                            self,
-                            mut seq: A,
-                        ) -> Result<Target, A::Error> {
-                            let mut n = 0usize;
-                            $( let $field = $crate::wire::wire_next_field!(seq, n, &self, $fty $(, $($with)::+)?); )*
-                            Ok(Target::$var { $($field),* })
-                        }
-                    }
-                    ::serde::de::VariantAccess::struct_variant(
-                        $var_access,
-                        &[$(stringify!($field)),*],
-                        Fields,
-                    )
-                }?;
+                *$place = $crate::wire::wire_de_struct!(
+                    $var_access, $var, $( $field: $fty $(as $($with)::+)? ),*)?;
                 Ok(())
             }]
             [$($text)* $var { $($field: $fty,)* },]
@@ -558,7 +514,32 @@ macro_rules! wire_de_newtype {
     }};
 }
 
-pub(crate) use {wire_de_newtype, wire_enum, wire_next_field, wire_ser_field};
+/// Reads the fields of struct variant `$var` (each through the table `$with` when one is named)
+/// from the variant access `$access`: a `Result` of `Target`, the enum `wire_enum!` declares.
+macro_rules! wire_de_struct {
+    ($access:ident, $var:ident, $( $field:ident : $fty:ty $(as $($with:ident)::+)? ),*) => {{
+        struct Fields;
+        impl<'de> ::serde::de::Visitor<'de> for Fields {
+            type Value = Target;
+            fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                f.write_str(concat!("the fields of ", stringify!($var)))
+            }
+            // The count after the last field is not read.
+            #[allow(unused_assignments)]
+            fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Target, A::Error> {
+                let mut n = 0usize;
+                $( let $field = $crate::wire::wire_next_field!(seq, n, &self, $fty $(, $($with)::+)?); )*
+                Ok(Target::$var { $($field),* })
+            }
+        }
+        ::serde::de::VariantAccess::struct_variant($access, &[$(stringify!($field)),*], Fields)
+    }};
+}
+
+pub(crate) use {wire_de_newtype, wire_de_struct, wire_enum, wire_next_field, wire_ser_field};
 
 /// [`serde::de::EnumAccess::variant`] with a `u32` index, out of line: inlined, every enum's
 /// decoder carried its own copy of the format's index code (postcard's varint). With that

@@ -281,13 +281,7 @@ where
                 &mut self.calibration,
             );
         }
-        for (m, c) in self.pulse_maps.iter_mut().zip(&self.calibration) {
-            // Each calibration was validated when it was loaded, and the defaults are valid:
-            // no map is left at `PulseMap::NONE`.
-            if let Ok(map) = c.pulse_map() {
-                *m = map;
-            }
-        }
+        self.refresh_pulse_maps();
         // The stance may not map within a stored calibration: then nothing is held.
         let _ = self.set_body_pose(&Pose::default());
     }

@@ -71,11 +71,7 @@ where
                 &self.config.pose_config,
                 &mut self.calibration,
             );
-            for (m, c) in self.pulse_maps.iter_mut().zip(&self.calibration) {
-                if let Ok(map) = c.pulse_map() {
-                    *m = map;
-                }
-            }
+            self.refresh_pulse_maps();
         }
         self.held = None;
         self.base_pose = None;
@@ -143,5 +139,15 @@ where
         self.calibration_unsaved = false;
         self.calibration_default = false;
         Ok(())
+    }
+
+    /// The pulse maps of the calibration table. Each calibration was validated when it was
+    /// loaded or set, and the defaults are valid: no map is left at `PulseMap::NONE`.
+    pub(super) fn refresh_pulse_maps(&mut self) {
+        for (m, c) in self.pulse_maps.iter_mut().zip(&self.calibration) {
+            if let Ok(map) = c.pulse_map() {
+                *m = map;
+            }
+        }
     }
 }
