@@ -77,8 +77,9 @@ pub struct Args {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
-    /// The robot compiled into the simulated device (--sim; its EEPROM may hold another).
-    #[arg(long, value_name = "PRESET", default_value = "fernando2025", value_parser = crate::args::parse_robot)]
+    /// The robot compiled into the simulated device (--sim; its EEPROM may hold another). The
+    /// default is the firmware's, as for every other device command.
+    #[arg(long, value_name = "PRESET", default_value = "shahriar2023", value_parser = crate::args::parse_robot)]
     pub sim_preset: String,
     #[command(subcommand)]
     #[allow(missing_docs)]
