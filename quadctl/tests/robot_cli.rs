@@ -85,8 +85,15 @@ fn a_robot_the_device_cannot_hold_is_refused_before_sending_naming_the_field() {
         "",
     );
     assert_eq!(sent.code, 2, "{}", sent.stdout);
-    assert!(sent.stderr.contains("stance"), "{}", sent.stderr);
-    assert!(sent.stderr.contains("not sent"), "{}", sent.stderr);
+    // The field, and what it must be for this robot, in its own numbers.
+    for said in [
+        "stance_height_m",
+        "[0.01, 0.240] m",
+        "= 0.120 m",
+        "not sent",
+    ] {
+        assert!(sent.stderr.contains(said), "{said}: {}", sent.stderr);
+    }
     // Nothing stored: the device still holds the firmware's robot.
     let shown = quadctl(&[&["robot"][..], &sim, &["show"]].concat(), "");
     assert!(

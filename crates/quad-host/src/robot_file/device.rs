@@ -101,8 +101,61 @@ pub enum DeviceError {
     RotationOrder(String),
     /// The description is one the device refuses (`quad_protocol::check_robot`, whose
     /// [`quad_protocol::NackReason::BadRobot`] names the field).
-    #[error("the device cannot hold this robot ({0}); not sent")]
-    Refused(quad_protocol::NackReason),
+    #[error(
+        "the device cannot hold this robot ({reason}{}); not sent",
+        hint_text(hint)
+    )]
+    Refused {
+        /// The device's refusal, naming the field.
+        reason: quad_protocol::NackReason,
+        /// What the field must be for this robot, when there is more to say than its name.
+        hint: Option<String>,
+    },
+}
+
+/// `: hint` when there is one.
+fn hint_text(hint: &Option<String>) -> String {
+    hint.as_ref().map(|h| format!(": {h}")).unwrap_or_default()
+}
+
+/// What a refused field of `d` must be, in the robot's own numbers: the ranges that depend on
+/// the robot (the stance height), and the poses the device must reach (the rest pose and the
+/// stance). `None` for a field whose range the protocol document lists as it is.
+fn refusal_hint(
+    reason: &quad_protocol::NackReason,
+    d: &quad_protocol::RobotDescription,
+) -> Option<String> {
+    use quad_protocol::range::{leg_span_m, reach_limit_m, MIN_STANCE_HEIGHT_M};
+    use quad_protocol::{NackReason, RobotField};
+    let NackReason::BadRobot(field) = reason else {
+        return None;
+    };
+    let r = &d.robot;
+    match field {
+        RobotField::StanceHeightM => Some(format!(
+            "{} m is outside [{MIN_STANCE_HEIGHT_M}, {:.3}] m, twice this leg's span \
+             d_lat_m + d_ax_m + femur_m + tibia_m = {:.3} m",
+            d.stance_height_m,
+            reach_limit_m(r),
+            leg_span_m(r)
+        )),
+        RobotField::Stance(leg) => Some(format!(
+            "leg {leg:?} cannot put its foot {} m below its hip (the stance height) at the zero \
+             body pose within its joint limits; the leg stretched is {:.3} m: lower \
+             stance_height_m or widen the limits",
+            d.stance_height_m,
+            leg_span_m(r)
+        )),
+        RobotField::RestPose(joint) => {
+            let rest = r.rest_leg();
+            Some(format!(
+                "the rest pose (abduction {}, hip {}, knee {} rad), where the device's sit, rest \
+                 and safe state go, leaves the {joint:?} limits",
+                rest.abduction_rad, rest.hip_rad, rest.knee_rad
+            ))
+        }
+        _ => None,
+    }
 }
 
 /// Resolves a `--robot` argument into the description a device holds (protocol 2.4): a preset
@@ -174,7 +227,12 @@ pub fn device_description(spec: &str) -> Result<quad_protocol::RobotDescription,
             })
         }),
     };
-    quad_protocol::check_robot::<kin_core::DefaultMath>(&d).map_err(DeviceError::Refused)?;
+    quad_protocol::check_robot::<kin_core::DefaultMath>(&d).map_err(|reason| {
+        DeviceError::Refused {
+            hint: refusal_hint(&reason, &d),
+            reason,
+        }
+    })?;
     Ok(d)
 }
 
