@@ -161,17 +161,7 @@ pub fn start(address: u8, bytes: &[u8], read_len: u8) -> bool {
     // SAFETY: TWCR is written by the starter only while the slot is idle (here) and by the
     // handler while it is busy.
     let twi = unsafe { pac::TWI::steal() };
-    // START (§24.6, Table 24-2): TWINT cleared by writing one, TWSTA, TWEN, TWIE.
-    twi.twcr().write(|w| {
-        w.twint()
-            .set_bit()
-            .twsta()
-            .set_bit()
-            .twen()
-            .set_bit()
-            .twie()
-            .set_bit()
-    });
+    send_start(&twi);
     true
 }
 
@@ -222,6 +212,22 @@ fn go(twi: &pac::TWI, ack: bool) {
     });
 }
 
+/// START, or a repeated START (§24.6, Table 24-2): TWINT cleared by writing one, TWSTA, TWEN,
+/// TWIE.
+#[inline(always)]
+fn send_start(twi: &pac::TWI) {
+    twi.twcr().write(|w| {
+        w.twint()
+            .set_bit()
+            .twsta()
+            .set_bit()
+            .twen()
+            .set_bit()
+            .twie()
+            .set_bit()
+    });
+}
+
 /// STOP, and the transfer ends with `state`. TWINT is cleared; no interrupt follows a STOP.
 #[inline(always)]
 fn stop(twi: &pac::TWI, state: u8) {
@@ -261,16 +267,7 @@ pub fn on_interrupt() {
             } else if slot.read_len > 0 {
                 slot.index = 0;
                 // Repeated START (§24.7.2).
-                twi.twcr().write(|w| {
-                    w.twint()
-                        .set_bit()
-                        .twsta()
-                        .set_bit()
-                        .twen()
-                        .set_bit()
-                        .twie()
-                        .set_bit()
-                });
+                send_start(&twi);
             } else {
                 stop(&twi, DONE);
             }

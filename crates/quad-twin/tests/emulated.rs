@@ -93,6 +93,23 @@ fn the_firmwares_own_trot_walks_in_the_twin() {
     assert!(travel.ratio >= 0.5, "{travel:?}");
 }
 
+/// `source` (the emulated firmware) run through `plan` in the twin on shahriar2023's model
+/// with `physical`, under `scenario`.
+fn run_on_slope(
+    source: &mut dyn FrameSource,
+    config: &Config,
+    physical: quad_model::Physical,
+    plan: &Plan,
+    scenario: &quad_twin::scenario::Scenario,
+) -> quad_twin::Run {
+    let model = quad_model::Model::new(config.robot, physical).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.xml");
+    quad_model::mjcf::write(&model, &path).unwrap();
+    quad_twin::run_source_in(source, &path, "shahriar2023", plan, None, false, scenario)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
 #[test]
 fn the_twins_imu_samples_queue_on_the_mcus_clock_for_the_emulated_sensor() {
     // Standing on a 10° roll slope: before the twin's first sample the feed reads the robot at
@@ -115,20 +132,7 @@ fn the_twins_imu_samples_queue_on_the_mcus_clock_for_the_emulated_sensor() {
     };
     assert!(feed.is_empty());
     assert!((roll_of(feed.read(0.0)) - 10f64.to_radians()).abs() < 1e-6);
-    let model = quad_model::Model::new(config.robot, physical).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("model.xml");
-    quad_model::mjcf::write(&model, &path).unwrap();
-    let run = quad_twin::run_source_in(
-        &mut firmware,
-        &path,
-        "shahriar2023",
-        &plan,
-        None,
-        false,
-        &scenario,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let run = run_on_slope(&mut firmware, &config, physical, &plan, &scenario);
     assert!(!run.summary.fell);
     // Four samples a frame, the last frame's excepted (the run ends before they are due),
     // some replaced where two frames overlapped on the MCU's clock; nothing dropped.
@@ -172,20 +176,7 @@ fn the_emulated_firmware_reads_the_twins_imu_over_its_twi_and_levels_on_a_slope(
             ..quad_protocol::BalanceConfig::DEFAULT
         })
         .unwrap_or_else(|e| panic!("{e}"));
-    let model = quad_model::Model::new(config.robot, physical).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("model.xml");
-    quad_model::mjcf::write(&model, &path).unwrap();
-    let run = quad_twin::run_source_in(
-        &mut firmware,
-        &path,
-        "shahriar2023",
-        &plan,
-        None,
-        false,
-        &scenario,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let run = run_on_slope(&mut firmware, &config, physical, &plan, &scenario);
     let s = run.summary;
     assert!(!s.fell, "{:?}", s.fall_reason);
     let report = firmware.imu_report().unwrap_or_else(|e| panic!("{e}"));
