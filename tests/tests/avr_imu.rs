@@ -279,7 +279,7 @@ fn steered_trot(imu: Option<SharedImuSource>, trot_s: f64) -> Trot {
         }
         // Two consecutive frames watched every fourth slot (watching takes two periods; the
         // other slots make the time up, so that the commands keep their 20 Hz on average).
-        if k % 4 == 0 {
+        if k.is_multiple_of(4) {
             let a = board.link.next_pulses().expect("runs");
             let b = board.link.next_pulses().expect("runs");
             for c in 0..12 {

@@ -672,7 +672,7 @@ fn streamed_poses_never_step_a_pin_beyond_the_limiter() {
             if k < 30 {
                 Pose::rotation(0.1, -0.05, 0.08)
             } else {
-                Pose::rotation(if k % 2 == 0 { 0.25 } else { -0.25 }, 0.0, 0.0)
+                Pose::rotation(if k.is_multiple_of(2) { 0.25 } else { -0.25 }, 0.0, 0.0)
             }
         };
         let mut requests = vec![

@@ -106,6 +106,27 @@ fn batch_benches(c: &mut Criterion) {
             });
         });
     }
+    #[cfg(target_arch = "x86_64")]
+    if has_avx512() {
+        group.bench_function("leg_ik_batch_avx512", |b| {
+            b.iter(|| {
+                for (k, (r, leg, rows)) in black_box(&groups).iter().enumerate() {
+                    // SAFETY: the CPU supports AVX-512 (checked above).
+                    let _ = unsafe {
+                        batch::avx512::leg_inverse(
+                            &solvers[*r],
+                            *leg,
+                            ReachPolicy::Reject,
+                            rows.as_flattened(),
+                            angles[k].as_flattened_mut(),
+                            &mut codes[k],
+                        )
+                    };
+                }
+                black_box(&angles);
+            });
+        });
+    }
     let mut soa_out: Vec<[Vec<f32>; 3]> = groups
         .iter()
         .map(|g| core::array::from_fn(|_| vec![0.0; g.2.len()]))
@@ -172,6 +193,15 @@ fn batch_benches(c: &mut Criterion) {
     });
     assert!(body_codes.iter().all(|&c| c == batch::code::OK));
     group.finish();
+}
+
+/// True when the CPU runs `batch::avx512`.
+#[cfg(target_arch = "x86_64")]
+fn has_avx512() -> bool {
+    std::is_x86_feature_detected!("avx512f")
+        && std::is_x86_feature_detected!("avx512vl")
+        && std::is_x86_feature_detected!("avx512bw")
+        && std::is_x86_feature_detected!("avx512dq")
 }
 
 criterion_group!(benches, batch_benches);

@@ -207,6 +207,15 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
     let abduction = M::atan2_lanes(&abd_y, &abd_x);
     let knee = M::atan2_lanes(&knee_y, &knee_x);
     let hip = M::atan2_lanes(&hip_y, &hip_x);
+    // The joint limits, one angle over all lanes at a time (`admits_all` per lane).
+    let (lo, hi, keys) = (&s.limits.min_rad, &s.limits.max_rad, &s.limit_keys);
+    let mut within = [u32::MAX; N];
+    for (j, angle) in [&abduction, &hip, &knee].into_iter().enumerate() {
+        for i in 0..N {
+            within[i] &=
+                0u32.wrapping_sub(u32::from(M::within_keys(angle[i], lo[j], hi[j], keys[j])));
+        }
+    }
     let mut out = LegLanes {
         abduction_rad: [0.0; N],
         hip_rad: [0.0; N],
@@ -214,9 +223,12 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
         code: [code::OK; N],
     };
     for i in 0..N {
-        let within = s.admits_all(JointAngles::new(abduction[i], hip[i], knee[i]));
         let k = code[i];
-        let k = select((k == u32::from(code::OK)) & !within, code::JOINT_LIMIT, k);
+        let k = select(
+            (k == u32::from(code::OK)) & (within[i] == 0),
+            code::JOINT_LIMIT,
+            k,
+        );
         // All ones where solved, zero elsewhere: the angles or +0.0.
         let keep = 0u32.wrapping_sub(u32::from(k == u32::from(code::OK)));
         out.abduction_rad[i] = f32::from_bits(abduction[i].to_bits() & keep);
@@ -244,15 +256,15 @@ fn select(cond: bool, code: u8, other: u32) -> u32 {
 // Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
 // (a call out of line would run the portable code).
 #[inline(always)]
-fn leg_chunk<M: Math>(
+fn leg_chunk<M: Math, const W: usize>(
     s: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
-    sd: &[f32; LANES],
-    x: &[f32; LANES],
-    y: &[f32; LANES],
-    z: &[f32; LANES],
-) -> LegLanes<LANES> {
+    sd: &[f32; W],
+    x: &[f32; W],
+    y: &[f32; W],
+    z: &[f32; W],
+) -> LegLanes<W> {
     let mut r = leg_lanes(s, sd, x, y, z);
     if policy == ReachPolicy::Clamp {
         let mut redo = false;
@@ -313,13 +325,13 @@ pub fn leg_inverse<M: Math>(
     angles_rad: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    leg_inverse_impl(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
+    leg_inverse_impl::<M, LANES>(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
 }
 
 // Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
 // (a call out of line would run the portable code).
 #[inline(always)]
-fn leg_inverse_impl<M: Math>(
+fn leg_inverse_impl<M: Math, const W: usize>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
@@ -330,12 +342,12 @@ fn leg_inverse_impl<M: Math>(
     let n = row_count("feet_in_hip_m", feet_in_hip_m, 3)?;
     check_len("angles_rad", 3 * n, angles_rad.len())?;
     check_len("codes", n, codes.len())?;
-    let sd = [solver.side_d_lat(leg); LANES];
+    let sd = [solver.side_d_lat(leg); W];
     let solve =
         |f: &[f32], a: &mut [f32], c: &mut [u8]| leg_rows_chunk(solver, leg, policy, &sd, f, a, c);
-    let mut feet = feet_in_hip_m.chunks_exact(3 * LANES);
-    let mut angles = angles_rad.chunks_exact_mut(3 * LANES);
-    let mut out_codes = codes.chunks_exact_mut(LANES);
+    let mut feet = feet_in_hip_m.chunks_exact(3 * W);
+    let mut angles = angles_rad.chunks_exact_mut(3 * W);
+    let mut out_codes = codes.chunks_exact_mut(W);
     for ((f, a), c) in (&mut feet).zip(&mut angles).zip(&mut out_codes) {
         solve(f, a, c);
     }
@@ -355,25 +367,35 @@ fn leg_inverse_impl<M: Math>(
 // Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
 // (a call out of line would run the portable code).
 #[inline(always)]
-fn leg_rows_chunk<M: Math>(
+fn leg_rows_chunk<M: Math, const W: usize>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
-    sd: &[f32; LANES],
+    sd: &[f32; W],
     f: &[f32],
     a: &mut [f32],
     c: &mut [u8],
 ) {
     let m = c.len();
-    let at = |i: usize, k: usize| if i < m { f[3 * i + k] } else { f[k] };
-    let x: [f32; LANES] = core::array::from_fn(|i| at(i, 0));
-    let y: [f32; LANES] = core::array::from_fn(|i| at(i, 1));
-    let z: [f32; LANES] = core::array::from_fn(|i| at(i, 2));
+    let (f, _) = f.as_chunks::<3>();
+    // A full chunk is read in place; a tail is padded with its first row.
+    let padded: [[f32; 3]; W];
+    let rows: &[[f32; 3]; W] = match f.try_into() {
+        Ok(rows) => rows,
+        Err(_) => {
+            padded = core::array::from_fn(|i| if i < m { f[i] } else { f[0] });
+            &padded
+        }
+    };
+    let x: [f32; W] = core::array::from_fn(|i| rows[i][0]);
+    let y: [f32; W] = core::array::from_fn(|i| rows[i][1]);
+    let z: [f32; W] = core::array::from_fn(|i| rows[i][2]);
     let r = leg_chunk(solver, leg, policy, sd, &x, &y, &z);
-    for (i, (a, c)) in a.chunks_exact_mut(3).zip(c.iter_mut()).enumerate() {
-        a.copy_from_slice(&[r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]]);
-        *c = r.code[i];
-    }
+    let out: [[f32; 3]; W] =
+        core::array::from_fn(|i| [r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]]);
+    let (a, _) = a.as_chunks_mut::<3>();
+    a.copy_from_slice(&out[..m]);
+    c.copy_from_slice(&r.code[..m]);
 }
 
 /// [`leg_inverse`] on a structure of arrays: the feet's coordinates `x_m`, `y_m`, `z_m` (one
@@ -393,7 +415,7 @@ pub fn leg_inverse_soa<M: Math>(
     knee_rad: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    leg_inverse_soa_impl(
+    leg_inverse_soa_impl::<M, LANES>(
         solver,
         leg,
         policy,
@@ -409,7 +431,7 @@ pub fn leg_inverse_soa<M: Math>(
 // (a call out of line would run the portable code).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn leg_inverse_soa_impl<M: Math>(
+fn leg_inverse_soa_impl<M: Math, const W: usize>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
@@ -426,15 +448,15 @@ fn leg_inverse_soa_impl<M: Math>(
     check_len("hip_rad", n, hip_rad.len())?;
     check_len("knee_rad", n, knee_rad.len())?;
     check_len("codes", n, codes.len())?;
-    let sd = [solver.side_d_lat(leg); LANES];
-    for first in (0..n).step_by(LANES) {
-        let m = LANES.min(n - first);
-        let lanes = |v: &[f32]| -> [f32; LANES] {
+    let sd = [solver.side_d_lat(leg); W];
+    for first in (0..n).step_by(W) {
+        let m = W.min(n - first);
+        let lanes = |v: &[f32]| -> [f32; W] {
             let v = &v[first..first + m];
             core::array::from_fn(|i| if i < m { v[i] } else { v[0] })
         };
         let (x, y, z) = (lanes(x_m), lanes(y_m), lanes(z_m));
-        let r = leg_chunk(solver, leg, policy, &sd, &x, &y, &z);
+        let r = leg_chunk::<M, W>(solver, leg, policy, &sd, &x, &y, &z);
         abduction_rad[first..first + m].copy_from_slice(&r.abduction_rad[..m]);
         hip_rad[first..first + m].copy_from_slice(&r.hip_rad[..m]);
         knee_rad[first..first + m].copy_from_slice(&r.knee_rad[..m]);
@@ -460,13 +482,13 @@ pub fn leg_forward<M: Math>(
     feet_in_hip_m: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    leg_forward_impl::<M>(geometry, leg, angles_rad, feet_in_hip_m, codes)
+    leg_forward_impl::<M, LANES>(geometry, leg, angles_rad, feet_in_hip_m, codes)
 }
 
 // Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
 // (a call out of line would run the portable code).
 #[inline(always)]
-fn leg_forward_impl<M: Math>(
+fn leg_forward_impl<M: Math, const W: usize>(
     geometry: &LegGeometry,
     leg: LegId,
     angles_rad: &[f32],
@@ -476,18 +498,18 @@ fn leg_forward_impl<M: Math>(
     let n = row_count("angles_rad", angles_rad, 3)?;
     check_len("feet_in_hip_m", 3 * n, feet_in_hip_m.len())?;
     check_len("codes", n, codes.len())?;
-    for first in (0..n).step_by(LANES) {
-        let m = LANES.min(n - first);
+    for first in (0..n).step_by(W) {
+        let m = W.min(n - first);
         let at = |i: usize, k: usize| {
             let i = if i < m { first + i } else { first };
             angles_rad[3 * i + k]
         };
-        let a: [f32; LANES] = core::array::from_fn(|i| at(i, 0));
-        let h: [f32; LANES] = core::array::from_fn(|i| at(i, 1));
-        let k: [f32; LANES] = core::array::from_fn(|i| at(i, 2));
-        let mut out = [[0.0f32; 3]; LANES];
-        let mut ok = [false; LANES];
-        for i in 0..LANES {
+        let a: [f32; W] = core::array::from_fn(|i| at(i, 0));
+        let h: [f32; W] = core::array::from_fn(|i| at(i, 1));
+        let k: [f32; W] = core::array::from_fn(|i| at(i, 2));
+        let mut out = [[0.0f32; 3]; W];
+        let mut ok = [false; W];
+        for i in 0..W {
             ok[i] = finite(a[i]) & finite(h[i]) & finite(k[i]);
             let q = JointAngles::new(a[i], h[i], k[i]);
             let f = leg::forward_on::<M>(geometry, leg, q);
@@ -548,14 +570,14 @@ pub fn body_inverse<M: Math>(
     codes: &mut [u8],
     legs: &mut [i8],
 ) -> Result<(), LengthMismatch> {
-    body_inverse_impl(solver, config, policy, poses, feet, angles_rad, codes, legs)
+    body_inverse_impl::<M, LANES>(solver, config, policy, poses, feet, angles_rad, codes, legs)
 }
 
 // Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
 // (a call out of line would run the portable code).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn body_inverse_impl<M: Math>(
+fn body_inverse_impl<M: Math, const W: usize>(
     solver: &body::Solver<M>,
     config: &BodyConfig,
     policy: ReachPolicy,
@@ -573,12 +595,12 @@ fn body_inverse_impl<M: Math>(
         check_len("feet_in_world_m", 12 * n, f.len())?;
     }
     let leg_solver = solver.leg();
-    let sd: [[f32; LANES]; 4] = LegId::ALL.map(|leg| [leg_solver.side_d_lat(leg); LANES]);
-    for first in (0..n).step_by(LANES) {
-        let m = LANES.min(n - first);
+    let sd: [[f32; W]; 4] = LegId::ALL.map(|leg| [leg_solver.side_d_lat(leg); W]);
+    for first in (0..n).step_by(W) {
+        let m = W.min(n - first);
         // The feet in the hip frames, per leg a structure of arrays over the chunk's poses.
-        let mut local = [[[0.0f32; LANES]; 3]; 4];
-        let mut pose_ok = [false; LANES];
+        let mut local = [[[0.0f32; W]; 3]; 4];
+        let mut pose_ok = [false; W];
         for i in 0..m {
             let pose = Pose::from_array(pose_at(poses, first + i));
             pose_ok[i] = body::check_finite(&pose, config).is_ok();
@@ -599,7 +621,7 @@ fn body_inverse_impl<M: Math>(
                 (local[k][0][i], local[k][1][i], local[k][2][i]) = (h.x, h.y, h.z);
             }
         }
-        let solved: [LegLanes<LANES>; 4] = core::array::from_fn(|k| {
+        let solved: [LegLanes<W>; 4] = core::array::from_fn(|k| {
             let [x, y, z] = &local[k];
             leg_lanes(leg_solver, &sd[k], x, y, z)
         });
@@ -677,104 +699,139 @@ fn body_scalar<M: Math>(
     }
 }
 
-/// The batch solves compiled for x86-64 CPUs with AVX2: the same functions, each value in one
-/// 256-bit register of 8 lanes and three-operand instructions instead of two SSE registers
-/// and the moves between them. The results are the same bits: the same operations in the
-/// same order (AVX2 alone enables no fused multiply–add, and the compiler never contracts
-/// a multiplication and an addition into one). A host checks the CPU once
-/// (`std::is_x86_feature_detected!("avx2")`) and calls these, else the portable ones.
+/// Defines a module of entry points: the batch solves compiled for one set of x86-64 CPU
+/// features, with `$lanes` targets per chunk. A `#[target_feature]` function must be a
+/// function of its own (and is unsafe to call: the CPU must have the features), so each public
+/// solve has one per feature set; they all inline the same generic solve.
 #[cfg(target_arch = "x86_64")]
-#[allow(unsafe_code)] // `#[target_feature]` functions are unsafe to call: the CPU must have it.
-pub mod avx2 {
-    use super::*;
+macro_rules! compiled_for {
+    ($(#[$doc:meta])* $name:ident, $features:literal, $lanes:literal, $needs:literal) => {
+        $(#[$doc])*
+        #[allow(unsafe_code)] // `#[target_feature]` functions are unsafe to call.
+        pub mod $name {
+            use super::*;
 
-    /// [`super::leg_inverse`] compiled for AVX2.
-    ///
-    /// # Safety
-    /// The CPU must support AVX2.
-    ///
-    /// # Errors
-    /// As [`super::leg_inverse`].
-    #[target_feature(enable = "avx2")]
-    pub unsafe fn leg_inverse<M: Math>(
-        solver: &leg::Solver<M>,
-        leg: LegId,
-        policy: ReachPolicy,
-        feet_in_hip_m: &[f32],
-        angles_rad: &mut [f32],
-        codes: &mut [u8],
-    ) -> Result<(), LengthMismatch> {
-        leg_inverse_impl(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
-    }
+            /// Targets per chunk of these entry points.
+            pub const LANES: usize = $lanes;
 
-    /// [`super::leg_inverse_soa`] compiled for AVX2.
-    ///
-    /// # Safety
-    /// The CPU must support AVX2.
-    ///
-    /// # Errors
-    /// As [`super::leg_inverse_soa`].
-    #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
-    pub unsafe fn leg_inverse_soa<M: Math>(
-        solver: &leg::Solver<M>,
-        leg: LegId,
-        policy: ReachPolicy,
-        feet_in_hip_m: [&[f32]; 3],
-        abduction_rad: &mut [f32],
-        hip_rad: &mut [f32],
-        knee_rad: &mut [f32],
-        codes: &mut [u8],
-    ) -> Result<(), LengthMismatch> {
-        leg_inverse_soa_impl(
-            solver,
-            leg,
-            policy,
-            feet_in_hip_m,
-            abduction_rad,
-            hip_rad,
-            knee_rad,
-            codes,
-        )
-    }
+            #[doc = concat!("[`super::leg_inverse`] compiled for ", $needs, ".")]
+            ///
+            /// # Safety
+            #[doc = concat!("The CPU must support ", $needs, ".")]
+            ///
+            /// # Errors
+            /// As [`super::leg_inverse`].
+            #[target_feature(enable = $features)]
+            pub unsafe fn leg_inverse<M: Math>(
+                solver: &leg::Solver<M>,
+                leg: LegId,
+                policy: ReachPolicy,
+                feet_in_hip_m: &[f32],
+                angles_rad: &mut [f32],
+                codes: &mut [u8],
+            ) -> Result<(), LengthMismatch> {
+                leg_inverse_impl::<M, LANES>(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
+            }
 
-    /// [`super::leg_forward`] compiled for AVX2.
-    ///
-    /// # Safety
-    /// The CPU must support AVX2.
-    ///
-    /// # Errors
-    /// As [`super::leg_forward`].
-    #[target_feature(enable = "avx2")]
-    pub unsafe fn leg_forward<M: Math>(
-        geometry: &LegGeometry,
-        leg: LegId,
-        angles_rad: &[f32],
-        feet_in_hip_m: &mut [f32],
-        codes: &mut [u8],
-    ) -> Result<(), LengthMismatch> {
-        leg_forward_impl::<M>(geometry, leg, angles_rad, feet_in_hip_m, codes)
-    }
+            #[doc = concat!("[`super::leg_inverse_soa`] compiled for ", $needs, ".")]
+            ///
+            /// # Safety
+            #[doc = concat!("The CPU must support ", $needs, ".")]
+            ///
+            /// # Errors
+            /// As [`super::leg_inverse_soa`].
+            #[target_feature(enable = $features)]
+            #[allow(clippy::too_many_arguments)]
+            pub unsafe fn leg_inverse_soa<M: Math>(
+                solver: &leg::Solver<M>,
+                leg: LegId,
+                policy: ReachPolicy,
+                feet_in_hip_m: [&[f32]; 3],
+                abduction_rad: &mut [f32],
+                hip_rad: &mut [f32],
+                knee_rad: &mut [f32],
+                codes: &mut [u8],
+            ) -> Result<(), LengthMismatch> {
+                leg_inverse_soa_impl::<M, LANES>(
+                    solver,
+                    leg,
+                    policy,
+                    feet_in_hip_m,
+                    abduction_rad,
+                    hip_rad,
+                    knee_rad,
+                    codes,
+                )
+            }
 
-    /// [`super::body_inverse`] compiled for AVX2.
-    ///
-    /// # Safety
-    /// The CPU must support AVX2.
-    ///
-    /// # Errors
-    /// As [`super::body_inverse`].
-    #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
-    pub unsafe fn body_inverse<M: Math>(
-        solver: &body::Solver<M>,
-        config: &BodyConfig,
-        policy: ReachPolicy,
-        poses: &[f32],
-        feet: BodyFeet<'_>,
-        angles_rad: &mut [f32],
-        codes: &mut [u8],
-        legs: &mut [i8],
-    ) -> Result<(), LengthMismatch> {
-        body_inverse_impl(solver, config, policy, poses, feet, angles_rad, codes, legs)
-    }
+            #[doc = concat!("[`super::leg_forward`] compiled for ", $needs, ".")]
+            ///
+            /// # Safety
+            #[doc = concat!("The CPU must support ", $needs, ".")]
+            ///
+            /// # Errors
+            /// As [`super::leg_forward`].
+            #[target_feature(enable = $features)]
+            pub unsafe fn leg_forward<M: Math>(
+                geometry: &LegGeometry,
+                leg: LegId,
+                angles_rad: &[f32],
+                feet_in_hip_m: &mut [f32],
+                codes: &mut [u8],
+            ) -> Result<(), LengthMismatch> {
+                leg_forward_impl::<M, LANES>(geometry, leg, angles_rad, feet_in_hip_m, codes)
+            }
+
+            #[doc = concat!("[`super::body_inverse`] compiled for ", $needs, ".")]
+            ///
+            /// # Safety
+            #[doc = concat!("The CPU must support ", $needs, ".")]
+            ///
+            /// # Errors
+            /// As [`super::body_inverse`].
+            #[target_feature(enable = $features)]
+            #[allow(clippy::too_many_arguments)]
+            pub unsafe fn body_inverse<M: Math>(
+                solver: &body::Solver<M>,
+                config: &BodyConfig,
+                policy: ReachPolicy,
+                poses: &[f32],
+                feet: BodyFeet<'_>,
+                angles_rad: &mut [f32],
+                codes: &mut [u8],
+                legs: &mut [i8],
+            ) -> Result<(), LengthMismatch> {
+                body_inverse_impl::<M, LANES>(
+                    solver, config, policy, poses, feet, angles_rad, codes, legs,
+                )
+            }
+        }
+    };
 }
+
+#[cfg(target_arch = "x86_64")]
+compiled_for!(
+    /// The batch solves compiled for x86-64 CPUs with AVX2: the same functions, each value in
+    /// one 256-bit register of 8 lanes and three-operand instructions instead of two SSE
+    /// registers and the moves between them. The results are the same bits: the same
+    /// operations in the same order (the compiler never contracts a multiplication and an
+    /// addition into a fused one). A host checks the CPU once
+    /// (`std::is_x86_feature_detected!("avx2")`) and calls these, else the portable ones.
+    avx2,
+    "avx2",
+    8,
+    "AVX2"
+);
+
+#[cfg(target_arch = "x86_64")]
+compiled_for!(
+    /// The batch solves compiled for x86-64 CPUs with AVX-512 (F, VL, BW, DQ): the same
+    /// functions over chunks of 16 targets, each value in one 512-bit register, the lanes'
+    /// comparisons in mask registers. The same bits as the portable ones, as [`avx2`]'s. A host
+    /// checks the CPU once (`std::is_x86_feature_detected!` for each of the four) and calls
+    /// these where it can.
+    avx512,
+    "avx512f,avx512vl,avx512bw,avx512dq",
+    16,
+    "AVX-512 F, VL, BW and DQ"
+);

@@ -4,11 +4,35 @@
 //! policies. Targets: proptest over a box enclosing the whole workspace with special values
 //! mixed in (±0, NaN, ±∞, huge, subnormal), and enumerated edges (the reach boundaries ± a
 //! few ulps, the offset circle, the quadrant boundaries y = 0 / z = 0 with both zeros, the
-//! joint limits ± an ulp), on every tail length `0..=LANES + 1` and beyond. The AVX2 entry
-//! points (`batch::avx2`) give the portable ones' bits, where the CPU has AVX2.
+//! joint limits ± an ulp), on every tail length `0..=LANES + 1` and beyond (three portable
+//! chunks and one more, a full AVX-512 chunk and nine more). The entry points compiled for
+//! AVX2 and AVX-512 (`batch::avx2`, `batch::avx512`) give the portable ones' bits, each
+//! where the CPU runs it.
 
-// The AVX2 entry points are unsafe to call: each call is behind the CPU's check.
+// The compiled entry points are unsafe to call: each call is behind the CPU's check.
 #![allow(unsafe_code)]
+
+/// Runs `$body` once for each module of compiled entry points this CPU runs, named `$form`
+/// inside it (`batch::avx2`, then `batch::avx512`).
+macro_rules! each_compiled_form {
+    ($form:ident => $body:block) => {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") {
+                use kin_core::batch::avx2 as $form;
+                $body
+            }
+            if std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512vl")
+                && std::is_x86_feature_detected!("avx512bw")
+                && std::is_x86_feature_detected!("avx512dq")
+            {
+                use kin_core::batch::avx512 as $form;
+                $body
+            }
+        }
+    };
+}
 
 use kin_core::batch::{self, code, BodyFeet, LANES, NO_LEG};
 use kin_core::math::{Fast, Libm, SoftFloat};
@@ -79,13 +103,12 @@ fn check_leg_on<M: Math>(robot: &Robot, leg: LegId, policy: ReachPolicy, feet: &
         &mut codes_soa,
     )
     .unwrap();
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx2") {
+    each_compiled_form!(form => {
         let mut angles2 = vec![[f32::NAN; 3]; n];
         let mut codes2 = vec![u8::MAX; n];
-        // SAFETY: the CPU supports AVX2 (checked above).
+        // SAFETY: the CPU supports the form's features (checked by the macro).
         unsafe {
-            batch::avx2::leg_inverse(
+            form::leg_inverse(
                 &s,
                 leg,
                 policy,
@@ -103,7 +126,7 @@ fn check_leg_on<M: Math>(robot: &Robot, leg: LegId, policy: ReachPolicy, feet: &
         let (mut a2, mut h2, mut k2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         // SAFETY: as above.
         unsafe {
-            batch::avx2::leg_inverse_soa(
+            form::leg_inverse_soa(
                 &s,
                 leg,
                 policy,
@@ -119,7 +142,7 @@ fn check_leg_on<M: Math>(robot: &Robot, leg: LegId, policy: ReachPolicy, feet: &
             assert_eq!(bits3([a2[i], h2[i], k2[i]]), bits3(angles[i]));
         }
         assert_eq!(codes2, codes);
-    }
+    });
     for (i, p) in feet.iter().enumerate() {
         let (want, want_code) = scalar_leg(&s, leg, policy, *p);
         let name = core::any::type_name::<M>();
@@ -368,14 +391,13 @@ proptest! {
         let mut feet = vec![[f32::NAN; 3]; q.len()];
         let mut codes = vec![u8::MAX; q.len()];
         batch::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, q.as_flattened(), feet.as_flattened_mut(), &mut codes).unwrap();
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
+        each_compiled_form!(form => {
             let (mut feet2, mut codes2) = (vec![[0.0; 3]; q.len()], vec![0; q.len()]);
-            // SAFETY: the CPU supports AVX2 (checked above).
-            unsafe { batch::avx2::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, q.as_flattened(), feet2.as_flattened_mut(), &mut codes2) }.unwrap();
+            // SAFETY: the CPU supports the form's features (checked by the macro).
+            unsafe { form::leg_forward::<kin_core::DefaultMath>(&robot.leg, leg, q.as_flattened(), feet2.as_flattened_mut(), &mut codes2) }.unwrap();
             prop_assert_eq!(feet2.iter().map(|f| bits3(*f)).collect::<Vec<_>>(), feet.iter().map(|f| bits3(*f)).collect::<Vec<_>>());
             prop_assert_eq!(&codes2, &codes);
-        }
+        });
         for (i, a) in q.iter().enumerate() {
             if a.iter().all(|v| v.is_finite()) {
                 let want = leg::forward(&robot.leg, leg, kin_core::JointAngles::from_array(*a));
@@ -449,13 +471,12 @@ fn check_body_on<M: Math>(
         &mut legs,
     )
     .unwrap();
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx2") {
+    each_compiled_form!(form => {
         let mut angles2 = vec![[f32::NAN; 12]; n];
         let (mut codes2, mut legs2) = (vec![u8::MAX; n], vec![i8::MAX; n]);
-        // SAFETY: the CPU supports AVX2 (checked above).
+        // SAFETY: the CPU supports the form's features (checked by the macro).
         unsafe {
-            batch::avx2::body_inverse(
+            form::body_inverse(
                 &s,
                 config,
                 policy,
@@ -472,7 +493,7 @@ fn check_body_on<M: Math>(
             (bits(&angles2), &codes2, &legs2),
             (bits(&angles), &codes, &legs)
         );
-    }
+    });
     for (j, p) in poses.iter().enumerate() {
         let (want, c, l) = scalar_body(&s, config, policy, *p, feet, j);
         assert_eq!(

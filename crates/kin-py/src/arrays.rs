@@ -9,8 +9,8 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-/// Rows per rayon task (a multiple of `kin_core::batch::LANES`, so that every task's chunks
-/// are full); batches of fewer than two chunks run on the calling thread.
+/// Rows per rayon task (a multiple of every form's lanes, `kin_core::batch::LANES` and
+/// `kin_core::batch::avx512::LANES`, so that every task's chunks are full); batches of fewer than two chunks run on the calling thread.
 pub const CHUNK_ROWS: usize = 16_384;
 
 /// A float array read from Python: float32 used as it is, float64 narrowed to f32 row by row

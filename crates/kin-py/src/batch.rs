@@ -1,7 +1,7 @@
 //! The batch kinematics of `kin_core::batch` on the host: large batches split into slices of
-//! [`CHUNK_ROWS`] rows over rayon's threads, each slice solved by the form compiled for this
-//! CPU (`kin_core::batch::avx2` where the CPU has AVX2, else the portable one; both give the
-//! same bits).
+//! [`CHUNK_ROWS`] rows over rayon's threads, each slice solved by the widest form compiled for
+//! this CPU ([`Form`]: `kin_core::batch::avx512`, `kin_core::batch::avx2` or the portable one;
+//! all give the same bits).
 //!
 //! Rows are flat slices: `width` floats per row, one row after the other (numpy's C order).
 
@@ -10,16 +10,61 @@ use kin_core::batch::{self, BodyFeet, LengthMismatch};
 use kin_core::{body, leg, BodyConfig, DefaultMath, LegGeometry, LegId, ReachPolicy};
 use rayon::prelude::*;
 
-/// True when this CPU runs `kin_core::batch::avx2` (the standard library caches the check).
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2")
+/// The form of kin-core's batch solves this CPU runs, the widest first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Form {
+    /// `kin_core::batch::avx512`: 16 lanes.
+    Avx512,
+    /// `kin_core::batch::avx2`: 8 lanes.
+    Avx2,
+    /// The portable solves (x86-64's baseline SSE2, or any other CPU).
+    Portable,
+}
+
+impl Form {
+    /// The widest form this CPU runs (the standard library caches the checks).
+    pub fn detect() -> Form {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512vl")
+                && std::is_x86_feature_detected!("avx512bw")
+                && std::is_x86_feature_detected!("avx512dq")
+            {
+                return Form::Avx512;
+            }
+            if std::is_x86_feature_detected!("avx2") {
+                return Form::Avx2;
+            }
+        }
+        Form::Portable
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
+
+    /// The form's name, as `quadkin.batch_form()` gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Form::Avx512 => "avx512",
+            Form::Avx2 => "avx2",
+            Form::Portable => "portable",
+        }
     }
+}
+
+/// Calls `kin_core::batch::$f` in the form `$form` ([`Form`]) with `$args`.
+macro_rules! in_form {
+    ($form:expr, $f:ident $(::<$m:ty>)? ($($args:expr),* $(,)?)) => {{
+        match $form {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Form::detect` found the CPU's AVX-512 features.
+            #[allow(unsafe_code)]
+            Form::Avx512 => unsafe { batch::avx512::$f $(::<$m>)? ($($args),*) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Form::detect` found the CPU's AVX2.
+            #[allow(unsafe_code)]
+            Form::Avx2 => unsafe { batch::avx2::$f $(::<$m>)? ($($args),*) },
+            _ => batch::$f $(::<$m>)? ($($args),*),
+        }
+    }};
 }
 
 /// Runs `solve(input, out, codes)` on the whole batch of `codes.len()` rows, or on slices of
@@ -60,16 +105,9 @@ pub fn leg_inverse(
     angles_rad: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    let avx2 = has_avx2();
+    let form = Form::detect();
     split(feet_in_hip_m, 3, angles_rad, 3, codes, |f, a, c| {
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: the CPU has AVX2 (`has_avx2`).
-            #[allow(unsafe_code)]
-            return unsafe { batch::avx2::leg_inverse(solver, leg, policy, f, a, c) };
-        }
-        let _ = avx2;
-        batch::leg_inverse(solver, leg, policy, f, a, c)
+        in_form!(form, leg_inverse(solver, leg, policy, f, a, c))
     })
 }
 
@@ -85,16 +123,9 @@ pub fn leg_forward(
     feet_in_hip_m: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    let avx2 = has_avx2();
+    let form = Form::detect();
     split(angles_rad, 3, feet_in_hip_m, 3, codes, |q, f, c| {
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: the CPU has AVX2 (`has_avx2`).
-            #[allow(unsafe_code)]
-            return unsafe { batch::avx2::leg_forward::<DefaultMath>(geometry, leg, q, f, c) };
-        }
-        let _ = avx2;
-        batch::leg_forward::<DefaultMath>(geometry, leg, q, f, c)
+        in_form!(form, leg_forward::<DefaultMath>(geometry, leg, q, f, c))
     })
 }
 
@@ -126,7 +157,7 @@ pub fn body_inverse(
     codes: &mut [u8],
     legs: &mut [i8],
 ) -> Result<(), LengthMismatch> {
-    let avx2 = has_avx2();
+    let form = Form::detect();
     // Per-pose feet are split with the poses: their slice of rows goes with each slice.
     let n = codes.len();
     let per_pose = match feet {
@@ -142,14 +173,7 @@ pub fn body_inverse(
                 BodyFeet::PerPose(&f[(12 * first_row).min(end)..end])
             }
         };
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: the CPU has AVX2 (`has_avx2`).
-            #[allow(unsafe_code)]
-            return unsafe { batch::avx2::body_inverse(solver, config, policy, p, f, a, c, l) };
-        }
-        let _ = avx2;
-        batch::body_inverse(solver, config, policy, p, f, a, c, l)
+        in_form!(form, body_inverse(solver, config, policy, p, f, a, c, l))
     };
     if let Some(f) = per_pose {
         if f.len() != 12 * n {

@@ -10,8 +10,8 @@
 //!   exceptions ([`errors`]).
 //!
 //! Batch calls run with the GIL released, over rayon's threads for large batches: leg IK/FK
-//! and body IK through kin-core's batch solves (`kin_core::batch`, the AVX2 form where the
-//! CPU has it; [`batch`]), the others row by row ([`arrays::for_rows`]). No Rust panic is
+//! and body IK through kin-core's batch solves (`kin_core::batch`, the widest form the CPU
+//! runs: AVX-512, AVX2 or the portable one; [`batch`]), the others row by row ([`arrays::for_rows`]). No Rust panic is
 //! meant to reach Python; PyO3 would turn one into `pyo3_runtime.PanicException`.
 
 pub mod arrays;
@@ -25,6 +25,13 @@ pub mod robot;
 
 use pyo3::prelude::*;
 
+/// The form of kin-core's batch solves that this CPU runs, which the batch calls use:
+/// `"avx512"` (16 lanes), `"avx2"` (8 lanes) or `"portable"`. All give the same bits.
+#[pyfunction]
+fn batch_form() -> &'static str {
+    batch::Form::detect().name()
+}
+
 /// The Python module `quadkin._quadkin` (re-exported by the `quadkin` package).
 #[pymodule]
 fn _quadkin(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -34,6 +41,7 @@ fn _quadkin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(motion::motion_laws, m)?)?;
     m.add_function(wrap_pyfunction!(protocol::encode_request, m)?)?;
     m.add_function(wrap_pyfunction!(protocol::decode_answer, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_form, m)?)?;
     m.add("OK", robot::OK)?;
     m.add("TOO_FAR", robot::TOO_FAR)?;
     m.add("TOO_CLOSE", robot::TOO_CLOSE)?;

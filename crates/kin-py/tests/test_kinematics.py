@@ -94,6 +94,32 @@ def test_single_solve_equals_batch_and_raises_typed_error():
             assert e.value.leg == "RR"
 
 
+def cpu_flags() -> set[str]:
+    """The CPU's feature flags as Linux lists them (empty elsewhere)."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("flags"):
+                    return set(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return set()
+
+
+def test_batch_form_is_the_widest_the_cpu_runs():
+    flags = cpu_flags()
+    if not flags:  # Not Linux: the flags are unknown here.
+        assert quadkin.batch_form() in ("avx512", "avx2", "portable")
+        return
+    if {"avx512f", "avx512vl", "avx512bw", "avx512dq"} <= flags:
+        want = "avx512"
+    elif "avx2" in flags:
+        want = "avx2"
+    else:
+        want = "portable"
+    assert quadkin.batch_form() == want
+
+
 def test_shapes_dtypes_and_large_batches_agree_with_small_ones():
     robot = quadkin.Robot("fernando2025")
     feet = random_feet(100_000, seed=4)

@@ -947,7 +947,7 @@ fn a_target_every_period_goes_through_the_limiter_after_the_enabling_frame() {
     )
     .unwrap();
     hello(&mut dev);
-    let pose = |k: u32| Pose::rotation(if k % 2 == 0 { 0.25 } else { -0.25 }, 0.0, 0.0);
+    let pose = |k: u32| Pose::rotation(if k.is_multiple_of(2) { 0.25 } else { -0.25 }, 0.0, 0.0);
     ack(ask(&mut dev, 1, Request::SetBodyPose(pose(0))));
     ack(ask(&mut dev, 2, Request::SetOutputs { enabled: true }));
     dev.poll();

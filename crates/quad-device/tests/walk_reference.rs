@@ -332,7 +332,7 @@ fn compare(pattern: Pattern, commands: &[(u32, Cmd)], stop_at: u32) -> (u32, f32
             current = Some(c);
             pending.next();
         }
-        if due.is_empty() && frame % 10 == 0 && frame < stop_at {
+        if due.is_empty() && frame.is_multiple_of(10) && frame < stop_at {
             due.extend(current);
         }
         for c in due {

@@ -314,7 +314,7 @@ impl Decimator {
 
     /// Offers one sample.
     pub fn push(&mut self, t_s: f64, angles: Option<[f32; 12]>) {
-        if self.seen % self.stride == 0 {
+        if self.seen.is_multiple_of(self.stride) {
             self.series.push(t_s, angles);
             if self.series.t_s.len() >= 2 * MAX_POINTS {
                 every_other(&mut self.series.t_s);

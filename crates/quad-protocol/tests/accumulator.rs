@@ -415,7 +415,7 @@ fn encoded_frames_are_the_reference_cobs_of_payload_and_crc() {
         let bytes: Vec<u8> = (0..len)
             .map(|_| {
                 let b = rng.next_u64() as u8;
-                if zero_share > 0 && b % zero_share == 0 {
+                if zero_share > 0 && b.is_multiple_of(zero_share) {
                     0
                 } else {
                     b

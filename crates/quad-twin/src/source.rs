@@ -233,7 +233,7 @@ pub fn onboard_request(
     if k == 0 {
         return Some(Request::StartMotion(command));
     }
-    if k % VELOCITY_EVERY_FRAMES != 0 {
+    if !k.is_multiple_of(VELOCITY_EVERY_FRAMES) {
         return None;
     }
     velocity.map(|v| Request::SetVelocity {

@@ -280,7 +280,7 @@ impl Walker {
             // (a swap and a sign change each: exact, and no table, which the AVR would hold in
             // SRAM).
             let r = self.p.reach_radius_m / COS_PI_8;
-            let (mut x, mut y) = if k % 2 == 0 {
+            let (mut x, mut y) = if k.is_multiple_of(2) {
                 (r, 0.0)
             } else {
                 let h = r * core::f32::consts::FRAC_1_SQRT_2;

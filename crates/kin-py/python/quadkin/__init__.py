@@ -34,6 +34,7 @@ from ._quadkin import (  # noqa: F401
     Robot,
     UnreachableError,
     VersionError,
+    batch_form,
     decode_answer,
     encode_request,
     motion_laws,
@@ -61,6 +62,7 @@ __all__ = [
     "Robot",
     "UnreachableError",
     "VersionError",
+    "batch_form",
     "motion_laws",
     "sample_motion",
 ]

@@ -149,6 +149,9 @@ def sample_motion(
     yaw_rad_s: Optional[float] = None,
 ) -> MotionSamples: ...
 def motion_laws() -> list[str]: ...
+def batch_form() -> Literal["avx512", "avx2", "portable"]:
+    """The form of the batch solves this CPU runs (the widest: AVX-512 with 16 lanes, AVX2 with
+    8, or the portable one); all give the same bits."""
 
 class Readback(TypedDict):
     angles_rad: F32

@@ -341,7 +341,7 @@ impl SimLink {
         while t < t_ns {
             self.clock.set_ns(t);
             if let Some(imu) = &self.imu {
-                if (t / MS_NS) % u64::from(READ_PERIOD_MS) == 0 {
+                if (t / MS_NS).is_multiple_of(u64::from(READ_PERIOD_MS)) {
                     self.device.on_imu(imu.read(t as f64 * 1e-9));
                 }
             }
