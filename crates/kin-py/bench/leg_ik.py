@@ -3,7 +3,7 @@ the same equations (written here for the comparison: kin-core's leg IK, seed 000
 reject policy, backward knee) and against a Python loop over single solves; and the overhead of
 one single-leg call. Medians of repeated runs, same run, ratios.
 
-    .venv-py/bin/python crates/kin-py/bench/leg_ik.py [--n 1000000] [--repeat 7]
+    .venv-py/bin/python crates/kin-py/bench/leg_ik.py [--n 1000000] [--repeat 15]
 
 Prints a Markdown table (the "Python" table of BENCHMARKS.md).
 """
@@ -14,9 +14,15 @@ import statistics
 import time
 import timeit
 
-import numpy as np
+# numpy's OpenBLAS keeps worker threads that spin on the cores for a while after it starts
+# (profiled: a quarter of the samples of the first batch calls), competing with the batch's
+# own threads. None of the compared code uses BLAS, so one OpenBLAS thread changes nothing
+# else; a value set by the caller is kept (`OPENBLAS_NUM_THREADS=2 …` shows the difference).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import quadkin
+import numpy as np  # noqa: E402
+
+import quadkin  # noqa: E402
 
 
 def numpy_leg_ik(robot: quadkin.Robot, left: bool, feet_m: np.ndarray):
@@ -52,7 +58,11 @@ def numpy_leg_ik(robot: quadkin.Robot, left: bool, feet_m: np.ndarray):
     return angles, code
 
 
-def median_s(f, repeat: int) -> float:
+def median_s(f, repeat: int, warmup: int = 3) -> float:
+    """The median time of `repeat` calls of `f`, after `warmup` calls (which start rayon's
+    threads and let the allocator settle on its large blocks, for every contender alike)."""
+    for _ in range(warmup):
+        f()
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -64,7 +74,7 @@ def median_s(f, repeat: int) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=1_000_000)
-    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--repeat", type=int, default=15)
     parser.add_argument("--loop-n", type=int, default=200_000)
     args = parser.parse_args()
     robot = quadkin.Robot("shahriar2023")
@@ -98,7 +108,7 @@ def main() -> None:
             except quadkin.UnreachableError:
                 pass
 
-    t_loop = median_s(loop, 3) * args.n / args.loop_n
+    t_loop = median_s(loop, 3, warmup=1) * args.n / args.loop_n
     one = timeit.Timer(lambda: robot.leg_ik_one("FL", 0.0, 0.044, -0.4))
     n_one, _ = one.autorange()
     t_one = statistics.median(r / n_one for r in one.repeat(5, n_one))
@@ -109,6 +119,8 @@ def main() -> None:
 
     ns = 1e9 / args.n
     print(f"N = {args.n:.0e} leg IKs (shahriar2023, FL, float32), {os.cpu_count()} cores, "
+          f"batch form {quadkin.batch_form()}, load {os.getloadavg()[0]:.1f}, "
+          f"OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}, "
           f"{100 * np.mean(c_q == quadkin.OK):.1f} % reachable; numpy agrees on "
           f"{100 * agree:.4f} % of codes, max |Δangle| {max_diff:.1e} rad")
     print()
