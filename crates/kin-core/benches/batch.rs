@@ -7,9 +7,12 @@
 //!   `common/mod.rs`), one `leg::Solver::inverse` each (the solvers kept).
 //! - `leg_ik_batch`: the same targets grouped by robot and leg, one `batch::leg_inverse` per
 //!   group (rows `[x, y, z]` in, rows of angles out).
+//! - `leg_ik_batch_avx2` / `leg_ik_batch_avx512`: `leg_ik_batch` by the entry points compiled
+//!   for AVX2 (8 lanes) and AVX-512 (16 lanes), where the CPU has them.
 //! - `leg_ik_batch_soa`: the same with `batch::leg_inverse_soa` (one slice per coordinate).
 //! - `body_ik_scalar` / `body_ik_batch`: the 10,000 seeded body poses at seed 000's nominal
-//!   stance, `body::Solver::inverse_at_stance_into` each / one `batch::body_inverse`.
+//!   stance, `body::Solver::inverse_at_stance_into` each / one `batch::body_inverse`
+//!   (`body_ik_batch_avx512`: compiled for AVX-512).
 
 // The AVX2 entry points of `kin_core::batch::avx2` are unsafe to call (the CPU must have
 // AVX2, checked before each use).
@@ -191,6 +194,27 @@ fn batch_benches(c: &mut Criterion) {
             black_box(&body_angles);
         });
     });
+    #[cfg(target_arch = "x86_64")]
+    if has_avx512() {
+        group.bench_function("body_ik_batch_avx512", |b| {
+            b.iter(|| {
+                // SAFETY: the CPU supports AVX-512 (checked above).
+                let _ = unsafe {
+                    batch::avx512::body_inverse(
+                        &solver,
+                        &config,
+                        ReachPolicy::Reject,
+                        black_box(pose_rows.as_flattened()),
+                        BodyFeet::Stance { height_m },
+                        body_angles.as_flattened_mut(),
+                        &mut body_codes,
+                        &mut body_legs,
+                    )
+                };
+                black_box(&body_angles);
+            });
+        });
+    }
     assert!(body_codes.iter().all(|&c| c == batch::code::OK));
     group.finish();
 }

@@ -1,9 +1,9 @@
 //! Batch kinematics: leg IK, leg FK and body IK over many targets at once.
 //!
-//! The targets are taken in chunks of [`LANES`]; within a chunk every stage of the solve runs
-//! over all lanes before the next (structure of arrays: one array per coordinate), with no
-//! branch on a lane's value (unreachable lanes are computed along and masked), so that the
-//! compiler vectorises each stage. The equations, their order of operations and the branch
+//! The targets are taken in chunks of [`LANES`] (16 in the AVX-512 form, [`avx512`]); within a
+//! chunk every stage of the solve runs over all lanes before the next (structure of arrays: one
+//! array per coordinate), with no branch on a lane's value (unreachable lanes are computed along
+//! and masked), so that the compiler vectorises each stage. The equations, their order of operations and the branch
 //! choices (the knee bend, the abduction with the foot below the hip, every quadrant in one
 //! `atan2`) are those of the scalar solve ([`leg::Solver::inverse`]): **each result equals the
 //! scalar one bit for bit**, on every backend, which the tests check over the workspace, at
@@ -17,8 +17,11 @@
 //! scalar solve (the clamp's projections are per target and rare), so it holds the clamped
 //! angles and the code of why it was clamped, as [`leg::Solver::inverse`] reports it.
 //!
-//! This module runs on one thread; a host splits a large batch into slices (multiples of
-//! [`LANES`] keep every slice's chunks full) and hands them to its threads.
+//! On x86-64 the same solves are compiled for AVX2 ([`avx2`]) and AVX-512 ([`avx512`]), for a
+//! host to call after checking the CPU: the same bits, more lanes per instruction.
+//!
+//! This module runs on one thread; a host splits a large batch into slices (multiples of 16
+//! keep every slice's chunks full in every form) and hands them to its threads.
 //!
 //! ```
 //! use kin_core::{batch, leg, LegId, ReachPolicy, Robot, Vec3};
@@ -50,7 +53,8 @@ use crate::vec::Vec3;
 use crate::ReachPolicy;
 use core::fmt;
 
-/// Targets per chunk: 8 f32 lanes, two SSE registers or one AVX register per value.
+/// Targets per chunk of the portable solves (and of [`avx2`]): 8 f32 lanes, two SSE registers
+/// or one AVX register per value.
 pub const LANES: usize = 8;
 
 /// The reach codes of the batch solves, one byte per target (the same numbers as the Python
@@ -144,6 +148,16 @@ pub(crate) struct LegLanes<const N: usize> {
     pub(crate) code: [u8; N],
 }
 
+impl<const N: usize> LegLanes<N> {
+    /// Zero angles, [`code::OK`].
+    const ZERO: Self = LegLanes {
+        abduction_rad: [0.0; N],
+        hip_rad: [0.0; N],
+        knee_rad: [0.0; N],
+        code: [code::OK; N],
+    };
+}
+
 /// The leg IK of `N` targets `(x, y, z)` (hip frames), lane `i` of the leg with
 /// `s·d_lat = sd[i]`, under [`ReachPolicy::Reject`]: the scalar solve's steps
 /// ([`leg::Solver::inverse`]: `depth`, `Consts::leg_plane`, `abduction_yx`,
@@ -216,12 +230,7 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
                 0u32.wrapping_sub(u32::from(M::within_keys(angle[i], lo[j], hi[j], keys[j])));
         }
     }
-    let mut out = LegLanes {
-        abduction_rad: [0.0; N],
-        hip_rad: [0.0; N],
-        knee_rad: [0.0; N],
-        code: [code::OK; N],
-    };
+    let mut out = LegLanes::ZERO;
     for i in 0..N {
         let k = code[i];
         let k = select(
@@ -621,10 +630,13 @@ fn body_inverse_impl<M: Math, const W: usize>(
                 (local[k][0][i], local[k][1][i], local[k][2][i]) = (h.x, h.y, h.z);
             }
         }
-        let solved: [LegLanes<W>; 4] = core::array::from_fn(|k| {
+        // A loop rather than `array::from_fn`: its closure is called through core's generic
+        // code, which is not compiled for the entry points' CPU features.
+        let mut solved = [LegLanes::<W>::ZERO; 4];
+        for (k, out) in solved.iter_mut().enumerate() {
             let [x, y, z] = &local[k];
-            leg_lanes(leg_solver, &sd[k], x, y, z)
-        });
+            *out = leg_lanes(leg_solver, &sd[k], x, y, z);
+        }
         for (i, &ok) in pose_ok.iter().enumerate().take(m) {
             let j = first + i;
             let failed = (0..4).find(|&k| solved[k].code[i] != code::OK);
