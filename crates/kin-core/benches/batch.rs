@@ -25,6 +25,28 @@ use kin_core::batch::{self, BodyFeet};
 use kin_core::{body, leg, BodyConfig, BodySolution, LegId, ReachPolicy, Robot};
 use std::hint::black_box;
 
+/// The signature of `batch::leg_inverse` and of its compiled entry points.
+type LegInverse = unsafe fn(
+    &leg::Solver,
+    LegId,
+    ReachPolicy,
+    &[f32],
+    &mut [f32],
+    &mut [u8],
+) -> Result<(), batch::LengthMismatch>;
+
+/// The signature of `batch::body_inverse` and of its compiled entry points.
+type BodyInverse = unsafe fn(
+    &body::Solver,
+    &BodyConfig,
+    ReachPolicy,
+    &[f32],
+    BodyFeet<'_>,
+    &mut [f32],
+    &mut [u8],
+    &mut [i8],
+) -> Result<(), batch::LengthMismatch>;
+
 fn batch_benches(c: &mut Criterion) {
     let robots = common::robots();
     let targets = common::leg_targets();
@@ -73,50 +95,26 @@ fn batch_benches(c: &mut Criterion) {
             }
         });
     });
-    group.bench_function("leg_ik_batch", |b| {
-        b.iter(|| {
-            for (k, (r, leg, rows)) in black_box(&groups).iter().enumerate() {
-                let _ = batch::leg_inverse(
-                    &solvers[*r],
-                    *leg,
-                    ReachPolicy::Reject,
-                    rows.as_flattened(),
-                    angles[k].as_flattened_mut(),
-                    &mut codes[k],
-                );
-            }
-            black_box(&angles);
-        });
-    });
+    // The batch leg IK in each form this CPU runs: the portable one, then the entry points
+    // compiled for AVX2 and AVX-512 (unsafe to call: each is listed only where the CPU has
+    // its features).
+    let mut forms: Vec<(&str, LegInverse)> = vec![("leg_ik_batch", batch::leg_inverse)];
     #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx2") {
-        group.bench_function("leg_ik_batch_avx2", |b| {
-            b.iter(|| {
-                for (k, (r, leg, rows)) in black_box(&groups).iter().enumerate() {
-                    // SAFETY: the CPU supports AVX2 (checked above).
-                    let _ = unsafe {
-                        batch::avx2::leg_inverse(
-                            &solvers[*r],
-                            *leg,
-                            ReachPolicy::Reject,
-                            rows.as_flattened(),
-                            angles[k].as_flattened_mut(),
-                            &mut codes[k],
-                        )
-                    };
-                }
-                black_box(&angles);
-            });
-        });
+    {
+        if std::is_x86_feature_detected!("avx2") {
+            forms.push(("leg_ik_batch_avx2", batch::avx2::leg_inverse));
+        }
+        if has_avx512() {
+            forms.push(("leg_ik_batch_avx512", batch::avx512::leg_inverse));
+        }
     }
-    #[cfg(target_arch = "x86_64")]
-    if has_avx512() {
-        group.bench_function("leg_ik_batch_avx512", |b| {
+    for (name, solve) in forms {
+        group.bench_function(name, |b| {
             b.iter(|| {
                 for (k, (r, leg, rows)) in black_box(&groups).iter().enumerate() {
-                    // SAFETY: the CPU supports AVX-512 (checked above).
+                    // SAFETY: the CPU has the form's features (checked when it was listed).
                     let _ = unsafe {
-                        batch::avx512::leg_inverse(
+                        solve(
                             &solvers[*r],
                             *leg,
                             ReachPolicy::Reject,
@@ -179,28 +177,18 @@ fn batch_benches(c: &mut Criterion) {
             }
         });
     });
-    group.bench_function("body_ik_batch", |b| {
-        b.iter(|| {
-            let _ = batch::body_inverse(
-                &solver,
-                &config,
-                ReachPolicy::Reject,
-                black_box(pose_rows.as_flattened()),
-                BodyFeet::Stance { height_m },
-                body_angles.as_flattened_mut(),
-                &mut body_codes,
-                &mut body_legs,
-            );
-            black_box(&body_angles);
-        });
-    });
+    // The batch body IK, portable and (where the CPU has it) compiled for AVX-512.
+    let mut forms: Vec<(&str, BodyInverse)> = vec![("body_ik_batch", batch::body_inverse)];
     #[cfg(target_arch = "x86_64")]
     if has_avx512() {
-        group.bench_function("body_ik_batch_avx512", |b| {
+        forms.push(("body_ik_batch_avx512", batch::avx512::body_inverse));
+    }
+    for (name, solve) in forms {
+        group.bench_function(name, |b| {
             b.iter(|| {
-                // SAFETY: the CPU supports AVX-512 (checked above).
+                // SAFETY: the CPU has the form's features (checked when it was listed).
                 let _ = unsafe {
-                    batch::avx512::body_inverse(
+                    solve(
                         &solver,
                         &config,
                         ReachPolicy::Reject,
