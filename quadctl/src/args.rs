@@ -240,7 +240,7 @@ impl TargetArgs {
 pub struct SessionArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub robot: RobotArgs,
+    pub robot: DeviceRobotArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub target: TargetArgs,
@@ -277,16 +277,13 @@ impl SessionArgs {
         }
     }
 
-    /// The library's session. The simulated device runs the robot given; the session refuses
-    /// a robot that is not a preset before the link is opened.
+    /// The library's session. The simulated device runs the preset given, else the
+    /// firmware's (a robot file: what its --sim-storage EEPROM holds; the session compares
+    /// the hashes); without --robot the session plans with the device's robot.
     pub fn session(&self) -> Session {
-        // A robot file: the simulated device compiled with the firmware's preset, holding what
-        // its --sim-storage EEPROM holds (protocol 2.4; the session compares the hashes).
-        let preset =
-            RobotPreset::from_name(self.robot.robot.trim()).unwrap_or(RobotPreset::Shahriar2023);
         Session {
             robot: self.robot.robot.clone(),
-            target: self.target.target(preset),
+            target: self.target.target(self.robot.sim_preset()),
             retries: self.target.retries,
             stance_height_m: self.stance_height_m,
             rotation_order: self.rotation_order,

@@ -1,6 +1,6 @@
 //! Black-box tests of `quadctl robot` on the simulated device: the robot shown, sent, stored
 //! across runs (the simulated EEPROM in a file), refused before sending, and the device
-//! commands' check of the robot they are given.
+//! commands' check of the robot they are given (or, without one, their use of the device's).
 
 mod common;
 
@@ -54,6 +54,31 @@ fn a_robot_sent_and_saved_is_the_device_s_in_the_next_run_and_another_is_refused
     // before anything moves, naming both robots and the fix.
     let stand = quadctl(&[&["stand"][..], &sim].concat(), "");
     assert_eq!(stand.code, 0, "{}", stand.stderr);
+    // `stream` too: every answer is checked against the host's kin-core for bench-pup, which
+    // agrees with the device on the pose whose knee bench-pup cannot bend that far.
+    let streamed = quadctl(
+        &[
+            &["stream"][..],
+            &sim,
+            &["--input", "examples/poses.csv", "--allow-refused"],
+        ]
+        .concat(),
+        "",
+    );
+    assert_eq!(streamed.code, 0, "{}", streamed.stderr);
+    assert!(
+        streamed.stdout.contains("\"acked\":7,\"nacked\":1,")
+            && streamed.stdout.contains("\"readback_mismatches\":0,"),
+        "{}",
+        streamed.stdout
+    );
+    assert!(
+        streamed
+            .stderr
+            .contains("joint limit: FL.knee (the host's kin-core agrees)"),
+        "{}",
+        streamed.stderr
+    );
     let refused = quadctl(
         &[&["sit"][..], &sim, &["--robot", "fernando2025"]].concat(),
         "",

@@ -22,8 +22,9 @@ then up to the stance; sit: down to the rest pose, held; rest: down to the rest 
 outputs off. With the outputs off, sit and rest have nothing to do (motion none).
 
 Output: the last line of stdout is one JSON object: motion, stood_up_first, motion_s, polls,
-velocity_commands, elapsed_s, outputs_enabled. Exit status: 0 done; 2 refused (the device's
-reason in words) or the link failed.";
+velocity_commands, elapsed_s, outputs_enabled. motion_s is the time of a motion's run stage,
+so 0 for these postures, which are ramps only; elapsed_s is how long the ramp took. Exit
+status: 0 done; 2 refused (the device's reason in words) or the link failed.";
 
 /// `--help`'s examples of `stand`, `sit` and `rest` (run from the repository root).
 pub const STAND_EXAMPLES: &str = "\

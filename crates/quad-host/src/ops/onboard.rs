@@ -678,7 +678,8 @@ pub struct Summary {
     pub motion: &'static str,
     /// True when the device stood up first (its outputs were off).
     pub stood_up_first: bool,
-    /// Motion time the device reported last, s.
+    /// The longest motion time the device reported: the time of the motion's run stage, s
+    /// (0 for a stand-up, sit or rest, which are ramps only: see `elapsed_s`).
     pub motion_s: f32,
     /// State requests while waiting.
     pub polls: u64,

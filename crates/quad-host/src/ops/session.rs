@@ -7,7 +7,7 @@ use crate::client::{
 };
 use crate::link::{self, Link, Target};
 use crate::robot_file;
-use kin_core::{Robot, RotationOrder};
+use kin_core::RotationOrder;
 use quad_protocol::{RobotDescription, RobotPreset};
 use serde::Serialize;
 use std::io::{self, Write};
@@ -16,8 +16,9 @@ use std::io::{self, Write};
 #[derive(Debug, Clone, PartialEq)]
 pub struct Session {
     /// The robot: a preset, a TOML or a URDF robot file. A device of protocol 2.4 or later
-    /// must hold it (compared by hash); an older device must run the preset named.
-    pub robot: String,
+    /// must hold it (compared by hash); an older device must run the preset named. `None`:
+    /// the robot the device holds (an older device: its preset).
+    pub robot: Option<String>,
     /// The device.
     pub target: Target,
     /// Resends per setpoint after the first attempt.
@@ -45,6 +46,10 @@ pub enum Error {
     /// The robot could not be resolved.
     #[error(transparent)]
     Robot(#[from] robot_file::Error),
+    /// No robot was given and the device's robot is not one the host can plan with (an older
+    /// device running a custom robot).
+    #[error(transparent)]
+    DeviceRobot(#[from] robot_file::DeviceRobotError),
     /// The robot was refused as a device's robot (before the link is opened).
     #[error(transparent)]
     Device(#[from] robot_file::DeviceError),
@@ -62,9 +67,8 @@ pub enum Error {
 /// A session whose arguments were checked ([`Session::check`]); nothing is opened yet.
 #[derive(Debug, Clone)]
 pub struct Checked {
-    preset: RobotPreset,
-    robot: Robot,
-    description: RobotDescription,
+    /// The robot given, resolved (`None`: the device's own).
+    given: Option<(RobotPreset, RobotDescription)>,
     check: AngleCheck,
 }
 
@@ -74,20 +78,19 @@ impl Session {
     /// # Errors
     /// [`Error::Device`], [`Error::Tolerance`].
     pub fn check(&self) -> Result<Checked, Error> {
-        let preset = RobotPreset::from_name(self.robot.trim()).unwrap_or(RobotPreset::Custom);
-        let description = robot_file::device_description(&self.robot)?;
-        let robot = description.robot;
+        let given = match &self.robot {
+            Some(name) => Some((
+                RobotPreset::from_name(name.trim()).unwrap_or(RobotPreset::Custom),
+                robot_file::device_description(name)?,
+            )),
+            None => None,
+        };
         let check = match self.angle_tolerance_rad {
             Some(t) if t.is_finite() && t >= 0.0 => AngleCheck::Within(t),
             Some(t) => return Err(Error::Tolerance(t)),
             None => AngleCheck::for_target(&self.target),
         };
-        Ok(Checked {
-            preset,
-            robot,
-            description,
-            check,
-        })
+        Ok(Checked { given, check })
     }
 
     /// Opens the link and connects the stream (handshake, configuration); the rotation order
@@ -95,10 +98,12 @@ impl Session {
     ///
     /// A device of protocol 2.4 or later must hold the robot checked (the hashes are
     /// compared, [`crate::ops::onboard::check_same_robot`]); an older one must run its preset.
+    /// Without a robot, the stream plans with the device's own.
     ///
     /// # Errors
     /// [`Error::Link`], [`Error::Client`] ([`client::Error::RobotMismatch`] for another
-    /// robot), [`Error::NotAPreset`] for a robot file and a device older than 2.4.
+    /// robot), [`Error::NotAPreset`] for a robot file and a device older than 2.4,
+    /// [`Error::DeviceRobot`] without a robot and an older device running a custom one.
     pub fn connect(
         &self,
         checked: Checked,
@@ -108,21 +113,26 @@ impl Session {
         let config = ClientConfig::for_target(&self.target, self.retries);
         let mut client = Client::new(link, config);
         let info = client.hello()?;
-        let preset = if quad_protocol::version_minor(info.version) >= 4 {
+        let given = checked.given.as_ref();
+        let (robot, preset) = if quad_protocol::version_minor(info.version) >= 4 {
             let held = client.get_robot()?;
             crate::ops::onboard::check_same_robot(
                 &held,
                 info.robot_hash,
-                Some(&checked.description),
+                given.map(|(_, description)| description),
             )?;
-            info.robot
-        } else if checked.preset == RobotPreset::Custom {
-            return Err(Error::NotAPreset(self.robot.clone()));
+            (held.robot, info.robot)
         } else {
-            checked.preset
+            match given {
+                Some((RobotPreset::Custom, _)) => {
+                    return Err(Error::NotAPreset(self.robot.clone().unwrap_or_default()));
+                }
+                Some((preset, description)) => (description.robot, *preset),
+                None => (robot_file::device_robot(&info, None, None)?, info.robot),
+            }
         };
         let setup = StreamSetup {
-            robot: checked.robot,
+            robot,
             preset,
             stance_height_m: self.stance_height_m,
             order: self.rotation_order.or(default_order),
