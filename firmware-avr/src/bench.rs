@@ -217,7 +217,9 @@ impl<M: Math> EngineBench<M> {
 
     fn tick(&mut self) -> MotionStage {
         self.now_ms += FRAME_MS;
-        let tick = self.engine.tick(1, self.now_ms, &self.out, &self.solver, None);
+        let tick = self
+            .engine
+            .tick(1, self.now_ms, &self.out, &self.solver, None);
         if let Some(target) = tick.target {
             self.engine.limiter().step(&mut self.out, &target);
         }

@@ -8,6 +8,7 @@
 //! | `fmt`          | `cargo fmt --all --check`                                             |
 //! | `clippy`       | `cargo clippy --workspace --all-targets -- -D warnings`               |
 //! | `avr-kin-core` | no_std build of kin-core, quad-protocol and quad-device for `avr-none` (atmega2560), nightly + build-std=core |
+//! | `firmware-fmt` | `cargo +stable fmt --check` in `firmware-avr/` (when that directory exists) |
 //! | `firmware`     | `cargo build --release` in `firmware-avr/` (when that directory exists) |
 //! | `budget`       | the firmware's flash ≤ 128 KB and SRAM (static + worst stack in simavr) ≤ 6 KB: figures and margins; tables read with `lpm` in the lowest 64 KB (`integration_tests::budget`) |
 //! | `test`         | `cargo test --workspace`                                              |
@@ -193,6 +194,11 @@ fn ci_steps(root: &Path) -> Vec<Step> {
     // The firmware is its own workspace with its own toolchain and .cargo/config.toml, which
     // cargo and rustup only read from the current directory.
     if root.join("firmware-avr/Cargo.toml").is_file() {
+        // The firmware's format, by the stable toolchain's rustfmt (its nightly is minimal).
+        steps.push(
+            Step::new("firmware-fmt", &["cargo", "+stable", "fmt", "--check"])
+                .in_dir("firmware-avr"),
+        );
         steps.push(
             Step::new("firmware", &["cargo", "build", "--release"])
                 .in_dir("firmware-avr")
