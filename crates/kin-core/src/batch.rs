@@ -165,7 +165,8 @@ impl<const N: usize> LegLanes<N> {
 /// The scalar solve returns at the first failing check; here every lane runs every stage and
 /// the code keeps the first failure in the scalar order (non-finite, inside the offset, too
 /// far, too close, a joint limit).
-// Always inlined: into the AVX2 entry points too, which compile it for AVX2.
+// Always inlined: into the entry points compiled for CPU features too, which compile it for
+// theirs.
 #[inline(always)]
 pub(crate) fn leg_lanes<M: Math, const N: usize>(
     s: &leg::Solver<M>,
@@ -262,8 +263,8 @@ fn select(cond: bool, code: u8, other: u32) -> u32 {
 /// [`leg_lanes`] of one chunk under `policy`: under [`ReachPolicy::Clamp`] a lane the chunk
 /// found unreachable (not [`code::NON_FINITE`]) is solved again by the scalar solve: its
 /// clamped angles and the code of why it was clamped.
-// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
-// (a call out of line would run the portable code).
+// Always inlined: into its public form and the entry points compiled for CPU features (a
+// call out of line would run the portable code).
 #[inline(always)]
 fn leg_chunk<M: Math, const W: usize>(
     s: &leg::Solver<M>,
@@ -337,8 +338,8 @@ pub fn leg_inverse<M: Math>(
     leg_inverse_impl::<M, LANES>(solver, leg, policy, feet_in_hip_m, angles_rad, codes)
 }
 
-// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
-// (a call out of line would run the portable code).
+// Always inlined: into its public form and the entry points compiled for CPU features (a
+// call out of line would run the portable code).
 #[inline(always)]
 fn leg_inverse_impl<M: Math, const W: usize>(
     solver: &leg::Solver<M>,
@@ -351,60 +352,82 @@ fn leg_inverse_impl<M: Math, const W: usize>(
     let n = row_count("feet_in_hip_m", feet_in_hip_m, 3)?;
     check_len("angles_rad", 3 * n, angles_rad.len())?;
     check_len("codes", n, codes.len())?;
-    let sd = [solver.side_d_lat(leg); W];
-    let solve =
-        |f: &[f32], a: &mut [f32], c: &mut [u8]| leg_rows_chunk(solver, leg, policy, &sd, f, a, c);
-    let mut feet = feet_in_hip_m.chunks_exact(3 * W);
-    let mut angles = angles_rad.chunks_exact_mut(3 * W);
-    let mut out_codes = codes.chunks_exact_mut(W);
-    for ((f, a), c) in (&mut feet).zip(&mut angles).zip(&mut out_codes) {
-        solve(f, a, c);
-    }
-    let (f, a, c) = (
-        feet.remainder(),
-        angles.into_remainder(),
-        out_codes.into_remainder(),
-    );
-    if !c.is_empty() {
-        solve(f, a, c);
+    // A block of rows at a time: the rows taken apart into one array per coordinate (a loop
+    // the compiler turns into shuffles), the chunks solved over them, the angles put back
+    // together into rows.
+    for ((f, a), c) in feet_in_hip_m
+        .chunks(3 * BLOCK_ROWS)
+        .zip(angles_rad.chunks_mut(3 * BLOCK_ROWS))
+        .zip(codes.chunks_mut(BLOCK_ROWS))
+    {
+        let m = c.len();
+        let (mut x, mut y, mut z) = (
+            [0.0f32; BLOCK_ROWS],
+            [0.0f32; BLOCK_ROWS],
+            [0.0f32; BLOCK_ROWS],
+        );
+        for (i, row) in f.chunks_exact(3).enumerate() {
+            (x[i], y[i], z[i]) = (row[0], row[1], row[2]);
+        }
+        let (mut abduction, mut hip, mut knee) = (
+            [0.0f32; BLOCK_ROWS],
+            [0.0f32; BLOCK_ROWS],
+            [0.0f32; BLOCK_ROWS],
+        );
+        leg_columns::<M, W>(
+            solver,
+            leg,
+            policy,
+            [&x[..m], &y[..m], &z[..m]],
+            [&mut abduction[..m], &mut hip[..m], &mut knee[..m]],
+            c,
+        );
+        for (i, row) in a.chunks_exact_mut(3).enumerate() {
+            row.copy_from_slice(&[abduction[i], hip[i], knee[i]]);
+        }
     }
     Ok(())
 }
 
-/// One chunk of [`leg_inverse`]: `f` (at most [`LANES`] rows of 3; a tail is padded with its
-/// first row, whose results are dropped) → `a`, `c` (as many rows).
-// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
-// (a call out of line would run the portable code).
+/// Rows per block of [`leg_inverse`] (taken apart into one array per coordinate, solved, put
+/// back together): a multiple of every form's lanes.
+pub const BLOCK_ROWS: usize = 128;
+
+/// The leg IK of the targets `x`, `y`, `z` (one slice per coordinate, of equal lengths) into
+/// `angles` (abduction, hip, knee) and `codes` (as long), [`leg_chunk`] over chunks of `W`; a
+/// tail is padded with its first target, whose results are dropped.
+// Always inlined: into the public forms and the entry points compiled for CPU features (a
+// call out of line would run the portable code).
 #[inline(always)]
-fn leg_rows_chunk<M: Math, const W: usize>(
+fn leg_columns<M: Math, const W: usize>(
     solver: &leg::Solver<M>,
     leg: LegId,
     policy: ReachPolicy,
-    sd: &[f32; W],
-    f: &[f32],
-    a: &mut [f32],
-    c: &mut [u8],
+    [x, y, z]: [&[f32]; 3],
+    [abduction, hip, knee]: [&mut [f32]; 3],
+    codes: &mut [u8],
 ) {
-    let m = c.len();
-    let (f, _) = f.as_chunks::<3>();
-    // A full chunk is read in place; a tail is padded with its first row.
-    let padded: [[f32; 3]; W];
-    let rows: &[[f32; 3]; W] = match f.try_into() {
-        Ok(rows) => rows,
-        Err(_) => {
-            padded = core::array::from_fn(|i| if i < m { f[i] } else { f[0] });
-            &padded
-        }
-    };
-    let x: [f32; W] = core::array::from_fn(|i| rows[i][0]);
-    let y: [f32; W] = core::array::from_fn(|i| rows[i][1]);
-    let z: [f32; W] = core::array::from_fn(|i| rows[i][2]);
-    let r = leg_chunk(solver, leg, policy, sd, &x, &y, &z);
-    let out: [[f32; 3]; W] =
-        core::array::from_fn(|i| [r.abduction_rad[i], r.hip_rad[i], r.knee_rad[i]]);
-    let (a, _) = a.as_chunks_mut::<3>();
-    a.copy_from_slice(&out[..m]);
-    c.copy_from_slice(&r.code[..m]);
+    let sd = [solver.side_d_lat(leg); W];
+    let n = codes.len();
+    for first in (0..n).step_by(W) {
+        let m = W.min(n - first);
+        let lanes = |v: &[f32]| -> [f32; W] {
+            let v = &v[first..first + m];
+            match v.try_into() {
+                Ok(full) => full,
+                Err(_) => {
+                    let mut padded = [v[0]; W];
+                    padded[..m].copy_from_slice(v);
+                    padded
+                }
+            }
+        };
+        let r = leg_chunk::<M, W>(solver, leg, policy, &sd, &lanes(x), &lanes(y), &lanes(z));
+        abduction[first..first + m].copy_from_slice(&r.abduction_rad[..m]);
+        hip[first..first + m].copy_from_slice(&r.hip_rad[..m]);
+        knee[first..first + m].copy_from_slice(&r.knee_rad[..m]);
+        codes[first..first + m].copy_from_slice(&r.code[..m]);
+    }
 }
 
 /// [`leg_inverse`] on a structure of arrays: the feet's coordinates `x_m`, `y_m`, `z_m` (one
@@ -436,8 +459,8 @@ pub fn leg_inverse_soa<M: Math>(
     )
 }
 
-// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
-// (a call out of line would run the portable code).
+// Always inlined: into its public form and the entry points compiled for CPU features (a
+// call out of line would run the portable code).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn leg_inverse_soa_impl<M: Math, const W: usize>(
@@ -457,20 +480,14 @@ fn leg_inverse_soa_impl<M: Math, const W: usize>(
     check_len("hip_rad", n, hip_rad.len())?;
     check_len("knee_rad", n, knee_rad.len())?;
     check_len("codes", n, codes.len())?;
-    let sd = [solver.side_d_lat(leg); W];
-    for first in (0..n).step_by(W) {
-        let m = W.min(n - first);
-        let lanes = |v: &[f32]| -> [f32; W] {
-            let v = &v[first..first + m];
-            core::array::from_fn(|i| if i < m { v[i] } else { v[0] })
-        };
-        let (x, y, z) = (lanes(x_m), lanes(y_m), lanes(z_m));
-        let r = leg_chunk::<M, W>(solver, leg, policy, &sd, &x, &y, &z);
-        abduction_rad[first..first + m].copy_from_slice(&r.abduction_rad[..m]);
-        hip_rad[first..first + m].copy_from_slice(&r.hip_rad[..m]);
-        knee_rad[first..first + m].copy_from_slice(&r.knee_rad[..m]);
-        codes[first..first + m].copy_from_slice(&r.code[..m]);
-    }
+    leg_columns::<M, W>(
+        solver,
+        leg,
+        policy,
+        [x_m, y_m, z_m],
+        [abduction_rad, hip_rad, knee_rad],
+        codes,
+    );
     Ok(())
 }
 
@@ -494,8 +511,8 @@ pub fn leg_forward<M: Math>(
     leg_forward_impl::<M, LANES>(geometry, leg, angles_rad, feet_in_hip_m, codes)
 }
 
-// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
-// (a call out of line would run the portable code).
+// Always inlined: into its public form and the entry points compiled for CPU features (a
+// call out of line would run the portable code).
 #[inline(always)]
 fn leg_forward_impl<M: Math, const W: usize>(
     geometry: &LegGeometry,
@@ -582,8 +599,8 @@ pub fn body_inverse<M: Math>(
     body_inverse_impl::<M, LANES>(solver, config, policy, poses, feet, angles_rad, codes, legs)
 }
 
-// Always inlined: into its public form and its AVX2 entry point, which compiles it for AVX2
-// (a call out of line would run the portable code).
+// Always inlined: into its public form and the entry points compiled for CPU features (a
+// call out of line would run the portable code).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn body_inverse_impl<M: Math, const W: usize>(

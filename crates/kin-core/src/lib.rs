@@ -63,8 +63,8 @@
 #![no_std]
 // `deny`, not `forbid`: the exceptions are the AVR's flash tables of `math` (their
 // `link_section`), which only the `Math` backend's reads can reach, the x86-64 square root of
-// the batch solves' lanes (`math::lanes`, SSE's `sqrtps`), and the AVX2 entry points of
-// `batch::avx2` (unsafe to call: the CPU must have AVX2).
+// the batch solves' lanes (`math::lanes`, SSE's `sqrtps`), and the entry points of
+// `batch::avx2` and `batch::avx512` (unsafe to call: the CPU must have the features).
 #![deny(unsafe_code)]
 
 pub mod attitude;

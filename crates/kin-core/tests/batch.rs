@@ -283,6 +283,15 @@ fn leg_batch_equals_scalar_on_every_tail_length() {
             }
         }
     }
+    // Around the blocks of `leg_inverse` (rows taken apart and put back together a block at a
+    // time): one short of a block, a block, one more, two blocks and a tail of 17.
+    let b = batch::BLOCK_ROWS;
+    let many: Vec<[f32; 3]> = feet.iter().cycle().take(2 * b + 17).copied().collect();
+    for n in [b - 1, b, b + 1, 2 * b, 2 * b + 17] {
+        for policy in POLICIES {
+            check_leg(&robot, LegId::FR, policy, &many[..n]);
+        }
+    }
 }
 
 #[test]
