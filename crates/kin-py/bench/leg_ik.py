@@ -1,7 +1,8 @@
 """From Python, 10^6 leg IKs: quadkin's batch call against a numpy-vectorised implementation of
 the same equations (written here for the comparison: kin-core's leg IK, seed 000 eq. 4.1–4.21,
 reject policy, backward knee) and against a Python loop over single solves; and the overhead of
-one single-leg call. Medians of repeated runs, same run, ratios.
+one single-leg call. Medians of repeated runs after at least 0.5 s of warm-up runs, same run,
+ratios.
 
     .venv-py/bin/python crates/kin-py/bench/leg_ik.py [--n 1000000] [--repeat 15]
 
@@ -14,15 +15,9 @@ import statistics
 import time
 import timeit
 
-# numpy's OpenBLAS keeps worker threads that spin on the cores for a while after it starts
-# (profiled: a quarter of the samples of the first batch calls), competing with the batch's
-# own threads. None of the compared code uses BLAS, so one OpenBLAS thread changes nothing
-# else; a value set by the caller is kept (`OPENBLAS_NUM_THREADS=2 …` shows the difference).
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-import quadkin  # noqa: E402
+import quadkin
 
 
 def numpy_leg_ik(robot: quadkin.Robot, left: bool, feet_m: np.ndarray):
@@ -58,11 +53,15 @@ def numpy_leg_ik(robot: quadkin.Robot, left: bool, feet_m: np.ndarray):
     return angles, code
 
 
-def median_s(f, repeat: int, warmup: int = 3) -> float:
-    """The median time of `repeat` calls of `f`, after `warmup` calls (which start rayon's
-    threads and let the allocator settle on its large blocks, for every contender alike)."""
-    for _ in range(warmup):
+def median_s(f, repeat: int, warmup: int = 3, warmup_s: float = 0.5) -> float:
+    """The median time of `repeat` calls of `f`, after at least `warmup` calls and `warmup_s`
+    seconds of calls (as criterion warms up for a time): rayon's threads start, the allocator
+    settles on its large blocks and an idle core wakes, for every contender alike."""
+    t_end = time.perf_counter() + warmup_s
+    done = 0
+    while done < warmup or time.perf_counter() < t_end:
         f()
+        done += 1
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -108,7 +107,7 @@ def main() -> None:
             except quadkin.UnreachableError:
                 pass
 
-    t_loop = median_s(loop, 3, warmup=1) * args.n / args.loop_n
+    t_loop = median_s(loop, 3, warmup=1, warmup_s=0.0) * args.n / args.loop_n
     one = timeit.Timer(lambda: robot.leg_ik_one("FL", 0.0, 0.044, -0.4))
     n_one, _ = one.autorange()
     t_one = statistics.median(r / n_one for r in one.repeat(5, n_one))
@@ -120,7 +119,6 @@ def main() -> None:
     ns = 1e9 / args.n
     print(f"N = {args.n:.0e} leg IKs (shahriar2023, FL, float32), {os.cpu_count()} cores, "
           f"batch form {quadkin.batch_form()}, load {os.getloadavg()[0]:.1f}, "
-          f"OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}, "
           f"{100 * np.mean(c_q == quadkin.OK):.1f} % reachable; numpy agrees on "
           f"{100 * agree:.4f} % of codes, max |Δangle| {max_diff:.1e} rad")
     print()
