@@ -3,11 +3,12 @@
 //! The targets are taken in chunks of [`LANES`] (16 in the AVX-512 form, [`avx512`]); within a
 //! chunk every stage of the solve runs over all lanes before the next (structure of arrays: one
 //! array per coordinate), with no branch on a lane's value (unreachable lanes are computed along
-//! and masked), so that the compiler vectorises each stage. The equations, their order of operations and the branch
-//! choices (the knee bend, the abduction with the foot below the hip, every quadrant in one
-//! `atan2`) are those of the scalar solve ([`leg::Solver::inverse`]): **each result equals the
-//! scalar one bit for bit**, on every backend, which the tests check over the workspace, at
-//! the reach and quadrant boundaries, on the backends' kernel edges and on every tail length.
+//! and masked), so that the compiler vectorises each stage. The equations, their order of
+//! operations and the branch choices (the knee bend, the abduction with the foot below the hip,
+//! every quadrant in one `atan2`) are those of the scalar solve ([`leg::Solver::inverse`]):
+//! **each result equals the scalar one bit for bit**, on every backend and in every form, which
+//! the tests check over the workspace, at the reach and quadrant boundaries, on the backends'
+//! kernel edges, on every tail length and around the row API's blocks ([`BLOCK_ROWS`]).
 //! The [`Math`] backend supplies the lane forms of its kernels ([`Math::atan2_lanes`],
 //! [`Math::sqrt_lanes`]; [`DefaultMath`](crate::DefaultMath)'s vectorise).
 //!
