@@ -225,18 +225,17 @@ pub(crate) fn leg_lanes<M: Math, const N: usize>(
     let hip = M::atan2_lanes(&hip_y, &hip_x);
     // The joint limits, one angle over all lanes at a time (`admits_all` per lane).
     let (lo, hi, keys) = (&s.limits.min_rad, &s.limits.max_rad, &s.limit_keys);
-    let mut within = [u32::MAX; N];
+    let mut outside = [0u32; N];
     for (j, angle) in [&abduction, &hip, &knee].into_iter().enumerate() {
         for i in 0..N {
-            within[i] &=
-                0u32.wrapping_sub(u32::from(M::within_keys(angle[i], lo[j], hi[j], keys[j])));
+            outside[i] |= u32::from(!M::within_keys(angle[i], lo[j], hi[j], keys[j]));
         }
     }
     let mut out = LegLanes::ZERO;
     for i in 0..N {
         let k = code[i];
         let k = select(
-            (k == u32::from(code::OK)) & (within[i] == 0),
+            (k == u32::from(code::OK)) & (outside[i] != 0),
             code::JOINT_LIMIT,
             k,
         );
@@ -424,10 +423,23 @@ fn leg_columns<M: Math, const W: usize>(
             }
         };
         let r = leg_chunk::<M, W>(solver, leg, policy, &sd, &lanes(x), &lanes(y), &lanes(z));
-        abduction[first..first + m].copy_from_slice(&r.abduction_rad[..m]);
-        hip[first..first + m].copy_from_slice(&r.hip_rad[..m]);
-        knee[first..first + m].copy_from_slice(&r.knee_rad[..m]);
-        codes[first..first + m].copy_from_slice(&r.code[..m]);
+        put(&mut abduction[first..first + m], &r.abduction_rad);
+        put(&mut hip[first..first + m], &r.hip_rad);
+        put(&mut knee[first..first + m], &r.knee_rad);
+        put(&mut codes[first..first + m], &r.code);
+    }
+}
+
+/// `dst` (at most `W` long) from the first lanes of `src`: a full chunk as one fixed-size copy
+/// (a copy of a length the compiler does not know is a call).
+// Always inlined: inside the chunk loops, compiled for the entry points' CPU features.
+#[inline(always)]
+fn put<T: Copy, const W: usize>(dst: &mut [T], src: &[T; W]) {
+    let m = dst.len();
+    if let Ok(full) = <&mut [T; W]>::try_from(&mut *dst) {
+        *full = *src;
+    } else {
+        dst.copy_from_slice(&src[..m]);
     }
 }
 
