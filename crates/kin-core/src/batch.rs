@@ -326,7 +326,9 @@ fn clamp_lanes<M: Math, const N: usize>(
 /// # Errors
 /// [`LengthMismatch`] when `feet_in_hip_m` is not whole rows of 3, or `angles_rad` or `codes`
 /// does not fit its rows (nothing is written).
-#[inline]
+// Never inlined: inlined into a caller's closure (the Python package's threads) it ran 1.6×
+// slower than as a function of its own.
+#[inline(never)]
 pub fn leg_inverse<M: Math>(
     solver: &leg::Solver<M>,
     leg: LegId,

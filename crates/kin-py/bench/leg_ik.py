@@ -4,7 +4,7 @@ reject policy, backward knee) and against a Python loop over single solves; and 
 one single-leg call. Medians of repeated runs after at least 0.5 s of warm-up runs, same run,
 ratios.
 
-    .venv-py/bin/python crates/kin-py/bench/leg_ik.py [--n 1000000] [--repeat 15]
+    .venv-py/bin/python crates/kin-py/bench/leg_ik.py [--n 1000000] [--repeat 15] [--form F]
 
 Prints a Markdown table (the "Python" table of BENCHMARKS.md).
 """
@@ -75,7 +75,11 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=1_000_000)
     parser.add_argument("--repeat", type=int, default=15)
     parser.add_argument("--loop-n", type=int, default=200_000)
+    parser.add_argument("--form", choices=["avx512", "avx2", "portable"],
+                        help="the batch solves' form (default: the widest this CPU runs)")
     args = parser.parse_args()
+    if args.form:
+        quadkin.set_batch_form(args.form)
     robot = quadkin.Robot("shahriar2023")
     rng = np.random.default_rng(0)
     # Targets around the leg's workspace (most reachable, some not).

@@ -9,9 +9,10 @@ use crate::arrays::CHUNK_ROWS;
 use kin_core::batch::{self, BodyFeet, LengthMismatch};
 use kin_core::{body, leg, BodyConfig, DefaultMath, LegGeometry, LegId, ReachPolicy};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU8, Ordering};
 
-/// The form of kin-core's batch solves this CPU runs, the widest first.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A form of kin-core's batch solves, the widest first (all give the same bits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Form {
     /// `kin_core::batch::avx512`: 16 lanes.
     Avx512,
@@ -21,9 +22,16 @@ pub enum Form {
     Portable,
 }
 
+/// The form chosen by [`Form::choose`]: 0 for none (the widest the CPU runs), else 1 + the
+/// form's index in [`Form::ALL`].
+static CHOSEN: AtomicU8 = AtomicU8::new(0);
+
 impl Form {
+    /// Every form, the widest first.
+    pub const ALL: [Form; 3] = [Form::Avx512, Form::Avx2, Form::Portable];
+
     /// The widest form this CPU runs (the standard library caches the checks).
-    pub fn detect() -> Form {
+    pub fn widest() -> Form {
         #[cfg(target_arch = "x86_64")]
         {
             if std::is_x86_feature_detected!("avx512f")
@@ -40,6 +48,38 @@ impl Form {
         Form::Portable
     }
 
+    /// The form the batch calls use: the one chosen ([`Form::choose`]), else the widest this
+    /// CPU runs. Never a form the CPU cannot run.
+    pub fn current() -> Form {
+        match CHOSEN.load(Ordering::Relaxed) {
+            0 => Form::widest(),
+            k => Form::ALL[usize::from(k - 1)],
+        }
+    }
+
+    /// Makes the batch calls use `form` (`None`: the widest this CPU runs again).
+    ///
+    /// # Errors
+    /// The form's name and the widest the CPU runs, when the CPU cannot run `form`.
+    pub fn choose(form: Option<Form>) -> Result<(), String> {
+        let widest = Form::widest();
+        match form {
+            None => CHOSEN.store(0, Ordering::Relaxed),
+            Some(f) if f < widest => {
+                return Err(format!(
+                    "this CPU cannot run the {} form; the widest it runs is {}",
+                    f.name(),
+                    widest.name()
+                ));
+            }
+            Some(f) => {
+                let k = Form::ALL.iter().position(|&g| g == f).unwrap_or(0);
+                CHOSEN.store(k as u8 + 1, Ordering::Relaxed);
+            }
+        }
+        Ok(())
+    }
+
     /// The form's name, as `quadkin.batch_form()` gives it.
     pub fn name(self) -> &'static str {
         match self {
@@ -48,6 +88,11 @@ impl Form {
             Form::Portable => "portable",
         }
     }
+
+    /// The form of a name of [`Form::name`].
+    pub fn from_name(name: &str) -> Option<Form> {
+        Form::ALL.into_iter().find(|f| f.name() == name)
+    }
 }
 
 /// Calls `kin_core::batch::$f` in the form `$form` ([`Form`]) with `$args`.
@@ -55,11 +100,11 @@ macro_rules! in_form {
     ($form:expr, $f:ident $(::<$m:ty>)? ($($args:expr),* $(,)?)) => {{
         match $form {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `Form::detect` found the CPU's AVX-512 features.
+            // SAFETY: `Form::current` is never a form the CPU cannot run.
             #[allow(unsafe_code)]
             Form::Avx512 => unsafe { batch::avx512::$f $(::<$m>)? ($($args),*) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `Form::detect` found the CPU's AVX2.
+            // SAFETY: as above.
             #[allow(unsafe_code)]
             Form::Avx2 => unsafe { batch::avx2::$f $(::<$m>)? ($($args),*) },
             _ => batch::$f $(::<$m>)? ($($args),*),
@@ -105,7 +150,7 @@ pub fn leg_inverse(
     angles_rad: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    let form = Form::detect();
+    let form = Form::current();
     split(feet_in_hip_m, 3, angles_rad, 3, codes, |f, a, c| {
         in_form!(form, leg_inverse(solver, leg, policy, f, a, c))
     })
@@ -123,7 +168,7 @@ pub fn leg_forward(
     feet_in_hip_m: &mut [f32],
     codes: &mut [u8],
 ) -> Result<(), LengthMismatch> {
-    let form = Form::detect();
+    let form = Form::current();
     split(angles_rad, 3, feet_in_hip_m, 3, codes, |q, f, c| {
         in_form!(form, leg_forward::<DefaultMath>(geometry, leg, q, f, c))
     })
@@ -157,7 +202,7 @@ pub fn body_inverse(
     codes: &mut [u8],
     legs: &mut [i8],
 ) -> Result<(), LengthMismatch> {
-    let form = Form::detect();
+    let form = Form::current();
     // Per-pose feet are split with the poses: their slice of rows goes with each slice.
     let n = codes.len();
     let per_pose = match feet {

@@ -25,11 +25,29 @@ pub mod robot;
 
 use pyo3::prelude::*;
 
-/// The form of kin-core's batch solves that this CPU runs, which the batch calls use:
-/// `"avx512"` (16 lanes), `"avx2"` (8 lanes) or `"portable"`. All give the same bits.
+/// The form of kin-core's batch solves that the batch calls use: the widest this CPU runs,
+/// `"avx512"` (16 lanes), `"avx2"` (8 lanes) or `"portable"`, unless `set_batch_form` chose
+/// another. All give the same bits.
 #[pyfunction]
 fn batch_form() -> &'static str {
-    batch::Form::detect().name()
+    batch::Form::current().name()
+}
+
+/// Makes the batch calls use the form `form` (`"avx512"`, `"avx2"` or `"portable"`; `None`:
+/// the widest this CPU runs again), to compare the forms or to measure one. Raises
+/// `ValueError` for another name or a form this CPU cannot run.
+#[pyfunction]
+#[pyo3(signature = (form))]
+fn set_batch_form(form: Option<&str>) -> PyResult<()> {
+    let chosen = match form {
+        None => None,
+        Some(name) => Some(batch::Form::from_name(name).ok_or_else(|| {
+            pyo3::exceptions::PyValueError::new_err(format!(
+                "form {name:?}: expected \"avx512\", \"avx2\", \"portable\" or None"
+            ))
+        })?),
+    };
+    batch::Form::choose(chosen).map_err(pyo3::exceptions::PyValueError::new_err)
 }
 
 /// The Python module `quadkin._quadkin` (re-exported by the `quadkin` package).
@@ -42,6 +60,7 @@ fn _quadkin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(protocol::encode_request, m)?)?;
     m.add_function(wrap_pyfunction!(protocol::decode_answer, m)?)?;
     m.add_function(wrap_pyfunction!(batch_form, m)?)?;
+    m.add_function(wrap_pyfunction!(set_batch_form, m)?)?;
     m.add("OK", robot::OK)?;
     m.add("TOO_FAR", robot::TOO_FAR)?;
     m.add("TOO_CLOSE", robot::TOO_CLOSE)?;

@@ -120,6 +120,44 @@ def test_batch_form_is_the_widest_the_cpu_runs():
     assert quadkin.batch_form() == want
 
 
+def test_every_form_the_cpu_runs_gives_the_same_bits():
+    widest = quadkin.batch_form()
+    forms = ["avx512", "avx2", "portable"]
+    runnable = forms[forms.index(widest):]
+    robot = quadkin.Robot("shahriar2023")
+    # Beyond two slices of the parallel path, with a tail; bad rows among them.
+    feet = random_feet(40_001, seed=9)
+    feet[::997] = np.nan
+    feet[5::1009, 2] = -10.0
+    rng = np.random.default_rng(11)
+    poses = rng.uniform([-0.3, -0.3, -0.5, -0.05, -0.05, -0.05],
+                        [0.3, 0.3, 0.5, 0.05, 0.05, 0.05], (40_001, 6))
+    angles_fk = rng.uniform(-2.0, 2.0, (40_001, 3))
+    results = {}
+    try:
+        for form in runnable:
+            quadkin.set_batch_form(form)
+            assert quadkin.batch_form() == form
+            results[form] = (
+                robot.leg_ik("FR", feet),
+                robot.leg_ik("FR", feet, policy="clamp"),
+                robot.leg_fk("RL", angles_fk),
+                robot.body_ik(poses, stance_height_m=0.25),
+            )
+    finally:
+        quadkin.set_batch_form(None)
+    assert quadkin.batch_form() == widest
+    portable = results["portable"]
+    for form in runnable:
+        for got, want in zip(results[form], portable):
+            for g, w in zip(got, want):
+                assert g.dtype == w.dtype and g.tobytes() == w.tobytes(), form
+    assert (portable[0][1] == quadkin.NON_FINITE).sum() == len(feet[::997])
+    with pytest.raises(ValueError, match="avx1024"):
+        quadkin.set_batch_form("avx1024")
+    assert quadkin.batch_form() == widest
+
+
 def test_shapes_dtypes_and_large_batches_agree_with_small_ones():
     robot = quadkin.Robot("fernando2025")
     feet = random_feet(100_000, seed=4)

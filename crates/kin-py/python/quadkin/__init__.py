@@ -39,6 +39,7 @@ from ._quadkin import (  # noqa: F401
     encode_request,
     motion_laws,
     sample_motion,
+    set_batch_form,
 )
 
 __all__ = [
@@ -65,4 +66,5 @@ __all__ = [
     "batch_form",
     "motion_laws",
     "sample_motion",
+    "set_batch_form",
 ]

@@ -150,8 +150,13 @@ def sample_motion(
 ) -> MotionSamples: ...
 def motion_laws() -> list[str]: ...
 def batch_form() -> Literal["avx512", "avx2", "portable"]:
-    """The form of the batch solves this CPU runs (the widest: AVX-512 with 16 lanes, AVX2 with
-    8, or the portable one); all give the same bits."""
+    """The form of the batch solves the batch calls use: the widest this CPU runs (AVX-512 with
+    16 lanes, AVX2 with 8, or the portable one) unless :func:`set_batch_form` chose another;
+    all give the same bits."""
+def set_batch_form(form: Optional[Literal["avx512", "avx2", "portable"]]) -> None:
+    """Makes the batch calls use ``form`` (``None``: the widest this CPU runs again), to compare
+    the forms or measure one. Raises ``ValueError`` for another name or a form this CPU cannot
+    run."""
 
 class Readback(TypedDict):
     angles_rad: F32
