@@ -72,10 +72,8 @@ impl Form {
                     widest.name()
                 ));
             }
-            Some(f) => {
-                let k = Form::ALL.iter().position(|&g| g == f).unwrap_or(0);
-                CHOSEN.store(k as u8 + 1, Ordering::Relaxed);
-            }
+            // The discriminants are the indices in `Form::ALL`.
+            Some(f) => CHOSEN.store(f as u8 + 1, Ordering::Relaxed),
         }
         Ok(())
     }
